@@ -1,0 +1,131 @@
+"""Getting mocap trials: download/copy with checksums, parse, and Table I.
+
+Real CMU files are fetched per file from ``<mirror>/subjects/<SS>/<file>``
+where the mirror is ``http://mocap.cs.cmu.edu`` (the official site) or any URL
+or local folder with the same layout (``cmu_mirror`` in the config).
+Checksums are SHA-256 of the file with line endings normalised to LF, since
+mirrors of the same CMU file differ only in CRLF vs LF. Files are written
+atomically: a failed download or a checksum mismatch leaves no file behind.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import os
+import shutil
+import urllib.error
+import urllib.request
+
+import pandas as pd
+
+from .io.amc import Motion, read_amc
+from .io.asf import read_asf
+from .io.atomic import atomic_path
+
+log = logging.getLogger("animsynth.data")
+
+
+class DownloadError(RuntimeError):
+    """A file could not be fetched, or its checksum did not match."""
+
+
+def sha256_normalised(data: bytes) -> str:
+    """SHA-256 of ``data`` with CRLF (and lone CR) line endings turned into LF."""
+    return hashlib.sha256(data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")).hexdigest()
+
+
+def _is_url(s: str) -> bool:
+    return s.startswith(("http://", "https://", "ftp://", "file://"))
+
+
+def fetch_bytes(source: str, rel: str, timeout: float = 60.0) -> bytes:
+    """Read ``rel`` below ``source`` (a URL or a local folder)."""
+    if _is_url(source):
+        url = source.rstrip("/") + "/" + rel.lstrip("/")
+        try:
+            with urllib.request.urlopen(url, timeout=timeout) as r:  # noqa: S310 (configured mirror)
+                return r.read()
+        except (urllib.error.URLError, TimeoutError, OSError) as exc:
+            raise DownloadError(f"cannot download {url}: {exc}") from None
+    path = os.path.join(source, rel)
+    try:
+        with open(path, "rb") as f:
+            return f.read()
+    except OSError as exc:
+        raise DownloadError(f"cannot read {path} (mirror {source!r}): {exc.strerror}") from None
+
+
+def fetch_file(source: str, rel: str, dest, sha256: str | None) -> str:
+    """Fetch ``rel`` from ``source`` into ``dest`` after checking its checksum.
+
+    Returns the normalised SHA-256. Raises :class:`DownloadError` on a network
+    failure or a checksum mismatch; ``dest`` is then not created.
+    """
+    data = fetch_bytes(source, rel)
+    got = sha256_normalised(data)
+    if sha256 is not None and got != sha256.lower():
+        raise DownloadError(
+            f"checksum mismatch for {rel} from {source!r}: expected {sha256}, got {got} "
+            "(SHA-256 after normalising line endings to LF)"
+        )
+    with atomic_path(dest) as tmp:
+        with open(tmp, "wb") as f:
+            f.write(data)
+    log.info("fetched %s from %s (sha256 %s)", rel, source, got)
+    return got
+
+
+def copy_local(src, dest) -> None:
+    with atomic_path(dest) as tmp:
+        shutil.copyfile(src, tmp)
+
+
+def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "") -> Motion:
+    """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion`."""
+    if bvh is not None:
+        from .io.bvh import read_bvh
+
+        m = read_bvh(bvh)
+    else:
+        m = read_amc(amc, read_asf(asf), fps=fps)
+    m.name = name or m.name
+    return m
+
+
+def datasets_table(subsets: dict, motions: dict, source: str) -> pd.DataFrame:
+    """Gauch & Peters Table I for the selected data.
+
+    Parameters
+    ----------
+    subsets : name -> list of trial ids (in order)
+    motions : trial id -> Motion
+    source : ``synthetic``, ``cmu`` or ``user``
+    """
+    rows = []
+    for name, ids in subsets.items():
+        lengths = [motions[t].n_frames for t in ids]
+        dims = {motions[t].without_root().shape[1] for t in ids}
+        if len(dims) != 1:
+            raise ValueError(f"subset {name!r} mixes trials with different DOF counts {sorted(dims)}")
+        rows.append(
+            {
+                "dataset": name,
+                "source": source,
+                "trials": " ".join(ids),
+                "dims": dims.pop(),
+                "n_sequences": len(ids),
+                "lengths": " ".join(str(n) for n in lengths),
+                "total_nodes": int(sum(lengths)),
+            }
+        )
+    return pd.DataFrame(rows, columns=["dataset", "source", "trials", "dims", "n_sequences", "lengths", "total_nodes"])
+
+
+#: Gauch & Peters Table I (frames per sequence), for the captions and tests.
+PAPER_TABLE_I = {
+    "w1": [443, 360, 455, 454],
+    "w2": [347, 520, 269, 282],
+    "r1": [167, 167, 175, 160],
+    "r2": [258, 139, 200, 163],
+}

@@ -1,0 +1,308 @@
+"""Acclaim ASF skeleton reader and writer (the CMU mocap skeleton format).
+
+The reader understands ``:units`` (``length``, ``angle``, ``mass``), ``:root``
+(``order``, ``axis``, ``position``, ``orientation``), ``:bonedata`` (``id``,
+``name``, ``direction``, ``length``, ``axis``, ``dof``, ``limits``) and
+``:hierarchy``. Lengths are kept in file units; ``Skeleton.length_to_m`` holds
+the CMU conversion ``(1 / length) * 2.54 / 100`` (file units -> inches -> m).
+
+Bones are reordered so that the skeleton's joint order is the CMU AMC order
+(:data:`animsynth.skeleton.CMU_BONE_ORDER`) for the bones it contains, then any
+other bones in breadth-first order; this fixes the column order of motions.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..skeleton import CMU_BONE_ORDER, Joint, Skeleton
+from .atomic import atomic_write_text
+from .errors import MotionFormatError, parse_float
+
+_AXES = {"X", "Y", "Z"}
+
+
+def _read_lines(path) -> list[str]:
+    try:
+        with open(path, encoding="utf-8", errors="strict", newline=None) as f:
+            return f.read().splitlines()
+    except UnicodeDecodeError as exc:
+        raise MotionFormatError(path, None, f"not a text file ({exc})") from None
+
+
+def read_asf(path) -> Skeleton:
+    """Parse an ASF file into a :class:`~animsynth.skeleton.Skeleton`.
+
+    Raises
+    ------
+    MotionFormatError
+        On any malformed line (message names file and line).
+    """
+    lines = _read_lines(path)
+    units = {"length": 1.0, "angle": "deg", "mass": 1.0}
+    root = {"order": ["tx", "ty", "tz", "rx", "ry", "rz"], "axis": "XYZ",
+            "position": np.zeros(3), "orientation": np.zeros(3)}
+    bones: dict[str, dict] = {}
+    children: dict[str, list[str]] = {}
+    name = os.path.splitext(os.path.basename(os.fspath(path)))[0]
+    section = None
+    bone = None
+    limits_pending = 0
+    for ln, raw in enumerate(lines, start=1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        tok = line.split()
+        if tok[0].startswith(":"):
+            section = tok[0][1:].lower()
+            if section == "name" and len(tok) > 1:
+                name = tok[1]
+            limits_pending = 0
+            continue
+        if section == "units":
+            if len(tok) != 2:
+                raise MotionFormatError(path, ln, f"bad units line {line!r}")
+            key = tok[0].lower()
+            if key == "angle":
+                if tok[1].lower() not in ("deg", "rad"):
+                    raise MotionFormatError(path, ln, f"unknown angle unit {tok[1]!r}")
+                units["angle"] = tok[1].lower()
+            else:
+                units[key] = parse_float(tok[1], path, ln, f"{key} unit")
+        elif section == "root":
+            key = tok[0].lower()
+            if key == "order":
+                order = [t.lower() for t in tok[1:]]
+                if sorted(order) != sorted(["tx", "ty", "tz", "rx", "ry", "rz"]):
+                    raise MotionFormatError(path, ln, f"root order must be a permutation of TX TY TZ RX RY RZ, got {tok[1:]}")
+                root["order"] = order
+            elif key == "axis":
+                if len(tok) != 2 or set(tok[1].upper()) != _AXES or len(tok[1]) != 3:
+                    raise MotionFormatError(path, ln, f"bad root axis {line!r}")
+                root["axis"] = tok[1].upper()
+            elif key in ("position", "orientation"):
+                if len(tok) != 4:
+                    raise MotionFormatError(path, ln, f"root {key} needs 3 numbers")
+                root[key] = np.array([parse_float(t, path, ln, key) for t in tok[1:]])
+            else:
+                raise MotionFormatError(path, ln, f"unknown root field {tok[0]!r}")
+        elif section == "bonedata":
+            key = tok[0].lower()
+            if limits_pending and (line.startswith("(") or key == "limits"):
+                vals = line[len("limits"):] if key == "limits" else line
+                for pair in vals.replace(")", ") ").split(")"):
+                    pair = pair.strip().lstrip("(").strip()
+                    if not pair:
+                        continue
+                    parts = pair.split()
+                    if len(parts) != 2:
+                        raise MotionFormatError(path, ln, f"bad limits {line!r}")
+                    lo, hi = (_limit(p, path, ln) for p in parts)
+                    bone["limits"].append((lo, hi))
+                    limits_pending -= 1
+                continue
+            if key == "begin":
+                bone = {"line": ln, "axis": np.zeros(3), "axis_order": "XYZ", "dof": [], "limits": []}
+                continue
+            if bone is None:
+                raise MotionFormatError(path, ln, f"{tok[0]!r} outside begin/end")
+            if key == "end":
+                for req in ("name", "direction", "length"):
+                    if req not in bone:
+                        raise MotionFormatError(path, bone["line"], f"bone without {req}")
+                if bone["dof"] and len(bone["limits"]) not in (0, len(bone["dof"])):
+                    raise MotionFormatError(path, ln, f"bone {bone['name']!r}: {len(bone['dof'])} dof but {len(bone['limits'])} limits")
+                if bone["name"] in bones:
+                    raise MotionFormatError(path, bone["line"], f"duplicate bone {bone['name']!r}")
+                bones[bone["name"]] = bone
+                bone = None
+            elif key == "id":
+                bone["id"] = tok[1] if len(tok) > 1 else None
+            elif key == "name":
+                if len(tok) != 2:
+                    raise MotionFormatError(path, ln, "bone name must be one word")
+                bone["name"] = tok[1]
+            elif key == "direction":
+                if len(tok) != 4:
+                    raise MotionFormatError(path, ln, "direction needs 3 numbers")
+                d = np.array([parse_float(t, path, ln, "direction") for t in tok[1:]])
+                n = np.linalg.norm(d)
+                bone["direction"] = d / n if n > 0 else d
+            elif key == "length":
+                if len(tok) != 2:
+                    raise MotionFormatError(path, ln, "length needs 1 number")
+                bone["length"] = parse_float(tok[1], path, ln, "length")
+                if bone["length"] < 0:
+                    raise MotionFormatError(path, ln, "negative bone length")
+            elif key == "axis":
+                if len(tok) != 5 or len(tok[4]) != 3 or set(tok[4].upper()) != _AXES:
+                    raise MotionFormatError(path, ln, f"axis needs 3 numbers and an order, got {line!r}")
+                bone["axis"] = np.array([parse_float(t, path, ln, "axis") for t in tok[1:4]])
+                bone["axis_order"] = tok[4].upper()
+            elif key == "dof":
+                dofs = [t.lower() for t in tok[1:]]
+                bad = [d for d in dofs if d not in ("rx", "ry", "rz", "tx", "ty", "tz", "l")]
+                if bad or not dofs or len(set(dofs)) != len(dofs):
+                    raise MotionFormatError(path, ln, f"bad dof list {tok[1:]}")
+                if "l" in dofs:
+                    raise MotionFormatError(path, ln, "length DOF 'l' is not supported")
+                bone["dof"] = dofs
+            elif key == "limits":
+                limits_pending = len(bone["dof"])
+                rest = line[len(tok[0]):].strip()
+                if rest:
+                    for pair in rest.replace(")", ") ").split(")"):
+                        pair = pair.strip().lstrip("(").strip()
+                        if pair:
+                            parts = pair.split()
+                            if len(parts) != 2:
+                                raise MotionFormatError(path, ln, f"bad limits {line!r}")
+                            bone["limits"].append(tuple(_limit(p, path, ln) for p in parts))
+                            limits_pending -= 1
+            elif key in ("bodymass", "cofmass"):
+                pass
+            else:
+                raise MotionFormatError(path, ln, f"unknown bone field {tok[0]!r}")
+        elif section == "hierarchy":
+            if tok[0].lower() in ("begin", "end"):
+                continue
+            parent, kids = tok[0], tok[1:]
+            if parent != "root" and parent not in bones:
+                raise MotionFormatError(path, ln, f"hierarchy names unknown bone {parent!r}")
+            for k in kids:
+                if k not in bones:
+                    raise MotionFormatError(path, ln, f"hierarchy names unknown bone {k!r}")
+                if any(k in v for v in children.values()):
+                    raise MotionFormatError(path, ln, f"bone {k!r} has two parents")
+            children.setdefault(parent, []).extend(kids)
+        elif section in ("version", "documentation", "name", None):
+            continue
+        else:
+            # unknown sections (e.g. :skin) are skipped, as Acclaim readers do
+            continue
+    if bone is not None:
+        raise MotionFormatError(path, len(lines), "file ends inside a bone's begin/end block (truncated?)")
+    if not bones:
+        raise MotionFormatError(path, None, "no :bonedata bones found")
+    if "root" not in children:
+        raise MotionFormatError(path, None, "no :hierarchy (or root has no children)")
+    return _build_skeleton(path, name, units, root, bones, children)
+
+
+def _limit(tok: str, path, ln: int) -> float:
+    t = tok.strip().lower()
+    if t in ("inf", "+inf"):
+        return float("inf")
+    if t == "-inf":
+        return float("-inf")
+    return parse_float(t, path, ln, "limit")
+
+
+def _build_skeleton(path, name, units, root, bones, children) -> Skeleton:
+    # breadth-first order from root, then re-sort by CMU order where known
+    parent_of: dict[str, str] = {}
+    order, queue = [], ["root"]
+    while queue:
+        b = queue.pop(0)
+        order.append(b)
+        for k in children.get(b, []):
+            parent_of[k] = b
+            queue.append(k)
+    missing = set(bones) - set(order)
+    if missing:
+        raise MotionFormatError(path, None, f"bones not reachable from root in :hierarchy: {sorted(missing)}")
+    rank = {b: i for i, b in enumerate(CMU_BONE_ORDER)}
+    # topological order compatible with CMU ranks: repeatedly take the
+    # available bone (parent placed) with the smallest (cmu rank, bfs index)
+    bfs_index = {b: i for i, b in enumerate(order)}
+    placed, final = {"root"}, ["root"]
+    pending = [b for b in order if b != "root"]
+    while pending:
+        avail = [b for b in pending if parent_of[b] in placed]
+        b = min(avail, key=lambda x: (rank.get(x, len(rank)), bfs_index[x]))
+        final.append(b)
+        placed.add(b)
+        pending.remove(b)
+    index = {b: i for i, b in enumerate(final)}
+    rot_to_deg = 1.0 if units["angle"] == "deg" else np.rad2deg(1.0)
+    joints = [
+        Joint(
+            name="root",
+            parent=-1,
+            offset=np.asarray(root["position"], float),
+            tail=np.zeros(3),
+            dofs=list(root["order"]),
+            axis=np.asarray(root["orientation"], float) * rot_to_deg,
+            axis_order=root["axis"],
+        )
+    ]
+    for b in final[1:]:
+        info = bones[b]
+        p = parent_of[b]
+        poff = np.zeros(3) if p == "root" else bones[p]["direction"] * bones[p]["length"]
+        joints.append(
+            Joint(
+                name=b,
+                parent=index[p],
+                offset=poff,
+                tail=info["direction"] * info["length"],
+                dofs=list(info["dof"]),
+                axis=info["axis"] * rot_to_deg,
+                axis_order=info["axis_order"],
+                limits=[tuple(x) for x in info["limits"]],
+                direction=info["direction"],
+                length=info["length"],
+            )
+        )
+    length_to_m = (1.0 / units["length"]) * 2.54 / 100.0
+    return Skeleton(joints, length_to_m=length_to_m, angle_unit="deg", name=name)
+
+
+def write_asf(path, skeleton: Skeleton, length_unit: float | None = None) -> None:
+    """Write an ASF file (degrees). ``length_unit`` is the ``:units length``
+    value; by default it is derived from ``skeleton.length_to_m``."""
+    if length_unit is None:
+        length_unit = 2.54 / 100.0 / skeleton.length_to_m
+    r = skeleton.joints[0]
+    out = [
+        "# ASF written by animsynth",
+        ":version 1.10",
+        f":name {skeleton.name}",
+        ":units",
+        "  mass 1.0",
+        f"  length {length_unit:.6g}",
+        "  angle deg",
+        ":documentation",
+        "   written by animsynth",
+        ":root",
+        "   order " + " ".join(d.upper() for d in r.dofs),
+        f"   axis {r.axis_order}",
+        "   position " + " ".join(f"{v:.6g}" for v in r.offset),
+        "   orientation " + " ".join(f"{v:.6g}" for v in r.axis),
+        ":bonedata",
+    ]
+    for i, j in enumerate(skeleton.joints[1:], start=1):
+        length = float(np.linalg.norm(j.tail)) if j.length is None else j.length
+        direction = j.direction if j.direction is not None else (j.tail / length if length > 0 else np.array([0.0, 1.0, 0.0]))
+        out += [
+            "  begin",
+            f"     id {i}",
+            f"     name {j.name}",
+            "     direction " + " ".join(f"{v:.9g}" for v in direction),
+            f"     length {length:.9g}",
+            "     axis " + " ".join(f"{v:.9g}" for v in j.axis) + f" {j.axis_order}",
+        ]
+        if j.dofs:
+            out.append("    dof " + " ".join(j.dofs))
+            lims = j.limits or [(-180.0, 180.0)] * len(j.dofs)
+            out.append("    limits " + "\n           ".join(f"({lo:.6g} {hi:.6g})" for lo, hi in lims))
+        out.append("  end")
+    out += [":hierarchy", "  begin"]
+    for i, j in enumerate(skeleton.joints):
+        kids = skeleton.children(i)
+        if kids:
+            out.append("    " + " ".join([j.name] + [skeleton.joints[k].name for k in kids]))
+    out.append("  end")
+    atomic_write_text(path, "\n".join(out) + "\n")

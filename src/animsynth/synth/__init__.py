@@ -1,0 +1,1 @@
+"""Synthetic data generators that write the real file formats."""

@@ -1,0 +1,35 @@
+"""Small helpers for workflow scripts (kept here so scripts stay thin)."""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+
+
+def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None = None) -> logging.Logger:
+    """Send ``animsynth`` log records (INFO and up) to the rule's ``log:`` file.
+
+    Uncaught exceptions are logged too, so the log explains a failed job.
+    """
+    if log_path is None and snakemake is not None and len(snakemake.log):
+        log_path = str(snakemake.log[0])
+    root = logging.getLogger("animsynth")
+    root.setLevel(logging.INFO)
+    for h in list(root.handlers):
+        root.removeHandler(h)
+    if log_path:
+        os.makedirs(os.path.dirname(os.path.abspath(log_path)), exist_ok=True)
+        handler: logging.Handler = logging.FileHandler(log_path, mode="w")
+    else:
+        handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    root.addHandler(handler)
+    logger = logging.getLogger(name if name.startswith("animsynth") else f"animsynth.{name}")
+
+    def _hook(exc_type, exc, tb):
+        root.error("job failed", exc_info=(exc_type, exc, tb))
+        sys.__excepthook__(exc_type, exc, tb)
+
+    sys.excepthook = _hook
+    return logger

@@ -1,0 +1,2 @@
+# Report, summary and benchmark aggregation (issue 7).
+REPORT_TARGETS = []

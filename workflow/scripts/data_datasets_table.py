@@ -1,0 +1,15 @@
+"""Gauch & Peters Table I for the configured data (results/data/datasets.csv + .md)."""
+import os
+
+from animsynth.data import PAPER_TABLE_I, datasets_table
+from animsynth.io import Motion
+from animsynth.tables import write_table
+from animsynth.workflow_utils import setup_logging
+
+log = setup_logging(snakemake)
+motions = {os.path.basename(p)[:-4]: Motion.load_npz(p) for p in snakemake.input}
+df = datasets_table(snakemake.params.subsets, motions, snakemake.params.source)
+note = "Paper (Gauch & Peters, Table I) lengths: " + "; ".join(
+    f"{k}: {' '.join(map(str, v))}" for k, v in PAPER_TABLE_I.items())
+write_table(df, snakemake.output.csv, md=True, title=f"Table I: datasets ({snakemake.params.source} data)", note=note)
+log.info("wrote Table I with %d subsets", len(df))
