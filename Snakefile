@@ -1,9 +1,18 @@
 # animsynth: reproduce four data-driven character-animation methods.
 # Run:  snakemake --cores 2            (embedded synthetic default, offline)
 #       snakemake --cores 2 --configfile config/cmu.yaml --config cmu_mirror=../shared/data/cmu_mocap
+import os
+import sys
+
 from snakemake.utils import min_version, validate
 
 min_version("9.0")
+
+# The animsynth library lives in src/: make it importable here and in every
+# job (also inside a conda env built from workflow/envs/animsynth.yaml).
+SRC = os.path.join(workflow.basedir, "src")
+sys.path.insert(0, SRC)
+os.environ.update(PYTHONPATH=os.pathsep.join(p for p in (SRC, os.environ.get("PYTHONPATH")) if p))
 
 
 configfile: "config/config.yaml"

@@ -42,7 +42,10 @@ def check_config(config: dict) -> None:
                 raise ConfigError(f"{where}: CMU trials need 'sha256' (LF-normalised) so downloads are verified")
     if src == "user" and not config.get("data_dir"):
         raise ConfigError("config key 'data_dir': mocap_source 'user' needs the folder holding your files")
-    for name, members in config["subsets"].items():
+    subsets = {k: v for k, v in config["subsets"].items() if v}
+    if not subsets:
+        raise ConfigError("config key 'subsets': at least one subset is needed")
+    for name, members in subsets.items():
         bad = [m for m in members if m not in known]
         if bad:
             raise ConfigError(f"config key 'subsets.{name}': unknown trial id(s) {bad}")

@@ -122,6 +122,28 @@ def bone_lengths(skeleton: Skeleton, values) -> np.ndarray:
     return np.linalg.norm(ends - starts, axis=-1)[:, 1:]
 
 
+def _wrap(a):
+    return (a + 180.0) % 360.0 - 180.0
+
+
+def _continuous_euler(ang: np.ndarray) -> np.ndarray:
+    """Pick, frame by frame, the Tait-Bryan solution closest to the previous frame.
+
+    Every rotation has two Euler triples ``(a, b, c)`` and
+    ``(a + 180, 180 - b, c + 180)``; scipy returns the one with ``|b| <= 90``.
+    A motion whose middle angle crosses 90 degrees (e.g. a CMU root yaw) is
+    continuous only if we switch to the other branch, as the original data did.
+    """
+    alt = _wrap(np.stack([ang[:, 0] + 180.0, 180.0 - ang[:, 1], ang[:, 2] + 180.0], axis=1))
+    out = ang.copy()
+    for t in range(1, len(ang)):
+        d0 = np.abs(_wrap(ang[t] - out[t - 1])).sum()
+        d1 = np.abs(_wrap(alt[t] - out[t - 1])).sum()
+        if d1 < d0:
+            out[t] = alt[t]
+    return out
+
+
 def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t: np.ndarray) -> np.ndarray:
     """Inverse of :func:`local_rotations`: DOF values (degrees) from local rotations.
 
@@ -140,7 +162,7 @@ def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t:
         if rd:
             axes = [d[1] for d in rd]
             full = axes + [a for a in "xyz" if a not in axes]
-            ang = M.as_euler("".join(full), degrees=True)
+            ang = _continuous_euler(M.as_euler("".join(full), degrees=True)) if len(axes) == 3 else M.as_euler("".join(full), degrees=True)
             for k, d in enumerate(j.dofs):
                 if d in ROT_DOFS:
                     block[:, k] = ang[:, axes.index(d[1])]

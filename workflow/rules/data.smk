@@ -2,19 +2,6 @@
 # CMU / copy user files with checksums), parse it with the real readers into
 # results/data/trials/{trial}.npz, and write Gauch & Peters Table I.
 
-SOURCE = config["mocap_source"]
-BVH_TRIALS = {t for t, rec in TRIALS.items() if "bvh" in rec and "amc" not in rec}
-
-
-def raw_trial_files(wildcards):
-    if wildcards.trial in BVH_TRIALS:
-        return {"bvh": f"resources/mocap/{wildcards.trial}.bvh"}
-    return {
-        "amc": f"resources/mocap/{wildcards.trial}.amc",
-        "asf": f"resources/mocap/{wildcards.trial}.asf",
-    }
-
-
 if SOURCE == "synthetic":
 
     rule synth_trial:
@@ -30,20 +17,19 @@ if SOURCE == "synthetic":
             "logs/data/synth_trial/{trial}.log",
         benchmark:
             "benchmarks/rules/data/synth_trial/{trial}.tsv"
+        conda:
+            "../envs/animsynth.yaml"
         script:
             "../scripts/data_synth_trial.py"
 
 else:
-
-    def mirror_root():
-        return config["cmu_mirror"] if SOURCE == "cmu" else config["data_dir"]
 
     rule download_trial:
         output:
             amc="resources/mocap/{trial}.amc",
             asf="resources/mocap/{trial}.asf",
         params:
-            source=mirror_root(),
+            source=MOCAP_MIRROR,
             amc=lambda wc: TRIALS[wc.trial]["amc"],
             asf=lambda wc: TRIALS[wc.trial]["asf"],
             sha256=lambda wc: TRIALS[wc.trial].get("sha256"),
@@ -53,6 +39,8 @@ else:
         benchmark:
             "benchmarks/rules/data/download_trial/{trial}.tsv"
         retries: 2
+        conda:
+            "../envs/animsynth.yaml"
         script:
             "../scripts/data_download_trial.py"
 
@@ -60,13 +48,15 @@ else:
         output:
             bvh="resources/mocap/{trial}.bvh",
         params:
-            source=mirror_root(),
+            source=MOCAP_MIRROR,
             bvh=lambda wc: TRIALS[wc.trial]["bvh"],
             sha256=lambda wc: TRIALS[wc.trial].get("sha256"),
         log:
             "logs/data/download_bvh_trial/{trial}.log",
         benchmark:
             "benchmarks/rules/data/download_bvh_trial/{trial}.tsv"
+        conda:
+            "../envs/animsynth.yaml"
         script:
             "../scripts/data_download_trial.py"
 
@@ -82,6 +72,8 @@ rule parse_trial:
         "logs/data/parse_trial/{trial}.log",
     benchmark:
         "benchmarks/rules/data/parse_trial/{trial}.tsv"
+    conda:
+        "../envs/animsynth.yaml"
     script:
         "../scripts/data_parse_trial.py"
 
@@ -104,6 +96,8 @@ rule datasets_table:
         "logs/data/datasets_table.log",
     benchmark:
         "benchmarks/rules/data/datasets_table.tsv"
+    conda:
+        "../envs/animsynth.yaml"
     script:
         "../scripts/data_datasets_table.py"
 

@@ -56,6 +56,8 @@ def read_asf(path) -> Skeleton:
             continue
         tok = line.split()
         if tok[0].startswith(":"):
+            if bone is not None:
+                raise MotionFormatError(path, bone["line"], f"bone block not closed with 'end' before {tok[0]}")
             section = tok[0][1:].lower()
             if section == "name" and len(tok) > 1:
                 name = tok[1]

@@ -1,0 +1,66 @@
+#!/usr/bin/env python3
+"""One entry point for newcomers (needs only Python >= 3.11 and pip):
+
+    python3 run.py            # full default reproduction + report (results/)
+    python3 run.py test       # the test suite (what CI runs)
+    python3 run.py snakemake ARGS...   # any snakemake call inside the project's venv
+
+It creates ./.venv on first use (or when pyproject.toml changes) and installs
+the pinned stack from pyproject.toml into it. Set ANIMSYNTH_VENV to use
+another location.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent
+VENV = Path(os.environ.get("ANIMSYNTH_VENV", ROOT / ".venv"))
+BIN = VENV / ("Scripts" if os.name == "nt" else "bin")
+PY = BIN / ("python.exe" if os.name == "nt" else "python")
+
+
+def ensure_venv() -> None:
+    if sys.version_info < (3, 11):
+        sys.exit(f"animsynth needs Python >= 3.11 (this is {sys.version.split()[0]})")
+    stamp = VENV / ".animsynth-installed"
+    want = hashlib.sha256((ROOT / "pyproject.toml").read_bytes()).hexdigest()
+    if stamp.exists() and stamp.read_text().strip() == want and PY.exists():
+        return
+    if not PY.exists():
+        print(f"[run.py] creating virtual environment {VENV}", flush=True)
+        venv.EnvBuilder(with_pip=True).create(VENV)
+    print("[run.py] installing the pinned stack (pyproject.toml) ...", flush=True)
+    subprocess.check_call([str(PY), "-m", "pip", "install", "--quiet", "--disable-pip-version-check",
+                           "-e", f"{ROOT}[test]"])
+    stamp.write_text(want + "\n")
+
+
+def sh(*args: str) -> int:
+    print("[run.py] " + " ".join(args), flush=True)
+    return subprocess.call(list(args), cwd=ROOT)
+
+
+def main(argv: list[str]) -> int:
+    ensure_venv()
+    snakemake = str(BIN / "snakemake")
+    if not argv:
+        rc = sh(snakemake, "--cores", str(os.cpu_count() or 2))
+        if rc == 0:
+            rc = sh(snakemake, "--report", "results/report.html")
+        return rc
+    if argv[0] == "test":
+        return sh(str(PY), "-m", "pytest", *argv[1:])
+    if argv[0] == "snakemake":
+        return sh(snakemake, *argv[1:])
+    print(__doc__)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

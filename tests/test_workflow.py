@@ -1,0 +1,66 @@
+"""The workflow itself: lint, a dry run of every config, the tiny run, determinism."""
+
+import re
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from conftest import REPO, copy_workflow, run_snakemake
+
+CONFIGS = sorted(p.name for p in (REPO / "config").glob("*.yaml") if p.name != "schema.yaml")
+TIMING = re.compile(r"(time|seconds|_ms$|_s$|per_s|fps|memory|peak|duration_wall|speed)", re.I)
+
+pytestmark = pytest.mark.workflow
+
+
+def test_lint_is_clean(tmp_path):
+    wd = copy_workflow(tmp_path)
+    res = run_snakemake(wd, "--lint")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-4000:]
+    assert "Lints for" not in out, out[-6000:]
+
+
+@pytest.mark.parametrize("cfg", CONFIGS)
+def test_dry_run_of_every_config(tmp_path, cfg):
+    wd = copy_workflow(tmp_path)
+    extra = []
+    if cfg == "cmu.yaml":
+        extra = ["--config", f"cmu_mirror={REPO.parent / 'shared' / 'data' / 'cmu_mocap'}"]
+    args = ["-n", "--quiet", "rules"] if cfg == "config.yaml" else ["-n", "--quiet", "rules", "--configfile", f"config/{cfg}"]
+    res = run_snakemake(wd, *args, *extra)
+    assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
+
+
+def test_tiny_run_data_outputs(tiny_workflow):
+    df = pd.read_csv(tiny_workflow / "results" / "data" / "datasets.csv")
+    assert list(df["dataset"]) == ["w1", "w2", "r1", "r2"]
+    assert (df["dims"] == 56).all() and (df["n_sequences"] == 3).all()
+    assert df.loc[0, "lengths"] == "90 80 96"
+    assert (tiny_workflow / "results" / "data" / "datasets.md").read_text().startswith("### Table I")
+    # every rule kept a log and a benchmark file
+    assert any((tiny_workflow / "logs").rglob("*.log"))
+    assert any((tiny_workflow / "benchmarks" / "rules").rglob("*.tsv"))
+
+
+def _tables(root: Path):
+    out = {}
+    for p in sorted((root / "results").rglob("*.csv")):
+        rel = p.relative_to(root)
+        if "timing" in p.name or "benchmark" in p.name:
+            continue
+        df = pd.read_csv(p)
+        df = df[[c for c in df.columns if not TIMING.search(str(c))]]
+        out[str(rel)] = df
+    return out
+
+
+def test_same_config_gives_identical_tables(tiny_workflow, tmp_path):
+    wd = copy_workflow(tmp_path)
+    res = run_snakemake(wd, "--configfile", "config/test.yaml")
+    assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
+    a, b = _tables(tiny_workflow), _tables(wd)
+    assert a.keys() == b.keys() and a
+    for k in a:
+        pd.testing.assert_frame_equal(a[k], b[k], check_exact=True, obj=k)
