@@ -1,0 +1,46 @@
+"""One-call motion generation for users (CLI, notebooks): train on clips, follow the field."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .experiment import fit_pca
+from .field import VectorField, training_vectors
+from .path import follow_field
+
+
+def generate_from_trials(clips, method: str = "delaunay", k: int = 16, latent_dim: int = 2, steps: int = 300,
+                         start=None, derivative: str = "forward", weights: str = "idw", seed: int = 0):
+    """Generate joint angles with the Gauch & Peters vector field.
+
+    Parameters
+    ----------
+    clips : list of arrays (frames_i, D)
+        Training joint angles (root DOF already removed, e.g. ``Motion.without_root()``).
+    method : {"delaunay", "knn", "kdelaunay"}
+    k, latent_dim, weights : see :class:`VectorField`
+    steps : int
+        Number of field steps (frames generated = steps + 1).
+    start : array (D,), optional
+        Start pose (joint angles); default the first frame of the first clip.
+    derivative : {"half", "forward", "central"}
+        Training vectors (``half`` is the paper's printed formula).
+    seed : int
+        Unused by the deterministic field; kept so every generator takes a seed.
+
+    Returns
+    -------
+    angles : ndarray (steps + 1, D)
+    info : str  (fallback steps, latent start)
+    """
+    clips = [np.asarray(c, float) for c in clips]
+    if not clips:
+        raise ValueError("generate_from_trials: no training clips")
+    pca = fit_pca(clips, latent_dim)
+    latent = [pca.transform(c) for c in clips]
+    vec = training_vectors(latent, derivative)
+    field = VectorField(method=method, k=k, weights=weights).fit(np.vstack(latent), vec)
+    x0 = pca.transform(np.asarray(clips[0][0] if start is None else start, float).reshape(1, -1))[0]
+    path = follow_field(field, x0, steps)
+    angles = pca.inverse_transform(path.points)
+    return angles, f"{method}, {path.fallback_steps} fallback steps of {path.steps}"

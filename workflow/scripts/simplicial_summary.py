@@ -1,0 +1,8 @@
+"""Derivative and beyond-the-paper summaries, their figures, and verdicts.csv."""
+from animsynth.simplicial.jobs import summary_job
+from animsynth.workflow_utils import setup_logging
+
+log = setup_logging(snakemake)  # noqa: F821
+i, p = snakemake.input, snakemake.params  # noqa: F821
+summary_job(list(i.derivative), list(i.beyond), i.folds, i.paired, list(p.datasets), dict(p.cfg, seed_value=p.seed),
+            dict(snakemake.output.items()))  # noqa: F821

@@ -1,0 +1,7 @@
+"""Fig 7: a generated walk reprojected to a stick figure (filmstrip PNG, BVH, animated GIF)."""
+from animsynth.simplicial.jobs import walk_job
+from animsynth.workflow_utils import setup_logging
+
+log = setup_logging(snakemake)  # noqa: F821
+p = snakemake.params  # noqa: F821
+walk_job(list(snakemake.input), list(p.ids), p.dataset, dict(p.cfg), dict(snakemake.output.items()))  # noqa: F821
