@@ -1,0 +1,156 @@
+"""Pose features for re-sequencing: joint quaternions, their Lee & Shin
+linearisation, and the global degrees of freedom.
+
+Conventions
+-----------
+* Quaternions are scipy's scalar-last ``(x, y, z, w)`` unit quaternions of the
+  *local* joint rotations (:func:`animsynth.kinematics.quaternions`).
+* ``log`` is the quaternion logarithm of a unit quaternion,
+  ``log(q) = (theta / 2) * axis`` -- *half* the rotation angle, in radians
+  (Lee & Shin 2002; Lee et al. 2002 use the same convention in their metric).
+  The shortest rotation is taken (``q`` and ``-q`` give the same log).
+* Lengths (root translation) are converted to metres with
+  ``skeleton.length_to_m``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..kinematics import quaternions, root_translation
+
+__all__ = ["quat_log", "relative_log", "linearize_quaternions", "MotionFeatures", "motion_features",
+           "angular_velocity"]
+
+
+def quat_log(q) -> np.ndarray:
+    """Quaternion logarithm ``(theta/2) * axis`` of unit quaternions ``(..., 4)`` (x, y, z, w).
+
+    Returns ``(..., 3)``; the shortest rotation is used (``q`` and ``-q`` agree).
+    """
+    q = np.asarray(q, float)
+    shape = q.shape[:-1]
+    rv = Rotation.from_quat(q.reshape(-1, 4)).as_rotvec()  # full angle, shortest (|angle| <= pi)
+    return (0.5 * rv).reshape(shape + (3,))
+
+
+def relative_log(qa, qb) -> np.ndarray:
+    """``log(qa^{-1} qb)`` for quaternion arrays of equal shape ``(..., 4)`` -> ``(..., 3)``."""
+    qa = np.asarray(qa, float)
+    qb = np.asarray(qb, float)
+    shape = qa.shape[:-1]
+    ra = Rotation.from_quat(qa.reshape(-1, 4))
+    rb = Rotation.from_quat(qb.reshape(-1, 4))
+    return (0.5 * (ra.inv() * rb).as_rotvec()).reshape(shape + (3,))
+
+
+def linearize_quaternions(q) -> np.ndarray:
+    """Lee & Shin linearisation of quaternion sequences.
+
+    For every joint (last-but-one axis) ``v_0 = 0`` and
+    ``v_i = sum_{j < i} log(q_j^{-1} q_{j+1})``: the running sum of the
+    body-frame rotation increments. A rotation with constant angular velocity
+    therefore becomes a straight line traversed at constant speed.
+
+    Parameters
+    ----------
+    q : array (frames, joints, 4) or (frames, 4)
+
+    Returns
+    -------
+    v : array (frames, joints, 3) or (frames, 3), radians (half-angle convention)
+
+    Notes
+    -----
+    ``v_0 = 0`` follows the issue's formula; any constant ``v_0`` (e.g.
+    ``log(q_0)``) shifts every frame of a joint by the same vector and leaves
+    all inter-frame distances unchanged.
+    """
+    q = np.asarray(q, float)
+    squeeze = q.ndim == 2
+    if squeeze:
+        q = q[:, None, :]
+    if q.ndim != 3 or q.shape[-1] != 4:
+        raise ValueError(f"expected quaternions of shape (frames, joints, 4), got {q.shape}")
+    n, j, _ = q.shape
+    v = np.zeros((n, j, 3))
+    if n > 1:
+        inc = relative_log(q[:-1], q[1:])
+        v[1:] = np.cumsum(inc, axis=0)
+    return v[:, 0, :] if squeeze else v
+
+
+def angular_velocity(q, fps: float) -> np.ndarray:
+    """Body-frame angular velocity ``log(q_{t-1}^{-1} q_{t+1}) * fps / 2`` per frame.
+
+    Central differences inside, one-sided at the ends; half-angle convention
+    (radians / s, i.e. half the physical angular speed), the same as
+    :func:`quat_log`. Shape ``(frames, joints, 3)`` for ``q`` ``(frames, joints, 4)``.
+    """
+    q = np.asarray(q, float)
+    n = q.shape[0]
+    w = np.zeros(q.shape[:-1] + (3,))
+    if n < 2:
+        return w
+    if n > 2:
+        w[1:-1] = relative_log(q[:-2], q[2:]) * (fps / 2.0)
+    w[0] = relative_log(q[0], q[1]) * fps
+    w[-1] = relative_log(q[-2], q[-1]) * fps
+    return w
+
+
+@dataclass
+class MotionFeatures:
+    """Per-frame pose data of one motion, ready for the distance functions.
+
+    Attributes
+    ----------
+    joint_names : list of str
+        Non-root joints that have rotational DOF (CMU: 28), in skeleton order.
+    quats : ndarray (frames, joints, 4)
+        Their local rotations (sign-continuous over time).
+    root_quat : ndarray (frames, 4)
+        Root (global) orientation.
+    root_pos : ndarray (frames, 3)
+        Root position in metres (Y up).
+    fps : float
+    """
+
+    joint_names: list
+    quats: np.ndarray
+    root_quat: np.ndarray
+    root_pos: np.ndarray
+    fps: float
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.quats.shape[0])
+
+    def linearised(self, include_global: bool) -> np.ndarray:
+        """Frames as vectors: the linearised joint rotations (3 per joint) and,
+        if ``include_global``, the linearised root orientation and the root
+        position in metres (6 more columns). Shape ``(frames, 3m [+ 6])``."""
+        v = linearize_quaternions(self.quats).reshape(self.n_frames, -1)
+        if include_global:
+            v = np.hstack([v, linearize_quaternions(self.root_quat), self.root_pos])
+        return v
+
+
+def motion_features(motion) -> MotionFeatures:
+    """Extract :class:`MotionFeatures` from an :class:`animsynth.io.Motion`."""
+    sk = motion.skeleton
+    values = np.asarray(motion.values, float)
+    if values.ndim != 2 or values.shape[0] < 2:
+        raise ValueError(f"motion {motion.name!r} needs at least 2 frames, got shape {values.shape}")
+    q = quaternions(sk, values)
+    keep = [i for i, j in enumerate(sk.joints) if i > 0 and j.rot_dofs]
+    return MotionFeatures(
+        joint_names=[sk.joints[i].name for i in keep],
+        quats=q[:, keep, :],
+        root_quat=q[:, 0, :],
+        root_pos=root_translation(sk, values) * sk.length_to_m,
+        fps=float(motion.fps),
+    )

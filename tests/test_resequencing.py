@@ -1,0 +1,469 @@
+"""Unit tests of the re-sequencing library (Isomap / ST-Isomap, issue 4)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial.distance import cdist
+from scipy.spatial.transform import Rotation
+from sklearn.manifold import Isomap
+from sklearn.neighbors import kneighbors_graph
+
+from animsynth.io.amc import Motion
+from animsynth.resequencing.distances import (PAPER_WEIGHTS, check_distance_matrix, joint_weights, l2_distances,
+                                              lee_distances, lee_metric)
+from animsynth.resequencing.embedding import (DisconnectedGraphError, PrecomputedIsomap, STIsomap, graph_components,
+                                              knn_graph, min_connected_k, neighbor_ranks, nontrivial_neighbors,
+                                              residual_variance, spatio_temporal_distances)
+from animsynth.resequencing.features import angular_velocity, linearize_quaternions, motion_features, quat_log
+from animsynth.resequencing.metrics import (Reference, foot_skate, jerk_magnitude, pose_steps, root_reversals,
+                                            smoothness)
+from animsynth.resequencing.paths import pad_path, play_path, resolve_frame, shortest_path_frames
+from animsynth.resequencing.study import (analyse, min_k_table, path_pairs, prepare_motion, resequence, splice,
+                                          summarise_paths, verdicts, with_defaults)
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+
+def rot(axis, deg):
+    return Rotation.from_euler(axis, np.reshape(np.asarray(deg, float), (-1, 1)), degrees=True).as_quat()
+
+
+@pytest.fixture(scope="module")
+def walk():
+    return generate_motion("walk_straight", 240, 5, cmu_like_skeleton("t35", 1))
+
+
+# --------------------------------------------------------------- linearisation
+def test_quat_log_is_half_angle():
+    q = rot("x", 90.0)[0]
+    np.testing.assert_allclose(quat_log(q), [np.pi / 4, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(quat_log(-q), [np.pi / 4, 0, 0], atol=1e-12)  # double cover
+
+
+def test_constant_velocity_rotation_linearises_to_a_straight_line():
+    axis = np.array([1.0, 2.0, -0.5]) / np.linalg.norm([1.0, 2.0, -0.5])
+    w = 0.13  # rad per frame, total 60 frames -> several full turns of the log range
+    rv = np.arange(60)[:, None] * w * axis[None, :]
+    q = Rotation.from_rotvec(rv).as_quat()
+    q[1::2] *= -1  # sign flips must not matter
+    v = linearize_quaternions(q)
+    np.testing.assert_allclose(v[0], 0.0)
+    # every frame lies on the line through 0 along the axis, equally spaced by w/2
+    np.testing.assert_allclose(v, np.arange(60)[:, None] * (w / 2) * axis[None, :], atol=1e-10)
+    # plain quaternion logs wrap around (not a line): the linearisation is needed
+    assert np.abs(quat_log(q) - v).max() > 1.0
+
+
+def test_linearisation_per_joint_shapes():
+    q = np.stack([rot("x", np.arange(5) * 10.0), rot("y", np.arange(5) * 5.0)], axis=1)
+    v = linearize_quaternions(q)
+    assert v.shape == (5, 2, 3)
+    np.testing.assert_allclose(v[:, 0, 0], np.deg2rad(np.arange(5) * 10.0) / 2, atol=1e-12)
+    np.testing.assert_allclose(v[:, 1, 1], np.deg2rad(np.arange(5) * 5.0) / 2, atol=1e-12)
+
+
+def test_motion_features_global_columns(walk):
+    f = motion_features(walk)
+    assert len(f.joint_names) == 28 and "root" not in f.joint_names
+    assert f.linearised(False).shape == (240, 84)
+    X = f.linearised(True)
+    assert X.shape == (240, 90)
+    np.testing.assert_allclose(X[:, -3:], f.root_pos)  # root position in metres, last
+    D = l2_distances(X)
+    np.testing.assert_allclose(D, cdist(X, X), atol=1e-12)
+    check_distance_matrix(D)
+    X[3, 2] = np.nan
+    with pytest.raises(ValueError, match="frame 3"):
+        l2_distances(X)
+
+
+# ------------------------------------------------------------------ Lee metric
+def test_lee_metric_on_hand_made_poses():
+    # frame 0: identity; frame 1: joint 0 turned 90 deg about x, joint 1 60 deg about y, joint 2 anything
+    q = np.zeros((2, 3, 4))
+    q[:, :, 3] = 1.0
+    q[1, 0] = rot("x", 90.0)[0]
+    q[1, 1] = rot("y", 60.0)[0]
+    q[1, 2] = rot("z", 170.0)[0]
+    w = np.array([1.0, 0.5, 0.0])
+    D = lee_metric(q, w, fps=1.0, nu=0.0)
+    expected = 1.0 * (np.pi / 4) ** 2 + 0.5 * (np.pi / 6) ** 2
+    np.testing.assert_allclose(D, [[0, expected], [expected, 0]], atol=1e-9)
+    # the root term (global DOF included): + |dp|^2
+    p = np.array([[0.0, 1.0, 0.0], [3.0, 1.0, 4.0]])
+    Dg = lee_metric(q, w, fps=1.0, nu=0.0, root_pos=p)
+    np.testing.assert_allclose(Dg[0, 1], expected + 25.0, atol=1e-9)
+    np.testing.assert_allclose(lee_metric(q, w, 1.0, 0.0, sqrt=True)[0, 1], np.sqrt(expected), atol=1e-9)
+
+
+def test_lee_metric_velocity_term():
+    # one weighted joint turning about x by 0, a, 3a degrees: half-angle velocities (rad/s) at fps 10 are
+    # forward a/2*fps, central (3a/2)/2*fps, backward (2a/2)*fps
+    a, fps, nu = np.deg2rad(6.0), 10.0, 0.3
+    q = Rotation.from_euler("x", [[0.0], [a], [3 * a]]).as_quat()[:, None, :]
+    D = lee_metric(q, np.array([1.0]), fps=fps, nu=nu)
+    om = np.array([a / 2 * fps, 3 * a / 4 * fps, a * fps])
+    ang = np.array([0.0, a, 3 * a]) / 2
+    for i in range(3):
+        for j in range(3):
+            assert D[i, j] == pytest.approx((ang[i] - ang[j]) ** 2 + nu * (om[i] - om[j]) ** 2, abs=1e-9)
+    np.testing.assert_allclose(angular_velocity(q, fps)[:, 0, 0], om, atol=1e-9)
+
+
+def test_lee_weights_and_global_term_on_a_cmu_motion(walk):
+    f = motion_features(walk)
+    w = joint_weights(f.joint_names, PAPER_WEIGHTS)
+    assert w[f.joint_names.index("lfemur")] == 1.0 and w[f.joint_names.index("rradius")] == 0.0247
+    assert np.count_nonzero(w) == 8
+    with pytest.raises(ValueError, match="neither"):
+        joint_weights(f.joint_names, {"ankles": 1.0})
+    D0 = lee_distances(f, nu=0.01, include_global=False)
+    D1 = lee_distances(f, nu=0.01, include_global=True)
+    check_distance_matrix(D0)
+    pv = np.gradient(f.root_pos, axis=0) * f.fps
+    extra = cdist(f.root_pos, f.root_pos, "sqeuclidean") + 0.01 * cdist(pv, pv, "sqeuclidean")
+    np.fill_diagonal(extra, 0.0)
+    np.testing.assert_allclose(D1 - D0, extra, atol=1e-9)
+
+
+# ------------------------------------------------------------------ min k
+def brute_force_min_k(D):
+    n = D.shape[0]
+    for k in range(1, n):
+        G = kneighbors_graph(D, k, metric="precomputed", mode="connectivity")
+        if connected_components(G, directed=False)[0] == 1:
+            return k
+    raise AssertionError("never connected")
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_exact_min_k_matches_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(12, 45))
+    # clusters of different sizes and spreads make the minimum k non-trivial
+    centres = rng.normal(scale=6.0, size=(int(rng.integers(1, 5)), int(rng.integers(2, 6))))
+    X = centres[rng.integers(0, len(centres), n)] + rng.normal(scale=rng.uniform(0.2, 2.0), size=(n, centres.shape[1]))
+    D = cdist(X, X)
+    k = min_connected_k(D)
+    assert k == brute_force_min_k(D)
+    assert graph_components(D, k) == 1
+    if k > 1:
+        assert graph_components(D, k - 1) > 1
+    # and on ST-adjusted matrices (treating the rows as a sequence)
+    Dst, _, _ = spatio_temporal_distances(D, 1, 3.0, 2.0, ctn_neighbors=2, ctn_min_gap=3, ctn_reach=2)
+    assert min_connected_k(Dst) == brute_force_min_k(Dst)
+
+
+def test_knn_graph_matches_scikit_learn():
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(40, 3))
+    D = cdist(X, X)
+    for k in (1, 3, 7):
+        ours = knn_graph(D, k).toarray() > 0
+        sk = kneighbors_graph(D, k, metric="precomputed", mode="connectivity").toarray() > 0
+        np.testing.assert_array_equal(ours, sk | sk.T)
+    R = neighbor_ranks(D)
+    assert (np.diag(R) == 0).all() and sorted(R[0]) == list(range(40))
+
+
+@pytest.mark.filterwarnings("ignore::scipy.sparse.SparseEfficiencyWarning")
+def test_isomap_refuses_disconnected_graphs_that_scikit_learn_joins():
+    rng = np.random.default_rng(0)
+    X = np.vstack([rng.normal(size=(15, 2)), rng.normal(size=(15, 2)) + 100.0])
+    D = cdist(X, X)
+    with pytest.raises(DisconnectedGraphError, match="smallest k giving one component is 15"):
+        PrecomputedIsomap(n_neighbors=5, n_components=2).fit(D)
+    with pytest.warns(UserWarning, match="connected components"):  # scikit-learn silently completes the graph
+        Isomap(n_neighbors=5, n_components=2, metric="precomputed").fit(D)
+    iso = PrecomputedIsomap(n_neighbors=None, n_components=2).fit(D)
+    assert iso.n_neighbors_ == iso.min_k_ == 15
+
+
+# ------------------------------------------------------------------ ST-Isomap
+def loops_sequence(n_loops=3, per_loop=40, reverse_last=False):
+    """A point circling n_loops times (radius drifts slightly); optionally a last loop backwards."""
+    t = np.arange(n_loops * per_loop)
+    phase = 2 * np.pi * (t % per_loop) / per_loop
+    if reverse_last:
+        last = t >= (n_loops - 1) * per_loop
+        phase[last] = -phase[last]
+    r = 1.0 + 0.01 * (t // per_loop)
+    return np.stack([r * np.cos(phase), r * np.sin(phase), 0.002 * t], axis=1)
+
+
+def test_st_isomap_neighbourhoods_on_repeated_loops():
+    P = 40
+    X = loops_sequence(3, P)
+    D = cdist(X, X)
+    Dst, temporal, ctn = spatio_temporal_distances(D, temporal_window=1, c_ctn=5.0, c_cctn=4.0, ctn_neighbors=2,
+                                                   ctn_min_gap=5, ctn_tolerance=1, ctn_reach=3)
+    n = len(X)
+    i, j = np.nonzero(temporal)
+    assert set(np.abs(i - j)) == {1} and temporal.sum() == 2 * (n - 1)
+    np.testing.assert_allclose(Dst[temporal], D[temporal] / 5.0)
+    # common temporal neighbours are the same phase one or two loops away (within the tolerance)
+    ci, cj = np.nonzero(ctn)
+    assert ci.size > 0
+    lag = np.abs(ci - cj)
+    assert np.all(np.minimum(lag % P, P - lag % P) <= 1)
+    np.testing.assert_allclose(Dst[ctn], D[ctn] / 4.0)
+    # nearly every frame of the middle loop has a CTN in each neighbouring loop
+    assert np.mean(ctn[P:2 * P].any(axis=1)) > 0.9
+    untouched = ~(temporal | ctn)
+    np.testing.assert_allclose(Dst[untouched], D[untouched])
+
+
+def test_st_isomap_no_ctn_for_a_pass_in_the_opposite_direction():
+    P = 40
+    X = loops_sequence(3, P, reverse_last=True)
+    D = cdist(X, X)
+    _, _, ctn = spatio_temporal_distances(D, 1, 5.0, 4.0, ctn_neighbors=2, ctn_min_gap=5, ctn_tolerance=1,
+                                          ctn_reach=3)
+    last = np.arange(2 * P + 2, 3 * P - 2)  # the reversed loop, away from where the direction flips
+    # it passes the same points as loops 1-2, but never in the same direction: no CTN with them
+    assert not ctn[np.ix_(last, np.arange(2, 2 * P - 2))].any()
+    assert ctn[:P, P:2 * P].any()
+
+
+def test_nontrivial_neighbours_one_per_pass():
+    X = loops_sequence(4, 30)
+    D = cdist(X, X)
+    M = nontrivial_neighbors(D, 3, min_gap=5)
+    assert (M >= 0).all()
+    for i, row in enumerate(M):
+        assert np.all(np.abs(row - i) > 5)
+        assert len({int(r) // 30 for r in row}) == 3  # each from a different loop
+
+
+def test_st_isomap_registers_loops_that_isomap_keeps_apart():
+    P = 40
+    X = loops_sequence(3, P)
+    X[:, 2] = 0.02 * np.arange(len(X))  # a helix: loops 0.8 apart, frames 0.16 apart
+    D = cdist(X, X)
+    iso = PrecomputedIsomap(6, 2).fit(D)
+    st = STIsomap(6, 2, c_ctn=2.0, c_cctn=50.0, ctn_neighbors=2, ctn_min_gap=15, ctn_tolerance=1, ctn_reach=20).fit(D)
+    ci, cj = np.nonzero(st.ctn_)
+    inner = (np.minimum(ci, cj) > 0) & (np.maximum(ci, cj) < len(X) - 1)  # the ends check one side only
+    lag = np.abs(ci - cj)[inner]
+    assert lag.size > 100 and np.all(np.abs(lag - P * np.round(lag / P)) <= 1)
+
+    def same_phase_ratio(Y):
+        Dy = cdist(Y, Y)
+        idx = np.arange(len(X) - P)
+        return Dy[idx, idx + P].mean() / Dy.mean()
+
+    assert same_phase_ratio(st.embedding_) < 0.5 * same_phase_ratio(iso.embedding_)
+
+
+# ------------------------------------------------------------ residual variance
+def test_residual_variance_on_known_intrinsic_dimension():
+    t = np.linspace(0, 3 * np.pi, 150)
+    curve = np.stack([np.cos(t), np.sin(t), 0.3 * t], axis=1)  # helix: intrinsic dimension 1
+    iso = PrecomputedIsomap(8, 4).fit(cdist(curve, curve))
+    rv = residual_variance(iso.dist_matrix_, iso.embedding_)
+    assert rv[0] < 0.01
+    u, v = np.meshgrid(np.linspace(0, 3, 15), np.linspace(0, 1.5, 8))
+    u, v = u.ravel(), v.ravel()
+    sheet = np.stack([np.cos(u) * 3, np.sin(u) * 3, v * 2], axis=1)  # rolled-up sheet: dimension 2
+    iso = PrecomputedIsomap(8, 4).fit(cdist(sheet, sheet))
+    rv = residual_variance(iso.dist_matrix_, iso.embedding_)
+    assert rv[0] > 0.05 and rv[1] < 0.01
+
+
+def test_residual_variance_rejects_disconnected_geodesics():
+    with pytest.raises(DisconnectedGraphError):
+        residual_variance(np.array([[0, np.inf], [np.inf, 0]]), np.zeros((2, 1)))
+
+
+# ------------------------------------------------------------------ paths
+def test_dijkstra_path_on_a_hand_made_graph():
+    # 0-1-2-3 chain (weight 1 each) and a shortcut 0-3 of weight 2.5 and 0-2 of 5
+    rows, cols, w = [0, 1, 2, 0, 0], [1, 2, 3, 3, 2], [1.0, 1.0, 1.0, 2.5, 5.0]
+    G = csr_matrix((w, (rows, cols)), shape=(5, 5))
+    path, cost = shortest_path_frames(G, 0, 3)
+    assert path.tolist() == [0, 3] and cost == 2.5
+    path, cost = shortest_path_frames(G, 1, 3)  # undirected: 1-2-3 (2.0) beats 1-0-3 (3.5)
+    assert path.tolist() == [1, 2, 3] and cost == 2.0
+    path, cost = shortest_path_frames(G, 3, 1)
+    assert path.tolist() == [3, 2, 1]
+    with pytest.raises(DisconnectedGraphError):
+        shortest_path_frames(G, 0, 4)
+
+
+def test_dijkstra_on_a_chain_graph_follows_time():
+    X = np.linspace(0, 1, 30)[:, None]
+    G = knn_graph(cdist(X, X), 2)
+    path, _ = shortest_path_frames(G, 3, 20)
+    assert path.tolist() == list(range(3, 21))
+
+
+def test_padding_and_frame_specs():
+    p = np.array([4, 5, 9])
+    assert pad_path(p, None).tolist() == [4, 5, 9]
+    assert pad_path(p, 2).tolist() == [4, 5, 9]
+    assert pad_path(p, 6).tolist() == [4, 5, 9, 9, 9, 9]
+    assert pad_path(p, 8, "reverse").tolist() == [4, 5, 9, 5, 4, 5, 9, 5]
+    assert resolve_frame(-1, 10) == 9 and resolve_frame(0.5, 11) == 5
+    with pytest.raises(ValueError):
+        resolve_frame(10, 10)
+    assert splice([5, 9, 3], 12, 2).tolist() == [3, 4, 5, 9, 3, 4, 5]
+
+
+def test_play_path_reproduces_the_original(walk):
+    idx = np.arange(walk.n_frames)
+    for mode in ("integrate", "absolute"):
+        m = play_path(walk, idx, root=mode)
+        from animsynth.kinematics import forward_kinematics
+
+        np.testing.assert_allclose(forward_kinematics(walk.skeleton, m.values),
+                                   forward_kinematics(walk.skeleton, walk.values), atol=1e-6)
+    # a jump keeps the root continuous when integrating, teleports when absolute
+    path = np.concatenate([np.arange(0, 50), np.arange(150, 200)])
+    sk = walk.skeleton
+    from animsynth.kinematics import root_translation
+
+    ri = root_translation(sk, play_path(walk, path, "integrate").values) * sk.length_to_m
+    ra = root_translation(sk, play_path(walk, path, "absolute").values) * sk.length_to_m
+    step_i = np.linalg.norm(np.diff(ri[:, [0, 2]], axis=0), axis=1)
+    step_a = np.linalg.norm(np.diff(ra[:, [0, 2]], axis=0), axis=1)
+    assert step_i.max() < 0.05 and step_a[49] > 0.5
+
+
+# ------------------------------------------------------------------ metrics
+def test_pose_steps_and_jerk_of_a_constant_rotation():
+    q = rot("x", np.arange(20) * 2.0)[:, None, :]
+    np.testing.assert_allclose(pose_steps(q), np.deg2rad(2.0), atol=1e-12)
+    np.testing.assert_allclose(jerk_magnitude(q, 100.0), 0.0, atol=1e-6)
+    # a jump of 20 degrees at one frame gives jerk at the three frames around it
+    ang = np.arange(20) * 2.0
+    ang[10:] += 20.0
+    q2 = rot("x", ang)[:, None, :]
+    j = jerk_magnitude(q2, 10.0)
+    assert np.count_nonzero(j > 1e-6) == 3
+    assert j.max() == pytest.approx(2 * np.deg2rad(20.0) * 1000.0, rel=1e-6)
+
+
+def _root_motion(xz, fps=10.0):
+    """A CMU-like skeleton motion whose root follows ``xz`` (metres), facing +z."""
+    sk = cmu_like_skeleton("t", 0)
+    v = np.zeros((len(xz), sk.n_dof))
+    v[:, 0] = xz[:, 0] / sk.length_to_m
+    v[:, 2] = xz[:, 1] / sk.length_to_m
+    return Motion(v, sk, fps, "root")
+
+
+def test_root_reversals_count_direction_changes():
+    fwd = np.stack([np.zeros(30), np.concatenate([np.arange(15), 14 - np.arange(15)]) * 0.1], axis=1)
+    assert root_reversals(_root_motion(fwd), 0.1) == 1
+    assert root_reversals(_root_motion(np.stack([np.zeros(30), np.arange(30) * 0.1], 1)), 0.1) == 0
+    still = np.zeros((30, 2))
+    assert root_reversals(_root_motion(still), 0.1) == 0
+
+
+def test_foot_skate_zero_when_planted_and_speed_when_sliding():
+    m = _root_motion(np.zeros((20, 2)))
+    from animsynth.resequencing.metrics import foot_ground
+
+    g = foot_ground(m)
+    skate, frac = foot_skate(m, g, 0.02)
+    assert skate == pytest.approx(0.0, abs=1e-9) and frac == 1.0
+    slide = _root_motion(np.stack([np.arange(20) * 0.05, np.zeros(20)], axis=1), fps=10.0)  # 0.5 m/s sideways
+    skate, _ = foot_skate(slide, g, 0.02)
+    assert skate == pytest.approx(0.5, rel=1e-6)
+
+
+def test_smoothness_of_the_original_path_is_one(walk):
+    ref = Reference(walk)
+    idx = np.arange(walk.n_frames)
+    s = smoothness(ref, play_path(walk, idx), idx)
+    assert s["jumps"] == 0 and s["jerk_events"] == 0
+    for c in ("jump_mean_ratio", "jump_p95_ratio", "jump_max_ratio", "jerk_mean_ratio"):
+        assert s[c] == pytest.approx(1.0, abs=1e-6)
+    jump = np.concatenate([np.arange(0, 60), np.arange(130, 200)])
+    s2 = smoothness(ref, play_path(walk, jump), jump)
+    assert s2["jumps"] == 1 and s2["jump_max_ratio"] > 1.0 and s2["jerk_events"] >= 1
+
+
+# ------------------------------------------------------------------ study
+def test_study_end_to_end_small(walk):
+    cfg = with_defaults({"n_neighbors": 6, "max_dim": 3, "path": {"random_pairs": 2}})
+    m = prepare_motion(walk, 150, 2)
+    assert m.n_frames == 75 and m.fps == walk.fps / 2
+    mk, rv, emb, timing = analyse(m, "walk", "t35", False, cfg)
+    assert len(mk) == 4 and (mk["components_at_min_k"] == 1).all()
+    assert (mk["k_used"] >= mk["min_k"]).all()
+    assert set(rv["dim"]) == {1, 2, 3}
+    assert emb["isomap_l2_xy"].shape == (75, 2)
+    paths, main, per_path = resequence(m, False, "stisomap", "lee", int(mk["k_used"].iloc[0]), cfg, seed=4)
+    assert len(paths) == 3 and paths[0][0] == 0 and paths[0][-1] == 74
+    assert main.n_frames == len(paths[0])
+    assert path_pairs(75, cfg["path"], 4) == path_pairs(75, cfg["path"], 4)
+    per_path.insert(0, "metric", "lee")
+    per_path.insert(0, "method", "stisomap")
+    per_path.insert(0, "global_dof", False)
+    per_path.insert(0, "dataset", "walk")
+    summ = summarise_paths(per_path)
+    assert len(summ) == 1 and summ["paths"].iloc[0] == 3
+
+
+def test_analyse_is_deterministic(walk):
+    cfg = with_defaults({"n_neighbors": 5, "max_dim": 3, "metrics": ["lee"]})
+    m = prepare_motion(walk, 120, 2)
+    a = analyse(m, "walk", "t", True, cfg)
+    b = analyse(m, "walk", "t", True, cfg)
+    assert a[0].to_csv() == b[0].to_csv() and a[1].to_csv() == b[1].to_csv()
+
+
+def test_min_k_table_fills_published_values():
+    mk = pd.DataFrame([{"dataset": "walk", "trial": "t", "frames": 10, "global_dof": g, "method": "isomap",
+                        "metric": "l2", "min_k": 3, "components_at_min_k_minus_1": 2, "components_at_min_k": 1,
+                        "k_used": 10, "ctn_pairs": np.nan, "nontrivial_edge_fraction": 0.5} for g in (True, False)])
+    t = min_k_table(mk, [{"dataset": "walk", "global_dof": True, "method": "isomap", "metric": "l2", "min_k": 7}])
+    assert t["global_dof"].tolist() == [False, True]
+    assert np.isnan(t["min_k_paper"].iloc[0]) and t["min_k_paper"].iloc[1] == 7
+
+
+def _smooth_rows(values):
+    rows = []
+    for (ds, method, metric, g), (ev, p95, rev, sk) in values.items():
+        rows.append({"dataset": ds, "method": method, "metric": metric, "global_dof": g, "jerk_events": ev,
+                     "jerk_mean_ratio": ev + 1.0, "jump_p95_ratio": p95, "root_reversals": rev,
+                     "foot_skate_mps": sk})
+    return pd.DataFrame(rows)
+
+
+def test_verdicts_from_hand_made_numbers():
+    vals = {}
+    for ds in ("walk", "run", "dance"):
+        for metric in ("l2", "lee"):
+            for g in (False, True):
+                hurt = g and ds != "dance"
+                base = (4.0, 2.0, 1.0, 0.5) if not hurt else (8.0, 3.0, 2.0, 0.9)
+                vals[(ds, "isomap", metric, g)] = base
+                vals[(ds, "stisomap", metric, g)] = (base[0] / 4, base[1], base[2], base[3])
+    v = verdicts(_smooth_rows(vals), 0.1).set_index("claim")
+    assert v.loc["ST-Isomap gives fewer jerks than Isomap", "verdict"] == "yes, by 75 %"
+    assert v.loc["global DOF hurt cyclic locomotion but not dance", "verdict"].startswith("yes")
+    # make dance hurt too: the combined claim fails
+    for k in list(vals):
+        if k[0] == "dance" and k[3]:
+            vals[k] = tuple(x * 3 for x in vals[k])
+    v = verdicts(_smooth_rows(vals), 0.1).set_index("claim")
+    assert v.loc["global DOF hurt cyclic locomotion but not dance", "verdict"].startswith("no")
+    # identical methods: no clear difference
+    same = {k: (1.0, 1.0, 1.0, 1.0) for k in vals}
+    v = verdicts(_smooth_rows(same), 0.1).set_index("claim")
+    assert v.loc["ST-Isomap gives fewer jerks than Isomap", "verdict"].startswith("no clear difference")
+
+
+def test_library_defaults_match_the_embedded_config():
+    import yaml
+    from pathlib import Path
+
+    from animsynth.resequencing.study import DEFAULTS
+
+    cfg = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text())
+    assert cfg["resequencing"] == DEFAULTS
