@@ -1,0 +1,314 @@
+"""Synthesis from expression labels on region motion graphs (paper section 5).
+
+For every requested label, in every region graph:
+
+* a **random valid peak node** is chosen: a node where a database sample of
+  that label peaks and that is reachable from the current node (seeded
+  generator);
+* **Dijkstra** (``scipy.sparse.csgraph.dijkstra``, edge weight = eq. 3
+  similarity) gives the path from the current node (the neutral node, or the
+  previous label's peak) to it. If no peak node of the label is reachable
+  from the current node (a graph whose neutral nodes did not all merge is not
+  strongly connected), the region restarts from the neutral node - a node
+  holding some sample's first pose - that reaches one (the one most samples
+  start from); this fallback is logged and listed in ``Animation.jumps``;
+* optional **coherent noise** replaces a share of the interior path nodes by
+  random nodes within ``noise_hops`` hops (undirected) that share a label with
+  the node they replace.
+
+**Motion recovery.**
+
+1. *Velocity-based pose expansion with clamping.* Each non-final path node
+   ``k`` becomes ``round(mean consecutive-merge count)`` frames that start at
+   its mean displacement and move towards the next path node at the node's
+   mean landmark speed; each landmark's travel is clamped to the distance to
+   the next node, so no frame overshoots it.
+2. *Duration from peak statistics.* The peak node is held for
+   ``round(mean peak duration)`` frames (with duration noise: a normal draw
+   with the stored std), at least one.
+3. *Region length normalisation.* Regions give paths of different lengths;
+   every region is resampled (linear interpolation in time) to the mean length
+   of the regions whose path moves (all regions if none does).
+4. *Smoothing.* A Savitzky-Golay filter along time, then per segment and per
+   landmark a sigmoid (eq. 1, shared timing for x and y, fitted by grid and
+   exact amplitudes) which is blended in with ``sigmoid_weight``.
+
+The regions are assembled into a (frames, 68, 2) displacement animation that
+is added to a neutral face.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.signal import savgol_filter
+from scipy.sparse.csgraph import dijkstra
+from scipy.special import expit
+
+from ..io.ckplus import EMOTIONS, emotion_code
+from .graph import RegionGraph
+from .preprocess import sigmoid_grid_fit
+
+log = logging.getLogger("animsynth.facegraph.synthesis")
+
+
+class SynthesisError(RuntimeError):
+    """A label cannot be reached in a region graph (disconnected graph or unknown label)."""
+
+
+@dataclass
+class Animation:
+    """A synthesised animation.
+
+    Attributes
+    ----------
+    disp : ndarray (frames, 68, 2)   displacements from the neutral face
+    segments : list of (start, stop, label)
+    paths : dict region -> list (per segment) of node-id arrays (after noise)
+    raw_paths : dict region -> list of Dijkstra paths (before noise)
+    jumps : list of (segment, region, from node, to neutral node) restarts (see module docs)
+    """
+
+    disp: np.ndarray
+    segments: list = field(default_factory=list)
+    paths: dict = field(default_factory=dict)
+    raw_paths: dict = field(default_factory=dict)
+    jumps: list = field(default_factory=list)
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.disp.shape[0])
+
+    def positions(self, neutral: np.ndarray) -> np.ndarray:
+        """Landmark positions: ``neutral`` (68, 2) plus the displacements."""
+        return np.asarray(neutral, float)[None] + self.disp
+
+
+def resample(traj: np.ndarray, n: int) -> np.ndarray:
+    """Linear resampling of a trajectory (T, ...) to ``n`` frames over the same time span."""
+    T = traj.shape[0]
+    if T == n:
+        return traj.copy()
+    if T == 1:
+        return np.repeat(traj, n, axis=0)
+    x = np.linspace(0.0, T - 1, n)
+    i0 = np.minimum(np.floor(x).astype(int), T - 2)
+    w = (x - i0).reshape((-1,) + (1,) * (traj.ndim - 1))
+    return traj[i0] * (1.0 - w) + traj[i0 + 1] * w
+
+
+def _path(pred: np.ndarray, src: int, dst: int) -> np.ndarray:
+    out = [dst]
+    while out[-1] != src:
+        p = pred[out[-1]]
+        if p < 0:
+            raise SynthesisError("broken predecessor chain")
+        out.append(int(p))
+    return np.array(out[::-1], int)
+
+
+def hop_neighbours(g: RegionGraph, node: int, hops: int) -> np.ndarray:
+    """Nodes within ``hops`` undirected hops of ``node`` (excluding it)."""
+    A = g.undirected()
+    seen = {int(node)}
+    frontier = [int(node)]
+    for _ in range(int(hops)):
+        nxt = []
+        for u in frontier:
+            for v in A.indices[A.indptr[u]:A.indptr[u + 1]]:
+                v = int(v)
+                if v not in seen:
+                    seen.add(v)
+                    nxt.append(v)
+        frontier = nxt
+        if not frontier:
+            break
+    seen.discard(int(node))
+    return np.array(sorted(seen), int)
+
+
+class FaceSynthesizer:
+    """Label-driven synthesis on region graphs.
+
+    Parameters
+    ----------
+    graphs : dict region -> RegionGraph
+    savgol_window, savgol_order : int
+        Savitzky-Golay smoothing (step 4); the window is shrunk to the
+        animation length when needed (odd), smoothing is skipped below order + 2 frames.
+    sigmoid_weight : float in [0, 1]
+        Blend of the per-segment sigmoid fit into the smoothed motion (step 4).
+    noise_share : float in [0, 1]
+        Share of interior path nodes replaced by coherent noise.
+    noise_hops : int
+        Neighbourhood radius (hops) of the replacement nodes.
+    duration_noise : bool
+        Draw the peak duration from N(mean, std) instead of using the mean.
+    """
+
+    def __init__(self, graphs: dict[str, RegionGraph], savgol_window: int = 7, savgol_order: int = 2,
+                 sigmoid_weight: float = 0.5, noise_share: float = 0.0, noise_hops: int = 2,
+                 duration_noise: bool = False):
+        if not 0.0 <= sigmoid_weight <= 1.0:
+            raise ValueError("sigmoid_weight must be in [0, 1]")
+        if not 0.0 <= noise_share <= 1.0:
+            raise ValueError("noise_share must be in [0, 1]")
+        if savgol_window < 3 or savgol_window % 2 == 0 or savgol_order >= savgol_window:
+            raise ValueError("savgol_window must be odd, >= 3 and > savgol_order")
+        self.graphs = graphs
+        self.savgol_window = int(savgol_window)
+        self.savgol_order = int(savgol_order)
+        self.sigmoid_weight = float(sigmoid_weight)
+        self.noise_share = float(noise_share)
+        self.noise_hops = int(noise_hops)
+        self.duration_noise = bool(duration_noise)
+
+    # ------------------------------------------------------------------
+    def start_nodes(self, sample: int | None = None) -> dict[str, int]:
+        """Start node per region: the node of a sample's neutral pose, or (None)
+        the neutral node shared by most samples."""
+        out = {}
+        for r, g in self.graphs.items():
+            if sample is None:
+                out[r] = int(np.bincount(g.start_of_sample).argmax())
+            else:
+                out[r] = int(g.start_of_sample[sample])
+        return out
+
+    def _neutral_reaching(self, g: RegionGraph, code: int):
+        """The neutral node (most samples' start first) from which a peak of ``code`` is reachable."""
+        cache = self.__dict__.setdefault("_neutral_cache", {})
+        key = (g.name, id(g), code)
+        if key not in cache:
+            starts, counts = np.unique(g.start_of_sample, return_counts=True)
+            peaks = g.peak_nodes(code)
+            cache[key] = None
+            for s in starts[np.argsort(-counts, kind="stable")]:
+                d = dijkstra(g.csr(), directed=True, indices=int(s))
+                if np.isfinite(d[peaks]).any():
+                    cache[key] = int(s)
+                    break
+        return cache[key]
+
+    def _coherent_noise(self, g: RegionGraph, path: np.ndarray, rng) -> np.ndarray:
+        path = path.copy()
+        interior = np.arange(1, len(path) - 1)
+        k = int(round(self.noise_share * interior.size))
+        if k == 0:
+            return path
+        for i in np.sort(rng.choice(interior, size=k, replace=False)):
+            u = path[i]
+            nb = hop_neighbours(g, u, self.noise_hops)
+            nb = nb[(g.label_mask[nb] & g.label_mask[u]) != 0]
+            if nb.size:
+                path[i] = nb[rng.integers(nb.size)]
+        return path
+
+    def _expand(self, g: RegionGraph, path: np.ndarray, first: bool, rng) -> np.ndarray:
+        """Steps 1-2 for one region path -> (frames, Lf, 2)."""
+        D = g.disp
+        end = path[-1]
+        mu, sd = g.peak_dur_mean[end], g.peak_dur_std[end]
+        if not np.isfinite(mu):
+            mu, sd = float(np.rint(g.merge_count[end])), 0.0
+        h = rng.normal(mu, sd) if (self.duration_noise and sd > 0) else mu
+        h = max(1, int(np.rint(h)))
+        hold = np.repeat(D[end][None], h, axis=0)
+        if len(path) == 1:
+            return hold
+        src, dst = path[:-1], path[1:]
+        n = np.maximum(1, np.rint(g.merge_count[src]).astype(int))
+        if not first:
+            n[0] = 0  # the previous segment already held this node
+        delta = D[dst] - D[src]                                  # (m, Lf, 2)
+        length = np.sqrt((delta ** 2).sum(-1))                   # (m, Lf)
+        unit = np.where(length[..., None] > 0, delta / np.where(length > 0, length, 1.0)[..., None], 0.0)
+        ks = np.repeat(np.arange(len(src)), n)
+        js = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+        travel = np.minimum(js[:, None] * g.speed[src[ks]], length[ks])  # clamped at the next node
+        frames = D[src[ks]] + travel[..., None] * unit[ks]
+        return np.concatenate([frames, hold], axis=0)
+
+    def _smooth(self, disp: np.ndarray, segments: list) -> np.ndarray:
+        T = disp.shape[0]
+        w = min(self.savgol_window, T if T % 2 else T - 1)
+        sm = savgol_filter(disp, w, self.savgol_order, axis=0, mode="interp") if w > self.savgol_order + 1 else disp
+        if self.sigmoid_weight == 0.0:
+            return sm
+        out = sm.copy()
+        for a, b, _ in segments:
+            seg = sm[a:b]
+            if b - a < 4:
+                continue
+            base = seg[0]
+            A, Bm, k, c = sigmoid_grid_fit(seg - base)
+            t = np.arange(b - a, dtype=float)
+            fit = base + A[None] + Bm[None] * expit(k[None, :] * (t[:, None] - c[None, :]))[..., None]
+            out[a:b] = (1.0 - self.sigmoid_weight) * seg + self.sigmoid_weight * fit
+        return out
+
+    # ------------------------------------------------------------------
+    def synthesize(self, labels, start: dict | None = None, rng=None, peak_rng=None) -> Animation:
+        """Animation through the peaks of ``labels`` (names or CK+ codes), in order.
+
+        Parameters
+        ----------
+        labels : sequence of str or int
+        start : dict region -> node, optional (default: :meth:`start_nodes`)
+        rng : numpy Generator or int seed (peak choice and noise)
+        peak_rng : numpy Generator or int seed, optional
+            Separate generator for the peak-node choice (then ``rng`` drives only the noise).
+        """
+        rng = np.random.default_rng(rng)
+        peak_rng = rng if peak_rng is None else np.random.default_rng(peak_rng)
+        codes = [emotion_code(lab) for lab in labels]
+        if not codes:
+            raise ValueError("need at least one expression label")
+        cur = dict(start) if start is not None else self.start_nodes()
+        segments, parts = [], []
+        paths = {r: [] for r in self.graphs}
+        raw = {r: [] for r in self.graphs}
+        jumps = []
+        t0 = 0
+        for si, code in enumerate(codes):
+            trajs, moving = {}, []
+            for r, g in self.graphs.items():
+                peaks = g.peak_nodes(code)
+                if peaks.size == 0:
+                    raise SynthesisError(f"region {r!r}: no peak node for label {EMOTIONS[code]!r} "
+                                         "(no database sample has that label)")
+                dist, pred = dijkstra(g.csr(), directed=True, indices=cur[r], return_predecessors=True)
+                reach = peaks[np.isfinite(dist[peaks])]
+                if reach.size == 0:
+                    alt = self._neutral_reaching(g, code)
+                    if alt is None:
+                        raise SynthesisError(f"region {r!r}: no {EMOTIONS[code]!r} peak node is reachable from "
+                                             f"node {cur[r]} nor from any neutral node (graph not connected)")
+                    log.warning("region %s: no %s peak reachable from node %d; restarting from neutral node %d",
+                                r, EMOTIONS[code], cur[r], alt)
+                    jumps.append((si, r, int(cur[r]), alt))
+                    cur[r] = alt
+                    dist, pred = dijkstra(g.csr(), directed=True, indices=cur[r], return_predecessors=True)
+                    reach = peaks[np.isfinite(dist[peaks])]
+                target = int(reach[peak_rng.integers(reach.size)])
+                p = _path(pred, cur[r], target)
+                raw[r].append(p)
+                if self.noise_share > 0:
+                    p = self._coherent_noise(g, p, rng)
+                paths[r].append(p)
+                trajs[r] = self._expand(g, p, si == 0, rng)
+                if len(p) > 1:
+                    moving.append(r)
+                cur[r] = target
+            use = moving or list(trajs)
+            n = max(1, int(np.rint(np.mean([len(trajs[r]) for r in use]))))
+            seg = np.zeros((n, 68, 2))
+            for r, g in self.graphs.items():
+                seg[:, g.landmarks] = resample(trajs[r], n)
+            parts.append(seg)
+            segments.append((t0, t0 + n, EMOTIONS[code]))
+            t0 += n
+        disp = self._smooth(np.concatenate(parts, axis=0), segments)
+        return Animation(disp, segments, paths, raw, jumps)

@@ -1,0 +1,13 @@
+"""Claims of the paper checked against the facegraph tables -> verdicts.csv."""
+import pandas as pd
+
+from animsynth.facegraph.experiments import data_note, verdicts
+from animsynth.tables import write_table
+from animsynth.workflow_utils import setup_logging
+
+log = setup_logging(snakemake)
+read = lambda p: pd.read_csv(p, keep_default_na=False, na_values=[""])  # noqa: E731
+table = verdicts(read(snakemake.input.table1), read(snakemake.input.baseline), read(snakemake.input.uniqueness),
+                 snakemake.params.source)
+write_table(table, snakemake.output.csv, title="Facegraph verdicts", note=data_note(snakemake.params.source))
+log.info("verdicts:\n%s", table.to_string())
