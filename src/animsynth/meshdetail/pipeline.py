@@ -1,0 +1,162 @@
+"""Workflow steps of the meshdetail family (the scripts in workflow/scripts only call these).
+
+Files between steps:
+
+* ``character/`` (synthetic only): ``main/mesh_NNNN.obj.gz`` and
+  ``edit_<name>/mesh_NNNN.obj.gz`` OBJ sequences, ``truth.npz`` (true rig, poses
+  of the clip and of every edit);
+* ``data/sequence.npz``: the parsed main sequence (:class:`MeshSequence`);
+  ``data/edits.npz``: parsed edited sequences with their true poses;
+* ``data/pose.npz``: fitted rig, skinning weights, per-frame root translation and angles.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+
+import numpy as np
+
+from ..io.obj import MeshSequence, read_obj_sequence, write_obj_sequence
+from .experiments import (Prepared, fit_skeleton, pack_weights, rig_fit_table, rig_from_joints, split_frames,
+                          unpack_weights)
+from .rig import Rig, cmu_motion_to_rig, default_rig, rebase, rebase_pose
+
+log = logging.getLogger("animsynth.meshdetail.pipeline")
+
+
+def driving_motion(cfg: dict, seed: int, speed: float = 1.0):
+    """Rig and pose (root_t, angles) that drive the synthetic character."""
+    from ..synth.character import procedural_motion
+
+    drv, fps, n = cfg["driver"], float(cfg["fps"]), int(cfg["frames"])
+    if drv == "procedural":
+        rig = default_rig()
+        rt, A = procedural_motion(cfg["motion"], n, fps, seed, rig, speed=speed)
+        return rig, rt, A
+    if drv == "cmu_synthetic":
+        from ..synth.mocap import cmu_like_skeleton, generate_motion
+
+        step = 120.0 / fps
+        if abs(step - round(step)) > 1e-9:
+            raise ValueError(f"config key 'meshdetail.character.fps': must divide 120 for the CMU-like generator, got {fps}")
+        sk = cmu_like_skeleton("syn_skirt", seed)
+        m = generate_motion(cfg["motion"], int(np.ceil(n * step * speed)) + 2, seed, sk, fps=120.0)
+    elif drv == "amc":
+        from ..io import read_amc, read_asf
+
+        if not cfg.get("asf") or not cfg.get("amc"):
+            raise ValueError("config keys 'meshdetail.character.asf' and '.amc' are needed for driver 'amc'")
+        m = read_amc(cfg["amc"], read_asf(cfg["asf"]), 120.0)
+        step = 120.0 / fps
+    else:
+        raise ValueError(f"config key 'meshdetail.character.driver': unknown driver {drv!r}")
+    rig, rt, A = cmu_motion_to_rig(m)
+    src = np.arange(n) * step * speed
+    if src[-1] > len(rt) - 1:
+        raise ValueError(f"driving motion has {len(rt)} frames at 120 fps, need {src[-1]:.0f}")
+    i0 = np.floor(src).astype(int)
+    i1 = np.minimum(i0 + 1, len(rt) - 1)
+    a = (src - i0)[:, None]
+    return rig, (1 - a) * rt[i0] + a * rt[i1], (1 - a[..., None]) * A[i0] + a[..., None] * A[i1]
+
+
+def make_character(cfg: dict, seed: int, out_dir: str) -> dict:
+    """Generate, simulate and write the synthetic skirt character (main clip + edits)."""
+    from ..synth.character import SkirtParams, build_character, edit_motion, simulate
+
+    rig, rt, A = driving_motion(cfg, seed)
+    ch = build_character(rig, cfg["resolution"], cfg["skirt_rings"], cfg["skirt_around"])
+    sp = SkirtParams(hem_frequency=cfg["hem_frequency"], damping=cfg["damping"], substeps=cfg["substeps"])
+    fps = float(cfg["fps"])
+    V = simulate(ch, rt, A, fps, sp)
+    log.info("character: %d vertices, %d faces, %d frames; skirt %d vertices", len(ch.rest), len(ch.faces), len(V),
+             ch.skirt.size)
+    write_obj_sequence(os.path.join(out_dir, "main"), MeshSequence(V, ch.faces, fps=fps), gz=True)
+    # The known skeleton placed in the first-frame mesh: poses are stored relative to frame 0.
+    rig0 = rebase(rig, rt[0], A[0])
+    truth = {"rig": np.array(rig0.to_json()), "root_t": rt, "angles": rebase_pose(rig, rt, A, A[0]),
+             "skirt": ch.skirt.ravel(), "edits": np.array(json.dumps(list(cfg["edits"]))),
+             "tpose_rig": np.array(rig.to_json())}
+    for name in cfg["edits"]:
+        regen = (lambda s: driving_motion(cfg, seed, speed=s)[1:]) if name.startswith("speed") else None
+        ert, eA = edit_motion(rt, A, name, regenerate=regen)
+        Ve = simulate(ch, ert, eA, fps, sp)
+        write_obj_sequence(os.path.join(out_dir, f"edit_{name}"), MeshSequence(Ve, ch.faces, fps=fps), gz=True)
+        truth[f"root_t:{name}"] = ert
+        truth[f"angles:{name}"] = rebase_pose(rig, ert, eA, A[0])
+    from ..io.atomic import atomic_path
+
+    with atomic_path(os.path.join(out_dir, "truth.npz"), suffix=".npz") as tmp:
+        np.savez_compressed(tmp, **truth)
+    return {"vertices": int(len(ch.rest)), "frames": int(len(V))}
+
+
+def load_sequences(main_dir: str, truth_npz: str | None, seq_out: str, edits_out: str, fps: float,
+                   max_frames: int | None = None) -> MeshSequence:
+    """Parse the main OBJ sequence (cached as npz) and, for synthetic data, the edited ones."""
+    seq = read_obj_sequence(main_dir, fps=fps, max_frames=max_frames)
+    seq.save_npz(seq_out)
+    edits = {}
+    if truth_npz:
+        root = os.path.dirname(truth_npz)
+        with np.load(truth_npz) as z:
+            names = json.loads(str(z["edits"]))
+            for name in names:
+                e = read_obj_sequence(os.path.join(root, f"edit_{name}"), fps=fps, max_frames=max_frames)
+                if e.n_vertices != seq.n_vertices or not np.array_equal(e.faces, seq.faces):
+                    raise ValueError(f"edited sequence {name!r} does not share the main sequence's topology")
+                edits[f"vertices:{name}"] = e.vertices
+                edits[f"root_t:{name}"] = z[f"root_t:{name}"][: e.n_frames]
+                edits[f"angles:{name}"] = z[f"angles:{name}"][: e.n_frames]
+    from ..io.atomic import atomic_path
+
+    with atomic_path(edits_out, suffix=".npz") as tmp:
+        np.savez_compressed(tmp, names=np.array(json.dumps(sorted({k.split(":", 1)[1] for k in edits}))), **edits)
+    return seq
+
+
+def fit_pose(seq_npz: str, truth_npz: str | None, rig_cfg: dict, out_npz: str):
+    """Embed the 18-joint skeleton, compute weights, fit every frame; returns the fit-quality table."""
+    seq = MeshSequence.load_npz(seq_npz)
+    true_angles = labels = None
+    if truth_npz:
+        with np.load(truth_npz) as z:
+            rig = Rig.from_json(str(z["rig"]))
+            true_angles = z["angles"][: seq.n_frames]
+            skirt = np.zeros(seq.n_vertices, bool)
+            skirt[z["skirt"]] = True
+        labels = {"body": ~skirt, "skirt": skirt}
+        refine = False
+        method = "ground-truth rig of the generator"
+    else:
+        if not rig_cfg.get("joints"):
+            raise ValueError("config key 'meshdetail.rig.joints': real mesh data needs an 18-joint embedding "
+                             "(joint start positions in the first frame; see docs/config_meshdetail.md)")
+        rig = rig_from_joints(rig_cfg["joints"], rig_cfg.get("ends") or {})
+        refine = bool(rig_cfg["refine"])
+        method = "user-supplied embedding" + (" refined from the mesh motion" if refine else "")
+    rig, weights, fitter = fit_skeleton(seq.vertices, rig, refine=refine, weight_power=rig_cfg["weight_power"],
+                                        max_influences=rig_cfg["max_influences"], iterations=rig_cfg["fit_iterations"])
+    table = rig_fit_table(seq.vertices, rig, weights, fitter, true_angles, labels)
+    from ..io.atomic import atomic_path
+
+    with atomic_path(out_npz, suffix=".npz") as tmp:
+        np.savez_compressed(tmp, rig=np.array(rig.to_json()), root_t=fitter.root_t_, angles=fitter.angles_,
+                            residual=fitter.residual_, method=np.array(method), **pack_weights(weights))
+    return table, method
+
+
+def load_prepared(seq_npz: str, pose_npz: str, edits_npz: str, train_fraction: float) -> Prepared:
+    seq = MeshSequence.load_npz(seq_npz)
+    with np.load(pose_npz) as z:
+        rig = Rig.from_json(str(z["rig"]))
+        weights = unpack_weights(z)
+        root_t, angles = z["root_t"], z["angles"]
+    edits = {}
+    with np.load(edits_npz) as z:
+        for name in json.loads(str(z["names"])):
+            edits[name] = (z[f"vertices:{name}"], z[f"root_t:{name}"], z[f"angles:{name}"])
+    tr, te = split_frames(seq.n_frames, train_fraction)
+    return Prepared(seq.vertices, seq.faces, rig, weights, root_t, angles, tr, te, edits)

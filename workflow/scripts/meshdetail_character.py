@@ -1,0 +1,10 @@
+"""Generate the synthetic skirt character: OBJ sequences of the clip and of its edits + truth.npz."""
+import os
+
+from animsynth.meshdetail.pipeline import make_character
+from animsynth.workflow_utils import setup_logging
+
+log = setup_logging(snakemake)  # noqa: F821
+out = snakemake.output  # noqa: F821
+info = make_character(dict(snakemake.params.cfg), int(snakemake.params.seed), os.path.dirname(out.truth))  # noqa: F821
+log.info("wrote %s", info)

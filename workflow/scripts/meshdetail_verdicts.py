@@ -1,0 +1,13 @@
+"""Claims of the hybrid-mesh paper checked against the meshdetail tables -> verdicts.csv."""
+import pandas as pd
+
+from animsynth.meshdetail.experiments import verdicts
+from animsynth.tables import write_table
+from animsynth.workflow_utils import setup_logging
+
+log = setup_logging(snakemake)  # noqa: F821
+i, o, p = snakemake.input, snakemake.output, snakemake.params  # noqa: F821
+read = lambda path: pd.read_csv(path, keep_default_na=False, na_values=[""])  # noqa: E731
+table = verdicts(read(i.fig5a), read(i.fig5b), read(i.fig5c), read(i.gen), p.source)
+write_table(table, o.csv, title="Meshdetail verdicts", note=f"Data: {p.source}.")
+log.info("verdicts:\n%s", table.to_string())
