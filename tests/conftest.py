@@ -38,10 +38,13 @@ def vlasic_dir():
 def copy_workflow(dest: Path) -> Path:
     """Copy what a workflow run needs (not results/, resources/, .venv) into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
-    for name in ("Snakefile", "config", "workflow", "profiles"):
+    for name in ("Snakefile", "config", "workflow", "profiles", "benchmarks"):
         src = REPO / name
         if src.is_dir():
-            shutil.copytree(src, dest / name, dirs_exist_ok=True)
+            skip = {"rules", ".results"} if name == "benchmarks" else set()
+            shutil.copytree(src, dest / name, dirs_exist_ok=True,
+                            ignore=lambda d, names, skip=skip, top=str(src): [
+                                n for n in names if n == "__pycache__" or (d == top and n in skip)])
         else:
             shutil.copy2(src, dest / name)
     return dest

@@ -29,6 +29,10 @@ def test_pyproject_and_environment_agree():
     env = yaml.safe_load((REPO / "environment.yml").read_text())
     conda = _pins([d for d in env["dependencies"] if isinstance(d, str) and "==" in d])
     assert conda == pins, f"environment.yml {conda} != pyproject.toml {pins}"
+    rule_env = yaml.safe_load((REPO / "workflow" / "envs" / "animsynth.yaml").read_text())
+    rule_pins = _pins([d for d in rule_env["dependencies"] if isinstance(d, str) and "==" in d])
+    for name, version in rule_pins.items():
+        assert pins.get(name) == version, f"workflow/envs/animsynth.yaml pins {name}=={version}, pyproject.toml {pins.get(name)}"
 
 
 def test_ci_runs_the_readme_test_command():

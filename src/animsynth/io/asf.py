@@ -30,6 +30,8 @@ def _read_lines(path) -> list[str]:
             return f.read().splitlines()
     except UnicodeDecodeError as exc:
         raise MotionFormatError(path, None, f"not a text file ({exc})") from None
+    except OSError as exc:
+        raise MotionFormatError(path, None, f"cannot open: {exc.strerror}") from None
 
 
 def read_asf(path) -> Skeleton:

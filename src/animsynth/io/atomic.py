@@ -25,6 +25,10 @@ def atomic_path(path, suffix: str | None = None):
         suffix = base[base.index("."):] if "." in base else ""
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=suffix, dir=folder)
     os.close(fd)
+    # mkstemp makes 0600 files; give the output the usual umask-based mode
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
     try:
         yield tmp
         os.replace(tmp, path)
