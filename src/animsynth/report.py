@@ -32,9 +32,11 @@ def aggregate_rule_benchmarks(paths, root: str = "benchmarks/rules") -> pd.DataF
             continue
         rel = os.path.relpath(p, root)
         parts = rel.split(os.sep)
-        rule = parts[1] if len(parts) > 2 else parts[0]
+        # layout: <family>/<step>.tsv (one job) or <family>/<step>/<job>.tsv
+        step = parts[1][:-4] if len(parts) == 2 else parts[1]
+        job = "/".join(parts[2:])[:-4] if len(parts) > 2 else ""
         for _, r in df.iterrows():
-            rows.append({"family": parts[0], "rule": rule, "job": "/".join(parts[2:])[:-4] if len(parts) > 2 else "",
+            rows.append({"family": parts[0], "rule": f"{parts[0]}/{step}", "job": job,
                          "seconds": float(r.get("s", np.nan)), "max_rss_mb": float(r.get("max_rss", np.nan)),
                          "max_vms_mb": float(r.get("max_vms", np.nan)), "cpu_time_s": float(r.get("cpu_time", np.nan))})
     cols = ["family", "rule", "job", "seconds", "max_rss_mb", "max_vms_mb", "cpu_time_s"]
