@@ -347,12 +347,18 @@ def _place_root(P: _Pose, fps, stance, run):
 def _dance(P: _Pose, rng, t, fps):
     n = len(t)
     sk = P.sk
+    # A dance repeats phrases: every joint moves with harmonics of one phrase
+    # period (3-5 s), so poses recur (as in real dance capture), plus a slow
+    # non-repeating drift so no two phrases are identical.
+    period = rng.uniform(3.0, 5.0)
+    drift_t = t / period
 
     def wave(amp, fmin=0.15, fmax=0.9, k=3):
         out = np.zeros(n)
         for _ in range(k):
-            f = rng.uniform(fmin, fmax)
+            f = max(1, int(round(rng.uniform(fmin, fmax) * period))) / period
             out += rng.uniform(0.3, 1.0) * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+        out += 0.08 * np.sin(2 * np.pi * rng.uniform(0.05, 0.12) * drift_t + rng.uniform(0, 2 * np.pi))
         return amp * out / k
 
     for j in ("lowerback", "upperback", "thorax"):
