@@ -61,6 +61,15 @@ def _r(x):
     return float(np.round(float(x), DECIMALS)) if np.isfinite(x) else float("nan")
 
 
+ACCURACY_KEYS = ("duration_diff_frames", "duration_diff_frames_sd", "duration_signed_frames", "landmark_diff_px",
+                 "landmark_diff_px_sd", "velocity_angle_diff_pct", "velocity_angle_diff_pct_sd")
+
+
+def _accuracy(sm) -> dict:
+    """The re-synthesis accuracy measures of a summary, rounded (same columns in Table 1 and the baseline)."""
+    return {k: _r(sm[k]) for k in ACCURACY_KEYS}
+
+
 def original_nbytes(db: FaceDatabase) -> int:
     """The original landmark data: frames x 68 x 2 coordinates as float32."""
     return int(db.lengths.sum()) * 68 * 2 * 4
@@ -95,13 +104,7 @@ def run_configuration(db: FaceDatabase, creation: float, merge: float, cfg: dict
         "reachable_peaks_mean": _r(conn["reachable_peaks_mean"]),
         "node_compression_pct": _r(100.0 * (1.0 - nodes / (len(graphs) * frames))),
         "data_compression_pct": _r(100.0 * (1.0 - sum(g.nbytes() for g in graphs.values()) / original_nbytes(db))),
-        "duration_diff_frames": _r(sm["duration_diff_frames"]),
-        "duration_diff_frames_sd": _r(sm["duration_diff_frames_sd"]),
-        "duration_signed_frames": _r(sm["duration_signed_frames"]),
-        "landmark_diff_px": _r(sm["landmark_diff_px"]),
-        "landmark_diff_px_sd": _r(sm["landmark_diff_px_sd"]),
-        "velocity_angle_diff_pct": _r(sm["velocity_angle_diff_pct"]),
-        "velocity_angle_diff_pct_sd": _r(sm["velocity_angle_diff_pct_sd"]),
+        **_accuracy(sm),
         "timing_creation_s": float(model.timings_["build_s"]),
         "timing_search_s": float(model.timings_["search_s"]),
         "timing_synthesis_ms": float(sm["timing_synthesis_ms"]),
@@ -221,13 +224,7 @@ def _baseline_row(method, structure, nodes, edges, nbytes, sm, times, n_queries,
         "nodes": int(nodes),
         "edges": int(edges),
         "memory_mb": _r(nbytes / 1e6),
-        "duration_diff_frames": _r(sm["duration_diff_frames"]),
-        "duration_diff_frames_sd": _r(sm["duration_diff_frames_sd"]),
-        "duration_signed_frames": _r(sm["duration_signed_frames"]),
-        "landmark_diff_px": _r(sm["landmark_diff_px"]),
-        "landmark_diff_px_sd": _r(sm["landmark_diff_px_sd"]),
-        "velocity_angle_diff_pct": _r(sm["velocity_angle_diff_pct"]),
-        "velocity_angle_diff_pct_sd": _r(sm["velocity_angle_diff_pct_sd"]),
+        **_accuracy(sm),
         "paper_pathfinding_s": paper_s,
         "timing_pathfinding_ms": float(t.mean()),
         "timing_pathfinding_ms_sd": float(t.std()),
