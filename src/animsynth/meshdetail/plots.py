@@ -19,19 +19,26 @@ def _shade_split(ax, df):
         ax.axvspan(test.min() - 0.5, test.max() + 0.5, color="0.9", zorder=0, label="held-out frames")
 
 
-def plot_fig5a(df: pd.DataFrame, path) -> None:
+def _per_frame_plot(df: pd.DataFrame, path, series, title: str) -> None:
+    """Per-frame error curves (column, label, colour) with the train/test split shaded."""
     fig, ax = plt.subplots(figsize=(7, 3.6))
     _shade_split(ax, df)
-    ax.plot(df["frame"], df["full_deformation_mm"], label="GP on full deformation", color="tab:red")
-    ax.plot(df["frame"], df["detail_only_mm"], label="GP on fine detail only (hybrid)", color="tab:blue")
+    for col, label, color in series:
+        ax.plot(df["frame"], df[col], label=label, color=color)
     ax.set_xlabel("frame")
     ax.set_ylabel("mean vertex error (mm)")
-    ax.set_title("Fig. 5a: full deformation vs fine detail")
+    ax.set_title(title)
     ax.legend(fontsize=8)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110)
     plt.close(fig)
+
+
+def plot_fig5a(df: pd.DataFrame, path) -> None:
+    _per_frame_plot(df, path, [("full_deformation_mm", "GP on full deformation", "tab:red"),
+                               ("detail_only_mm", "GP on fine detail only (hybrid)", "tab:blue")],
+                    "Fig. 5a: full deformation vs fine detail")
 
 
 def plot_fig5b(df: pd.DataFrame, path) -> None:
@@ -54,19 +61,9 @@ def plot_fig5b(df: pd.DataFrame, path) -> None:
 
 
 def plot_fig5c(df: pd.DataFrame, path) -> None:
-    fig, ax = plt.subplots(figsize=(7, 3.6))
-    _shade_split(ax, df)
-    ax.plot(df["frame"], df["lbs_mm"], label="LBS only", color="tab:gray")
-    ax.plot(df["frame"], df["linear_mm"], label="linear detail (ridge)", color="tab:orange")
-    ax.plot(df["frame"], df["hybrid_mm"], label="hybrid (SGPLVM+GPDM)", color="tab:blue")
-    ax.set_xlabel("frame")
-    ax.set_ylabel("mean vertex error (mm)")
-    ax.set_title("Fig. 5c: LBS vs hybrid vs linear detail")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
+    _per_frame_plot(df, path, [("lbs_mm", "LBS only", "tab:gray"), ("linear_mm", "linear detail (ridge)", "tab:orange"),
+                               ("hybrid_mm", "hybrid (SGPLVM+GPDM)", "tab:blue")],
+                    "Fig. 5c: LBS vs hybrid vs linear detail")
 
 
 def _view_axes(rest: np.ndarray):
