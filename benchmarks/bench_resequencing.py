@@ -15,7 +15,7 @@ on a shared machine):
   geodesics differ by design (reported, not required).
 * ``min_k_exact_<data>``: the exact minimum connected k (one argsort + one
   minimum spanning tree) against a plain scan: one scikit-learn
-  ``NearestNeighbors`` fit, then ``kneighbors_graph`` +
+  ``NearestNeighbors`` fit, then its ``kneighbors_graph`` +
   ``scipy.sparse.csgraph.connected_components`` for k = 1, 2, ... until one
   component. Both must give the same k. Data: a trial whose min k is small
   (CMU 35_01, continuous linearisation, L2) and one whose min k is large (the
@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 from scipy.sparse.csgraph import connected_components
 from sklearn.manifold import Isomap
-from sklearn.neighbors import NearestNeighbors, kneighbors_graph
+from sklearn.neighbors import NearestNeighbors
 from threadpoolctl import threadpool_limits
 
 from animsynth.io.amc import Motion
@@ -79,7 +79,7 @@ def _walk_features():
 def _scan_min_k(D):
     nn = NearestNeighbors(metric="precomputed").fit(D)
     for k in range(1, D.shape[0]):
-        if connected_components(kneighbors_graph(nn, k), directed=False)[0] == 1:
+        if connected_components(nn.kneighbors_graph(n_neighbors=k), directed=False)[0] == 1:
             return k
     return None
 

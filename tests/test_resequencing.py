@@ -546,6 +546,15 @@ def test_global_dof_verdict_per_dataset():
         flipped[("dance", "isomap", "lee", True, p)] = ("resequences", 9.0)
         flipped[("dance", "isomap", "lee", False, p)] = ("resequences", 1.0)
     assert global_dof_verdict(_paths(flipped))["verdict"] == "contradicted"
+    # with the global DOF, walk and run never re-sequence while dance does: hurt by losing the ability
+    lost = dict(vals)
+    for ds in ("walk", "run"):
+        for p in range(10):
+            lost[(ds, "isomap", "lee", True, p)] = ("replays_backwards", np.nan)
+    for p in range(10):
+        lost[("dance", "isomap", "lee", True, p)] = ("resequences", 1.0)
+    v = global_dof_verdict(_paths(lost))
+    assert v["verdict"] == "reproduced" and "walk: re-sequencing paths 10/10 without vs 0/10 with" in v["ours"]
 
 
 def test_library_defaults_match_the_embedded_config():
