@@ -683,3 +683,20 @@ def test_transition_measures_on_the_original_and_on_a_jump(walk):
     assert tr[0]["pose_jump_ratio"] > 1.0 and tr[0]["velocity_jump_ratio"] > 1.0
     # a jump outside [first, last] (in the context) is not counted
     assert transition_measures(tref, play_path(walk, jump), jump, 70, len(jump) - 1, 5) == []
+
+
+def test_config_cross_checks_name_the_key():
+    from animsynth.config import ConfigError
+    from animsynth.resequencing.settings import check_resequencing_config
+
+    rs = with_defaults({})
+    trials = {"walk": "35_01", "run": "35_17", "dance": "05_02"}
+    check_resequencing_config(rs, trials)
+    with pytest.raises(ConfigError, match="resequencing.datasets"):
+        check_resequencing_config(rs, {"walk": "35_01"})
+    bad = with_defaults({"frame_step": 2})
+    with pytest.raises(ConfigError, match="explanations.frame_steps"):
+        check_resequencing_config(bad, trials)
+    bad = with_defaults({"explanations": {"sign_modes": ["matrix_naive"]}})
+    with pytest.raises(ConfigError, match="explanations.sign_modes"):
+        check_resequencing_config(bad, trials)

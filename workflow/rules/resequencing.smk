@@ -9,7 +9,7 @@
 # smoothness, verdicts).
 # Wildcards are prefixed rs* because `dataset` and `method` are constrained
 # globally by other families.
-from animsynth.config import ConfigError
+from animsynth.resequencing.settings import check_resequencing_config
 
 RESEQ = config["resequencing"]
 RESEQ_DATASETS = list(RESEQ["datasets"])
@@ -17,20 +17,7 @@ RESEQ_METHODS = list(RESEQ["methods"])
 RESEQ_METRICS = list(RESEQ["metrics"])
 RESEQ_GDOF = ["global" if g else "noglobal" for g in RESEQ["global_dof"]]
 
-for _ds in RESEQ_DATASETS:
-    if _ds not in RESEQ_TRIALS:
-        raise ConfigError(
-            f"config key 'resequencing.datasets': {_ds!r} is not a key of 'resequencing_trials' ({sorted(RESEQ_TRIALS)})"
-        )
-for _key, _vals in (("datasets", RESEQ_DATASETS), ("methods", RESEQ_METHODS), ("metrics", RESEQ_METRICS),
-                    ("global_dof", RESEQ_GDOF)):
-    if len(set(_vals)) != len(_vals):
-        raise ConfigError(f"config key 'resequencing.{_key}': duplicate entries {_vals}")
-if int(RESEQ["frame_step"]) not in [int(s) for s in RESEQ["explanations"]["frame_steps"]]:
-    raise ConfigError(
-        f"config key 'resequencing.explanations.frame_steps' {RESEQ['explanations']['frame_steps']} must include "
-        f"resequencing.frame_step ({RESEQ['frame_step']}): Table 2 is read from those rows"
-    )
+check_resequencing_config(RESEQ, RESEQ_TRIALS)
 
 
 wildcard_constraints:
