@@ -13,8 +13,9 @@ on a shared machine):
   matrix and k. For Isomap the geodesics must be identical; ST-Isomap's graph
   holds the temporal chain, which scikit-learn's k-NN graph does not, so its
   geodesics differ by design (reported, not required).
-* ``min_k_exact_<data>``: the exact minimum connected k (one argsort + one
-  minimum spanning tree) against a plain scan: one scikit-learn
+* ``min_k_exact_<data>``: the exact minimum connected k (one argsort, then
+  one minimum spanning tree of the sparse graph at the first doubled k that
+  connects it) against a plain scan: one scikit-learn
   ``NearestNeighbors`` fit, then its ``kneighbors_graph`` +
   ``scipy.sparse.csgraph.connected_components`` for k = 1, 2, ... until one
   component. Both must give the same k. Data: a trial whose min k is small

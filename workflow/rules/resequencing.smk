@@ -7,6 +7,9 @@
 # per-path and per-transition smoothness); one Fig 2 per dataset x method, one
 # Fig 3 per dataset; one aggregation (Table 2 beside the paper, explanations,
 # smoothness, verdicts).
+# Resources: measured on CMU (05_02 at 800 frames, 2 cores at load ~20): peak RSS 200 MB (analyse,
+# explain, figures), 275 MB (path), 170 MB (tables); wall time at most 70 s (analyse, explain), 285 s
+# (path; 24 s of CPU), 55 s (figures), 21 s (tables). Memory about 3x and runtime (minutes) about 4x that.
 # Wildcards are prefixed rs* because `dataset` and `method` are constrained
 # globally by other families.
 from animsynth.resequencing.settings import check_resequencing_config
@@ -66,8 +69,8 @@ rule resequencing_analyse:
         "benchmarks/rules/resequencing/analyse/{rsdata}_{rsgdof}.tsv"
     threads: 1
     resources:
-        mem_mb=1500,
-        runtime=30,
+        mem_mb=800,
+        runtime=20,
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -89,8 +92,8 @@ rule resequencing_explain:
         "benchmarks/rules/resequencing/explain/{rsdata}.tsv"
     threads: 1
     resources:
-        mem_mb=1500,
-        runtime=30,
+        mem_mb=800,
+        runtime=20,
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -116,7 +119,7 @@ rule resequencing_path:
         "benchmarks/rules/resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.tsv"
     threads: 1
     resources:
-        mem_mb=1500,
+        mem_mb=1000,
         runtime=30,
     conda:
         "../envs/animsynth.yaml"
@@ -143,7 +146,7 @@ rule resequencing_fig2:
         "benchmarks/rules/resequencing/fig2/{rsdata}_{rsmethod}.tsv"
     threads: 1
     resources:
-        mem_mb=1000,
+        mem_mb=600,
         runtime=10,
     conda:
         "../envs/animsynth.yaml"
@@ -167,7 +170,7 @@ rule resequencing_fig3:
         "benchmarks/rules/resequencing/fig3/{rsdata}.tsv"
     threads: 1
     resources:
-        mem_mb=1000,
+        mem_mb=600,
         runtime=10,
     conda:
         "../envs/animsynth.yaml"
@@ -239,7 +242,7 @@ rule resequencing_tables:
         "benchmarks/rules/resequencing/tables.tsv"
     threads: 1
     resources:
-        mem_mb=1000,
+        mem_mb=600,
         runtime=10,
     conda:
         "../envs/animsynth.yaml"
