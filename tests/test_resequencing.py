@@ -1,4 +1,4 @@
-"""Unit tests of the re-sequencing library (Isomap / ST-Isomap, issue 4)."""
+"""Unit tests of the re-sequencing library (Isomap / ST-Isomap)."""
 
 from __future__ import annotations
 
@@ -18,12 +18,16 @@ from animsynth.resequencing.distances import (PAPER_WEIGHTS, check_distance_matr
 from animsynth.resequencing.embedding import (DisconnectedGraphError, PrecomputedIsomap, STIsomap, graph_components,
                                               knn_graph, min_connected_k, neighbor_ranks, nontrivial_neighbors,
                                               residual_variance, spatio_temporal_distances)
-from animsynth.resequencing.features import angular_velocity, linearize_quaternions, motion_features, quat_log
-from animsynth.resequencing.metrics import (Reference, foot_skate, jerk_magnitude, pose_steps, root_reversals,
-                                            smoothness)
+from animsynth.resequencing.features import (angular_velocity, linearize_quaternions, matrix_naive_quaternions,
+                                             motion_features, quat_log, sign_flips)
+from animsynth.resequencing.metrics import (Reference, TransitionReference, classify_path, foot_skate, pass_jumps,
+                                            jerk_magnitude, pose_steps, root_reversals, smoothness,
+                                            transition_measures, transitions)
 from animsynth.resequencing.paths import pad_path, play_path, resolve_frame, shortest_path_frames
-from animsynth.resequencing.study import (analyse, min_k_table, path_pairs, prepare_motion, resequence, splice,
-                                          summarise_paths, verdicts, with_defaults)
+from animsynth.resequencing.study import (analyse, explain, min_k_table, path_pairs, prepare_motion, read_published,
+                                          resequence, splice, summarise_paths, with_defaults)
+from animsynth.resequencing.verdicts import (explanation_verdicts, global_dof_verdict, lee_vs_l2_verdict,
+                                             st_smoother_verdict)
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 
@@ -198,7 +202,7 @@ def test_st_isomap_neighbourhoods_on_repeated_loops():
     P = 40
     X = loops_sequence(3, P)
     D = cdist(X, X)
-    Dst, temporal, ctn = spatio_temporal_distances(D, temporal_window=1, c_ctn=5.0, c_cctn=4.0, ctn_neighbors=2,
+    Dst, temporal, ctn = spatio_temporal_distances(D, temporal_window=1, c_atn=5.0, c_ctn=4.0, ctn_neighbors=2,
                                                    ctn_min_gap=5, ctn_tolerance=1, ctn_reach=3)
     n = len(X)
     i, j = np.nonzero(temporal)
@@ -244,7 +248,7 @@ def test_st_isomap_registers_loops_that_isomap_keeps_apart():
     X[:, 2] = 0.02 * np.arange(len(X))  # a helix: loops 0.8 apart, frames 0.16 apart
     D = cdist(X, X)
     iso = PrecomputedIsomap(6, 2).fit(D)
-    st = STIsomap(6, 2, c_ctn=2.0, c_cctn=50.0, ctn_neighbors=2, ctn_min_gap=15, ctn_tolerance=1, ctn_reach=20).fit(D)
+    st = STIsomap(6, 2, c_atn=2.0, c_ctn=50.0, ctn_neighbors=2, ctn_min_gap=15, ctn_tolerance=1, ctn_reach=20).fit(D)
     ci, cj = np.nonzero(st.ctn_)
     inner = (np.minimum(ci, cj) > 0) & (np.maximum(ci, cj) < len(X) - 1)  # the ends check one side only
     lag = np.abs(ci - cj)[inner]
@@ -389,74 +393,168 @@ def test_smoothness_of_the_original_path_is_one(walk):
 
 # ------------------------------------------------------------------ study
 def test_study_end_to_end_small(walk):
-    cfg = with_defaults({"n_neighbors": 6, "max_dim": 3, "path": {"random_pairs": 2}})
+    cfg = with_defaults({"fixed_k_sweep": [6], "max_dim": 3, "path": {"random_pairs": 3}})
     m = prepare_motion(walk, 150, 2)
     assert m.n_frames == 75 and m.fps == walk.fps / 2
     mk, rv, emb, timing = analyse(m, "walk", "t35", False, cfg)
     assert len(mk) == 4 and (mk["components_at_min_k"] == 1).all()
-    assert (mk["k_used"] >= mk["min_k"]).all()
-    assert set(rv["dim"]) == {1, 2, 3}
+    # the paper's k: every embedding at its configuration's exact min k; ST-Isomap's is 1
+    assert (mk["k_used"] == mk["min_k"]).all()
+    assert (mk.loc[mk["method"] == "stisomap", "min_k"] == 1).all()
+    assert set(rv["dim"]) == {1, 2, 3} and set(rv["k_mode"]) == {"min_k", "fixed"}
+    assert set(rv.loc[rv["k_mode"] == "fixed", "k"]) == {6}
     assert emb["isomap_l2_xy"].shape == (75, 2)
-    paths, main, per_path = resequence(m, False, "stisomap", "lee", int(mk["k_used"].iloc[0]), cfg, seed=4)
-    assert len(paths) == 3 and paths[0][0] == 0 and paths[0][-1] == 74
-    assert main.n_frames == len(paths[0])
-    assert path_pairs(75, cfg["path"], 4) == path_pairs(75, cfg["path"], 4)
-    per_path.insert(0, "metric", "lee")
-    per_path.insert(0, "method", "stisomap")
-    per_path.insert(0, "global_dof", False)
-    per_path.insert(0, "dataset", "walk")
+    paths, (main_path, main), per_path, per_tr = resequence(m, False, "isomap", "lee", int(mk["k_used"].iloc[2]),
+                                                            cfg, seed=4)
+    assert len(paths) == 3 and main_path[0] == 74 and main_path[-1] == 0
+    assert main.n_frames == len(main_path)
+    pairs = path_pairs(75, cfg["path"], 4)
+    assert pairs == path_pairs(75, cfg["path"], 4)
+    assert all(a - b >= round(0.3 * 75) for a, b in pairs)  # end before start, far enough apart
+    assert (per_path["transitions"] == [len(transitions(p)) for p in paths]).all()
+    assert len(per_tr) == per_path["transitions"].sum()
+    for df in (per_path,):
+        df.insert(0, "metric", "lee")
+        df.insert(0, "method", "isomap")
+        df.insert(0, "global_dof", False)
+        df.insert(0, "dataset", "walk")
     summ = summarise_paths(per_path)
     assert len(summ) == 1 and summ["paths"].iloc[0] == 3
+    assert summ["resequencing_paths"].iloc[0] == (per_path["path_class"] == "resequences").sum()
 
 
 def test_analyse_is_deterministic(walk):
-    cfg = with_defaults({"n_neighbors": 5, "max_dim": 3, "metrics": ["lee"]})
+    cfg = with_defaults({"fixed_k_sweep": [5], "max_dim": 3, "metrics": ["lee"]})
     m = prepare_motion(walk, 120, 2)
     a = analyse(m, "walk", "t", True, cfg)
     b = analyse(m, "walk", "t", True, cfg)
     assert a[0].to_csv() == b[0].to_csv() and a[1].to_csv() == b[1].to_csv()
 
 
-def test_min_k_table_fills_published_values():
-    mk = pd.DataFrame([{"dataset": "walk", "trial": "t", "frames": 10, "global_dof": g, "method": "isomap",
-                        "metric": "l2", "min_k": 3, "components_at_min_k_minus_1": 2, "components_at_min_k": 1,
-                        "k_used": 10, "ctn_pairs": np.nan, "nontrivial_edge_fraction": 0.5} for g in (True, False)])
-    t = min_k_table(mk, [{"dataset": "walk", "global_dof": True, "method": "isomap", "metric": "l2", "min_k": 7}])
-    assert t["global_dof"].tolist() == [False, True]
-    assert np.isnan(t["min_k_paper"].iloc[0]) and t["min_k_paper"].iloc[1] == 7
+def _published():
+    return pd.DataFrame([
+        {"motion": "walk", "frames": 516, "global_dof": "excluded", "method": "isomap", "metric": "l2", "min_k": 79},
+        {"motion": "walk", "frames": 516, "global_dof": "excluded", "method": "isomap", "metric": "lee", "min_k": 3},
+        {"motion": "walk", "frames": 516, "global_dof": "excluded", "method": "st-isomap", "metric": "lee",
+         "min_k": 1}])
 
 
-def _smooth_rows(values):
+def test_min_k_table_fills_published_values(tmp_path):
+    grid = pd.DataFrame([{"dataset": "walk", "trial": "t", "frame_step": st, "fps": 120 / st, "frames": 10,
+                          "global_dof": g, "sign_mode": mode, "method": "isomap", "metric": "l2", "min_k": 3,
+                          "components_at_min_k_minus_1": 2, "components_at_min_k": 1}
+                         for st in (1, 4) for g in (True, False) for mode in ("matrix_naive", "continuous")])
+    f = tmp_path / "t2.csv"
+    _published().to_csv(f, index=False)
+    pub = read_published(f)
+    assert read_published(tmp_path / "absent.csv") is None  # missing file: no published values, no error
+    t = min_k_table(grid, pub, 1)
+    assert len(t) == 4 and (t["fps"] == 120).all()
+    assert t["global_dof"].tolist() == [False, False, True, True]
+    assert t["sign_mode"].tolist() == ["continuous", "matrix_naive"] * 2
+    assert t.loc[~t["global_dof"], "min_k_paper"].tolist() == [79, 79]
+    assert t.loc[t["global_dof"], "min_k_paper"].isna().all()
+    bad = _published()
+    bad.loc[1, "method"] = "lle"
+    bad.to_csv(f, index=False)
+    with pytest.raises(ValueError, match="line 3"):
+        read_published(f)
+
+
+def test_explanation_verdict_names_the_matching_candidate(tmp_path):
     rows = []
-    for (ds, method, metric, g), (ev, p95, rev, sk) in values.items():
-        rows.append({"dataset": ds, "method": method, "metric": metric, "global_dof": g, "jerk_events": ev,
-                     "jerk_mean_ratio": ev + 1.0, "jump_p95_ratio": p95, "root_reversals": rev,
-                     "foot_skate_mps": sk})
+    for mode, l2 in (("continuous", 4), ("matrix_naive", 60)):
+        for st, fac in ((1, 1), (4, 0.5)):
+            for metric, k in (("l2", l2), ("lee", 3)):
+                rows.append({"dataset": "walk", "frame_step": st, "fps": 120 / st, "global_dof": False,
+                             "sign_mode": mode, "method": "isomap", "metric": metric,
+                             "min_k": max(1, int(k * fac)) if metric == "l2" else k})
+    grid = pd.DataFrame(rows)
+    f = tmp_path / "t2.csv"
+    _published().to_csv(f, index=False)
+    v = pd.DataFrame(explanation_verdicts(grid, read_published(f), 1))
+    summary = v.iloc[0]
+    assert "matrix_naive" in summary["evidence"] and summary["verdict"] == "reproduced"
+    naive = v[v["claim"].str.contains(r"matrix_naive, 120")].iloc[0]
+    assert naive["verdict"] == "reproduced"
+    assert v[v["claim"].str.contains("lower frame rate")].iloc[0]["verdict"] == "not reproduced"
+    # 60 vs 79 is within the factor; 30 (matrix_naive at 30 fps) is too
+    assert v[v["claim"].str.contains("matrix_naive signs at frame_step 4")].iloc[0]["verdict"] == "reproduced"
+    none = explanation_verdicts(grid, None, 1)
+    assert len(none) == 1 and "not available" in none[0]["evidence"]
+
+
+def test_lee_vs_l2_verdict():
+    t = pd.DataFrame([{"dataset": d, "global_dof": False, "sign_mode": "continuous", "method": "isomap",
+                       "metric": m, "min_k": k, "min_k_paper": np.nan}
+                      for d, kl2 in (("walk", 40), ("run", 5)) for m, k in (("l2", kl2), ("lee", 4))])
+    assert lee_vs_l2_verdict(t)["verdict"] == "partly"
+    t.loc[(t["dataset"] == "run") & (t["metric"] == "l2"), "min_k"] = 30
+    assert lee_vs_l2_verdict(t)["verdict"] == "reproduced"
+    t.loc[t["metric"] == "l2", "min_k"] = 2
+    assert lee_vs_l2_verdict(t)["verdict"] == "contradicted"
+
+
+def _paths(values):
+    """per-path rows: values[(dataset, method, metric, global, pair)] = (class, velocity_jump_ratio)."""
+    rows = []
+    for (ds, method, metric, g, p), (cls, v) in values.items():
+        rows.append({"dataset": ds, "method": method, "metric": metric, "global_dof": g, "pair": p,
+                     "root_playback": "integrate", "path_class": cls, "transitions": int(cls == "resequences"),
+                     "transitions_per_100_frames": 1.0, "velocity_jump_ratio": v, "pose_jump_ratio": v,
+                     "accel_jump_ratio": v, "foot_skate_ratio": v})
     return pd.DataFrame(rows)
 
 
-def test_verdicts_from_hand_made_numbers():
+def test_smoothness_verdicts_use_only_pairs_where_both_resequence():
+    vals = {}
+    for p in range(12):
+        vals[("walk", "isomap", "l2", False, p)] = ("resequences", 3.0)
+        vals[("walk", "stisomap", "l2", False, p)] = ("resequences", 1.0 + 0.01 * p)
+    assert st_smoother_verdict(_paths(vals))["verdict"] == "reproduced"
+    # ST-Isomap replays on most pairs: those pairs are left out, and 2 pairs are too few to decide
+    for p in range(10):
+        vals[("walk", "stisomap", "l2", False, p)] = ("replays_backwards", np.nan)
+    v = st_smoother_verdict(_paths(vals))
+    assert v["verdict"] == "within noise" and "both 2" in v["evidence"]
+    for p in range(12):
+        vals[("walk", "stisomap", "l2", False, p)] = ("replays", np.nan)
+    assert st_smoother_verdict(_paths(vals))["verdict"] == "not reproduced"
+    # half and half: within noise
+    for p in range(12):
+        vals[("walk", "stisomap", "l2", False, p)] = ("resequences", 2.0 if p % 2 else 4.0)
+    assert st_smoother_verdict(_paths(vals))["verdict"] == "within noise"
+
+
+def test_global_dof_verdict_per_dataset():
     vals = {}
     for ds in ("walk", "run", "dance"):
-        for metric in ("l2", "lee"):
-            for g in (False, True):
-                hurt = g and ds != "dance"
-                base = (4.0, 2.0, 1.0, 0.5) if not hurt else (8.0, 3.0, 2.0, 0.9)
-                vals[(ds, "isomap", metric, g)] = base
-                vals[(ds, "stisomap", metric, g)] = (base[0] / 4, base[1], base[2], base[3])
-    v = verdicts(_smooth_rows(vals), 0.1).set_index("claim")
-    assert v.loc["ST-Isomap gives fewer jerks than Isomap", "verdict"] == "yes, by 75 %"
-    assert v.loc["global DOF hurt cyclic locomotion but not dance", "verdict"].startswith("yes")
-    # make dance hurt too: the combined claim fails
-    for k in list(vals):
-        if k[0] == "dance" and k[3]:
-            vals[k] = tuple(x * 3 for x in vals[k])
-    v = verdicts(_smooth_rows(vals), 0.1).set_index("claim")
-    assert v.loc["global DOF hurt cyclic locomotion but not dance", "verdict"].startswith("no")
-    # identical methods: no clear difference
-    same = {k: (1.0, 1.0, 1.0, 1.0) for k in vals}
-    v = verdicts(_smooth_rows(same), 0.1).set_index("claim")
-    assert v.loc["ST-Isomap gives fewer jerks than Isomap", "verdict"].startswith("no clear difference")
+        for p in range(10):
+            base = 2.0 + 0.1 * p
+            vals[(ds, "isomap", "lee", False, p)] = ("resequences", base)
+            vals[(ds, "isomap", "lee", True, p)] = ("resequences", base * (0.5 if ds == "dance" else 2.0))
+    assert global_dof_verdict(_paths(vals))["verdict"] == "reproduced"
+    for p in range(10):
+        vals[("dance", "isomap", "lee", True, p)] = ("resequences", 10.0)
+    assert global_dof_verdict(_paths(vals))["verdict"] == "partly"
+    flipped = {k: (c, 1.0 / v if k[3] else v) for k, (c, v) in vals.items()}
+    for ds in ("walk", "run"):
+        for p in range(10):
+            flipped[(ds, "isomap", "lee", True, p)] = ("resequences", 0.1)
+            flipped[(ds, "isomap", "lee", False, p)] = ("resequences", 5.0)
+    for p in range(10):
+        flipped[("dance", "isomap", "lee", True, p)] = ("resequences", 9.0)
+        flipped[("dance", "isomap", "lee", False, p)] = ("resequences", 1.0)
+    assert global_dof_verdict(_paths(flipped))["verdict"] == "contradicted"
+    # with the global DOF, walk and run never re-sequence while dance does: hurt by losing the ability
+    lost = dict(vals)
+    for ds in ("walk", "run"):
+        for p in range(10):
+            lost[(ds, "isomap", "lee", True, p)] = ("replays_backwards", np.nan)
+    for p in range(10):
+        lost[("dance", "isomap", "lee", True, p)] = ("resequences", 1.0)
+    v = global_dof_verdict(_paths(lost))
+    assert v["verdict"] == "reproduced" and "walk: re-sequencing paths 10/10 without vs 0/10 with" in v["ours"]
 
 
 def test_library_defaults_match_the_embedded_config():
@@ -467,3 +565,138 @@ def test_library_defaults_match_the_embedded_config():
 
     cfg = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text())
     assert cfg["resequencing"] == DEFAULTS
+
+
+# ------------------------------------------------------- sign modes (Table 2 explanation)
+def test_matrix_naive_sign_flip_gives_a_jump_of_pi_and_continuous_none():
+    # rotation about x from 200 to 340 degrees: past 270 degrees |w| becomes the largest component while w < 0,
+    # so the largest-component-positive conversion flips the quaternion's sign exactly once
+    theta = np.linspace(200.0, 340.0, 71)
+    q = rot("x", theta)
+    qn = matrix_naive_quaternions(q)
+    assert sign_flips(qn[:, None, :]).tolist() == [1]
+    assert sign_flips(q[:, None, :]).tolist() == [0]
+    step = np.deg2rad(theta[1] - theta[0]) / 2  # half-angle log of one increment
+    cont = np.linalg.norm(np.diff(linearize_quaternions(q, "continuous"), axis=0), axis=1)
+    naive = np.linalg.norm(np.diff(linearize_quaternions(q, "matrix_naive"), axis=0), axis=1)
+    np.testing.assert_allclose(cont, step, rtol=1e-6)
+    flip_at = int(np.argmax(naive))
+    assert naive[flip_at] == pytest.approx(np.pi, abs=2 * step)  # the jump of about pi
+    np.testing.assert_allclose(np.delete(naive, flip_at), step, rtol=1e-6)  # elsewhere the same increments
+    # the flip happens where |w| overtakes |x| (270 degrees)
+    assert theta[flip_at] <= 270.0 <= theta[flip_at + 1]
+    # every later frame is offset by about pi from where the continuous linearisation puts it
+    off = np.linalg.norm(linearize_quaternions(q, "matrix_naive") - linearize_quaternions(q, "continuous"), axis=1)
+    np.testing.assert_allclose(off[:flip_at + 1], 0.0, atol=1e-9)
+    np.testing.assert_allclose(off[flip_at + 1:], np.pi, atol=2 * step)
+    with pytest.raises(ValueError, match="sign_mode"):
+        linearize_quaternions(q, "other")
+
+
+def test_explain_counts_flips_and_raises_l2_min_k_only():
+    sk = cmu_like_skeleton("t05", 3)
+    m = generate_motion("dance", 160, 2, sk)
+    # make one joint turn round and round (large rotations: the largest quaternion component changes)
+    j = sk.index("lhumerus")
+    sl = sk.dof_slices()["lhumerus"]
+    ang = np.linspace(0.0, 1440.0, m.n_frames)  # four turns: w changes sign, the largest component changes
+    vals = np.array(m.values, float)
+    vals[:, sl] = 0.0
+    vals[:, sl.start] = ang
+    m = Motion(vals, sk, m.fps, "flip", {})
+    cfg = with_defaults({"explanations": {"frame_steps": [1], "global_dof": [False]}})
+    grid, flips = explain(m, "dance", "flip", cfg)
+    f = flips.set_index("joint")
+    assert f.loc["lhumerus", "flips_matrix_naive"] >= 3 and (flips["flips_continuous"] == 0).all()
+    g = grid.set_index(["sign_mode", "method", "metric"])["min_k"]
+    assert g[("matrix_naive", "isomap", "l2")] > g[("continuous", "isomap", "l2")]
+    assert g[("matrix_naive", "isomap", "lee")] == g[("continuous", "isomap", "lee")]  # Lee is sign-invariant
+    assert (grid.loc[grid["method"] == "stisomap", "min_k"] == 1).all()
+    assert j >= 0
+
+
+# ------------------------------------------------------- ST-Isomap neighbourhoods
+def test_st_isomap_on_a_single_chain_needs_k_1():
+    # three tight clusters visited one after another: Isomap needs many neighbours to join them,
+    # ST-Isomap keeps the adjacent temporal neighbours in every neighbourhood, so k = 1 connects the chain
+    rng = np.random.default_rng(0)
+    X = np.concatenate([rng.normal(c, 0.05, size=(30, 3)) for c in (0.0, 5.0, 10.0)])
+    D = cdist(X, X)
+    assert min_connected_k(D) > 10
+    st = STIsomap(None, 2, ctn_neighbors=0, ctn_min_gap=5).fit(D)
+    assert st.min_k_ == 1 and st.n_neighbors_ == 1
+    gi, gj = st.graph_.nonzero()
+    edges = set(zip(gi.tolist(), gj.tolist()))
+    assert all((i, i + 1) in edges for i in range(len(X) - 1))  # the whole chain is in the graph
+    assert np.isfinite(st.dist_matrix_).all()
+    # without the always-present chain, the same adjusted distances need more than one neighbour
+    assert min_connected_k(st.dist_st_) > 1
+    assert min_connected_k(st.dist_st_, always=st.atn_) == 1
+
+
+def test_precomputed_isomap_equals_scikit_learn_isomap_on_a_connected_graph():
+    rng = np.random.default_rng(1)
+    t = np.sort(rng.uniform(0, 3 * np.pi, 120))
+    X = np.stack([t * np.cos(t), rng.uniform(0, 5, 120), t * np.sin(t)], axis=1)
+    D = cdist(X, X)
+    ours = PrecomputedIsomap(8, 2).fit(D)
+    sk = Isomap(n_neighbors=8, n_components=2, metric="precomputed", path_method="D", eigen_solver="dense").fit(D)
+    np.testing.assert_allclose(ours.dist_matrix_, sk.dist_matrix_, rtol=1e-9, atol=1e-9)
+    for c in range(2):
+        a, b = ours.embedding_[:, c], sk.embedding_[:, c]
+        assert min(np.abs(a - b).max(), np.abs(a + b).max()) < 1e-6 * np.abs(b).max()
+
+
+# ------------------------------------------------------- paths and transitions
+def test_path_classification():
+    assert classify_path(np.arange(10, 30)) == "replays"
+    assert classify_path(np.arange(30, 10, -1)) == "replays_backwards"
+    assert classify_path([5, 6, 7, 6, 5]) == "replays_backwards"
+    assert classify_path([5, 6, 7, 40, 41]) == "resequences"
+    assert classify_path([5, 6, 6, 7]) == "resequences"  # a held frame is not the next or previous one
+    # with a same-pass span, skipping frames of one pass is not re-sequencing; jumping to another pass is
+    assert classify_path([40, 38, 36, 35], same_pass=10) == "skips"
+    assert classify_path([40, 38, 36, 12, 11], same_pass=10) == "resequences"
+    assert pass_jumps([40, 38, 36, 12, 11], 10).tolist() == [3]
+    assert transitions([5, 6, 7, 40, 41, 3]).tolist() == [3, 5]
+
+
+def test_a_path_on_a_chain_replays_and_a_jump_resequences():
+    n = 40
+    chain = np.diag(np.ones(n - 1), 1)
+    G = csr_matrix(chain + chain.T)
+    path, _ = shortest_path_frames(G, 3, 30)
+    assert classify_path(path) == "replays"
+    G2 = G.tolil()
+    G2[5, 25] = G2[25, 5] = 1.0  # a shortcut between two passes
+    path2, _ = shortest_path_frames(G2.tocsr(), 30, 2)
+    assert classify_path(path2) == "resequences" and transitions(path2).size == 1
+
+
+def test_transition_measures_on_the_original_and_on_a_jump(walk):
+    tref = TransitionReference(walk)
+    idx = np.arange(walk.n_frames)
+    assert transition_measures(tref, play_path(walk, idx), idx, 0, len(idx) - 1, 5) == []
+    jump = np.concatenate([np.arange(0, 60), np.arange(130, 200)])
+    tr = transition_measures(tref, play_path(walk, jump), jump, 0, len(jump) - 1, 5)
+    assert len(tr) == 1 and tr[0]["from_frame"] == 59 and tr[0]["to_frame"] == 130
+    assert tr[0]["pose_jump_ratio"] > 1.0 and tr[0]["velocity_jump_ratio"] > 1.0
+    # a jump outside [first, last] (in the context) is not counted
+    assert transition_measures(tref, play_path(walk, jump), jump, 70, len(jump) - 1, 5) == []
+
+
+def test_config_cross_checks_name_the_key():
+    from animsynth.config import ConfigError
+    from animsynth.resequencing.settings import check_resequencing_config
+
+    rs = with_defaults({})
+    trials = {"walk": "35_01", "run": "35_17", "dance": "05_02"}
+    check_resequencing_config(rs, trials)
+    with pytest.raises(ConfigError, match="resequencing.datasets"):
+        check_resequencing_config(rs, {"walk": "35_01"})
+    bad = with_defaults({"frame_step": 2})
+    with pytest.raises(ConfigError, match="explanations.frame_steps"):
+        check_resequencing_config(bad, trials)
+    bad = with_defaults({"explanations": {"sign_modes": ["matrix_naive"]}})
+    with pytest.raises(ConfigError, match="explanations.sign_modes"):
+        check_resequencing_config(bad, trials)

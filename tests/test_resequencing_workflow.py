@@ -1,4 +1,4 @@
-"""Re-sequencing (issue 4): workflow outputs on the tiny config, and real CMU data checks."""
+"""Re-sequencing: workflow outputs on the tiny config, and real CMU data checks."""
 
 from __future__ import annotations
 
@@ -18,25 +18,44 @@ from animsynth.resequencing.features import motion_features
 def test_tiny_workflow_resequencing_outputs(tiny_workflow):
     out = tiny_workflow / "results" / "resequencing"
     t2 = pd.read_csv(out / "table2_min_k.csv")
-    assert len(t2) == 3 * 2 * 2 * 2
+    assert len(t2) == 3 * 2 * 2 * 2 * 2  # dataset x global x sign mode x method x metric
+    assert set(t2["sign_mode"]) == {"continuous", "matrix_naive"}
     assert (t2["components_at_min_k"] == 1).all()
     assert (t2.loc[t2["min_k"] > 1, "components_at_min_k_minus_1"] > 1).all()
-    assert (t2["min_k"] >= 1).all() and (t2["k_used"] >= t2["min_k"]).all()
-    assert (out / "table2_min_k.md").read_text().count("\n|") >= 25
+    assert (t2.loc[t2["method"] == "stisomap", "min_k"] == 1).all()  # adjacent temporal neighbours: one chain
+    # the Lee metric is sign-invariant: same min k in both sign modes
+    lee = t2[t2["metric"] == "lee"].pivot_table(index=["dataset", "global_dof", "method"], columns="sign_mode",
+                                                values="min_k")
+    assert (lee["continuous"] == lee["matrix_naive"]).all()
+    grid = pd.read_csv(out / "min_k_explanations.csv")
+    assert set(grid["frame_step"]) == {1, 4} and len(grid) == 2 * len(t2)
+    flips = pd.read_csv(out / "sign_flips.csv")
+    assert (flips["flips_continuous"] == 0).all()
     rv = pd.read_csv(out / "residual_variance.csv")
-    assert rv["residual_variance"].between(0, 1).all()
+    assert rv["residual_variance"].between(0, 1).all() and set(rv["k_mode"]) <= {"min_k", "fixed"}
+    mk = rv[rv["k_mode"] == "min_k"].merge(t2[t2["sign_mode"] == "continuous"],
+                                           on=["dataset", "global_dof", "method", "metric"])
+    assert (mk["k"] == mk["min_k"]).all()  # the reproduction uses each configuration's min k
     sm = pd.read_csv(out / "smoothness.csv")
-    assert len(sm) == 24 and (sm["paths"] >= 1).all()
+    assert len(sm) == 24 and (sm["paths"] == 3).all()
+    paths = pd.read_csv(out / "smoothness_paths.csv")
+    assert (paths["end"] < paths["start"]).all()  # pairs chosen so the path must leave the original order
+    assert set(paths["path_class"]) <= {"replays", "replays_backwards", "skips", "resequences"}
+    tr = pd.read_csv(out / "smoothness_transitions.csv")
+    assert len(tr) == paths["transitions"].sum()
     v = pd.read_csv(out / "verdicts.csv")
-    claims = set(v["claim"])
-    assert "ST-Isomap gives fewer jerks than Isomap" in claims
-    assert "global DOF hurt cyclic locomotion but not dance" in claims
+    assert list(v.columns) == ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
+    assert set(v["verdict"]) <= {"reproduced", "partly", "not reproduced", "contradicted", "within noise"}
+    claims = " ".join(v["claim"])
+    for text in ("ST-Isomap re-sequences more smoothly", "global DOF", "Lee metric needs far fewer",
+                 "which candidate explanation"):
+        assert text in claims
     for d in ("walk", "run", "dance"):
         assert (out / "figures" / f"fig3_residual_variance_{d}.png").stat().st_size > 0
         for m in ("isomap", "stisomap"):
             assert (out / "figures" / f"fig2_{d}_{m}.png").stat().st_size > 0
     p = pd.read_csv(out / "paths" / "walk_stisomap_lee_noglobal.csv")
-    main = p[p["pair"] == 0]
+    main = p[p["pair"] == "main"]
     assert main["step"].tolist() == list(range(len(main)))
     assert (out / "paths" / "walk_stisomap_lee_noglobal.bvh").read_text().startswith("HIERARCHY")
     assert (out / "paths" / "walk_stisomap_lee_noglobal.gif").read_bytes()[:3] == b"GIF"
@@ -58,8 +77,20 @@ def test_exact_min_k_on_real_cmu_trials(cmu_dir, trial):
     f = motion_features(m)
     for metric in ("l2", "lee"):
         for g in (False, True):
-            D = base_distances(f, metric, g, cfg["lee"])
-            for method in ("isomap", "stisomap"):
-                Dm, _ = method_distances(D, method, cfg, m.fps)
-                assert min_connected_k(Dm) == _brute_min_k(Dm), (metric, g, method)
+            D = base_distances(f, metric, g, cfg)
+            Dm, _, _ = method_distances(D, "isomap", cfg, m.fps)
+            assert min_connected_k(Dm) == _brute_min_k(Dm), (metric, g)
     assert np.isfinite(D).all()
+
+
+@pytest.mark.realdata
+def test_matrix_naive_flips_the_humerus_and_raises_l2_min_k_on_cmu_walk(cmu_dir):
+    m = read_amc(cmu_dir / "35" / "35_01.amc", read_asf(cmu_dir / "35" / "35.asf"))
+    cfg = with_defaults({"metrics": ["l2"], "explanations": {"frame_steps": [1], "global_dof": [False]}})
+    from animsynth.resequencing.study import explain
+
+    grid, flips = explain(m, "walk", "35_01", cfg)
+    f = flips.set_index("joint")["flips_matrix_naive"]
+    assert f["lhumerus"] > 0 and f.drop("lhumerus").sum() == 0
+    g = grid[grid["method"] == "isomap"].set_index("sign_mode")["min_k"]
+    assert g["continuous"] < 10 <= g["matrix_naive"]

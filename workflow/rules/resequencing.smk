@@ -1,12 +1,18 @@
-# Re-sequencing motion with Isomap and ST-Isomap (issue 4).
+# Re-sequencing motion with Isomap and ST-Isomap.
 # Jobs: one analysis per dataset x global-DOF flag (distances, exact min k,
-# Isomap / ST-Isomap fits, residual variance, 2-D embeddings); one path job per
-# dataset x method x metric x global flag (Dijkstra paths, BVH, GIF,
-# smoothness); one Fig 2 per dataset x method, one Fig 3 per dataset; one
-# aggregation (Table 2, residual variance, smoothness, verdicts).
+# Isomap / ST-Isomap fits at each configuration's min k, the fixed-k sweep,
+# residual variance, 2-D embeddings); one explanation job per dataset (min k
+# over sign mode x frame rate x global DOF, quaternion sign flips); one path job
+# per dataset x method x metric x global flag (Dijkstra paths, BVH, GIF,
+# per-path and per-transition smoothness); one Fig 2 per dataset x method, one
+# Fig 3 per dataset; one aggregation (Table 2 beside the paper, explanations,
+# smoothness, verdicts).
+# Resources: measured on CMU (05_02 at 800 frames, 2 cores at load ~20): peak RSS 200 MB (analyse,
+# explain, figures), 275 MB (path), 170 MB (tables); wall time at most 70 s (analyse, explain), 285 s
+# (path; 24 s of CPU), 55 s (figures), 21 s (tables). Memory about 3x and runtime (minutes) about 4x that.
 # Wildcards are prefixed rs* because `dataset` and `method` are constrained
 # globally by other families.
-from animsynth.config import ConfigError
+from animsynth.resequencing.settings import check_resequencing_config
 
 RESEQ = config["resequencing"]
 RESEQ_DATASETS = list(RESEQ["datasets"])
@@ -14,15 +20,7 @@ RESEQ_METHODS = list(RESEQ["methods"])
 RESEQ_METRICS = list(RESEQ["metrics"])
 RESEQ_GDOF = ["global" if g else "noglobal" for g in RESEQ["global_dof"]]
 
-for _ds in RESEQ_DATASETS:
-    if _ds not in RESEQ_TRIALS:
-        raise ConfigError(
-            f"config key 'resequencing.datasets': {_ds!r} is not a key of 'resequencing_trials' ({sorted(RESEQ_TRIALS)})"
-        )
-for _key, _vals in (("datasets", RESEQ_DATASETS), ("methods", RESEQ_METHODS), ("metrics", RESEQ_METRICS),
-                    ("global_dof", RESEQ_GDOF)):
-    if len(set(_vals)) != len(_vals):
-        raise ConfigError(f"config key 'resequencing.{_key}': duplicate entries {_vals}")
+check_resequencing_config(RESEQ, RESEQ_TRIALS)
 
 
 wildcard_constraints:
@@ -34,10 +32,19 @@ wildcard_constraints:
 
 # The config keys each job depends on (passed as params, so a change reruns exactly those jobs).
 RESEQ_ANALYSE_CFG = {
-    k: RESEQ[k] for k in ("methods", "metrics", "max_frames", "frame_step", "n_neighbors", "max_dim", "lee", "stisomap")
+    k: RESEQ[k]
+    for k in ("methods", "metrics", "max_frames", "frame_step", "linearisation", "fixed_k_sweep", "max_dim", "lee",
+              "stisomap")
+}
+RESEQ_EXPLAIN_CFG = {
+    k: RESEQ[k] for k in ("methods", "metrics", "max_frames", "linearisation", "lee", "stisomap", "explanations")
 }
 RESEQ_PATH_CFG = {
-    k: RESEQ[k] for k in ("max_frames", "frame_step", "lee", "stisomap", "path", "smoothness", "gif_fps")
+    k: RESEQ[k]
+    for k in ("max_frames", "frame_step", "linearisation", "lee", "stisomap", "path", "smoothness", "gif_fps")
+}
+RESEQ_TABLES_CFG = {
+    k: RESEQ[k] for k in ("frame_step", "explanations", "verdict_share", "verdict_alpha", "lee")
 }
 RESEQ_WORK = "results/resequencing/work"
 RESEQ_CONFIGS = [
@@ -60,10 +67,37 @@ rule resequencing_analyse:
         "logs/resequencing/analyse/{rsdata}_{rsgdof}.log",
     benchmark:
         "benchmarks/rules/resequencing/analyse/{rsdata}_{rsgdof}.tsv"
+    threads: 1
+    resources:
+        mem_mb=800,
+        runtime=20,
     conda:
         "../envs/animsynth.yaml"
     script:
         "../scripts/resequencing_analyse.py"
+
+
+rule resequencing_explain:
+    input:
+        lambda wc: trial_npz(RESEQ_TRIALS[wc.rsdata]),
+    output:
+        grid=f"{RESEQ_WORK}/{{rsdata}}_explain_min_k.csv",
+        flips=f"{RESEQ_WORK}/{{rsdata}}_sign_flips.csv",
+    params:
+        trial=lambda wc: RESEQ_TRIALS[wc.rsdata],
+        cfg=RESEQ_EXPLAIN_CFG,
+    log:
+        "logs/resequencing/explain/{rsdata}.log",
+    benchmark:
+        "benchmarks/rules/resequencing/explain/{rsdata}.tsv"
+    threads: 1
+    resources:
+        mem_mb=800,
+        runtime=20,
+    conda:
+        "../envs/animsynth.yaml"
+    script:
+        "../scripts/resequencing_explain.py"
 
 
 rule resequencing_path:
@@ -75,6 +109,7 @@ rule resequencing_path:
         bvh="results/resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.bvh",
         gif="results/resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.gif",
         smooth=f"{RESEQ_WORK}/{{rsdata}}_{{rsmethod}}_{{rsmetric}}_{{rsgdof}}_smoothness.csv",
+        transitions=f"{RESEQ_WORK}/{{rsdata}}_{{rsmethod}}_{{rsmetric}}_{{rsgdof}}_transitions.csv",
     params:
         cfg=RESEQ_PATH_CFG,
         seed=lambda wc: seed_for("resequencing", "pairs", wc.rsdata),
@@ -82,6 +117,10 @@ rule resequencing_path:
         "logs/resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.log",
     benchmark:
         "benchmarks/rules/resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.tsv"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=30,
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -105,6 +144,10 @@ rule resequencing_fig2:
         "logs/resequencing/fig2/{rsdata}_{rsmethod}.log",
     benchmark:
         "benchmarks/rules/resequencing/fig2/{rsdata}_{rsmethod}.tsv"
+    threads: 1
+    resources:
+        mem_mb=600,
+        runtime=10,
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -125,6 +168,10 @@ rule resequencing_fig3:
         "logs/resequencing/fig3/{rsdata}.log",
     benchmark:
         "benchmarks/rules/resequencing/fig3/{rsdata}.tsv"
+    threads: 1
+    resources:
+        mem_mb=600,
+        runtime=10,
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -134,9 +181,12 @@ rule resequencing_fig3:
 rule resequencing_tables:
     input:
         min_k=expand(f"{RESEQ_WORK}/{{d}}_{{g}}_min_k.csv", d=RESEQ_DATASETS, g=RESEQ_GDOF),
+        explain=expand(f"{RESEQ_WORK}/{{d}}_explain_min_k.csv", d=RESEQ_DATASETS),
+        flips=expand(f"{RESEQ_WORK}/{{d}}_sign_flips.csv", d=RESEQ_DATASETS),
         rv=expand(f"{RESEQ_WORK}/{{d}}_{{g}}_residual_variance.csv", d=RESEQ_DATASETS, g=RESEQ_GDOF),
         timing=expand(f"{RESEQ_WORK}/{{d}}_{{g}}_timing.csv", d=RESEQ_DATASETS, g=RESEQ_GDOF),
         smooth=[f"{RESEQ_WORK}/{d}_{m}_{x}_{g}_smoothness.csv" for d, m, x, g in RESEQ_CONFIGS],
+        transitions=[f"{RESEQ_WORK}/{d}_{m}_{x}_{g}_transitions.csv" for d, m, x, g in RESEQ_CONFIGS],
     output:
         table2=report(
             "results/resequencing/table2_min_k.csv",
@@ -145,6 +195,20 @@ rule resequencing_tables:
             subcategory="Table 2 minimum k",
         ),
         table2_md="results/resequencing/table2_min_k.md",
+        explanations=report(
+            "results/resequencing/min_k_explanations.csv",
+            caption="../report/resequencing_explanations.rst",
+            category="Re-sequencing",
+            subcategory="Table 2 minimum k",
+        ),
+        explanations_md="results/resequencing/min_k_explanations.md",
+        flips=report(
+            "results/resequencing/sign_flips.csv",
+            caption="../report/resequencing_sign_flips.rst",
+            category="Re-sequencing",
+            subcategory="Table 2 minimum k",
+        ),
+        lee_weights="results/resequencing/lee_weights.csv",
         rv=report(
             "results/resequencing/residual_variance.csv",
             caption="../report/resequencing_residual_variance.rst",
@@ -159,6 +223,7 @@ rule resequencing_tables:
         ),
         smooth_md="results/resequencing/smoothness.md",
         smooth_paths="results/resequencing/smoothness_paths.csv",
+        smooth_transitions="results/resequencing/smoothness_transitions.csv",
         verdicts=report(
             "results/resequencing/verdicts.csv",
             caption="../report/resequencing_verdicts.rst",
@@ -166,14 +231,19 @@ rule resequencing_tables:
             subcategory="Verdicts",
         ),
         verdicts_md="results/resequencing/verdicts.md",
-        timing="results/resequencing/timings_machine_dependent.csv",
+        timing="results/resequencing/resequencing_timing.csv",
     params:
-        published=RESEQ["published_min_k"],
-        margin=RESEQ["verdict_margin"],
+        cfg=RESEQ_TABLES_CFG,
+        published=RESEQ["published"],
+        trials={d: RESEQ_TRIALS[d] for d in RESEQ_DATASETS},
     log:
         "logs/resequencing/tables.log",
     benchmark:
         "benchmarks/rules/resequencing/tables.tsv"
+    threads: 1
+    resources:
+        mem_mb=600,
+        runtime=10,
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -183,6 +253,8 @@ rule resequencing_tables:
 RESEQUENCING_TARGETS = (
     [
         "results/resequencing/table2_min_k.csv",
+        "results/resequencing/min_k_explanations.csv",
+        "results/resequencing/sign_flips.csv",
         "results/resequencing/residual_variance.csv",
         "results/resequencing/smoothness.csv",
         "results/resequencing/verdicts.csv",
@@ -202,14 +274,15 @@ RESEQUENCING_SUMMARY = [
     {
         "title": "Re-sequencing Table 2: smallest k giving one connected neighbourhood graph",
         "csv": "results/resequencing/table2_min_k.csv",
-        "note": "Exact (MST bottleneck over neighbour ranks), cross-checked with connected_components. "
-        "min_k_paper is empty unless resequencing.published_min_k is filled (the published values were not "
-        "available to us).",
+        "note": "Exact (MST bottleneck over neighbour ranks), cross-checked with connected_components, in both "
+        "linearisation sign modes (continuous = our method; matrix_naive = reproduction of a probable artefact); "
+        "min_k_paper from resequencing.published.table2 (empty when the file is absent).",
     },
     {
         "title": "Re-sequencing: smoothness of the re-sequenced motions",
         "csv": "results/resequencing/smoothness.csv",
-        "note": "Means over the start/end pairs of each configuration; ratios against the original capture.",
+        "note": "Transition counts over all pairs (end before start); per-transition smoothness means over the "
+        "re-sequencing paths only; ratios against the original capture.",
     },
 ]
 RESEQUENCING_VERDICTS = ["results/resequencing/verdicts.csv"]

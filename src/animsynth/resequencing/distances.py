@@ -153,8 +153,14 @@ def lee_metric(quats, weights, fps: float, nu: float, root_pos=None, sqrt: bool 
 
 
 def lee_distances(features: MotionFeatures, weights: dict | None = None, nu: float = 0.01,
-                  include_global: bool = False, sqrt: bool = False) -> np.ndarray:
-    """Lee metric between all frames of ``features`` (see :func:`lee_metric`)."""
+                  include_global: bool = False, sqrt: bool = False, translation_scale: float = 1.0) -> np.ndarray:
+    """Lee metric between all frames of ``features`` (see :func:`lee_metric`).
+
+    With ``include_global`` the root position enters in metres times
+    ``translation_scale`` (the same scale as the L2 features, so both metrics
+    weigh root travel alike). The Lee metric is sign-invariant
+    (``arccos |<q_i, q_j>|``), so the linearisation's ``sign_mode`` does not
+    apply to it."""
     w = joint_weights(features.joint_names, PAPER_WEIGHTS if weights is None else weights)
-    return lee_metric(features.quats, w, features.fps, nu,
-                      root_pos=features.root_pos if include_global else None, sqrt=sqrt)
+    root = float(translation_scale) * features.root_pos if include_global else None
+    return lee_metric(features.quats, w, features.fps, nu, root_pos=root, sqrt=sqrt)

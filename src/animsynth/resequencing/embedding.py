@@ -16,13 +16,22 @@ Let ``r_i(j)`` be the rank of ``j`` in row ``i`` (1 = nearest). The edge
 graph for ``k`` is the set of edges with ``K_ij <= k`` and it is connected
 exactly when ``k`` is at least the *bottleneck* (largest edge) of a minimum
 spanning tree of the complete graph weighted by ``K``
-(:func:`min_connected_k`). One argsort and one MST per configuration, no
-Isomap fit. :func:`graph_components` cross-checks with
+(:func:`min_connected_k`). One argsort per configuration, then the MST of
+the sparse graph ``{K_ij <= k}`` for the first doubled ``k`` (1, 2, 4, ...)
+at which it is connected -- it holds every edge up to the bottleneck, so the
+answer is exact; no Isomap fit. :func:`graph_components` cross-checks with
 ``scipy.sparse.csgraph.connected_components`` at ``k`` and ``k - 1``.
+
+Edges that are *always* present (ST-Isomap's adjacent temporal neighbours)
+enter with ``K_ij = 0``: they belong to every graph, and the minimum k is the
+bottleneck of the MST over ``K`` (at least 1).
 
 scikit-learn's ``Isomap`` silently *adds* edges between components when the
 graph is disconnected; :class:`PrecomputedIsomap` refuses instead
-(:class:`DisconnectedGraphError`).
+(:class:`DisconnectedGraphError`). Geodesics are scipy's
+``csgraph.shortest_path`` on our graph and the embedding is scikit-learn's
+``KernelPCA`` of ``-G**2 / 2`` -- the two steps of scikit-learn's ``Isomap``,
+run on a graph that may hold the always-present edges.
 """
 
 from __future__ import annotations
@@ -32,10 +41,9 @@ import warnings
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components, minimum_spanning_tree
+from scipy.sparse.csgraph import connected_components, minimum_spanning_tree, shortest_path
 from scipy.spatial.distance import pdist, squareform
-from sklearn.manifold import Isomap
-from sklearn.neighbors import kneighbors_graph
+from sklearn.decomposition import KernelPCA
 from threadpoolctl import threadpool_limits
 
 from .distances import check_distance_matrix
@@ -43,6 +51,7 @@ from .distances import check_distance_matrix
 log = logging.getLogger("animsynth.resequencing")
 
 __all__ = ["DisconnectedGraphError", "neighbor_ranks", "knn_graph", "graph_components", "min_connected_k",
+           "temporal_adjacency",
            "PrecomputedIsomap", "STIsomap", "spatio_temporal_distances", "nontrivial_neighbors",
            "residual_variance"]
 
@@ -81,45 +90,78 @@ def _floor_zeros(D) -> np.ndarray:
     return D
 
 
-def knn_graph(D, k: int, ranks=None) -> csr_matrix:
-    """Undirected k-NN graph of a distance matrix (see module docstring), weighted by ``D``."""
+def temporal_adjacency(n: int, window: int = 1) -> np.ndarray:
+    """Bool ``(n, n)`` matrix of the adjacent temporal neighbours ``0 < |i - j| <= window``."""
+    idx = np.arange(n)
+    lag = np.abs(idx[:, None] - idx[None, :])
+    return (lag >= 1) & (lag <= int(window))
+
+
+def _adjacency(R, k: int, always=None) -> np.ndarray:
+    A = (R >= 1) & (R <= k)
+    if always is not None:
+        A = A | np.asarray(always, bool)
+    return A | A.T
+
+
+def knn_graph(D, k: int, ranks=None, always=None) -> csr_matrix:
+    """Undirected k-NN graph of a distance matrix (see module docstring), weighted by ``D``.
+
+    ``always`` (bool ``(n, n)``, optional): edges present whatever ``k``
+    (ST-Isomap's adjacent temporal neighbours)."""
     D = np.asarray(D, float)
     n = D.shape[0]
     if k < 0:
         raise ValueError(f"k must be >= 0, got {k}")
     R = neighbor_ranks(D) if ranks is None else ranks
-    A = (R >= 1) & (R <= k)
-    A = A | A.T
+    A = _adjacency(R, k, always)
     W = _floor_zeros(D)
     i, j = np.nonzero(A)
     return csr_matrix((W[i, j], (i, j)), shape=(n, n))
 
 
-def graph_components(D, k: int, ranks=None) -> int:
-    """Number of connected components of the k-NN graph of ``D``."""
+def graph_components(D, k: int, ranks=None, always=None) -> int:
+    """Number of connected components of the k-NN graph of ``D`` (plus the ``always`` edges)."""
     n = np.asarray(D).shape[0]
     R = neighbor_ranks(D) if ranks is None else ranks
-    A = (R >= 1) & (R <= k)
-    A = A | A.T
+    A = _adjacency(R, k, always)
     i, j = np.nonzero(A)
     G = csr_matrix((np.ones(i.size), (i, j)), shape=(n, n))
     return int(connected_components(G, directed=False)[0])
 
 
-def min_connected_k(D, ranks=None) -> int:
-    """Smallest ``k`` whose undirected k-NN graph of ``D`` is connected (exact).
+def min_connected_k(D, ranks=None, always=None) -> int:
+    """Smallest ``k >= 1`` whose undirected k-NN graph of ``D`` (plus the ``always``
+    edges) is connected (exact).
 
     The bottleneck edge of a minimum spanning tree over the edge-appearance
-    ranks ``K_ij = min(r_i(j), r_j(i))`` (module docstring). 0 for one frame.
+    ranks ``K_ij = min(r_i(j), r_j(i))``, with ``K_ij = 0`` for always-present
+    edges (module docstring). 0 for one frame.
     """
     D = np.asarray(D, float)
     n = D.shape[0]
     if n <= 1:
         return 0
     R = neighbor_ranks(D) if ranks is None else ranks
-    K = np.minimum(R, R.T).astype(float)  # >= 1 off the diagonal, 0 on it (= no edge)
-    mst = minimum_spanning_tree(K)
-    return int(round(mst.data.max()))
+    K = np.minimum(R, R.T)
+    np.fill_diagonal(K, n)  # never an edge
+    if always is not None:
+        a = np.asarray(always, bool)
+        a = a | a.T
+        np.fill_diagonal(a, False)
+        K = np.where(a, 0, K)
+    # The MST bottleneck only involves edges up to the answer: find a k whose graph is connected by doubling,
+    # then take the MST of that sparse graph (exact, and far cheaper than an MST of all n^2 pairs).
+    k = 1
+    while True:
+        i, j = np.nonzero(K <= k)
+        G = csr_matrix((np.ones(i.size), (i, j)), shape=(n, n))
+        if k >= n - 1 or connected_components(G, directed=False)[0] == 1:
+            break
+        k = min(2 * k, n - 1)
+    W = csr_matrix((K[i, j] + 1.0, (i, j)), shape=(n, n))  # shifted by one: sparse MST drops zero weights
+    mst = minimum_spanning_tree(W)
+    return max(1, int(round(mst.data.max())) - 1)
 
 
 def _check_k(k, n: int, what: str = "n_neighbors") -> int:
@@ -133,7 +175,14 @@ def _check_k(k, n: int, what: str = "n_neighbors") -> int:
 
 
 class PrecomputedIsomap:
-    """scikit-learn Isomap on a precomputed distance matrix that refuses disconnected graphs.
+    """Isomap on a precomputed distance matrix that refuses disconnected graphs.
+
+    The k-NN graph of :func:`knn_graph` (the graph scikit-learn's ``Isomap``
+    builds, plus optional always-present edges), geodesics with scipy's
+    ``csgraph.shortest_path`` and classical MDS with scikit-learn's
+    ``KernelPCA`` of ``-G**2 / 2`` -- scikit-learn ``Isomap``'s own two steps,
+    so the result equals ``Isomap(metric="precomputed")`` on a connected graph
+    (checked in the tests and benchmarks).
 
     Parameters
     ----------
@@ -144,7 +193,7 @@ class PrecomputedIsomap:
         Embedding dimension (prefixes of the embedding are the lower-dimensional
         embeddings, so one fit with 10 components serves d = 1..10).
     path_method : str
-        Passed to scikit-learn (``"D"`` = Dijkstra).
+        scipy ``shortest_path`` method (``"D"`` = Dijkstra, ``"auto"``).
     blas_threads : int or None
         BLAS threads for the eigendecomposition (``None`` = library default).
         One by default: workflow jobs run side by side on few cores, where
@@ -153,8 +202,8 @@ class PrecomputedIsomap:
     Attributes
     ----------
     n_neighbors_ : int
-    graph_ : scipy.sparse.csr_matrix, the weighted k-NN graph (the one Isomap uses)
-    dist_matrix_ : ndarray, geodesic (shortest-path) distances
+    graph_ : scipy.sparse.csr_matrix, the weighted graph the geodesics run on
+    dist_matrix_ : ndarray (frames, frames), geodesic (shortest-path) distances
     embedding_ : ndarray (frames, n_components)
     eigenvalues_ : ndarray, kernel-PCA eigenvalues (descending)
     min_k_ : int, exact minimum connected k of the input
@@ -172,42 +221,34 @@ class PrecomputedIsomap:
         self.path_method = path_method
         self.blas_threads = blas_threads
 
-    def fit(self, D):
+    def fit(self, D, always=None):
+        """Fit on distances ``D`` (frames, frames); ``always``: bool (frames, frames)
+        edges kept whatever k (used by :class:`STIsomap`)."""
         D = check_distance_matrix(D)
         n = D.shape[0]
         if n < 3:
             raise ValueError(f"Isomap needs at least 3 frames, got {n}")
         R = neighbor_ranks(D)
-        self.min_k_ = min_connected_k(D, ranks=R)
+        self.min_k_ = min_connected_k(D, ranks=R, always=always)
         k = _check_k(self.n_neighbors, n)
         k = self.min_k_ if k is None else k
-        ncomp = graph_components(D, k, ranks=R)
+        ncomp = graph_components(D, k, ranks=R, always=always)
         if ncomp > 1:
             raise DisconnectedGraphError(
                 f"the {k}-NN graph of {n} frames has {ncomp} connected components; "
                 f"the smallest k giving one component is {self.min_k_}")
-        Dw = _floor_zeros(D)
-        # scikit-learn's own graph must agree (tie-breaking could differ): check it too
-        skg = kneighbors_graph(Dw, k, metric="precomputed", mode="connectivity")
-        nsk = int(connected_components(skg, directed=False)[0])
-        if nsk > 1:
-            raise DisconnectedGraphError(
-                f"scikit-learn's {k}-NN graph has {nsk} components (tied distances broken differently); "
-                f"use a larger k")
+        self.graph_ = knn_graph(D, k, ranks=R, always=always)
+        self.dist_matrix_ = shortest_path(self.graph_, method=self.path_method, directed=False)
         nc = min(int(self.n_components), n - 1)
-        iso = Isomap(n_neighbors=k, n_components=nc, metric="precomputed", path_method=self.path_method,
-                     eigen_solver="dense", neighbors_algorithm="brute")
-        with warnings.catch_warnings(), threadpool_limits(limits=self.blas_threads, user_api="blas"):
-            warnings.filterwarnings("error", message=r"(?is).*connected components")
-            self.embedding_ = iso.fit_transform(Dw)
+        kpca = KernelPCA(n_components=nc, kernel="precomputed", eigen_solver="dense")
+        with threadpool_limits(limits=self.blas_threads, user_api="blas"):
+            self.embedding_ = kpca.fit_transform(-0.5 * self.dist_matrix_ ** 2)
         self.n_neighbors_ = k
-        self.graph_ = knn_graph(D, k, ranks=R)
-        self.dist_matrix_ = iso.dist_matrix_
-        self.eigenvalues_ = np.asarray(iso.kernel_pca_.eigenvalues_)
+        self.eigenvalues_ = np.asarray(kpca.eigenvalues_)
         return self
 
-    def fit_transform(self, D):
-        return self.fit(D).embedding_
+    def fit_transform(self, D, always=None):
+        return self.fit(D, always=always).embedding_
 
 
 def nontrivial_neighbors(D, m: int, min_gap: int, allowed=None) -> np.ndarray:
@@ -241,39 +282,41 @@ def nontrivial_neighbors(D, m: int, min_gap: int, allowed=None) -> np.ndarray:
     return M
 
 
-def spatio_temporal_distances(D, temporal_window: int = 1, c_ctn: float = 10.0, c_cctn: float = 10.0,
+def spatio_temporal_distances(D, temporal_window: int = 1, c_atn: float = 10.0, c_ctn: float = 10.0,
                               ctn_neighbors: int = 4, ctn_min_gap: int = 30, ctn_tolerance: int = 2,
                               ctn_reach: int = 6):
-    """ST-Isomap's distance adjustment for one continuous sequence (Jenkins & Mataric 2004).
+    """ST-Isomap's distance adjustment for one continuous sequence (Jenkins & Mataric 2004, Sec. 3).
 
-    * Temporal neighbours: ``0 < |i - j| <= temporal_window``. Their distance is
-      divided by ``c_ctn``.
-    * Common temporal neighbours (CTN): ``j`` is one of ``i``'s
-      ``ctn_neighbors`` non-trivial neighbours (:func:`nontrivial_neighbors`
-      with ``min_gap = ctn_min_gap``) among the frames *closer to i than i's
-      own frames ``ctn_reach`` frames earlier and later*
-      (``D[i, j] < min(D[i, i - ctn_reach], D[i, i + ctn_reach])``: the other
-      pass is within a few frames' worth of motion, so a CTN is a real
+    Constants named as in the paper: ``c_atn`` divides the distances of the
+    *adjacent temporal neighbours* (ATN), ``c_ctn`` those of the *common
+    temporal neighbours* (CTN).
+
+    * ATN: ``0 < |i - j| <= temporal_window`` (the paper: the previous and next
+      frame, ``temporal_window = 1``). Distance divided by ``c_atn``.
+    * CTN: ``j`` is one of ``i``'s ``ctn_neighbors`` non-trivial neighbours
+      (the paper's K-nearest non-trivial neighbours,
+      :func:`nontrivial_neighbors`; ``ctn_min_gap`` frames define "the same
+      pass" -- our parameter) among the frames *closer to i than i's own
+      frames ``ctn_reach`` frames earlier and later* (our gate: a CTN is a real
       crossing, never a far frame that merely happens to be the nearest of its
-      pass), and the relation persists one frame
-      earlier and one frame later: ``i - 1`` has a non-trivial neighbour within
-      ``ctn_tolerance`` frames of ``j - 1`` and ``i + 1`` one within
-      ``ctn_tolerance`` of ``j + 1`` (only the side that exists at the ends of
-      the sequence). The two trajectories pass each other *in the same
-      direction*. Symmetrised; distance divided by ``c_cctn``.
+      pass), and the relation persists one frame earlier and one frame later:
+      ``i - 1`` has a non-trivial neighbour within ``ctn_tolerance`` frames
+      (our slack) of ``j - 1`` and ``i + 1`` one within ``ctn_tolerance`` of
+      ``j + 1`` (only the side that exists at the ends of the sequence): the
+      two passes move the same way. Symmetrised; distance divided by ``c_ctn``.
     * Every other pair keeps its distance.
 
     Returns
     -------
-    D_st : ndarray, the adjusted distances
-    temporal : bool ndarray, temporal-neighbour pairs
-    ctn : bool ndarray, common-temporal-neighbour pairs
+    D_st : ndarray (frames, frames), the adjusted distances
+    atn : bool ndarray (frames, frames), adjacent-temporal-neighbour pairs
+    ctn : bool ndarray (frames, frames), common-temporal-neighbour pairs
     """
     D = check_distance_matrix(D)
     n = D.shape[0]
-    for name, v in (("c_ctn", c_ctn), ("c_cctn", c_cctn)):
+    for name, v in (("c_atn", c_atn), ("c_ctn", c_ctn)):
         if not (np.isfinite(v) and v >= 1.0):
-            raise ValueError(f"{name} must be >= 1 (it divides distances), got {v}")
+            raise ValueError(f"config key 'resequencing.stisomap.{name}' must be >= 1 (it divides distances), got {v}")
     if temporal_window < 1:
         raise ValueError(f"temporal_window must be >= 1, got {temporal_window}")
     if ctn_min_gap < temporal_window:
@@ -282,7 +325,7 @@ def spatio_temporal_distances(D, temporal_window: int = 1, c_ctn: float = 10.0, 
         raise ValueError("ctn_neighbors and ctn_tolerance must be >= 0, ctn_reach >= 1")
     idx = np.arange(n)
     lag = np.abs(idx[:, None] - idx[None, :])
-    temporal = (lag >= 1) & (lag <= temporal_window)
+    atn = temporal_adjacency(n, temporal_window)
     ctn = np.zeros((n, n), bool)
     if ctn_neighbors > 0 and n > 2:
         back = np.where(idx - ctn_reach >= 0, D[idx, np.clip(idx - ctn_reach, 0, n - 1)], np.inf)
@@ -307,58 +350,57 @@ def spatio_temporal_distances(D, temporal_window: int = 1, c_ctn: float = 10.0, 
         ctn = ctn | ctn.T
         ctn &= lag > ctn_min_gap
     D_st = D.copy()
-    D_st[temporal] /= c_ctn
-    D_st[ctn] /= c_cctn
-    return D_st, temporal, ctn
+    D_st[atn] /= c_atn
+    D_st[ctn] /= c_ctn
+    return D_st, atn, ctn
 
 
 class STIsomap:
-    """Spatio-temporal Isomap (Jenkins & Mataric 2004) for one continuous sequence.
+    """Spatio-temporal Isomap (Jenkins & Mataric 2004), continuous version, for one sequence.
 
-    1. Adjust the distances (:func:`spatio_temporal_distances`): temporal
-       neighbours divided by ``c_ctn``, common temporal neighbours by ``c_cctn``.
-    2. Spatio-temporal neighbourhoods: the undirected k-NN graph of the
-       *adjusted* distances (with ``c_ctn`` large the temporal neighbours
-       usually rank first, so the chain of frames is kept for small k).
-    3. Geodesics (Dijkstra) on that graph and classical MDS (scikit-learn's
-       Isomap on the adjusted matrix, via :class:`PrecomputedIsomap`).
+    1. Adjust the distances (:func:`spatio_temporal_distances`): adjacent
+       temporal neighbours divided by ``c_atn``, common temporal neighbours by
+       ``c_ctn``.
+    2. Spatio-temporal neighbourhoods: every frame's adjacent temporal
+       neighbours are *always* in its neighbourhood, plus its ``k`` nearest
+       frames under the adjusted distances (undirected). The chain of frames
+       is therefore connected at any k, and the minimum connected k is 1 --
+       the value the paper reports for most of its ST-Isomap rows.
+    3. Geodesics (Dijkstra) on that graph and classical MDS
+       (:class:`PrecomputedIsomap` with the ATN as always-present edges).
 
-    **What k means here**: ``n_neighbors`` is the number of neighbours per
-    frame chosen under the *adjusted* distances (the same rule as Isomap's k,
-    applied after the temporal adjustment); the exact minimum connected k of
-    ST-Isomap is :func:`min_connected_k` of the adjusted matrix. Frame windowing
-    (the paper's optional step 1) is not used: the Lee metric's velocity term
-    plays that role.
+    Frame windowing (the paper's optional step 1) is not used: the Lee
+    metric's velocity term plays that role.
 
     Parameters
     ----------
-    n_neighbors : int or None (None = exact minimum connected k)
+    n_neighbors : int or None (None = exact minimum connected k, 1 on one sequence)
     n_components : int
-    temporal_window : int, frames on each side that are temporal neighbours
-    c_ctn : float >= 1, divisor of temporal-neighbour distances
-    c_cctn : float >= 1, divisor of common-temporal-neighbour distances
-    ctn_neighbors : int, non-trivial neighbours examined per frame for CTN
-    ctn_min_gap : int, frames closer than this in time are never CTN (same pass)
-    ctn_tolerance : int, frames of slack when following a CTN one frame forward/back
-    ctn_reach : int, a CTN must be closer than the frame's own frames this many frames away
+    temporal_window : int, frames on each side that are adjacent temporal neighbours (paper: 1)
+    c_atn : float >= 1, divisor of adjacent-temporal-neighbour distances (paper's constant; value ours)
+    c_ctn : float >= 1, divisor of common-temporal-neighbour distances (paper's constant; value ours)
+    ctn_neighbors : int, non-trivial neighbours examined per frame for CTN (paper's K of KNTN)
+    ctn_min_gap : int, frames closer than this in time are the same pass, never CTN (ours)
+    ctn_tolerance : int, frames of slack when following a CTN one frame forward/back (ours)
+    ctn_reach : int, a CTN must be closer than the frame's own frames this many frames away (ours)
     path_method : str, shortest-path method (``"D"`` = Dijkstra)
     blas_threads : int or None, as :class:`PrecomputedIsomap`
 
     Attributes
     ----------
-    dist_st_ : adjusted distance matrix
-    temporal_, ctn_ : bool matrices of the adjusted pairs
+    dist_st_ : ndarray (frames, frames), adjusted distance matrix
+    atn_, ctn_ : bool ndarray (frames, frames), the adjusted pairs
     n_neighbors_, min_k_, graph_, dist_matrix_, embedding_, eigenvalues_ : as :class:`PrecomputedIsomap`
     """
 
-    def __init__(self, n_neighbors=None, n_components: int = 2, temporal_window: int = 1, c_ctn: float = 10.0,
-                 c_cctn: float = 10.0, ctn_neighbors: int = 4, ctn_min_gap: int = 30, ctn_tolerance: int = 2,
+    def __init__(self, n_neighbors=None, n_components: int = 2, temporal_window: int = 1, c_atn: float = 10.0,
+                 c_ctn: float = 10.0, ctn_neighbors: int = 4, ctn_min_gap: int = 30, ctn_tolerance: int = 2,
                  ctn_reach: int = 6, path_method: str = "D", blas_threads: int | None = 1):
         self.n_neighbors = n_neighbors
         self.n_components = n_components
         self.temporal_window = temporal_window
+        self.c_atn = c_atn
         self.c_ctn = c_ctn
-        self.c_cctn = c_cctn
         self.ctn_neighbors = ctn_neighbors
         self.ctn_min_gap = ctn_min_gap
         self.ctn_tolerance = ctn_tolerance
@@ -368,14 +410,15 @@ class STIsomap:
 
     def adjusted_distances(self, D):
         """Return (and store as ``dist_st_``) the spatio-temporally adjusted matrix."""
-        self.dist_st_, self.temporal_, self.ctn_ = spatio_temporal_distances(
-            D, self.temporal_window, self.c_ctn, self.c_cctn, self.ctn_neighbors, self.ctn_min_gap,
+        self.dist_st_, self.atn_, self.ctn_ = spatio_temporal_distances(
+            D, self.temporal_window, self.c_atn, self.c_ctn, self.ctn_neighbors, self.ctn_min_gap,
             self.ctn_tolerance, self.ctn_reach)
         return self.dist_st_
 
     def fit(self, D):
         Dst = self.adjusted_distances(D)
-        iso = PrecomputedIsomap(self.n_neighbors, self.n_components, self.path_method, self.blas_threads).fit(Dst)
+        iso = PrecomputedIsomap(self.n_neighbors, self.n_components, self.path_method,
+                                self.blas_threads).fit(Dst, always=self.atn_)
         for a in ("n_neighbors_", "min_k_", "graph_", "dist_matrix_", "embedding_", "eigenvalues_"):
             setattr(self, a, getattr(iso, a))
         return self

@@ -23,7 +23,11 @@ from scipy.spatial.transform import Rotation
 from ..kinematics import quaternions, root_translation
 
 __all__ = ["quat_log", "relative_log", "linearize_quaternions", "MotionFeatures", "motion_features",
-           "angular_velocity"]
+           "angular_velocity", "SIGN_MODES", "quat_multiply", "matrix_naive_quaternions", "naive_quat_log",
+           "sign_flips"]
+
+#: Quaternion sign handling of the linearisation (config key ``resequencing.linearisation.sign_mode``).
+SIGN_MODES = ("continuous", "matrix_naive")
 
 
 def quat_log(q) -> np.ndarray:
@@ -47,7 +51,67 @@ def relative_log(qa, qb) -> np.ndarray:
     return (0.5 * (ra.inv() * rb).as_rotvec()).reshape(shape + (3,))
 
 
-def linearize_quaternions(q) -> np.ndarray:
+def quat_multiply(a, b) -> np.ndarray:
+    """Hamilton product of scalar-last quaternions ``(..., 4)``, *without* any sign normalisation.
+
+    Written out because :mod:`scipy.spatial.transform` composes rotations and is
+    free to return either sign; the ``matrix_naive`` reproduction needs the raw product.
+    """
+    a = np.asarray(a, float)
+    b = np.asarray(b, float)
+    x1, y1, z1, w1 = np.moveaxis(a, -1, 0)
+    x2, y2, z2, w2 = np.moveaxis(b, -1, 0)
+    return np.stack([w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+                     w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2], axis=-1)
+
+
+def matrix_naive_quaternions(q) -> np.ndarray:
+    """Quaternions as a rotation-matrix conversion gives them: largest component positive.
+
+    Each rotation ``(..., 4)`` is turned into its rotation matrix and back with
+    the classic largest-component (Shepperd) conversion, whose result has its
+    largest-magnitude component positive. Nothing keeps the sign continuous
+    over time, so ``q`` and ``-q`` alternate between neighbouring frames
+    whenever the largest component changes (large rotations, e.g. the humeri).
+
+    This reproduces a *probable artefact* of the re-sequencing paper's
+    pipeline (``sign_mode: matrix_naive``); it is not a method.
+    """
+    q = np.asarray(q, float)
+    flat = q.reshape(-1, 4)
+    qn = Rotation.from_matrix(Rotation.from_quat(flat).as_matrix()).as_quat()
+    big = np.argmax(np.abs(qn), axis=1)
+    qn *= np.sign(qn[np.arange(len(qn)), big])[:, None]
+    return qn.reshape(q.shape)
+
+
+def naive_quat_log(q) -> np.ndarray:
+    """``acos(w) * v / |v|`` of quaternions ``(..., 4)`` *without* taking ``|w|``.
+
+    For ``w < 0`` this is the log of the *long* way round (up to ``pi``
+    instead of ``pi / 2``): ``-q`` and ``q`` give logs about ``pi`` apart.
+    Part of the ``matrix_naive`` reproduction only.
+    """
+    q = np.asarray(q, float)
+    w = np.clip(q[..., 3], -1.0, 1.0)
+    v = q[..., :3]
+    nv = np.linalg.norm(v, axis=-1, keepdims=True)
+    axis = np.where(nv > 1e-12, v / np.maximum(nv, 1e-300), 0.0)
+    return np.arccos(w)[..., None] * axis
+
+
+def sign_flips(q) -> np.ndarray:
+    """Frames whose quaternion has the opposite sign to the previous frame's
+    (``<q_t, q_{t+1}> < 0``), counted per joint: ``(frames, joints, 4)`` -> ``(joints,)``."""
+    q = np.asarray(q, float)
+    if q.shape[0] < 2:
+        return np.zeros(q.shape[1:-1], dtype=np.int64)
+    return np.count_nonzero(np.sum(q[1:] * q[:-1], axis=-1) < 0, axis=0)
+
+
+def linearize_quaternions(q, sign_mode: str = "continuous") -> np.ndarray:
     """Lee & Shin linearisation of quaternion sequences.
 
     For every joint (last-but-one axis) ``v_0 = 0`` and
@@ -58,6 +122,13 @@ def linearize_quaternions(q) -> np.ndarray:
     Parameters
     ----------
     q : array (frames, joints, 4) or (frames, 4)
+    sign_mode : {"continuous", "matrix_naive"}
+        ``continuous`` (the method): each increment is the shortest rotation,
+        so ``q`` and ``-q`` agree. ``matrix_naive`` (a reproduction of a
+        probable artefact): quaternions from :func:`matrix_naive_quaternions`,
+        raw products, log via ``acos(w)`` (:func:`naive_quat_log`) -- each sign
+        change between two frames adds a jump of about ``pi`` to the running
+        sum, offsetting every later frame.
 
     Returns
     -------
@@ -75,10 +146,16 @@ def linearize_quaternions(q) -> np.ndarray:
         q = q[:, None, :]
     if q.ndim != 3 or q.shape[-1] != 4:
         raise ValueError(f"expected quaternions of shape (frames, joints, 4), got {q.shape}")
+    if sign_mode not in SIGN_MODES:
+        raise ValueError(f"config key 'resequencing.linearisation.sign_mode': {sign_mode!r} is not one of {SIGN_MODES}")
     n, j, _ = q.shape
     v = np.zeros((n, j, 3))
     if n > 1:
-        inc = relative_log(q[:-1], q[1:])
+        if sign_mode == "continuous":
+            inc = relative_log(q[:-1], q[1:])
+        else:
+            qn = matrix_naive_quaternions(q)
+            inc = naive_quat_log(quat_multiply(qn[:-1] * np.array([-1.0, -1.0, -1.0, 1.0]), qn[1:]))
         v[1:] = np.cumsum(inc, axis=0)
     return v[:, 0, :] if squeeze else v
 
@@ -129,13 +206,17 @@ class MotionFeatures:
     def n_frames(self) -> int:
         return int(self.quats.shape[0])
 
-    def linearised(self, include_global: bool) -> np.ndarray:
+    def linearised(self, include_global: bool, sign_mode: str = "continuous",
+                   translation_scale: float = 1.0) -> np.ndarray:
         """Frames as vectors: the linearised joint rotations (3 per joint) and,
         if ``include_global``, the linearised root orientation and the root
-        position in metres (6 more columns). Shape ``(frames, 3m [+ 6])``."""
-        v = linearize_quaternions(self.quats).reshape(self.n_frames, -1)
+        position in metres times ``translation_scale`` (radians per metre; 6
+        more columns). Shape ``(frames, 3m [+ 6])``. ``sign_mode``: see
+        :func:`linearize_quaternions` (applies to the root orientation too)."""
+        v = linearize_quaternions(self.quats, sign_mode).reshape(self.n_frames, -1)
         if include_global:
-            v = np.hstack([v, linearize_quaternions(self.root_quat), self.root_pos])
+            v = np.hstack([v, linearize_quaternions(self.root_quat, sign_mode),
+                           float(translation_scale) * self.root_pos])
         return v
 
 

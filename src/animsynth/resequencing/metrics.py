@@ -34,12 +34,14 @@ from .features import relative_log
 
 log = logging.getLogger("animsynth.resequencing")
 
-__all__ = ["pose_steps", "jerk_magnitude", "root_reversals", "foot_ground", "foot_skate", "Reference", "smoothness"]
+__all__ = ["joint_quats", "transitions", "pass_jumps", "classify_path", "TransitionReference", "transition_measures",
+           "pose_steps", "jerk_magnitude", "root_reversals", "foot_ground", "foot_skate", "Reference", "smoothness"]
 
 FOOT_JOINTS = ("lfoot", "ltoes", "rfoot", "rtoes")
 
 
-def _joint_quats(motion) -> np.ndarray:
+def joint_quats(motion) -> np.ndarray:
+    """Local quaternions (frames, joints, 4) of the non-root joints with rotational DOF."""
     sk = motion.skeleton
     q = quaternions(sk, motion.values)
     keep = [i for i, j in enumerate(sk.joints) if i > 0 and j.rot_dofs]
@@ -123,7 +125,7 @@ class Reference:
         self.contact_height = float(contact_height)
         self.speed_threshold = float(speed_threshold)
         self.foot_joints = tuple(foot_joints)
-        q = _joint_quats(original)
+        q = joint_quats(original)
         self.steps = pose_steps(q)
         self.jerk = jerk_magnitude(q, original.fps)
         self.ground = foot_ground(original, self.foot_joints)
@@ -148,7 +150,7 @@ def smoothness(reference: Reference, played, path) -> dict:
     ref = reference
     path = np.asarray(path, dtype=np.int64)
     steps = np.diff(path)
-    qp = _joint_quats(played)
+    qp = joint_quats(played)
     sp = pose_steps(qp)
     jp = jerk_magnitude(qp, played.fps)
     skp, frac = foot_skate(played, ref.ground, ref.contact_height, ref.foot_joints)
@@ -172,3 +174,123 @@ def smoothness(reference: Reference, played, path) -> dict:
         "foot_skate_original_mps": ref.skate,
         "contact_fraction": frac,
     }
+
+
+def transitions(path) -> np.ndarray:
+    """Indices ``t`` of the steps ``path[t-1] -> path[t]`` that are *non-temporal*
+    transitions: a jump to a frame that is neither the next nor the previous one."""
+    path = np.asarray(path, dtype=np.int64)
+    return np.flatnonzero(np.abs(np.diff(path)) != 1) + 1
+
+
+def pass_jumps(path, same_pass: int) -> np.ndarray:
+    """The transitions that jump to *another pass* of the capture: ``|path[t] - path[t-1]| > same_pass``
+    (the others skip or hold frames of the same pass)."""
+    path = np.asarray(path, dtype=np.int64)
+    return np.flatnonzero(np.abs(np.diff(path)) > int(same_pass)) + 1
+
+
+def classify_path(path, same_pass: int | None = None) -> str:
+    """What a path plays.
+
+    * ``"replays"``: every step is the next frame (the capture as recorded);
+    * ``"replays_backwards"``: only next/previous frames, at least one previous;
+    * ``"skips"``: non-temporal transitions, but all within ``same_pass``
+      frames (the capture played forwards or backwards with frames dropped
+      or held) -- only when ``same_pass`` is given;
+    * ``"resequences"``: at least one jump to another pass (any non-temporal
+      transition when ``same_pass`` is None).
+    """
+    path = np.asarray(path, dtype=np.int64)
+    if transitions(path).size:
+        if same_pass is None or pass_jumps(path, same_pass).size:
+            return "resequences"
+        return "skips"
+    return "replays_backwards" if np.any(np.diff(path) < 0) else "replays"
+
+
+def _step_velocities(q, fps: float) -> np.ndarray:
+    """Angular velocity of every forward step (rad/s, full angle): (frames-1, joints, 3)."""
+    return 2.0 * relative_log(q[:-1], q[1:]) * fps
+
+
+class TransitionReference:
+    """The capture's typical frame-to-frame changes that transitions are judged against.
+
+    * ``step``: mean pose step (radians, :func:`pose_steps`);
+    * ``vel``: mean over the capture of ``||w_{s+1} - w_{s-1}||`` (rad/s), the
+      change of the step velocity across one step -- what a transition at
+      step ``s`` changes;
+    * ``acc``: mean of ``||(w_{s+2} - w_{s+1}) - (w_{s-1} - w_{s-2})||``,
+      the change of acceleration across one step;
+    * ``skate``: the capture's mean contact foot speed (:func:`foot_skate`).
+    """
+
+    def __init__(self, original, contact_height: float = 0.02, foot_joints=FOOT_JOINTS):
+        q = joint_quats(original)
+        if q.shape[0] < 6:
+            raise ValueError("the original motion needs at least 6 frames")
+        w = _step_velocities(q, original.fps)
+        self.fps = float(original.fps)
+        self.step = float(pose_steps(q).mean())
+        self.vel = float(np.linalg.norm((w[2:] - w[:-2]).reshape(len(w) - 2, -1), axis=1).mean())
+        a = np.diff(w, axis=0)  # a[s] = w[s+1] - w[s]
+        self.acc = float(np.linalg.norm((a[3:] - a[:-3]).reshape(len(a) - 3, -1), axis=1).mean())
+        self.contact_height = float(contact_height)
+        self.foot_joints = tuple(foot_joints)
+        self.ground = foot_ground(original, self.foot_joints)
+        self.skate, _ = foot_skate(original, self.ground, self.contact_height, self.foot_joints)
+
+
+def transition_measures(reference: TransitionReference, played, full_path, first: int, last: int,
+                        window: int) -> list[dict]:
+    """Smoothness of every non-temporal transition of a played path.
+
+    Parameters
+    ----------
+    reference : :class:`TransitionReference` of the original trial
+    played : Motion of ``full_path`` (the path inside its context frames)
+    full_path : int array (frames,), frame indices of ``played``
+    first, last : positions in ``full_path`` of the path's first and last frame
+        (the context frames outside are never counted as transitions)
+    window : frames on each side of a transition for its foot-skate window
+
+    Returns one dict per transition (position ``t`` = the step ``t-1 -> t``):
+    ``pose_jump_ratio`` (the step's pose distance over the capture's mean step),
+    ``velocity_jump_ratio`` (``||w_t - w_{t-2}||``, step velocities after and
+    before the transition step, over the capture's same quantity),
+    ``accel_jump_ratio`` (``||(w_{t+1} - w_t) - (w_{t-2} - w_{t-3})||`` over
+    the capture's), ``foot_skate_ratio`` (mean contact foot speed within
+    ``window`` frames of the transition over the capture's). NaN where the
+    played motion has too few frames on a side.
+    """
+    ref = reference
+    full_path = np.asarray(full_path, dtype=np.int64)
+    q = joint_quats(played)
+    w = _step_velocities(q, played.fps)  # w[s]: step s -> s+1
+    steps = pose_steps(q)
+    P = _foot_positions(played, ref.foot_joints)
+    contact = (P[:, :, 1] - np.asarray(ref.ground)[None, :]) <= ref.contact_height
+    both = contact[:-1] & contact[1:]
+    speed = np.linalg.norm(np.diff(P[:, :, [0, 2]], axis=0), axis=-1) * played.fps
+    F = q.shape[0]
+    out = []
+    for t in transitions(full_path[first:last + 1]) + first:
+        s = t - 1  # the transition step s -> s+1 = t
+        row = {"position": int(t - first), "from_frame": int(full_path[t - 1]), "to_frame": int(full_path[t]),
+               "lag": int(full_path[t] - full_path[t - 1]),
+               "pose_jump_ratio": _ratio(steps[s], ref.step)}
+        if s - 1 >= 0 and s + 1 < F - 1:
+            row["velocity_jump_ratio"] = _ratio(np.linalg.norm(w[s + 1] - w[s - 1]), ref.vel)
+        else:
+            row["velocity_jump_ratio"] = float("nan")
+        if s - 2 >= 0 and s + 2 < F - 1:
+            row["accel_jump_ratio"] = _ratio(np.linalg.norm((w[s + 2] - w[s + 1]) - (w[s - 1] - w[s - 2])), ref.acc)
+        else:
+            row["accel_jump_ratio"] = float("nan")
+        lo, hi = max(0, s - window), min(F - 1, s + window + 1)
+        sel = both[lo:hi]
+        row["foot_skate_ratio"] = (_ratio(float(speed[lo:hi][sel].mean()), ref.skate) if sel.any()
+                                   else float("nan"))
+        out.append(row)
+    return out

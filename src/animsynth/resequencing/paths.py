@@ -87,7 +87,7 @@ def _wrap(a):
     return (a + np.pi) % (2 * np.pi) - np.pi
 
 
-def play_path(motion: Motion, path, root: str = "integrate", name: str | None = None) -> Motion:
+def play_path(motion: Motion, path, root: str = "integrate", name: str | None = None, same_pass: int = 1) -> Motion:
     """The motion a frame-index path plays.
 
     Joint angles are those of the path's frames. The root:
@@ -96,8 +96,10 @@ def play_path(motion: Motion, path, root: str = "integrate", name: str | None = 
       character teleports when the path jumps between distant frames).
     * ``"integrate"``: root motion is re-integrated. Each step ``a -> b`` moves
       the root by the original displacement ``p[b] - p[a]`` and turns it by the
-      original heading change when ``|b - a| == 1`` (a temporal step, forward
-      *or backward*); after a jump it uses frame ``b``'s own step ``b-1 -> b``.
+      original heading change when ``1 <= |b - a| <= same_pass`` (a step within
+      the same pass of the capture, forward *or backward*, possibly skipping
+      frames); after a jump to another pass it uses frame ``b``'s own step
+      ``b-1 -> b``.
       Displacements are expressed in the heading frame (rotation about Y), so
       they follow the accumulated heading; the height is frame ``b``'s own.
 
@@ -123,7 +125,7 @@ def play_path(motion: Motion, path, root: str = "integrate", name: str | None = 
         new_p[0] = p[path[0]]
         for t in range(1, m):
             a, b = int(path[t - 1]), int(path[t])
-            if abs(b - a) == 1:
+            if 1 <= abs(b - a) <= max(1, int(same_pass)):
                 src, dst = a, b
             elif b > 0:
                 src, dst = b - 1, b

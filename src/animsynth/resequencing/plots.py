@@ -48,7 +48,10 @@ def embedding_figure(path, panels: list[dict], title: str) -> None:
 
 def residual_variance_figure(path, rv: pd.DataFrame, title: str) -> None:
     """Fig. 3: residual variance against embedding dimension, one line per
-    method x metric x global flag."""
+    method x metric x global flag, at each configuration's minimum k (the
+    paper's choice; rows of the fixed-k sweep, ``k_mode == "fixed"``, are left out)."""
+    if "k_mode" in rv.columns:
+        rv = rv[rv["k_mode"] == "min_k"]
     fig, ax = plt.subplots(figsize=(6.0, 4.0), dpi=100)
     styles = {("isomap", "l2"): ("tab:blue", "-"), ("isomap", "lee"): ("tab:blue", "--"),
               ("stisomap", "l2"): ("tab:red", "-"), ("stisomap", "lee"): ("tab:red", "--")}

@@ -2,10 +2,13 @@
 
 A *configuration* is dataset x global-DOF flag x method (``isomap``,
 ``stisomap``) x metric (``l2``, ``lee``). :func:`analyse` handles every
-method x metric of one dataset x global flag (distances, exact minimum k,
-Isomap / ST-Isomap fit, residual variance, 2-D embedding);
-:func:`resequence` makes and measures one re-sequenced motion;
-:func:`min_k_table`, :func:`verdicts` aggregate.
+method x metric of one dataset x global flag at the paper's k -- each
+configuration's exact minimum connected k -- (distances, Isomap / ST-Isomap
+fit, residual variance, 2-D embedding) plus the labelled fixed-k sweep;
+:func:`explain` computes the minimum k over the candidate explanations of the
+paper's Table 2 (sign mode x frame rate x global DOF) and the quaternion sign
+flips; :func:`resequence` makes and measures the re-sequenced motions;
+:func:`min_k_table` and :mod:`.verdicts` aggregate.
 
 The configuration dictionary ``cfg`` is the ``resequencing`` block of the
 workflow config (``docs/config_resequencing.md``); :data:`DEFAULTS` holds
@@ -17,6 +20,7 @@ from __future__ import annotations
 import copy
 import logging
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -24,9 +28,11 @@ import pandas as pd
 from ..io.amc import Motion
 from .distances import PAPER_WEIGHTS, l2_distances, lee_distances
 from .embedding import (DisconnectedGraphError, PrecomputedIsomap, graph_components, knn_graph,
-                        min_connected_k, neighbor_ranks, residual_variance, spatio_temporal_distances)
-from .features import motion_features
-from .metrics import Reference, smoothness
+                        min_connected_k, neighbor_ranks, residual_variance, spatio_temporal_distances,
+                        temporal_adjacency)
+from .features import SIGN_MODES, matrix_naive_quaternions, motion_features, sign_flips
+from .metrics import (Reference, TransitionReference, classify_path, jerk_magnitude, joint_quats, pass_jumps,
+                      transition_measures)
 from .paths import pad_path, play_path, resolve_frame, shortest_path_frames
 
 log = logging.getLogger("animsynth.resequencing")
@@ -44,17 +50,22 @@ DEFAULTS = {
     "global_dof": [False, True],
     "max_frames": 800,
     "frame_step": 1,
-    "n_neighbors": 10,
+    "linearisation": {"sign_mode": "continuous", "translation_scale": 1.0},
+    "fixed_k_sweep": [10],
     "max_dim": 10,
     "lee": {"weights": dict(PAPER_WEIGHTS), "nu": 0.01, "sqrt": False},
-    "stisomap": {"temporal_window": 1, "c_ctn": 10.0, "c_cctn": 10.0, "ctn_neighbors": 4,
+    "stisomap": {"temporal_window": 1, "c_atn": 10.0, "c_ctn": 10.0, "ctn_neighbors": 4,
                  "ctn_min_gap_s": 0.25, "ctn_tolerance": 2, "ctn_reach_s": 0.05},
-    "path": {"start": 0, "end": -1, "random_pairs": 20, "min_separation": 0.25, "context_s": 0.25,
-             "pad_to": None, "pad_mode": "hold", "root_playback": "auto"},
+    "explanations": {"sign_modes": ["continuous", "matrix_naive"], "frame_steps": [1, 4],
+                     "global_dof": [False, True], "magnitude_factor": 3.16, "lee_small_max": 7},
+    "path": {"start": -1, "end": 0, "random_pairs": 20, "min_separation": 0.3, "context_s": 0.25,
+             "transition_window_s": 0.1, "pad_to": None, "pad_mode": "hold", "root_playback": "integrate"},
     "smoothness": {"contact_height_m": 0.02, "reversal_speed_mps": 0.1},
-    "verdict_margin": 0.1,
+    "verdict_share": 0.75,
+    "verdict_alpha": 0.05,
     "gif_fps": 30,
-    "published_min_k": [],
+    "published": {"table2": "../shared/papers/s2_table2_min_k.csv",
+                  "lee_weights": "../shared/papers/s2_lee_weights.csv"},
 }
 
 
@@ -98,8 +109,8 @@ def st_kwargs(st: dict, fps: float) -> dict:
     tw = int(st["temporal_window"])
     return {
         "temporal_window": tw,
+        "c_atn": float(st["c_atn"]),
         "c_ctn": float(st["c_ctn"]),
-        "c_cctn": float(st["c_cctn"]),
         "ctn_neighbors": int(st["ctn_neighbors"]),
         "ctn_min_gap": max(tw, int(round(float(st["ctn_min_gap_s"]) * fps))),
         "ctn_tolerance": int(st["ctn_tolerance"]),
@@ -107,36 +118,55 @@ def st_kwargs(st: dict, fps: float) -> dict:
     }
 
 
-def base_distances(features, metric: str, include_global: bool, lee: dict) -> np.ndarray:
-    """The frame distance matrix of one metric."""
+def sign_mode_of(cfg: dict) -> str:
+    mode = cfg["linearisation"]["sign_mode"]
+    if mode not in SIGN_MODES:
+        raise ValueError(f"config key 'resequencing.linearisation.sign_mode': {mode!r} is not one of {SIGN_MODES}")
+    return mode
+
+
+def base_distances(features, metric: str, include_global: bool, cfg: dict, sign_mode: str | None = None) -> np.ndarray:
+    """The frame distance matrix of one metric (``cfg``: the resequencing block, with defaults).
+
+    ``sign_mode`` (default: ``linearisation.sign_mode``) applies to the L2
+    features only; the Lee metric is sign-invariant."""
+    lin = cfg["linearisation"]
+    scale = float(lin["translation_scale"])
     if metric == "l2":
-        return l2_distances(features.linearised(include_global))
+        mode = sign_mode_of(cfg) if sign_mode is None else sign_mode
+        return l2_distances(features.linearised(include_global, mode, scale))
     if metric == "lee":
-        return lee_distances(features, lee["weights"], float(lee["nu"]), include_global, bool(lee["sqrt"]))
+        lee = cfg["lee"]
+        return lee_distances(features, lee["weights"], float(lee["nu"]), include_global, bool(lee["sqrt"]), scale)
     raise ValueError(f"unknown metric {metric!r} (expected one of {METRICS})")
 
 
 def method_distances(D: np.ndarray, method: str, cfg: dict, fps: float):
-    """The matrix a method builds its k-NN graph on: ``D`` (Isomap) or the ST-adjusted ``D`` (ST-Isomap).
+    """The matrix a method builds its k-NN graph on, and the edges it always keeps.
 
-    Returns ``(matrix, n_ctn_pairs)`` (``n_ctn_pairs`` is 0 for Isomap)."""
+    Isomap: ``(D, None, 0)``. ST-Isomap: the spatio-temporally adjusted ``D``,
+    the adjacent-temporal-neighbour matrix (always in the neighbourhood) and
+    the number of common-temporal-neighbour pairs."""
     if method == "isomap":
-        return D, 0
+        return D, None, 0
     if method == "stisomap":
-        Dst, _, ctn = spatio_temporal_distances(D, **st_kwargs(cfg["stisomap"], fps))
-        return Dst, int(np.count_nonzero(np.triu(ctn)))
+        Dst, atn, ctn = spatio_temporal_distances(D, **st_kwargs(cfg["stisomap"], fps))
+        return Dst, atn, int(np.count_nonzero(np.triu(ctn)))
     raise ValueError(f"unknown method {method!r} (expected one of {METHODS})")
 
 
-def k_to_use(min_k: int, n_neighbors) -> int:
-    """``n_neighbors`` (or the minimum k if null); raised to the minimum k when smaller (logged)."""
-    if n_neighbors is None:
-        return int(min_k)
-    if n_neighbors < min_k:
-        log.warning("n_neighbors=%d leaves the graph disconnected; using the minimum connected k=%d",
-                    n_neighbors, min_k)
-        return int(min_k)
-    return int(n_neighbors)
+def checked_min_k(Dm, always=None, what: str = "") -> tuple[int, int, int, np.ndarray]:
+    """Exact min k cross-checked with ``connected_components``: ``(min_k, components at
+    min_k - 1, components at min_k, ranks)``; components at ``k = 0`` count the
+    always-present edges alone (the bare frames when there are none)."""
+    R = neighbor_ranks(Dm)
+    kmin = min_connected_k(Dm, ranks=R, always=always)
+    below = graph_components(Dm, kmin - 1, ranks=R, always=always)
+    at = graph_components(Dm, kmin, ranks=R, always=always)
+    if at != 1 or (kmin > 1 and below <= 1):
+        raise RuntimeError(f"min-k cross-check failed for {what}: {below} components at k={kmin - 1}, "
+                           f"{at} at k={kmin}")
+    return kmin, below, at, R
 
 
 def nontrivial_edge_fraction(graph, min_gap: int) -> float:
@@ -149,12 +179,18 @@ def nontrivial_edge_fraction(graph, min_gap: int) -> float:
 
 
 def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg: dict):
-    """Minimum k, residual variance and 2-D embeddings of every method x metric of one dataset x global flag.
+    """Min k, residual variance and 2-D embeddings of every method x metric of one dataset x global flag.
+
+    The embeddings, residual variance (``k_mode = "min_k"``) and the paths use
+    the paper's k: each configuration's exact minimum connected k. The
+    ``fixed_k_sweep`` values give extra residual-variance rows labelled
+    ``k_mode = "fixed"`` (skipped, and logged, where a fixed k leaves the graph
+    disconnected).
 
     Returns
     -------
     min_k : DataFrame, one row per method x metric
-    rv : DataFrame, residual variance per method x metric x dimension
+    rv : DataFrame, residual variance per method x metric x k x dimension
     embeddings : dict of arrays for the Fig. 2 plots (``<method>_<metric>_xy``, ``..._edges``)
     timings : DataFrame (machine-dependent seconds)
     """
@@ -162,70 +198,136 @@ def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg:
     feats = motion_features(motion)
     n = feats.n_frames
     gap = st_kwargs(cfg["stisomap"], motion.fps)["ctn_min_gap"]
+    mode = sign_mode_of(cfg)
     rows, rv_rows, t_rows, emb = [], [], [], {}
     max_dim = min(int(cfg["max_dim"]), n - 2)
     for metric in cfg["metrics"]:
         t0 = time.perf_counter()
-        D = base_distances(feats, metric, include_global, cfg["lee"])
+        D = base_distances(feats, metric, include_global, cfg)
         t_dist = time.perf_counter() - t0
         for method in cfg["methods"]:
             t0 = time.perf_counter()
-            Dm, n_ctn = method_distances(D, method, cfg, motion.fps)
-            R = neighbor_ranks(Dm)
-            kmin = min_connected_k(Dm, ranks=R)
+            Dm, always, n_ctn = method_distances(D, method, cfg, motion.fps)
+            kmin, below, at, R = checked_min_k(Dm, always, f"{dataset}/{method}/{metric}")
             t_mink = time.perf_counter() - t0
-            below = graph_components(Dm, kmin - 1, ranks=R) if kmin > 1 else n
-            at = graph_components(Dm, kmin, ranks=R)
-            if at != 1 or below <= 1:
-                raise RuntimeError(f"min-k cross-check failed for {dataset}/{method}/{metric}: "
-                                   f"{below} components at k={kmin - 1}, {at} at k={kmin}")
-            k = k_to_use(kmin, cfg["n_neighbors"])
-            t0 = time.perf_counter()
-            iso = PrecomputedIsomap(k, max_dim).fit(Dm)
-            t_fit = time.perf_counter() - t0
-            rv = residual_variance(iso.dist_matrix_, iso.embedding_)
+            t0, c0 = time.perf_counter(), time.process_time()
+            iso = PrecomputedIsomap(kmin, max_dim).fit(Dm, always=always)
+            t_fit, c_fit = time.perf_counter() - t0, time.process_time() - c0
             key = f"{method}_{metric}"
             emb[f"{key}_xy"] = iso.embedding_[:, :2]
             gi, gj = iso.graph_.nonzero()
             up = gi < gj
             emb[f"{key}_edges"] = np.stack([gi[up], gj[up]], axis=1).astype(np.int32)
-            emb[f"{key}_k"] = np.int64(k)
+            emb[f"{key}_k"] = np.int64(kmin)
             rows.append({
-                "dataset": dataset, "trial": trial, "frames": n, "global_dof": include_global,
-                "method": method, "metric": metric, "min_k": kmin,
+                "dataset": dataset, "trial": trial, "frames": n, "fps": motion.fps, "global_dof": include_global,
+                "sign_mode": mode, "method": method, "metric": metric, "min_k": kmin,
                 "components_at_min_k_minus_1": below, "components_at_min_k": at,
-                "k_used": k, "ctn_pairs": n_ctn if method == "stisomap" else np.nan,
+                "k_used": kmin, "ctn_pairs": n_ctn if method == "stisomap" else np.nan,
                 "nontrivial_edge_fraction": round(nontrivial_edge_fraction(iso.graph_, gap), 6),
             })
-            for d, r in enumerate(rv, start=1):
-                rv_rows.append({"dataset": dataset, "global_dof": include_global, "method": method,
-                                "metric": metric, "k": k, "dim": d, "residual_variance": round(float(r), 6)})
+            fits = [("min_k", kmin, iso)]
+            for kf in cfg["fixed_k_sweep"] or []:
+                kf = int(kf)
+                if kf > n - 1 or graph_components(Dm, kf, ranks=R, always=always) > 1:
+                    log.warning("%s %s/%s: fixed k=%d leaves the graph disconnected (min k %d); skipped",
+                                dataset, method, metric, kf, kmin)
+                    continue
+                fits.append(("fixed", kf, PrecomputedIsomap(kf, max_dim).fit(Dm, always=always)))
+            for k_mode, k, est in fits:
+                rv = residual_variance(est.dist_matrix_, est.embedding_)
+                for d, r in enumerate(rv, start=1):
+                    rv_rows.append({"dataset": dataset, "global_dof": include_global, "method": method,
+                                    "metric": metric, "k_mode": k_mode, "k": k, "dim": d,
+                                    "residual_variance": round(float(r), 6)})
             t_rows.append({"dataset": dataset, "global_dof": include_global, "method": method, "metric": metric,
                            "frames": n, "seconds_distances": t_dist, "seconds_min_k": t_mink,
-                           "seconds_geodesics_embedding": t_fit})
-            log.info("%s global=%s %s/%s: min k %d (components %d at k-1), k used %d, RV(2)=%.4f, fit %.2fs",
-                     dataset, include_global, method, metric, kmin, below, k, rv[min(1, len(rv) - 1)], t_fit)
+                           "seconds_geodesics_embedding": t_fit, "cpu_seconds_geodesics_embedding": c_fit})
+            log.info("%s global=%s %s/%s: min k %d (components %d at k-1), fit %.2fs",
+                     dataset, include_global, method, metric, kmin, below, t_fit)
     return pd.DataFrame(rows), pd.DataFrame(rv_rows), emb, pd.DataFrame(t_rows)
 
 
+def explain(motion: Motion, dataset: str, trial: str, cfg: dict):
+    """Minimum k over the candidate explanations of the paper's Table 2, and sign flips.
+
+    ``motion`` is the trial *before* ``frame_step`` (``max_frames`` applied
+    here). For every ``explanations.frame_steps`` x ``explanations.global_dof``
+    x ``explanations.sign_modes`` x method x metric: the exact minimum k,
+    cross-checked. The Lee metric does not depend on the sign mode (it is
+    computed once per frame step x global flag and repeated in both rows).
+
+    Returns
+    -------
+    grid : DataFrame, one row per condition x method x metric
+    flips : DataFrame, sign flips per joint (root included) of the ``matrix_naive``
+        quaternions per frame step (``continuous`` has none by construction)
+    """
+    cfg = with_defaults(cfg)
+    ex = cfg["explanations"]
+    rows, flip_rows = [], []
+    for step in ex["frame_steps"]:
+        m = prepare_motion(motion, cfg["max_frames"], int(step))
+        feats = motion_features(m)
+        qall = np.concatenate([feats.root_quat[:, None, :], feats.quats], axis=1)
+        names = ["root"] + list(feats.joint_names)
+        fl = sign_flips(matrix_naive_quaternions(qall))
+        cont = sign_flips(qall)
+        for j, name in enumerate(names):
+            flip_rows.append({"dataset": dataset, "trial": trial, "frame_step": int(step), "fps": m.fps,
+                              "frames": m.n_frames, "joint": name, "flips_matrix_naive": int(fl[j]),
+                              "flips_continuous": int(cont[j])})
+        for g in ex["global_dof"]:
+            g = bool(g)
+            for metric in cfg["metrics"]:
+                modes = ex["sign_modes"]
+                D_lee = base_distances(feats, "lee", g, cfg) if metric == "lee" else None
+                for mode in modes:
+                    D = D_lee if metric == "lee" else base_distances(feats, "l2", g, cfg, sign_mode=mode)
+                    for method in cfg["methods"]:
+                        Dm, always, _ = method_distances(D, method, cfg, m.fps)
+                        kmin, below, at, _ = checked_min_k(Dm, always, f"{dataset}/{step}/{g}/{mode}/{method}/{metric}")
+                        rows.append({"dataset": dataset, "trial": trial, "frame_step": int(step), "fps": m.fps,
+                                     "frames": m.n_frames, "global_dof": g, "sign_mode": mode, "method": method,
+                                     "metric": metric, "min_k": kmin, "components_at_min_k_minus_1": below,
+                                     "components_at_min_k": at})
+        log.info("%s frame_step %d: matrix_naive flips %s", dataset, step,
+                 {nm: int(c) for nm, c in zip(names, fl) if c})
+    return pd.DataFrame(rows), pd.DataFrame(flip_rows)
+
+
 def path_pairs(n: int, path_cfg: dict, seed: int) -> list[tuple[int, int]]:
-    """Start/end frame pairs: the configured pair first, then ``random_pairs`` seeded
-    random pairs whose frames are at least ``min_separation * n`` apart."""
+    """The measured start/end pairs: ``random_pairs`` seeded pairs whose *end comes
+    before the start* by at least ``min_separation * n`` frames.
+
+    Why: a path that only steps to the next frame can never reach an earlier
+    frame, so every such pair forces the shortest path to leave the original
+    order -- it either jumps between passes (re-sequences) or plays the capture
+    backwards (classified ``replays_backwards``). With ``min_separation`` 0.3
+    the two frames lie about a cycle or more apart on the CMU walk (358
+    frames, about 1 s per cycle) and run (167 frames, about 0.7 s per cycle).
+    The same pairs are used for every method, metric and global flag of a dataset.
+    """
+    count = int(path_cfg["random_pairs"])
+    sep = max(2, int(round(float(path_cfg["min_separation"]) * n)))
+    if count > 0 and sep >= n:
+        raise ValueError(f"config key 'resequencing.path.min_separation': no pair of {n} frames is {sep} apart")
+    rng = np.random.default_rng(seed)
+    pairs = []
+    while len(pairs) < count:
+        a, b = (int(x) for x in rng.integers(0, n, size=2))
+        if a - b >= sep:
+            pairs.append((a, b))
+    return pairs
+
+
+def main_pair(n: int, path_cfg: dict) -> tuple[int, int]:
+    """The configured start/end of the main path (BVH and GIF)."""
     start = resolve_frame(path_cfg["start"], n, "config key 'resequencing.path.start'")
     end = resolve_frame(path_cfg["end"], n, "config key 'resequencing.path.end'")
     if start == end:
         raise ValueError("config keys 'resequencing.path.start' and '.end' name the same frame")
-    pairs = [(start, end)]
-    count = int(path_cfg["random_pairs"])
-    sep = max(1, int(round(float(path_cfg["min_separation"]) * n)))
-    if count > 0 and sep >= n:
-        raise ValueError(f"config key 'resequencing.path.min_separation': no pair of {n} frames is {sep} apart")
-    rng = np.random.default_rng(seed)
-    while len(pairs) < count + 1:
-        a, b = (int(x) for x in rng.integers(0, n, size=2))
-        if abs(a - b) >= sep:
-            pairs.append((a, b))
-    return pairs
+    return start, end
 
 
 def splice(path, n: int, context: int) -> np.ndarray:
@@ -236,196 +338,187 @@ def splice(path, n: int, context: int) -> np.ndarray:
     return np.concatenate([pre, path, post])
 
 
-def resequence(motion: Motion, include_global: bool, method: str, metric: str, k: int, cfg: dict, seed: int = 0):
-    """Re-sequence one configuration: Dijkstra paths on the method's k-NN graph, played and measured.
+def config_graph(motion: Motion, include_global: bool, method: str, metric: str, k: int, cfg: dict):
+    """The weighted neighbourhood graph a configuration's paths run on (k checked)."""
+    cfg = with_defaults(cfg)
+    feats = motion_features(motion)
+    D = base_distances(feats, metric, include_global, cfg)
+    Dm, always, _ = method_distances(D, method, cfg, motion.fps)
+    ncomp = graph_components(Dm, k, always=always)
+    if ncomp > 1:
+        raise DisconnectedGraphError(f"{method}/{metric}: the {k}-NN graph has {ncomp} components "
+                                     f"(the smallest connected k is {min_connected_k(Dm, always=always)})")
+    return knn_graph(Dm, k, always=always)
 
-    Every start/end pair of :func:`path_pairs` gives one path. Each path is
-    played inside its context (``path.context_s`` seconds of the original
-    before the start and after the end, so a transition is judged where it
-    happens) and measured against the original (:func:`~.metrics.smoothness`).
+
+#: Per-transition measures (ratios to the capture; 1 = an ordinary step of the capture, larger = rougher).
+TRANSITION_MEASURES = ["pose_jump_ratio", "velocity_jump_ratio", "accel_jump_ratio", "foot_skate_ratio"]
+
+
+def resequence(motion: Motion, include_global: bool, method: str, metric: str, k: int, cfg: dict, seed: int = 0):
+    """Re-sequence one configuration: Dijkstra paths on the method's graph, played and measured.
+
+    Every pair of :func:`path_pairs` gives one path. Each path is played inside
+    its context (``path.context_s`` seconds of the original before the start
+    and after the end, so a transition near an end is judged with real
+    neighbours) with the root ``path.root_playback`` (the same whatever the
+    global-DOF flag). Per path: frames played, non-temporal transitions (and
+    per 100 frames played), backward steps, its class
+    (:func:`~.metrics.classify_path`), jerk events per 100 frames played
+    (frames of the path -- not of the context -- jerkier than the capture's
+    jerkiest) and the mean of each per-transition measure
+    (:func:`~.metrics.transition_measures`).
 
     Returns
     -------
-    paths : list of int arrays (the Dijkstra paths, unpadded, pair 0 first)
-    main : Motion, the motion of pair 0's path (padded to ``path.pad_to`` if set)
-    per_path : DataFrame, one row of measures per pair
+    paths : list of int arrays, the Dijkstra paths of the measured pairs
+    main : (int array, Motion), the main path (padded to ``path.pad_to``) and the motion it plays
+    per_path : DataFrame, one row per pair
+    per_transition : DataFrame, one row per transition
     """
     cfg = with_defaults(cfg)
-    feats = motion_features(motion)
-    n = feats.n_frames
-    D = base_distances(feats, metric, include_global, cfg["lee"])
-    Dm, _ = method_distances(D, method, cfg, motion.fps)
-    ncomp = graph_components(Dm, k)
-    if ncomp > 1:
-        raise DisconnectedGraphError(f"{method}/{metric}: the {k}-NN graph has {ncomp} components")
-    G = knn_graph(Dm, k)
+    n = motion.n_frames
+    G = config_graph(motion, include_global, method, metric, k, cfg)
     pc = cfg["path"]
     mode = pc["root_playback"]
-    if mode == "auto":
-        mode = "absolute" if include_global else "integrate"
+    if mode not in ("absolute", "integrate"):
+        raise ValueError(f"config key 'resequencing.path.root_playback': {mode!r} is not absolute or integrate")
     sm = cfg["smoothness"]
     ref = Reference(motion, float(sm["contact_height_m"]), float(sm["reversal_speed_mps"]))
+    tref = TransitionReference(motion, float(sm["contact_height_m"]))
     context = int(round(float(pc["context_s"]) * motion.fps))
-    paths, rows = [], []
+    window = max(1, int(round(float(pc["transition_window_s"]) * motion.fps)))
+    same_pass = st_kwargs(cfg["stisomap"], motion.fps)["ctn_min_gap"]  # frames closer in time: the same pass
+    paths, rows, trows = [], [], []
     for p, (a, b) in enumerate(path_pairs(n, pc, seed)):
         path, cost = shortest_path_frames(G, a, b)
         paths.append(path)
         full = splice(path, n, context)
-        played = play_path(motion, full, root=mode)
-        row = {"pair": p, "start": a, "end": b, "path_frames": int(path.size), "path_cost": cost}
-        row.update(smoothness(ref, played, full))
+        first = int(a - max(0, a - context))  # position of the path's first frame in ``full``
+        last = first + path.size - 1
+        played = play_path(motion, full, root=mode, same_pass=same_pass)
+        tr = transition_measures(tref, played, full, first, last, window)
+        jm = jerk_magnitude(joint_quats(played), played.fps)
+        lo, hi = max(0, first - 1), max(0, last - 1)  # jerk i spans frames i..i+3: centre inside the path
+        jerk_events = int(np.count_nonzero(jm[lo:hi] > ref.jerk.max())) if jm.size else 0
+        nt = len(tr)
+        row = {"pair": p, "start": a, "end": b, "frames_played": int(path.size), "path_cost": cost,
+               "transitions": nt, "transitions_per_100_frames": 100.0 * nt / path.size,
+               "pass_jumps": int(pass_jumps(path, same_pass).size),
+               "backward_steps": int(np.count_nonzero(np.diff(path) < 0)),
+               "path_class": classify_path(path, same_pass),
+               "jerk_events_per_100_frames": 100.0 * jerk_events / path.size}
+        for c in TRANSITION_MEASURES:
+            vals = np.array([t[c] for t in tr], float)
+            row[c] = float(np.nanmean(vals)) if nt and np.isfinite(vals).any() else np.nan
         rows.append(row)
-    padded = pad_path(paths[0], pc["pad_to"], pc["pad_mode"])
-    main = play_path(motion, padded, root=mode,
-                     name=f"{motion.name}_{method}_{metric}_{gdof_name(include_global)}")
+        for i, t in enumerate(tr):
+            trows.append({"pair": p, "transition": i, **t})
+    a, b = main_pair(n, pc)
+    main_path, _ = shortest_path_frames(G, a, b)
+    padded = pad_path(main_path, pc["pad_to"], pc["pad_mode"])
+    main = play_path(motion, padded, root=mode, name=f"{motion.name}_{method}_{metric}_{gdof_name(include_global)}",
+                     same_pass=same_pass)
     per_path = pd.DataFrame(rows)
     per_path.insert(0, "root_playback", mode)
     per_path.insert(0, "k", k)
-    return paths, main, per_path
+    per_tr = pd.DataFrame(trows, columns=["pair", "transition", "position", "from_frame", "to_frame", "lag",
+                                          *TRANSITION_MEASURES])
+    per_tr.insert(per_tr.columns.get_loc("lag") + 1, "kind",
+                  np.where(per_tr["lag"].abs() > same_pass, "pass_jump", "skip"))
+    return paths, (padded, main), per_path, per_tr
 
 
-#: Columns of smoothness.csv averaged over the pairs of a configuration.
-SMOOTH_MEANS = ["path_frames", "jumps", "backward_steps", "jump_mean_ratio", "jump_p95_ratio", "jump_max_ratio",
-                "jerk_mean_ratio", "jerk_events", "root_reversals", "foot_skate_mps"]
+CONFIG_KEYS = ["dataset", "global_dof", "method", "metric"]
 
 
 def summarise_paths(per_path: pd.DataFrame) -> pd.DataFrame:
-    """One smoothness row per configuration: means over its start/end pairs (NaN-aware),
-    plus the original's reference values."""
-    keys = ["dataset", "global_dof", "method", "metric", "k", "root_playback"]
-    g = per_path.groupby(keys, sort=False)
-    out = g[SMOOTH_MEANS].mean()
-    out.insert(0, "paths", g.size())
-    out["root_reversals_per_s_original"] = g["root_reversals_per_s_original"].first()
-    out["foot_skate_original_mps"] = g["foot_skate_original_mps"].first()
-    out = out.reset_index()
-    for c in SMOOTH_MEANS + ["root_reversals_per_s_original", "foot_skate_original_mps"]:
-        out[c] = out[c].astype(float).round(6)
-    return out
+    """One smoothness row per configuration.
+
+    Counts over all measured pairs (paths, share re-sequencing -- at least one
+    jump to another pass --, replaying, backward-replaying and frame-skipping
+    paths, mean transitions per path and per 100 frames played, pass jumps per
+    path); smoothness means over the *re-sequencing* paths only (replaying
+    paths have no transitions to judge)."""
+    keys = CONFIG_KEYS + ["k", "root_playback"]
+    out = []
+    for key, g in per_path.groupby(keys, sort=False):
+        rs = g[g["path_class"] == "resequences"]
+        row = dict(zip(keys, key))
+        row.update({
+            "paths": len(g), "resequencing_paths": len(rs),
+            "share_resequencing": round(len(rs) / len(g), 6),
+            "replaying_paths": int((g["path_class"] == "replays").sum()),
+            "backward_replaying_paths": int((g["path_class"] == "replays_backwards").sum()),
+            "skipping_paths": int((g["path_class"] == "skips").sum()),
+            "frames_played_mean": round(float(g["frames_played"].mean()), 3),
+            "transitions_per_path": round(float(g["transitions"].mean()), 4),
+            "transitions_per_100_frames": round(float(g["transitions_per_100_frames"].mean()), 4),
+            "pass_jumps_per_path": round(float(g["pass_jumps"].mean()), 4),
+        })
+        for c in TRANSITION_MEASURES + ["jerk_events_per_100_frames"]:
+            row[f"{c}_resequencing_mean"] = round(float(rs[c].mean()), 6) if len(rs) else np.nan
+        out.append(row)
+    return pd.DataFrame(out)
 
 
-def min_k_table(min_k: pd.DataFrame, published=None) -> pd.DataFrame:
-    """The paper's Table 2 layout (long form) with the published values beside ours.
+def read_published(path) -> pd.DataFrame | None:
+    """The paper's Table 2 from ``path`` (CSV: motion, frames, global_dof, method, metric, min_k),
+    mapped to our names; ``None`` when the file does not exist (no published values)."""
+    if path is None or not Path(path).is_file():
+        log.info("published Table 2 %s not found: min_k_paper left empty", path)
+        return None
+    df = pd.read_csv(path)
+    need = {"motion", "frames", "global_dof", "method", "metric", "min_k"}
+    if not need <= set(df.columns):
+        raise ValueError(f"{path}: expected columns {sorted(need)}, got {list(df.columns)}")
+    gd = {"included": True, "excluded": False}
+    meth = {"isomap": "isomap", "st-isomap": "stisomap", "stisomap": "stisomap"}
+    bad = df[~df["global_dof"].isin(gd) | ~df["method"].isin(meth) | ~df["metric"].isin(METRICS)]
+    if len(bad):
+        raise ValueError(f"{path} line {int(bad.index[0]) + 2}: unknown global_dof/method/metric "
+                         f"{bad.iloc[0][['global_dof', 'method', 'metric']].tolist()}")
+    return pd.DataFrame({"dataset": df["motion"], "paper_frames": df["frames"].astype(int),
+                         "global_dof": df["global_dof"].map(gd), "method": df["method"].map(meth),
+                         "metric": df["metric"], "min_k_paper": df["min_k"].astype(int)})
 
-    ``published``: list of ``{dataset, global_dof, method, metric, min_k}``;
-    missing values stay empty (we do not know the paper's numbers unless given).
-    """
-    df = min_k.copy()
+
+def check_lee_weights(path, weights: dict) -> pd.DataFrame | None:
+    """Our Lee weights beside the paper's (``joint_pair, weight``); ``None`` without the file."""
+    if path is None or not Path(path).is_file():
+        return None
+    df = pd.read_csv(path)
+    if not {"joint_pair", "weight"} <= set(df.columns):
+        raise ValueError(f"{path}: expected columns joint_pair, weight; got {list(df.columns)}")
+    df = df.rename(columns={"joint_pair": "group", "weight": "weight_paper"})
+    df["weight_ours"] = df["group"].map(lambda g: float(weights.get(g, 0.0)))
+    df["match"] = np.isclose(df["weight_ours"], df["weight_paper"], rtol=0, atol=5e-5)
+    return df
+
+
+def min_k_table(grid: pd.DataFrame, published: pd.DataFrame | None, frame_step: int) -> pd.DataFrame:
+    """The paper's Table 2 layout (long form): our min k in both sign modes at the
+    workflow's ``frame_step``, with the paper's value beside the matching rows
+    (the paper's global-DOF setting per motion; other rows empty)."""
+    df = grid[grid["frame_step"] == int(frame_step)].copy()
     df["min_k_paper"] = np.nan
-    for rec in published or []:
-        m = ((df["dataset"] == rec["dataset"]) & (df["global_dof"] == bool(rec["global_dof"]))
-             & (df["method"] == rec["method"]) & (df["metric"] == rec["metric"]))
-        df.loc[m, "min_k_paper"] = rec["min_k"]
+    df["paper_frames"] = np.nan
+    if published is not None:
+        for rec in published.itertuples():
+            m = ((df["dataset"] == rec.dataset) & (df["global_dof"] == bool(rec.global_dof))
+                 & (df["method"] == rec.method) & (df["metric"] == rec.metric))
+            df.loc[m, "min_k_paper"] = rec.min_k_paper
+            df.loc[m, "paper_frames"] = rec.paper_frames
     order = {"walk": 0, "run": 1, "dance": 2}
     df["_o"] = df["dataset"].map(lambda d: order.get(d, 9))
-    df = df.sort_values(["_o", "dataset", "global_dof", "method", "metric"], kind="stable").drop(columns="_o")
-    cols = ["dataset", "trial", "frames", "global_dof", "method", "metric", "min_k", "min_k_paper",
-            "components_at_min_k_minus_1", "components_at_min_k", "k_used", "ctn_pairs", "nontrivial_edge_fraction"]
-    return df[cols].reset_index(drop=True)
-
-
-def _pct(x: float) -> str:
-    if not np.isfinite(x):
-        return "+inf %" if x > 0 else "n/a"
-    return f"{100 * x:+.0f} %"
-
-
-def _change(a: float, b: float) -> float:
-    """Relative change a -> b; +inf when a == 0 < b, 0 when both are 0."""
-    if a > 0:
-        return b / a - 1.0
-    return 0.0 if b <= 0 else float("inf")
-
-
-#: (column, label) of the measures behind the verdicts; larger = worse for all.
-VERDICT_MEASURES = [("jerk_events", "jerk events per path"), ("jump_p95_ratio", "pose jumps (p95 ratio)"),
-                    ("root_reversals", "root reversals per path"), ("foot_skate_mps", "foot skate (m/s)")]
-
-
-def verdicts(smooth: pd.DataFrame, margin: float = 0.1) -> pd.DataFrame:
-    """Verdicts on the paper's qualitative claims, computed from ``smoothness.csv`` rows
-    (each a configuration's mean over its start/end pairs).
-
-    * **ST-Isomap gives fewer jerks than Isomap**: jerk events (frames jerkier
-      than anything in the capture) summed over the configurations present for
-      both methods (dataset x metric x global flag). "yes, by x %" when
-      ST-Isomap's total is more than ``margin`` below Isomap's, "no" when more
-      than ``margin`` above, "no clear difference" otherwise.
-    * **Global DOF hurt cyclic locomotion but not dance**: for each dataset,
-      each measure of :data:`VERDICT_MEASURES` is summed over method x metric
-      with and without the global DOF; the dataset is *hurt* when at least
-      three of the four get worse by more than ``margin``. "yes" when walk and
-      run are hurt and dance is not.
-    """
-    cols = ["claim", "verdict", "evidence"]
-    if smooth.empty:
-        return pd.DataFrame(columns=cols)
-    rows = []
-    keys = ["dataset", "metric", "global_dof"]
-    iso = smooth[smooth["method"] == "isomap"].set_index(keys)
-    st = smooth[smooth["method"] == "stisomap"].set_index(keys)
-    common = iso.index.intersection(st.index)
-    for col, label in [("jerk_events", "jerks"), ("jerk_mean_ratio", "mean jerk"),
-                       ("jump_p95_ratio", "pose jumps (p95)")]:
-        claim = f"ST-Isomap gives fewer {label} than Isomap"
-        if len(common) == 0:
-            rows.append({"claim": claim, "verdict": "not measured", "evidence": "no configuration has both methods"})
-            continue
-        a = iso.loc[common, col].astype(float)
-        b = st.loc[common, col].astype(float)
-        ok = a.notna() & b.notna()
-        a, b = a[ok], b[ok]
-        ta, tb = float(a.sum()), float(b.sum())
-        ch = _change(ta, tb)
-        if ch < -margin:
-            verdict = f"yes, by {abs(ch) * 100:.0f} %"
-        elif ch > margin:
-            verdict = f"no: {ch * 100:.0f} % more" if np.isfinite(ch) else "no: Isomap has none, ST-Isomap some"
-        else:
-            verdict = f"no clear difference ({_pct(ch)}, within +-{margin * 100:.0f} %)"
-        per = "; ".join(f"{d} {m} {'global' if g else 'noglobal'} {x:.3g} vs {y:.3g}"
-                        for (d, m, g), x, y in zip(a.index, a.values, b.values))
-        rows.append({"claim": claim, "verdict": verdict,
-                     "evidence": f"{col} summed over {len(a)} configurations: Isomap {ta:.4g}, ST-Isomap {tb:.4g} "
-                                 f"({_pct(ch)}); ST-Isomap lower in {int((b < a).sum())}, higher in "
-                                 f"{int((b > a).sum())}; per configuration (Isomap vs ST-Isomap): {per}"})
-    keys_g = ["dataset", "method", "metric"]
-    without = smooth[~smooth["global_dof"].astype(bool)].set_index(keys_g)
-    with_ = smooth[smooth["global_dof"].astype(bool)].set_index(keys_g)
-    both = without.index.intersection(with_.index)
-    hurt, parts = {}, []
-    per_measure = {col: [] for col, _ in VERDICT_MEASURES}
-    for ds in dict.fromkeys(both.get_level_values(0)):
-        idx = [i for i in both if i[0] == ds]
-        worse, desc = 0, []
-        for col, label in VERDICT_MEASURES:
-            a = without.loc[idx, col].astype(float)
-            b = with_.loc[idx, col].astype(float)
-            ok = a.notna() & b.notna()
-            ta, tb = float(a[ok].sum()), float(b[ok].sum())
-            ch = _change(ta, tb)
-            worse += ch > margin
-            desc.append(f"{label} {ta:.3g} -> {tb:.3g} ({_pct(ch)})")
-            per_measure[col].append(f"{ds} {ta:.3g} -> {tb:.3g} ({_pct(ch)})")
-        hurt[ds] = worse >= 3
-        parts.append(f"{ds}: {'hurt' if hurt[ds] else 'not hurt'}, {worse}/4 measures worse with global DOF "
-                     f"[{'; '.join(desc)}]")
-    for col, label in VERDICT_MEASURES:  # supporting rows: each measure on its own
-        if per_measure[col]:
-            rows.append({"claim": f"including the global DOF increases {label}", "verdict": "see evidence",
-                         "evidence": "sum over method x metric, without -> with global DOF: "
-                                     + "; ".join(per_measure[col])})
-    claim = "global DOF hurt cyclic locomotion but not dance"
-    loco = [d for d in ("walk", "run") if d in hurt]
-    if loco and "dance" in hurt:
-        verdict = "yes" if all(hurt[d] for d in loco) and not hurt["dance"] else "no"
-        verdict += " (" + ", ".join(f"{d} {'hurt' if h else 'not hurt'}" for d, h in hurt.items()) + ")"
-    else:
-        verdict = "not measured (needs walk or run, and dance, with both global flags)"
-    rows.insert(1, {"claim": claim, "verdict": verdict,
-                    "evidence": f"sums over method x metric without -> with global DOF; hurt = at least 3 of 4 "
-                                f"measures worse by more than {margin * 100:.0f} %. " + " | ".join(parts)})
-    return pd.DataFrame(rows, columns=cols)
+    df["_s"] = df["sign_mode"].map(lambda x: SIGN_MODES.index(x) if x in SIGN_MODES else 9)
+    df = df.sort_values(["_o", "dataset", "global_dof", "_s", "method", "metric"], kind="stable")
+    cols = ["dataset", "trial", "frames", "fps", "global_dof", "sign_mode", "method", "metric", "min_k",
+            "min_k_paper", "paper_frames", "components_at_min_k_minus_1", "components_at_min_k"]
+    out = df[cols].reset_index(drop=True)
+    for c in ("min_k_paper", "paper_frames"):
+        out[c] = out[c].astype("Int64")
+    return out
 
 
 def resequence_motion(motion: Motion, start: int, end: int, method: str = "stisomap", metric: str = "l2",
@@ -434,22 +527,19 @@ def resequence_motion(motion: Motion, start: int, end: int, method: str = "stiso
     """One-call re-sequencing (CLI, notebooks): Dijkstra from ``start`` to ``end``.
 
     ``k`` defaults to the smallest k giving one connected component of the
-    method's k-NN graph. Returns the frame index path (padded to ``length``
-    if given) and the motion it plays.
+    method's graph. Returns the frame index path (padded to ``length`` if
+    given) and the motion it plays (root: ``path.root_playback``).
     """
     method = {"st-isomap": "stisomap"}.get(method, method)
     cfg = with_defaults(cfg)
     feats = motion_features(motion)
     n = feats.n_frames
     a, b = resolve_frame(start, n, "start"), resolve_frame(end, n, "end")
-    D = base_distances(feats, metric, global_dof, cfg["lee"])
-    Dm, _ = method_distances(D, method, cfg, motion.fps)
-    kmin = min_connected_k(Dm)
-    k = kmin if k is None else int(k)
-    ncomp = graph_components(Dm, k)
-    if ncomp > 1:
-        raise DisconnectedGraphError(f"{method}/{metric}: the {k}-NN graph has {ncomp} components "
-                                     f"(the smallest connected k is {kmin})")
-    path, _ = shortest_path_frames(knn_graph(Dm, k), a, b)
+    if k is None:
+        D = base_distances(feats, metric, global_dof, cfg)
+        Dm, always, _ = method_distances(D, method, cfg, motion.fps)
+        k = min_connected_k(Dm, always=always)
+    G = config_graph(motion, global_dof, method, metric, int(k), cfg)
+    path, _ = shortest_path_frames(G, a, b)
     path = pad_path(path, length, "hold")
-    return path, play_path(motion, path, root="absolute" if global_dof else "integrate", name="resequenced")
+    return path, play_path(motion, path, root=cfg["path"]["root_playback"], name="resequenced")
