@@ -43,7 +43,7 @@ def cmd_preview(a) -> None:
 
 def cmd_generate(a) -> None:
     from .io import read_amc, read_asf
-    from .io.amc import Motion
+    from .motion import Motion
     from .simplicial import generate_from_trials
 
     sk = read_asf(a.asf)

@@ -19,9 +19,10 @@ import urllib.request
 
 import pandas as pd
 
-from .io.amc import Motion, read_amc
+from .io.amc import read_amc
 from .io.asf import read_asf
 from .io.atomic import atomic_path
+from .motion import Motion
 
 log = logging.getLogger("animsynth.data")
 

@@ -2,7 +2,7 @@
 import os
 
 from animsynth.data import PAPER_TABLE_I, datasets_table
-from animsynth.io import Motion
+from animsynth.motion import Motion
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 

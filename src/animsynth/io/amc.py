@@ -1,76 +1,21 @@
 """Acclaim AMC motion reader and writer.
 
-:func:`read_amc` returns a :class:`Motion`: a ``(frames, n_dof)`` float array in
-degrees whose columns are ``skeleton.columns()`` (for CMU: 62 columns, the 6
-root DOF first, then the 56 joint angles in CMU AMC bone order).
+:func:`read_amc` returns a :class:`~animsynth.motion.Motion`: a
+``(frames, n_dof)`` float array in degrees whose columns are
+``skeleton.columns()`` (for CMU: 62 columns, the 6 root DOF first, then the 56
+joint angles in CMU AMC bone order).
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..motion import Motion
 from ..skeleton import Skeleton
 from .atomic import atomic_write_text
 from .errors import MotionFormatError, parse_float
-
-
-@dataclass
-class Motion:
-    """A motion on a skeleton.
-
-    Attributes
-    ----------
-    values : ndarray, shape (frames, n_dof)
-        DOF values: translations in skeleton length units, angles in degrees.
-    skeleton : Skeleton
-    fps : float
-    name : str
-    """
-
-    values: np.ndarray
-    skeleton: Skeleton
-    fps: float = 120.0
-    name: str = ""
-    meta: dict = field(default_factory=dict)
-
-    @property
-    def columns(self) -> list[str]:
-        return self.skeleton.columns()
-
-    @property
-    def n_frames(self) -> int:
-        return int(self.values.shape[0])
-
-    def without_root(self) -> np.ndarray:
-        """The joint angles with the root joint's DOF dropped (CMU: 56 columns)."""
-        n_root = len(self.skeleton.joints[0].dofs)
-        return self.values[:, n_root:]
-
-    # -- .npz storage used between workflow rules -------------------------
-    def save_npz(self, path) -> None:
-        from .atomic import atomic_path
-
-        with atomic_path(path, suffix=".npz") as tmp:
-            np.savez_compressed(
-                tmp,
-                values=self.values,
-                columns=np.array(self.columns),
-                fps=np.float64(self.fps),
-                name=np.array(self.name),
-                skeleton=np.array(self.skeleton.to_json()),
-            )
-
-    @classmethod
-    def load_npz(cls, path) -> "Motion":
-        with np.load(path, allow_pickle=False) as z:
-            sk = Skeleton.from_json(str(z["skeleton"]))
-            m = cls(np.array(z["values"], float), sk, float(z["fps"]), str(z["name"]))
-            if list(z["columns"]) != sk.columns():
-                raise MotionFormatError(path, None, "stored columns do not match the stored skeleton")
-        return m
 
 
 def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:

@@ -1,6 +1,6 @@
 """BVH (Biovision hierarchy) writer and reader.
 
-:func:`write_bvh` writes any :class:`~animsynth.io.amc.Motion` so that it opens
+:func:`write_bvh` writes any :class:`~animsynth.motion.Motion` so that it opens
 in Blender: one BVH joint per skeleton joint (ASF bone), ``OFFSET`` = where
 the joint starts relative to its parent (the parent bone's direction x
 length), an ``End Site`` at the tip of every leaf, root channels
@@ -25,8 +25,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..kinematics import dof_values_from_local, local_rotations, root_translation
+from ..motion import Motion
 from ..skeleton import Joint, Skeleton
-from .amc import Motion
 from .atomic import atomic_write_text
 from .errors import MotionFormatError, parse_float
 
