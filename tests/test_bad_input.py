@@ -1,0 +1,208 @@
+"""Bad input, fed to the readers and the command line as a careful user would.
+
+Every case asserts the error type, that the message names the file and line
+(or the argument / config key), and that nothing was written.
+"""
+
+import gzip
+import re
+
+import numpy as np
+import pytest
+
+from animsynth.io import MotionFormatError, read_amc, read_asf, write_amc, write_asf
+from animsynth.io.bvh import read_bvh, write_bvh
+from animsynth.io.obj import read_obj, read_obj_sequence, write_obj
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("bad_input")
+    sk = cmu_like_skeleton("s1", 3)
+    m = generate_motion("walk_straight", 40, 5, sk)
+    write_asf(d / "s1.asf", sk, length_unit=0.45)
+    write_amc(d / "s1_01.amc", m)
+    write_bvh(d / "s1_01.bvh", m)
+    return d, sk, m
+
+
+def _line_of(err: MotionFormatError, path) -> int:
+    """The line number in the message, checking that the message names the file."""
+    msg = str(err)
+    m = re.match(re.escape(str(path)) + r":(\d+): ", msg)
+    assert m, f"message does not start with 'file:line:': {msg}"
+    assert err.line == int(m.group(1))
+    return err.line
+
+
+def _replace_line(text: str, startswith: str, new: str) -> tuple[str, int]:
+    lines = text.split("\n")
+    k = next(i for i, ln in enumerate(lines) if ln.strip().startswith(startswith))
+    lines[k] = new
+    return "\n".join(lines), k + 1
+
+
+# --- OBJ ---------------------------------------------------------------
+
+SIX = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
+
+
+@pytest.mark.parametrize("faces,line,msg", [
+    # a quad then a two-vertex face: 6 tokens, once read as two triangles
+    ("f 1 2 3 4\nf 5 6\n", 8, "at least 3 vertices"),
+    # a face naming a vertex defined only after it
+    ("f 1 2 3\nf 4 5 7\nv 3 3 0\n", 8, "not defined before it"),
+    ("f 1 2 3\nf 1 2 3.5\n", 8, "non-integer face index"),
+])
+def test_obj_irregular_records_are_refused_and_not_cached(tmp_path, faces, line, msg):
+    d = tmp_path / "seq"
+    d.mkdir()
+    (d / "mesh_0000.obj").write_text(SIX + faces)
+    with pytest.raises(MotionFormatError, match=msg) as ei:
+        read_obj(d / "mesh_0000.obj")
+    assert _line_of(ei.value, d / "mesh_0000.obj") == line
+    cache = tmp_path / "cache.npz"
+    with pytest.raises(MotionFormatError, match=msg):
+        read_obj_sequence(d, cache=cache)
+    assert not cache.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["seq"]
+
+
+def test_obj_fast_and_careful_parsers_agree(tmp_path):
+    """Regular files take the fast path; the result equals the careful parser's."""
+    from animsynth.io.obj import _fast_parse, _slow_parse
+
+    rng = np.random.default_rng(0)
+    v = rng.normal(size=(30, 3))
+    f = rng.integers(0, 30, size=(40, 3))
+    write_obj(tmp_path / "a.obj", v, f)
+    lines = (tmp_path / "a.obj").read_text().splitlines()
+    fv, ff = _fast_parse(lines)
+    sv, sf = _slow_parse(tmp_path / "a.obj", lines)
+    np.testing.assert_array_equal(fv, np.array(sv))
+    np.testing.assert_array_equal(ff, np.array(sf))
+    # a polygon or i/t/n tokens leave the fast path (the careful one fans them)
+    assert _fast_parse(lines + ["f 1 2 3 4"]) is None
+    assert _fast_parse(lines + ["f 1/1 2/2 3/3"]) is None
+
+
+@pytest.mark.parametrize("damage", ["truncated", "corrupt", "not_gzip"])
+def test_obj_gz_damage_names_the_file(tmp_path, damage):
+    good = gzip.compress((SIX + "f 1 2 3\n").encode() * 50, mtime=0)
+    if damage == "truncated":
+        data = good[: len(good) // 2]
+    elif damage == "corrupt":
+        data = good[:12] + bytes(b ^ 0xFF for b in good[12:40]) + good[40:]
+    else:
+        data = b"this is not gzip data at all\n"
+    d = tmp_path / "seq"
+    d.mkdir()
+    p = d / "mesh_0000.obj.gz"
+    p.write_bytes(data)
+    with pytest.raises(MotionFormatError, match="gzip") as ei:
+        read_obj(p)
+    assert str(ei.value).startswith(f"{p}: ")
+    with pytest.raises(MotionFormatError):
+        read_obj_sequence(d, cache=tmp_path / "c.npz")
+    assert not (tmp_path / "c.npz").exists()
+
+
+# --- AMC ---------------------------------------------------------------
+
+def test_amc_non_utf8_names_line(tmp_path, files):
+    d, sk, _ = files
+    text = (d / "s1_01.amc").read_text()
+    body, line = _replace_line(text, "head ", "head 0.0 \xe9 0.0")
+    p = tmp_path / "latin1.amc"
+    p.write_bytes(body.encode("latin-1"))
+    with pytest.raises(MotionFormatError, match="not UTF-8") as ei:
+        read_amc(p, sk)
+    assert _line_of(ei.value, p) == line
+
+
+def test_amc_unicode_digit_frame_number(tmp_path, files):
+    d, sk, _ = files
+    text = (d / "s1_01.amc").read_text()
+    body, line = _replace_line(text, "2", "\u00b2")  # superscript two: isdigit() but not int()
+    p = tmp_path / "sup.amc"
+    p.write_text(body, encoding="utf-8")
+    with pytest.raises(MotionFormatError, match="unknown bone '²'") as ei:
+        read_amc(p, sk)
+    assert _line_of(ei.value, p) == line
+
+
+def test_amc_byte_order_mark_is_an_encoding_signature(tmp_path, files):
+    """A UTF-8 BOM (Windows editors) is dropped: same values as without it, with CRLF too."""
+    d, sk, m = files
+    text = (d / "s1_01.amc").read_text()
+    p = tmp_path / "bom.amc"
+    p.write_bytes(b"\xef\xbb\xbf" + text.replace("\n", "\r\n").encode())
+    np.testing.assert_array_equal(read_amc(p, sk).values, read_amc(d / "s1_01.amc", sk).values)
+    # a BOM anywhere else is content, and refused with the line
+    p.write_bytes(text.replace("\nroot", "\n\ufeffroot", 1).encode())
+    with pytest.raises(MotionFormatError, match="unknown bone") as ei:
+        read_amc(p, sk)
+    assert _line_of(ei.value, p) > 1
+
+
+# --- ASF ---------------------------------------------------------------
+
+@pytest.mark.parametrize("case,msg", [
+    ("length0", "length unit must be positive"),
+    ("length_neg", "length unit must be positive"),
+    ("no_root", "no :root section"),
+    ("latin1", "not UTF-8"),
+])
+def test_asf_bad_units_root_encoding(tmp_path, files, case, msg):
+    d, _, _ = files
+    text = (d / "s1.asf").read_text()
+    p = tmp_path / f"{case}.asf"
+    line = None
+    if case == "length0":
+        text, line = _replace_line(text, "length 0.45", "  length 0")
+    elif case == "length_neg":
+        text, line = _replace_line(text, "length 0.45", "  length -1")
+    elif case == "no_root":
+        start = text.index(":root")
+        text = text[:start] + text[text.index(":bonedata"):]
+    elif case == "latin1":
+        text, line = _replace_line(text, "written by animsynth", "   \xe9crit par animsynth")
+    p.write_bytes(text.encode("latin-1"))
+    with pytest.raises(MotionFormatError, match=msg) as ei:
+        read_asf(p)
+    if line is None:
+        assert str(ei.value).startswith(f"{p}: ")
+    else:
+        assert _line_of(ei.value, p) == line
+
+
+# --- BVH ---------------------------------------------------------------
+
+@pytest.mark.parametrize("case,msg", [
+    ("time0", "frame time must be positive"),
+    ("time_neg", "frame time must be positive"),
+    ("frames0", "frame count must be at least 1"),
+    ("latin1", "not UTF-8"),
+    ("extra_row", "more frame rows"),
+])
+def test_bvh_bad_header_and_encoding(tmp_path, files, case, msg):
+    d, _, _ = files
+    text = (d / "s1_01.bvh").read_text()
+    p = tmp_path / f"{case}.bvh"
+    if case == "time0":
+        text, line = _replace_line(text, "Frame Time:", "Frame Time: 0")
+    elif case == "time_neg":
+        text, line = _replace_line(text, "Frame Time:", "Frame Time: -0.008333")
+    elif case == "frames0":
+        text, line = _replace_line(text, "Frames:", "Frames: 0")
+    elif case == "latin1":
+        text, line = _replace_line(text, "ROOT", "ROOT r\xf6\xf6t")
+    else:
+        rows = text.rstrip("\n").split("\n")
+        text = "\n".join(rows + [rows[-1]]) + "\n"
+        line = len(rows) + 1
+    p.write_bytes(text.encode("latin-1"))
+    with pytest.raises(MotionFormatError, match=msg) as ei:
+        read_bvh(p)
+    assert _line_of(ei.value, p) == line
