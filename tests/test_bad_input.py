@@ -206,3 +206,64 @@ def test_bvh_bad_header_and_encoding(tmp_path, files, case, msg):
     with pytest.raises(MotionFormatError, match=msg) as ei:
         read_bvh(p)
     assert _line_of(ei.value, p) == line
+
+
+# --- the command line -----------------------------------------------------
+
+def _cli_cases():
+    g = ["generate", "{amc}", "--asf", "{asf}", "--steps", "5"]
+    r = ["resequence", "{asf}", "{amc}", "--start", "0", "--end", "30"]
+    a = ["amc2bvh", "{asf}", "{amc}", "{out}.bvh"]
+    return [
+        ("start_frame", g + ["--start-frame", "9999", "--out", "{out}.bvh"], "--start-frame", "40 frames"),
+        ("start_trial", g + ["--start-trial", "7", "--out", "{out}.bvh"], "--start-trial", "1 training file"),
+        ("fps0", a + ["--fps", "0"], "--fps", "must be > 0"),
+        ("fps_neg", a + ["--fps", "-30"], "--fps", "must be > 0"),
+        ("fps_nan", a + ["--fps", "nan"], "--fps", "finite"),
+        ("fps_inf", g + ["--fps", "inf", "--out", "{out}.amc"], "--fps", "finite"),
+        ("start_neg", r + ["--start", "-5", "--out", "{out}.bvh"], "--start", "must be >= 0"),
+        ("end_past", ["resequence", "{asf}", "{amc}", "--start", "0", "--end", "9999", "--out", "{out}.bvh"],
+         "--end", "40 frames"),
+        ("k_reseq", r + ["--k", "40", "--out", "{out}.bvh"], "--k", "only 40 frames"),
+        ("k_generate", g + ["--method", "knn", "--k", "41", "--out", "{out}.bvh"], "--k", "only 40 frames"),
+        ("k_zero", g + ["--k", "0", "--out", "{out}.bvh"], "--k", "must be >= 1"),
+        ("steps0", ["generate", "{amc}", "--asf", "{asf}", "--steps", "0", "--out", "{out}.bvh"], "--steps", ">= 1"),
+        ("length0", r + ["--length", "0", "--out", "{out}.bvh"], "--length", ">= 1"),
+        ("seed_neg", g + ["--seed", "-1", "--out", "{out}.bvh"], "--seed", "2**32"),
+        ("out_ext", g + ["--out", "{out}.txt"], "--out", "use a .bvh, .amc or .gif"),
+        ("bvh_ext", ["amc2bvh", "{asf}", "{amc}", "{out}.amc"], "out", "use a .bvh file name"),
+        ("missing_amc", ["amc2bvh", "{asf}", "{dir}/nope.amc", "{out}.bvh"], "amc", "no such file"),
+        ("labels_empty", ["face", "--labels", ",", "{out}.gif"], "--labels", "comma-separated"),
+        ("ckplus_missing", ["face", "--labels", "fear", "--ckplus", "{dir}/nope", "{out}.gif"], "--ckplus", "no such folder"),
+    ]
+
+
+@pytest.mark.parametrize("name,argv,option,fragment", _cli_cases(), ids=[c[0] for c in _cli_cases()])
+def test_cli_bad_argument_one_line_exit_2_nothing_written(tmp_path, files, capsys, name, argv, option, fragment):
+    from animsynth.cli import main
+
+    d, _, _ = files
+    out = tmp_path / "out"
+    out.mkdir()
+    fill = {"asf": str(d / "s1.asf"), "amc": str(d / "s1_01.amc"), "out": str(out / "o"), "dir": str(tmp_path)}
+    rc = main([a.format(**fill) for a in argv])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2, err
+    assert len(err.splitlines()) == 1, err
+    assert f"argument {option}" in err or f"argument {option.lstrip('-')}" in err, err
+    assert fragment in err, err
+    assert list(out.iterdir()) == []
+
+
+def test_cli_malformed_input_names_file_and_line(tmp_path, files, capsys):
+    from animsynth.cli import main
+
+    d, _, _ = files
+    text = (d / "s1_01.amc").read_text()
+    body, line = _replace_line(text, "head ", "head 0.0 x 0.0")
+    (tmp_path / "bad.amc").write_text(body)
+    rc = main(["amc2bvh", str(d / "s1.asf"), str(tmp_path / "bad.amc"), str(tmp_path / "o.bvh")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1
+    assert f"{tmp_path / 'bad.amc'}:{line}: non-numeric" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.amc"]
