@@ -267,3 +267,172 @@ def test_cli_malformed_input_names_file_and_line(tmp_path, files, capsys):
     assert rc == 2 and len(err.splitlines()) == 1
     assert f"{tmp_path / 'bad.amc'}:{line}: non-numeric" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.amc"]
+
+
+# --- where data may come from ----------------------------------------------
+
+def _user_config(data_dir, **trial):
+    import yaml
+
+    from conftest import REPO
+
+    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    cfg.update(mocap_source="user", data_dir=str(data_dir))
+    t = {"id": "t1", "subject": "me", "kind": "walk_straight", "amc": "me/t1.amc", "asf": "me/me.asf"}
+    t.update(trial)
+    t2 = {"id": "t2", "subject": "me", "kind": "walk_straight", "amc": "me/t1.amc", "asf": "me/me.asf"}
+    cfg["trials"] = [t, t2]
+    cfg["subsets"] = {"w1": ["t1", "t2"], "w2": None, "r1": None, "r2": None}
+    cfg["resequencing_trials"] = {"walk": "t1", "run": "t1", "dance": "t1"}
+    return cfg
+
+
+@pytest.mark.parametrize("field,value,fragment", [
+    ("amc", "../../../../etc/hostname", "leaves"),
+    ("amc", "me/../../outside.amc", "leaves"),
+    ("asf", "/etc/hostname", "absolute path"),
+    ("asf", "~/me.asf", "absolute path"),
+    ("bvh", "C:\\mocap\\t1.bvh", "absolute path"),
+    ("amc", "..", "leaves"),
+])
+def test_config_paths_must_stay_inside_data_dir(tmp_path, field, value, fragment):
+    from animsynth.config import ConfigError, check_config
+
+    cfg = _user_config(tmp_path, **{field: value})
+    with pytest.raises(ConfigError, match=fragment) as ei:
+        check_config(cfg)
+    assert f"config key 'trials[0].{field}'" in str(ei.value)
+
+
+def test_config_path_symlink_leaving_data_dir_is_refused(tmp_path):
+    from animsynth.config import ConfigError, check_config
+    from animsynth.data import DownloadError, fetch_file
+
+    (tmp_path / "outside.amc").write_text("secret\n")
+    data = tmp_path / "data"
+    (data / "me").mkdir(parents=True)
+    (data / "me" / "t1.amc").symlink_to(tmp_path / "outside.amc")
+    with pytest.raises(ConfigError, match=r"trials\[0\]\.amc.*outside"):
+        check_config(_user_config(data))
+    # the library refuses it too, at fetch time, and writes nothing
+    dest = tmp_path / "res" / "t1.amc"
+    with pytest.raises(DownloadError, match="refusing to fetch 'me/t1.amc'"):
+        fetch_file(str(data), "me/t1.amc", dest, None)
+    with pytest.raises(DownloadError, match="refusing to fetch"):
+        fetch_file(str(data), "../outside.amc", dest, None)
+    assert not (tmp_path / "res").exists()
+    # a normal path inside is fine
+    (data / "me" / "ok.amc").write_text("x\n")
+    cfg = _user_config(data, amc="me/./ok.amc")
+    cfg["trials"][1]["amc"] = "me/ok.amc"
+    check_config(cfg)
+
+
+# --- honest, quiet failures ---------------------------------------------------
+
+def test_atomic_write_names_the_target_on_permission_error(tmp_path):
+    import os
+
+    from animsynth.io.atomic import atomic_write_text
+
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    os.chmod(ro, 0o555)
+    try:
+        if os.access(ro, os.W_OK):
+            pytest.skip("running as a user who can write a read-only folder (root)")
+        with pytest.raises(PermissionError) as ei:
+            atomic_write_text(ro / "table.csv", "a\n")
+        assert str(ro / "table.csv") in str(ei.value) and ".tmp-" not in str(ei.value)
+    finally:
+        os.chmod(ro, 0o755)
+
+
+def test_atomic_replace_failure_names_the_target(tmp_path):
+    from animsynth.io.atomic import atomic_write_text
+
+    (tmp_path / "table.csv").mkdir()  # a folder where the file should go: rename fails
+    with pytest.raises(OSError) as ei:
+        atomic_write_text(tmp_path / "table.csv", "a\n")
+    assert str(tmp_path / "table.csv") in str(ei.value) and ".tmp-" not in str(ei.value)
+    assert [p.name for p in tmp_path.iterdir()] == ["table.csv"]
+
+
+def test_stale_temporaries_of_a_jobs_outputs_are_removed(tmp_path):
+    """SIGKILL leaves .tmp-<name>-* behind; the next job for that output removes them, no others."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    from animsynth.io.atomic import clean_stale_temporaries
+
+    out = tmp_path / "big.csv"
+    code = ("import sys, time\nfrom animsynth.io.atomic import atomic_path\n"
+            "with atomic_path(sys.argv[1]) as tmp:\n"
+            "    open(tmp, 'w').write('partial')\n    print('ready', flush=True)\n    time.sleep(60)\n")
+    proc = subprocess.Popen([sys.executable, "-c", code, str(out)], stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "ready"
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=30)
+    left = sorted(p.name for p in tmp_path.glob(".tmp-*"))
+    assert len(left) == 1 and left[0].startswith(".tmp-big.csv-") and not out.exists()
+    other = tmp_path / ".tmp-other.csv-abc123.csv"  # another job's live temporary
+    other.write_text("busy")
+    removed = clean_stale_temporaries([out, tmp_path / "never_written.csv"])
+    assert [os.path.basename(r) for r in removed] == left
+    assert sorted(p.name for p in tmp_path.iterdir()) == [other.name]
+
+
+@pytest.fixture
+def user_workflow(tmp_path, files):
+    """A copy of the workflow and a user data folder with one ASF/AMC trial."""
+    import shutil
+
+    import yaml
+
+    from conftest import copy_workflow
+
+    d, _, _ = files
+    data = tmp_path / "data"
+    (data / "me").mkdir(parents=True)
+    shutil.copyfile(d / "s1.asf", data / "me" / "me.asf")
+    shutil.copyfile(d / "s1_01.amc", data / "me" / "t1.amc")
+    wd = copy_workflow(tmp_path / "wf")
+
+    def write(**trial):
+        cfg = _user_config(data, **trial)
+        keep = {k: cfg[k] for k in ("mocap_source", "data_dir", "trials", "subsets", "resequencing_trials")}
+        (wd / "config" / "bad.yaml").write_text(yaml.safe_dump(keep))
+        return wd
+
+    return write
+
+
+@pytest.mark.workflow
+def test_workflow_checksum_mismatch_is_one_line_not_retried(user_workflow):
+    from conftest import run_snakemake
+
+    wd = user_workflow(sha256="0" * 64)
+    res = run_snakemake(wd, "resources/mocap/t1.amc", "--configfile", "config/bad.yaml")
+    out = res.stdout + res.stderr
+    assert res.returncode != 0
+    log = (wd / "logs" / "data" / "download_trial" / "t1.log").read_text()
+    assert "checksum mismatch for me/t1.amc" in log and "expected " + "0" * 64 + ", got " in log
+    assert "Traceback" not in log and "Traceback" not in out
+    assert out.count("Error in rule download_trial") == 1  # no retries
+    assert not (wd / "resources" / "mocap" / "t1.amc").exists()
+    assert not list((wd / "resources").rglob(".tmp-*"))
+
+
+@pytest.mark.workflow
+def test_workflow_refuses_a_path_leaving_data_dir(user_workflow):
+    from conftest import run_snakemake
+
+    wd = user_workflow(amc="../../../../../../etc/hostname")
+    res = run_snakemake(wd, "resources/mocap/t1.amc", "--configfile", "config/bad.yaml")
+    out = res.stdout + res.stderr
+    assert res.returncode != 0
+    assert "config key 'trials[0].amc'" in out and "leaves" in out
+    assert len(out.strip().splitlines()) < 15, out
+    assert not (wd / "resources").exists()

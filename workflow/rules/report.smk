@@ -1,4 +1,4 @@
-# One summary for all four systems, benchmark aggregation (issue 7).
+# One summary for all four systems, and benchmark aggregation.
 # Each family's .smk defines <FAMILY>_SUMMARY (tables for results/summary.md)
 # and <FAMILY>_VERDICTS (its verdicts.csv files); they are collected here.
 
@@ -29,6 +29,10 @@ rule summary:
         source=SOURCE,
         mesh_dir=config["mesh_dir"],
         faces=config["facegraph"].get("ckplus_dir"),
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=10,
     log:
         "logs/report/summary.log",
     benchmark:
@@ -48,6 +52,10 @@ rule benchmarks:
             caption="../report/benchmarks.rst",
             category="0. Summary",
         ),
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=30,
     log:
         "logs/report/benchmarks.log",
     benchmark:
@@ -69,8 +77,14 @@ rule rule_benchmarks:
             caption="../report/rule_benchmarks.rst",
             category="0. Summary",
         ),
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=10,
     log:
         "logs/report/rule_benchmarks.log",
+    benchmark:
+        "benchmarks/rules/report/rule_benchmarks.tsv"
     conda:
         "../envs/animsynth.yaml"
     script:
