@@ -34,7 +34,9 @@ include: "workflow/rules/meshdetail.smk"
 include: "workflow/rules/report.smk"
 
 
+# The target rule runs nothing: it is local, so it needs no threads/resources.
 rule all:
     input:
         all_targets(),
     default_target: True
+    localrule: True
