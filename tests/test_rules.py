@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import ast
 import io
 import re
 import subprocess
@@ -147,11 +148,11 @@ def test_slurm_profile_has_no_per_rule_blocks():
 def script_style_problems(source: str) -> list[str]:
     """Lines breaking the rule: a line using ``snakemake`` ends with the F821
     marker, a line not using it has none, and no other ``noqa`` hides F821."""
-    uses, marked = set(), {}
+    # uses from the syntax tree (it sees names inside f-strings, as pyflakes does)
+    uses = {n.lineno for n in ast.walk(ast.parse(source)) if isinstance(n, ast.Name) and n.id == "snakemake"}
+    marked = {}
     for tok in tokenize.generate_tokens(io.StringIO(source).readline):
-        if tok.type == tokenize.NAME and tok.string == "snakemake":
-            uses.add(tok.start[0])
-        elif tok.type == tokenize.COMMENT and "noqa" in tok.string:
+        if tok.type == tokenize.COMMENT and "noqa" in tok.string:
             marked[tok.start[0]] = tok.string
     problems = []
     for ln in sorted(uses):
@@ -172,7 +173,8 @@ def test_script_style_checker_can_fail():
     assert script_style_problems("log = setup(snakemake)\n")
     assert script_style_problems(f"x = 1  {MARK}\n")
     assert script_style_problems("f(snakemake)  # noqa\n")
-    # a string or comment mentioning snakemake is not a use
+    # an f-string expression is a use; a string or comment mentioning snakemake is not
+    assert script_style_problems("t = f'{snakemake.params.x} data'\n")
     assert script_style_problems("'''snakemake'''\n# snakemake\n") == []
 
 
