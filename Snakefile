@@ -4,7 +4,7 @@
 import os
 import sys
 
-from snakemake.utils import min_version, validate
+from snakemake.utils import min_version
 
 min_version("9.0")
 
@@ -18,7 +18,11 @@ os.environ.update(PYTHONPATH=os.pathsep.join(p for p in (SRC, os.environ.get("PY
 configfile: "config/config.yaml"
 
 
-validate(config, "config/schema.yaml")
+# A wrong type or unknown key stops the run with a few lines: the key, where
+# it is, and the closest valid key (plus defaults filled in from the schema).
+from animsynth.config import validate_config
+
+validate_config(config, os.path.join(workflow.basedir, "config", "schema.yaml"))
 
 
 include: "workflow/rules/common.smk"
@@ -30,7 +34,9 @@ include: "workflow/rules/meshdetail.smk"
 include: "workflow/rules/report.smk"
 
 
+# The target rule runs nothing: it is local, so it needs no threads/resources.
 rule all:
     input:
         all_targets(),
     default_target: True
+    localrule: True

@@ -57,6 +57,22 @@ def test_cross_key_errors():
         check_config(bad)
 
 
+@pytest.mark.parametrize("mutate,lines", [
+    (lambda c: c.update(fsp=30), ["config key 'fsp' is not allowed (at the top level)", "closest valid key: 'fps'"]),
+    (lambda c: c["trials"][0].update(colour="red"), ["config key 'trials[0].colour' is not allowed (in 'trials[0]')"]),
+    (lambda c: c["simplicial"].update(sed=1), ["config key 'simplicial.sed' is not allowed (in 'simplicial')"]),
+])
+def test_unknown_key_message_is_short(mutate, lines):
+    from animsynth.config import validate_config
+
+    cfg = default_config()
+    mutate(cfg)
+    with pytest.raises(ConfigError) as ei:
+        validate_config(cfg, SCHEMA)
+    msg = str(ei.value)
+    assert all(line in msg for line in lines) and len(msg.splitlines()) <= 4
+
+
 def test_derive_seed_is_stable():
     assert derive_seed(1, "a", 2) == derive_seed(1, "a", 2)
     assert derive_seed(1, "a", 2) != derive_seed(1, "a", 3)
@@ -67,7 +83,13 @@ def test_derive_seed_is_stable():
 def test_snakemake_stops_on_unknown_key(tmp_path):
     wd = copy_workflow(tmp_path)
     res = run_snakemake(wd, "-n", "--config", "fsp=30")
+    out = (res.stdout + res.stderr).strip()
     assert res.returncode != 0
-    assert "fsp" in res.stdout + res.stderr
+    # a few lines: the key, where it is, the closest valid key (not the whole schema and config)
+    assert "config key 'fsp' is not allowed (at the top level)" in out
+    assert "closest valid key: 'fps'" in out
+    assert len(out.splitlines()) <= 10, out
     res = run_snakemake(wd, "-n", "--config", "fps=fast")
-    assert res.returncode != 0 and "fast" in res.stdout + res.stderr
+    out = (res.stdout + res.stderr).strip()
+    assert res.returncode != 0 and "config key 'fps': 'fast' is not of type" in out
+    assert len(out.splitlines()) <= 10, out

@@ -36,8 +36,8 @@ def test_network_failure_is_a_clear_error(tmp_path):
     s.bind(("127.0.0.1", 0))
     port = s.getsockname()[1]
     s.close()  # nothing listens there now
-    with pytest.raises(DownloadError, match=rf"cannot download http://127.0.0.1:{port}/subjects/35/35_01.amc"):
-        fetch_file(f"http://127.0.0.1:{port}", "subjects/35/35_01.amc", tmp_path / "x.amc", None)
+    with pytest.raises(DownloadError, match=rf"cannot download http://127.0.0.1:{port}/subjects/35/35_01.amc.*2 attempts"):
+        fetch_file(f"http://127.0.0.1:{port}", "subjects/35/35_01.amc", tmp_path / "x.amc", None, attempts=2, wait=0)
     assert not (tmp_path / "x.amc").exists()
 
 

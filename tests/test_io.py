@@ -208,7 +208,7 @@ def test_nan_motion_is_rejected_everywhere(tmp_path, synth_files):
     v[7, 10] = np.nan
     with pytest.raises(ValueError, match="frame 7"):
         forward_kinematics(sk, v)
-    from animsynth.io.amc import Motion
+    from animsynth.motion import Motion
     with pytest.raises(ValueError, match="frame 8"):
         write_amc(tmp_path / "x.amc", Motion(v, sk))
     assert not (tmp_path / "x.amc").exists()

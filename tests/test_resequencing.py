@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from sklearn.manifold import Isomap
 from sklearn.neighbors import kneighbors_graph
 
-from animsynth.io.amc import Motion
+from animsynth.motion import Motion
 from animsynth.resequencing.distances import (PAPER_WEIGHTS, check_distance_matrix, joint_weights, l2_distances,
                                               lee_distances, lee_metric)
 from animsynth.resequencing.embedding import (DisconnectedGraphError, PrecomputedIsomap, STIsomap, graph_components,

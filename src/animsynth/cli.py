@@ -6,17 +6,118 @@
     animsynth resequence SKEL.asf MOTION.amc --start 10 --end 300 OUT.bvh
     animsynth face --labels fear,surprise,happy OUT.gif
 
-``animsynth COMMAND --help`` explains each. Errors name the file/line or
-option and exit with status 2.
+``animsynth COMMAND --help`` explains each. Every argument is checked before
+any work (types and ranges in argparse; frame indices and ``--k`` against the
+loaded motion). A bad argument or input file prints one line naming the
+argument or the file and line, exits with status 2 and writes nothing.
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import math
+import os
 import sys
 
 import numpy as np
+
+MOTION_OUTPUTS = (".bvh", ".amc", ".gif")
+
+
+class UsageError(ValueError):
+    """An argument is invalid for the data it applies to (e.g. a frame past the end)."""
+
+    def __init__(self, option: str, message: str):
+        self.option = option
+        super().__init__(f"argument {option}: {message}")
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``animsynth CMD: error: argument --x: ...``."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _finite(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0 (frame rates)."""
+    value = _finite(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text!r}")
+    return value
+
+
+def _int(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1 (counts)."""
+    value = _int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {text!r}")
+    return value
+
+
+def index_int(text: str) -> int:
+    """argparse type: an integer >= 0 (0-based frame or file index)."""
+    value = _int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0 (0-based index), got {text!r}")
+    return value
+
+
+def seed_int(text: str) -> int:
+    """argparse type: a seed for numpy, 0 <= seed < 2**32."""
+    value = _int(text)
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"must be in [0, 2**32), got {text!r}")
+    return value
+
+
+def _out_with(suffixes: tuple[str, ...]):
+    def check(text: str) -> str:
+        if not text.lower().endswith(suffixes):
+            raise argparse.ArgumentTypeError(f"use a {', '.join(suffixes[:-1])} or {suffixes[-1]} file name, got {text!r}"
+                                             if len(suffixes) > 1 else f"use a {suffixes[0]} file name, got {text!r}")
+        folder = os.path.dirname(os.path.abspath(text))
+        if os.path.exists(folder) and not os.path.isdir(folder):
+            raise argparse.ArgumentTypeError(f"{folder!r} is not a folder")
+        return text
+    return check
+
+
+def _existing_file(text: str) -> str:
+    if not os.path.isfile(text):
+        raise argparse.ArgumentTypeError(f"no such file {text!r}")
+    return text
+
+
+def _existing_dir(text: str) -> str:
+    if not os.path.isdir(text):
+        raise argparse.ArgumentTypeError(f"no such folder {text!r}")
+    return text
+
+
+def _labels(text: str) -> str:
+    parts = text.split(",")
+    if not text.strip() or any(not p.strip() for p in parts):
+        raise argparse.ArgumentTypeError(f"expected comma-separated labels such as fear,surprise,happy, got {text!r}")
+    return text
 
 
 def _load(asf: str, amc: str, fps: float):
@@ -43,11 +144,21 @@ def cmd_preview(a) -> None:
 
 def cmd_generate(a) -> None:
     from .io import read_amc, read_asf
-    from .io.amc import Motion
+    from .motion import Motion
     from .simplicial import generate_from_trials
 
+    if a.start_trial >= len(a.train):
+        raise UsageError("--start-trial", f"{a.start_trial} but only {len(a.train)} training file(s) given (0-based)")
     sk = read_asf(a.asf)
     train = [read_amc(p, sk, fps=a.fps) for p in a.train]
+    n_start = train[a.start_trial].n_frames
+    if a.start_frame >= n_start:
+        raise UsageError("--start-frame", f"{a.start_frame} is outside {a.train[a.start_trial]} ({n_start} frames, 0-based)")
+    n_train = sum(m.n_frames for m in train)
+    if a.k > n_train:
+        raise UsageError("--k", f"{a.k} neighbours but the training files hold only {n_train} frames")
+    if a.latent_dim > train[0].without_root().shape[1]:
+        raise UsageError("--latent-dim", f"{a.latent_dim} exceeds the {train[0].without_root().shape[1]} joint angles")
     start = train[a.start_trial].without_root()[a.start_frame] if a.start_pose is None else None
     angles, info = generate_from_trials(
         [m.without_root() for m in train], method=a.method, k=a.k, latent_dim=a.latent_dim,
@@ -64,6 +175,11 @@ def cmd_resequence(a) -> None:
     from .resequencing.study import resequence_motion
 
     m = _load(a.asf, a.amc, a.fps)
+    for option, value in (("--start", a.start), ("--end", a.end)):
+        if value >= m.n_frames:
+            raise UsageError(option, f"{value} is outside {a.amc} ({m.n_frames} frames, 0-based)")
+    if a.k is not None and a.k >= m.n_frames:
+        raise UsageError("--k", f"{a.k} neighbours but {a.amc} has only {m.n_frames} frames")
     frames, played = resequence_motion(m, a.start, a.end, method=a.method, metric=a.metric, k=a.k,
                                        global_dof=a.global_dof, length=a.length)
     _write_motion(a.out, played)
@@ -95,63 +211,71 @@ def _write_motion(path: str, motion) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="animsynth", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = _Parser(prog="animsynth", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
 
     s = sub.add_parser("amc2bvh", help="convert an ASF/AMC trial to BVH (opens in Blender)")
-    s.add_argument("asf"), s.add_argument("amc"), s.add_argument("out", help="output .bvh")
-    s.add_argument("--fps", type=float, default=120.0)
+    s.add_argument("asf", type=_existing_file), s.add_argument("amc", type=_existing_file)
+    s.add_argument("out", type=_out_with((".bvh",)), help="output .bvh")
+    s.add_argument("--fps", type=positive_float, default=120.0)
     s.add_argument("--metres", action="store_true", help="write lengths in metres instead of ASF units")
     s.set_defaults(func=cmd_amc2bvh)
 
     s = sub.add_parser("preview", help="animated GIF of an ASF/AMC trial's skeleton")
-    s.add_argument("asf"), s.add_argument("amc"), s.add_argument("out", help="output .gif")
-    s.add_argument("--fps", type=float, default=120.0)
+    s.add_argument("asf", type=_existing_file), s.add_argument("amc", type=_existing_file)
+    s.add_argument("out", type=_out_with((".gif",)), help="output .gif")
+    s.add_argument("--fps", type=positive_float, default=120.0)
     s.set_defaults(func=cmd_preview)
 
     s = sub.add_parser("generate", help="generate a motion with the Delaunay or k-NN vector field (Gauch & Peters)")
-    s.add_argument("train", nargs="+", help="training .amc files (same skeleton)")
-    s.add_argument("--asf", required=True)
+    s.add_argument("train", nargs="+", type=_existing_file, help="training .amc files (same skeleton)")
+    s.add_argument("--asf", required=True, type=_existing_file)
     s.add_argument("--method", choices=["delaunay", "knn"], default="delaunay")
-    s.add_argument("--k", type=int, default=16, help="neighbours for k-NN (and the Delaunay fallback)")
-    s.add_argument("--latent-dim", type=int, default=2)
-    s.add_argument("--steps", type=int, default=300)
-    s.add_argument("--start-trial", type=int, default=0, help="index of the training file holding the start frame")
-    s.add_argument("--start-frame", type=int, default=0)
+    s.add_argument("--k", type=positive_int, default=16, help="neighbours for k-NN (and the Delaunay fallback)")
+    s.add_argument("--latent-dim", type=positive_int, default=2)
+    s.add_argument("--steps", type=positive_int, default=300)
+    s.add_argument("--start-trial", type=index_int, default=0, help="index of the training file holding the start frame")
+    s.add_argument("--start-frame", type=index_int, default=0)
     s.add_argument("--start-pose", default=None, help=argparse.SUPPRESS)
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--fps", type=float, default=120.0)
-    s.add_argument("--out", required=True, help="output .bvh, .amc or .gif")
+    s.add_argument("--seed", type=seed_int, default=0)
+    s.add_argument("--fps", type=positive_float, default=120.0)
+    s.add_argument("--out", required=True, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_generate)
 
     s = sub.add_parser("resequence", help="re-sequence a trial between two frames (Isomap / ST-Isomap + Dijkstra)")
-    s.add_argument("asf"), s.add_argument("amc")
-    s.add_argument("--start", type=int, required=True)
-    s.add_argument("--end", type=int, required=True)
+    s.add_argument("asf", type=_existing_file), s.add_argument("amc", type=_existing_file)
+    s.add_argument("--start", type=index_int, required=True, help="first frame (0-based)")
+    s.add_argument("--end", type=index_int, required=True, help="last frame (0-based)")
     s.add_argument("--method", choices=["isomap", "st-isomap"], default="st-isomap")
     s.add_argument("--metric", choices=["l2", "lee"], default="l2")
-    s.add_argument("--k", type=int, default=None, help="neighbours (default: smallest k giving one component)")
+    s.add_argument("--k", type=positive_int, default=None, help="neighbours (default: smallest k giving one component)")
     s.add_argument("--global-dof", action="store_true", help="include root translation and orientation")
-    s.add_argument("--length", type=int, default=None, help="pad the path to this many frames")
-    s.add_argument("--fps", type=float, default=120.0)
-    s.add_argument("--out", required=True, help="output .bvh, .amc or .gif")
+    s.add_argument("--length", type=positive_int, default=None, help="pad the path to this many frames")
+    s.add_argument("--fps", type=positive_float, default=120.0)
+    s.add_argument("--out", required=True, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_resequence)
 
     s = sub.add_parser("face", help="synthesise a face animation (68 landmarks) from expression labels")
-    s.add_argument("--labels", required=True, help="comma-separated, e.g. fear,surprise,happy")
-    s.add_argument("--ckplus", default=None, help="CK+ root folder (default: a synthetic CK+-layout database)")
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("out", help="output .gif (or .csv of landmarks)")
+    s.add_argument("--labels", required=True, type=_labels, help="comma-separated, e.g. fear,surprise,happy")
+    s.add_argument("--ckplus", default=None, type=_existing_dir,
+                   help="CK+ root folder (default: a synthetic CK+-layout database)")
+    s.add_argument("--seed", type=seed_int, default=0)
+    s.add_argument("out", type=_out_with((".gif", ".csv")), help="output .gif (or .csv of landmarks)")
     s.set_defaults(func=cmd_face)
     return p
 
 
 def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run one command; return the exit status (0 ok, 2 bad argument or input)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # argparse: --help (0) or a bad argument (2, message printed)
+        return int(exc.code or 0)
     logging.basicConfig(level=logging.WARNING, format="animsynth: %(levelname)s: %(message)s")
     try:
         args.func(args)
-    except (ValueError, KeyError, OSError, ImportError) as exc:
+    except (ValueError, KeyError, IndexError, OSError, ImportError) as exc:
+        # UsageError names the argument; MotionFormatError names file and line
         print(f"animsynth {args.command}: error: {exc}", file=sys.stderr)
         return 2
     return 0

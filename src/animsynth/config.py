@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import hashlib
+import ntpath
+import os
+import posixpath
+import re
 
 
 class ConfigError(ValueError):
@@ -19,6 +23,57 @@ def derive_seed(master: int, *names) -> int:
     return int.from_bytes(hashlib.sha256(text.encode()).digest()[:4], "little")
 
 
+#: Trial fields that name a file below ``data_dir`` / ``cmu_mirror``.
+TRIAL_FILE_KEYS = ("amc", "asf", "bvh")
+
+
+def resolve_inside(root: str, rel: str, key: str) -> str:
+    """Join ``rel`` below ``root``, refusing any path that leaves ``root``.
+
+    ``rel`` must be a relative path that stays inside ``root`` after
+    normalisation (no absolute path, drive letter, ``~`` or ``..`` escape).
+    When ``root`` is a local folder that exists, symbolic links are resolved
+    too, so a link inside ``root`` cannot point outside it. ``root`` may also
+    be a URL (a mirror); then the check is on the path text only.
+
+    Parameters
+    ----------
+    root : str
+        ``data_dir`` or ``cmu_mirror``.
+    rel : str
+        The configured path, e.g. ``subjects/35/35_01.amc``.
+    key : str
+        The config key holding ``rel``, named in the error.
+
+    Returns
+    -------
+    str
+        ``root`` joined with the normalised ``rel``.
+
+    Raises
+    ------
+    ConfigError
+        The path is absolute or leaves ``root``; the message names ``key``.
+    """
+    if not isinstance(rel, str) or not rel.strip():
+        raise ConfigError(f"config key '{key}': expected a file path relative to {root!r}, got {rel!r}")
+    if posixpath.isabs(rel) or ntpath.isabs(rel) or ntpath.splitdrive(rel)[0] or rel.startswith("~"):
+        raise ConfigError(f"config key '{key}': {rel!r} is an absolute path; give it relative to {root!r}")
+    norm = posixpath.normpath(rel.replace("\\", "/"))
+    if norm == ".." or norm.startswith("../") or norm == ".":
+        raise ConfigError(f"config key '{key}': {rel!r} leaves {root!r}; paths must stay inside it")
+    if "://" in root:
+        return root.rstrip("/") + "/" + norm
+    path = os.path.join(root, *norm.split("/"))
+    if os.path.isdir(root):
+        real_root = os.path.realpath(root)
+        real = os.path.realpath(path)
+        if os.path.commonpath([real_root, real]) != real_root:
+            raise ConfigError(f"config key '{key}': {rel!r} resolves to {real!r}, outside {root!r} "
+                              "(a symbolic link leaving the folder)")
+    return path
+
+
 def check_config(config: dict) -> None:
     """Cross-key checks on a schema-validated config; raise :class:`ConfigError`."""
     ids = [t["id"] for t in config["trials"]]
@@ -27,6 +82,8 @@ def check_config(config: dict) -> None:
         raise ConfigError(f"config key 'trials': duplicate id(s) {dup}")
     known = set(ids)
     src = config["mocap_source"]
+    if src == "user" and not config.get("data_dir"):
+        raise ConfigError("config key 'data_dir': mocap_source 'user' needs the folder holding your files")
     for k, t in enumerate(config["trials"]):
         where = f"config key 'trials[{k}]' (id {t['id']!r})"
         if src == "synthetic":
@@ -40,8 +97,10 @@ def check_config(config: dict) -> None:
                 raise ConfigError(f"{where}: mocap_source {src!r} needs 'amc' and 'asf', or 'bvh'")
             if src == "cmu" and "sha256" not in t:
                 raise ConfigError(f"{where}: CMU trials need 'sha256' (LF-normalised) so downloads are verified")
-    if src == "user" and not config.get("data_dir"):
-        raise ConfigError("config key 'data_dir': mocap_source 'user' needs the folder holding your files")
+            root = config.get("cmu_mirror") if src == "cmu" else config.get("data_dir")
+            for field in TRIAL_FILE_KEYS:
+                if field in t:
+                    resolve_inside(root or ".", t[field], f"trials[{k}].{field}")
     subsets = {k: v for k, v in config["subsets"].items() if v}
     if not subsets:
         raise ConfigError("config key 'subsets': at least one subset is needed")
@@ -52,3 +111,64 @@ def check_config(config: dict) -> None:
     for name, tid in config["resequencing_trials"].items():
         if tid not in known:
             raise ConfigError(f"config key 'resequencing_trials.{name}': unknown trial id {tid!r}")
+
+
+def _where(path) -> str:
+    out = ""
+    for p in path:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out
+
+
+def explain_schema_error(config: dict, schema: dict) -> str | None:
+    """A few lines about the most relevant schema violation, or None if valid.
+
+    For an unknown key: the key, where it is, and the closest valid key (the
+    default message of a JSON Schema validator prints the whole schema and
+    config, thousands of lines).
+    """
+    import difflib
+
+    import jsonschema
+
+    cls = jsonschema.validators.validator_for(schema)
+    error = jsonschema.exceptions.best_match(cls(schema).iter_errors(config))
+    if error is None:
+        return None
+    where = _where(error.absolute_path)
+    if error.validator == "additionalProperties" and isinstance(error.instance, dict):
+        props = sorted(error.schema.get("properties", {}))
+        patterns = list(error.schema.get("patternProperties", {}))
+        extra = sorted(k for k in error.instance if k not in props and not any(re.search(p, k) for p in patterns))
+        lines = []
+        for key in extra:
+            full = f"{where}.{key}" if where else key
+            lines.append(f"config key '{full}' is not allowed ({'in ' + repr(where) if where else 'at the top level'})")
+            close = difflib.get_close_matches(key, props, n=1, cutoff=0.5)
+            lines.append(f"  closest valid key: '{close[0]}'" if close else
+                         "  valid keys there: " + ", ".join(props))
+        lines.append("  (keys and their meaning: config/README.md and config/schema.yaml)")
+        return "\n".join(lines)
+    message = error.message if len(error.message) <= 300 else error.message[:300] + " ..."
+    return f"config key '{where or '<top level>'}': {message}\n  (keys and their meaning: config/README.md and config/schema.yaml)"
+
+
+def validate_config(config: dict, schema_path: str) -> None:
+    """Validate ``config`` against the YAML JSON Schema and fill in defaults.
+
+    Wraps :func:`snakemake.utils.validate` (which also sets defaults) so that
+    a violation raises a :class:`ConfigError` of a few lines (see
+    :func:`explain_schema_error`) instead of the validator's dump.
+    """
+    import yaml
+    from snakemake.utils import validate
+
+    try:
+        validate(config, schema_path)
+    except Exception as exc:  # snakemake's WorkflowError embeds the whole schema and config
+        with open(schema_path, encoding="utf-8") as fh:
+            schema = yaml.safe_load(fh)
+        short = explain_schema_error(config, schema)
+        if short is None:
+            short = "\n".join(str(exc).splitlines()[:5])
+        raise ConfigError(short) from None

@@ -14,14 +14,17 @@ import hashlib
 import logging
 import os
 import shutil
+import time
 import urllib.error
 import urllib.request
 
 import pandas as pd
 
-from .io.amc import Motion, read_amc
+from .config import ConfigError, resolve_inside
+from .io.amc import read_amc
 from .io.asf import read_asf
 from .io.atomic import atomic_path
+from .motion import Motion
 
 log = logging.getLogger("animsynth.data")
 
@@ -39,16 +42,35 @@ def _is_url(s: str) -> bool:
     return s.startswith(("http://", "https://", "ftp://", "file://"))
 
 
-def fetch_bytes(source: str, rel: str, timeout: float = 60.0) -> bytes:
-    """Read ``rel`` below ``source`` (a URL or a local folder)."""
+def fetch_bytes(source: str, rel: str, timeout: float = 60.0, attempts: int = 3, wait: float = 5.0) -> bytes:
+    """Read ``rel`` below ``source`` (a URL or a local folder).
+
+    ``rel`` must stay inside ``source`` (see
+    :func:`animsynth.config.resolve_inside`); anything else is refused.
+    A network failure (no answer, timeout) is tried ``attempts`` times,
+    ``wait * n`` seconds apart; an HTTP error status, a missing local file and
+    (in :func:`fetch_file`) a checksum mismatch are deterministic and fail at
+    once, so the workflow rule itself does not retry.
+    """
+    try:
+        inside = resolve_inside(source, rel, rel)
+    except ConfigError as exc:
+        raise DownloadError(f"refusing to fetch {rel!r}: {str(exc).split(': ', 1)[1]}") from None
     if _is_url(source):
-        url = source.rstrip("/") + "/" + rel.lstrip("/")
-        try:
-            with urllib.request.urlopen(url, timeout=timeout) as r:  # noqa: S310 (configured mirror)
-                return r.read()
-        except (urllib.error.URLError, TimeoutError, OSError) as exc:
-            raise DownloadError(f"cannot download {url}: {exc}") from None
-    path = os.path.join(source, rel)
+        url = inside
+        for attempt in range(1, attempts + 1):
+            try:
+                with urllib.request.urlopen(url, timeout=timeout) as r:  # noqa: S310 (configured mirror)
+                    return r.read()
+            except urllib.error.HTTPError as exc:  # the server answered: retrying gives the same answer
+                raise DownloadError(f"cannot download {url}: {exc}") from None
+            except (urllib.error.URLError, TimeoutError, OSError) as exc:
+                if attempt == attempts:
+                    raise DownloadError(f"cannot download {url}: {exc} ({attempts} attempts)") from None
+                log.warning("download of %s failed (%s); attempt %d of %d in %.0f s", url, exc, attempt + 1,
+                            attempts, wait * attempt)
+                time.sleep(wait * attempt)
+    path = inside
     try:
         with open(path, "rb") as f:
             return f.read()
@@ -56,18 +78,20 @@ def fetch_bytes(source: str, rel: str, timeout: float = 60.0) -> bytes:
         raise DownloadError(f"cannot read {path} (mirror {source!r}): {exc.strerror}") from None
 
 
-def fetch_file(source: str, rel: str, dest, sha256: str | None) -> str:
+def fetch_file(source: str, rel: str, dest, sha256: str | None, attempts: int = 3, wait: float = 5.0) -> str:
     """Fetch ``rel`` from ``source`` into ``dest`` after checking its checksum.
 
     Returns the normalised SHA-256. Raises :class:`DownloadError` on a network
-    failure or a checksum mismatch; ``dest`` is then not created.
+    failure (after ``attempts`` tries, see :func:`fetch_bytes`), a path that
+    leaves ``source`` or a checksum mismatch (at once); ``dest`` is then not
+    created.
     """
-    data = fetch_bytes(source, rel)
+    data = fetch_bytes(source, rel, attempts=attempts, wait=wait)
     got = sha256_normalised(data)
     if sha256 is not None and got != sha256.lower():
         raise DownloadError(
             f"checksum mismatch for {rel} from {source!r}: expected {sha256}, got {got} "
-            "(SHA-256 after normalising line endings to LF)"
+            "(SHA-256 after normalising line endings to LF; not retried: the file itself differs)"
         )
     with atomic_path(dest) as tmp:
         with open(tmp, "wb") as f:

@@ -11,6 +11,8 @@ def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None 
     """Send ``animsynth`` log records (INFO and up) to the rule's ``log:`` file.
 
     Uncaught exceptions are logged too, so the log explains a failed job.
+    Temporaries that an interrupted earlier run left for this job's outputs
+    are removed (:func:`animsynth.io.atomic.clean_stale_temporaries`).
     """
     if log_path is None and snakemake is not None and len(snakemake.log):
         log_path = str(snakemake.log[0])
@@ -26,6 +28,10 @@ def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None 
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     root.addHandler(handler)
     logger = logging.getLogger(name if name.startswith("animsynth") else f"animsynth.{name}")
+    if snakemake is not None:
+        from .io.atomic import clean_stale_temporaries
+
+        clean_stale_temporaries(str(o) for o in snakemake.output)
 
     def _hook(exc_type, exc, tb):
         root.error("job failed", exc_info=(exc_type, exc, tb))

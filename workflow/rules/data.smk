@@ -1,6 +1,14 @@
 # Data layer: get every trial (generate synthetic ASF/AMC, or download real
 # CMU / copy user files with checksums), parse it with the real readers into
 # results/data/trials/{trial}.npz, and write Gauch & Peters Table I.
+# Downloads are not retried by Snakemake: animsynth.data retries network
+# failures itself, and a checksum mismatch is deterministic.
+# threads/resources (mem_mb in MB, runtime in minutes) are sized from the
+# measured peak memory and run time (results/rule_benchmarks_per_rule.csv)
+# with headroom (2x memory, 3x time, at least 500 MB / 10 min); a SLURM
+# profile submits each job with them. Measured (tiny and CMU configs, loaded
+# 2-core machine): every data job peaks at <= 110 MB and takes <= 14 s; the
+# downloads get 20 min for a slow network (3 attempts with a 60 s timeout each).
 
 if SOURCE == "synthetic":
 
@@ -13,6 +21,10 @@ if SOURCE == "synthetic":
             seed=lambda wc: seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], wc.trial),
             subject_seed=config["synthetic_mocap"]["seed"],
             fps=config["fps"],
+        threads: 1
+        resources:
+            mem_mb=500,
+            runtime=10,
         log:
             "logs/data/synth_trial/{trial}.log",
         benchmark:
@@ -34,11 +46,14 @@ else:
             asf=lambda wc: TRIALS[wc.trial]["asf"],
             sha256=lambda wc: TRIALS[wc.trial].get("sha256"),
             asf_sha256=lambda wc: TRIALS[wc.trial].get("asf_sha256"),
+        threads: 1
+        resources:
+            mem_mb=500,
+            runtime=20,
         log:
             "logs/data/download_trial/{trial}.log",
         benchmark:
             "benchmarks/rules/data/download_trial/{trial}.tsv"
-        retries: 2
         conda:
             "../envs/animsynth.yaml"
         script:
@@ -51,6 +66,10 @@ else:
             source=MOCAP_MIRROR,
             bvh=lambda wc: TRIALS[wc.trial]["bvh"],
             sha256=lambda wc: TRIALS[wc.trial].get("sha256"),
+        threads: 1
+        resources:
+            mem_mb=500,
+            runtime=20,
         log:
             "logs/data/download_bvh_trial/{trial}.log",
         benchmark:
@@ -68,6 +87,10 @@ rule parse_trial:
         "results/data/trials/{trial}.npz",
     params:
         fps=config["fps"],
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=10,
     log:
         "logs/data/parse_trial/{trial}.log",
     benchmark:
@@ -92,6 +115,10 @@ rule datasets_table:
     params:
         subsets=SUBSETS,
         source=SOURCE,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=10,
     log:
         "logs/data/datasets_table.log",
     benchmark:

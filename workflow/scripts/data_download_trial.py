@@ -1,11 +1,19 @@
 """Fetch one trial's files from the CMU site, a mirror or a user folder, verifying checksums."""
-from animsynth.data import fetch_file
+import sys
+
+from animsynth.data import DownloadError, fetch_file
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)
-p = snakemake.params
-if "bvh" in snakemake.output.keys():
-    fetch_file(p.source, p.bvh, snakemake.output.bvh, p.sha256)
-else:
-    fetch_file(p.source, p.asf, snakemake.output.asf, p.asf_sha256)
-    fetch_file(p.source, p.amc, snakemake.output.amc, p.sha256)
+log = setup_logging(snakemake)  # noqa: F821
+p = snakemake.params  # noqa: F821
+out = snakemake.output  # noqa: F821
+try:
+    if "bvh" in out.keys():
+        fetch_file(p.source, p.bvh, out.bvh, p.sha256)
+    else:
+        fetch_file(p.source, p.asf, out.asf, p.asf_sha256)
+        fetch_file(p.source, p.amc, out.amc, p.sha256)
+except DownloadError as exc:  # deterministic or already retried: one line, no traceback
+    log.error("%s", exc)
+    print(f"error: {exc}", file=sys.stderr)
+    sys.exit(1)

@@ -1,7 +1,7 @@
 """Exact min k, Isomap / ST-Isomap fits, residual variance and 2-D embeddings of one dataset x global flag."""
 import numpy as np
 
-from animsynth.io import Motion
+from animsynth.motion import Motion
 from animsynth.io.atomic import atomic_path
 from animsynth.resequencing.study import analyse, gdof_flag, prepare_motion
 from animsynth.workflow_utils import setup_logging

@@ -1,7 +1,7 @@
 """Re-sequence one dataset x method x metric x global flag: Dijkstra paths, BVH + GIF of the main path, smoothness."""
 import pandas as pd
 
-from animsynth.io import Motion
+from animsynth.motion import Motion
 from animsynth.io.atomic import atomic_path
 from animsynth.resequencing.study import gdof_flag, prepare_motion, resequence
 from animsynth.viz import motion_previews

@@ -1,76 +1,21 @@
 """Acclaim AMC motion reader and writer.
 
-:func:`read_amc` returns a :class:`Motion`: a ``(frames, n_dof)`` float array in
-degrees whose columns are ``skeleton.columns()`` (for CMU: 62 columns, the 6
-root DOF first, then the 56 joint angles in CMU AMC bone order).
+:func:`read_amc` returns a :class:`~animsynth.motion.Motion`: a
+``(frames, n_dof)`` float array in degrees whose columns are
+``skeleton.columns()`` (for CMU: 62 columns, the 6 root DOF first, then the 56
+joint angles in CMU AMC bone order).
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..motion import Motion
 from ..skeleton import Skeleton
 from .atomic import atomic_write_text
-from .errors import MotionFormatError, parse_float
-
-
-@dataclass
-class Motion:
-    """A motion on a skeleton.
-
-    Attributes
-    ----------
-    values : ndarray, shape (frames, n_dof)
-        DOF values: translations in skeleton length units, angles in degrees.
-    skeleton : Skeleton
-    fps : float
-    name : str
-    """
-
-    values: np.ndarray
-    skeleton: Skeleton
-    fps: float = 120.0
-    name: str = ""
-    meta: dict = field(default_factory=dict)
-
-    @property
-    def columns(self) -> list[str]:
-        return self.skeleton.columns()
-
-    @property
-    def n_frames(self) -> int:
-        return int(self.values.shape[0])
-
-    def without_root(self) -> np.ndarray:
-        """The joint angles with the root joint's DOF dropped (CMU: 56 columns)."""
-        n_root = len(self.skeleton.joints[0].dofs)
-        return self.values[:, n_root:]
-
-    # -- .npz storage used between workflow rules -------------------------
-    def save_npz(self, path) -> None:
-        from .atomic import atomic_path
-
-        with atomic_path(path, suffix=".npz") as tmp:
-            np.savez_compressed(
-                tmp,
-                values=self.values,
-                columns=np.array(self.columns),
-                fps=np.float64(self.fps),
-                name=np.array(self.name),
-                skeleton=np.array(self.skeleton.to_json()),
-            )
-
-    @classmethod
-    def load_npz(cls, path) -> "Motion":
-        with np.load(path, allow_pickle=False) as z:
-            sk = Skeleton.from_json(str(z["skeleton"]))
-            m = cls(np.array(z["values"], float), sk, float(z["fps"]), str(z["name"]))
-            if list(z["columns"]) != sk.columns():
-                raise MotionFormatError(path, None, "stored columns do not match the stored skeleton")
-        return m
+from .errors import MotionFormatError, parse_float, read_text_lines
 
 
 def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
@@ -83,8 +28,9 @@ def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
     ------
     MotionFormatError
         Truncated file, unknown bone, wrong DOF count, non-numeric value, NaN,
-        missing bone in a frame, or out-of-sequence frame number; the message
-        names file and line.
+        missing bone in a frame, out-of-sequence frame number, or bytes that
+        are not UTF-8; the message names file and line. A leading UTF-8
+        byte-order mark is ignored.
     """
     slices = skeleton.dof_slices()
     ndof = {j.name: len(j.dofs) for j in skeleton.joints}
@@ -106,45 +52,41 @@ def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
             raise MotionFormatError(path, cur_line, f"frame {frame_no} is missing bones {sorted(missing)} (truncated file?)")
         frames.append(cur)
 
-    try:
-        fh = open(path, encoding="utf-8", newline=None)
-    except OSError as exc:
-        raise MotionFormatError(path, None, f"cannot open: {exc.strerror}") from None
-    with fh:
-        ln = 0
-        for ln, raw in enumerate(fh, start=1):
-            line = raw.strip()
-            if not line or line.startswith("#"):
-                continue
-            if line.startswith(":"):
-                if line.upper().startswith(":RADIANS"):
-                    degrees_flag = False
-                continue
-            tok = line.split()
-            if len(tok) == 1 and tok[0].isdigit():
-                finish(ln)
-                n = int(tok[0])
-                if frame_no is not None and n != frame_no + 1:
-                    raise MotionFormatError(path, ln, f"frame number {n} follows {frame_no}")
-                frame_no = n
-                cur = np.empty(n_cols)
-                seen = set()
-                cur_line = ln
-                in_header = False
-                continue
-            if in_header:
-                raise MotionFormatError(path, ln, f"expected a frame number, got {line[:40]!r}")
-            bone = tok[0]
-            if bone not in slices:
-                raise MotionFormatError(path, ln, f"unknown bone {bone!r} (not in skeleton {skeleton.name!r})")
-            if bone in seen:
-                raise MotionFormatError(path, ln, f"bone {bone!r} appears twice in frame {frame_no}")
-            if len(tok) - 1 != ndof[bone]:
-                raise MotionFormatError(path, ln, f"bone {bone!r} has {len(tok) - 1} values, skeleton says {ndof[bone]} DOF")
-            vals = [parse_float(t, path, ln, f"{bone} value") for t in tok[1:]]
-            cur[slices[bone]] = vals
-            seen.add(bone)
-        finish(ln)
+    lines = read_text_lines(path)
+    ln = 0
+    for ln, raw in enumerate(lines, start=1):
+        line = raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        if line.startswith(":"):
+            if line.upper().startswith(":RADIANS"):
+                degrees_flag = False
+            continue
+        tok = line.split()
+        if len(tok) == 1 and tok[0].isascii() and tok[0].isdigit():
+            finish(ln)
+            n = int(tok[0])
+            if frame_no is not None and n != frame_no + 1:
+                raise MotionFormatError(path, ln, f"frame number {n} follows {frame_no}")
+            frame_no = n
+            cur = np.empty(n_cols)
+            seen = set()
+            cur_line = ln
+            in_header = False
+            continue
+        if in_header:
+            raise MotionFormatError(path, ln, f"expected a frame number, got {line[:40]!r}")
+        bone = tok[0]
+        if bone not in slices:
+            raise MotionFormatError(path, ln, f"unknown bone {bone!r} (not in skeleton {skeleton.name!r})")
+        if bone in seen:
+            raise MotionFormatError(path, ln, f"bone {bone!r} appears twice in frame {frame_no}")
+        if len(tok) - 1 != ndof[bone]:
+            raise MotionFormatError(path, ln, f"bone {bone!r} has {len(tok) - 1} values, skeleton says {ndof[bone]} DOF")
+        vals = [parse_float(t, path, ln, f"{bone} value") for t in tok[1:]]
+        cur[slices[bone]] = vals
+        seen.add(bone)
+    finish(ln)
     if not frames:
         raise MotionFormatError(path, None, "no frames")
     values = np.vstack(frames)

@@ -19,19 +19,9 @@ import numpy as np
 
 from ..skeleton import CMU_BONE_ORDER, Joint, Skeleton
 from .atomic import atomic_write_text
-from .errors import MotionFormatError, parse_float
+from .errors import MotionFormatError, parse_float, read_text_lines
 
 _AXES = {"X", "Y", "Z"}
-
-
-def _read_lines(path) -> list[str]:
-    try:
-        with open(path, encoding="utf-8", errors="strict", newline=None) as f:
-            return f.read().splitlines()
-    except UnicodeDecodeError as exc:
-        raise MotionFormatError(path, None, f"not a text file ({exc})") from None
-    except OSError as exc:
-        raise MotionFormatError(path, None, f"cannot open: {exc.strerror}") from None
 
 
 def read_asf(path) -> Skeleton:
@@ -40,9 +30,11 @@ def read_asf(path) -> Skeleton:
     Raises
     ------
     MotionFormatError
-        On any malformed line (message names file and line).
+        On any malformed line (message names file and line), a file that is
+        not UTF-8 text, a non-positive ``:units length`` or a missing
+        ``:root`` section. A leading UTF-8 byte-order mark is ignored.
     """
-    lines = _read_lines(path)
+    lines = read_text_lines(path)
     units = {"length": 1.0, "angle": "deg", "mass": 1.0}
     root = {"order": ["tx", "ty", "tz", "rx", "ry", "rz"], "axis": "XYZ",
             "position": np.zeros(3), "orientation": np.zeros(3)}
@@ -50,6 +42,7 @@ def read_asf(path) -> Skeleton:
     children: dict[str, list[str]] = {}
     name = os.path.splitext(os.path.basename(os.fspath(path)))[0]
     section = None
+    root_line = None
     bone = None
     limits_pending = 0
     for ln, raw in enumerate(lines, start=1):
@@ -61,6 +54,8 @@ def read_asf(path) -> Skeleton:
             if bone is not None:
                 raise MotionFormatError(path, bone["line"], f"bone block not closed with 'end' before {tok[0]}")
             section = tok[0][1:].lower()
+            if section == "root":
+                root_line = ln
             if section == "name" and len(tok) > 1:
                 name = tok[1]
             limits_pending = 0
@@ -75,6 +70,8 @@ def read_asf(path) -> Skeleton:
                 units["angle"] = tok[1].lower()
             else:
                 units[key] = parse_float(tok[1], path, ln, f"{key} unit")
+                if key == "length" and units[key] <= 0:
+                    raise MotionFormatError(path, ln, f"length unit must be positive, got {tok[1]!r}")
         elif section == "root":
             key = tok[0].lower()
             if key == "order":
@@ -188,6 +185,8 @@ def read_asf(path) -> Skeleton:
             continue
     if bone is not None:
         raise MotionFormatError(path, len(lines), "file ends inside a bone's begin/end block (truncated?)")
+    if root_line is None:
+        raise MotionFormatError(path, None, "no :root section (the root's DOF order, axis and position)")
     if not bones:
         raise MotionFormatError(path, None, "no :bonedata bones found")
     if "root" not in children:

@@ -1,6 +1,6 @@
 """BVH (Biovision hierarchy) writer and reader.
 
-:func:`write_bvh` writes any :class:`~animsynth.io.amc.Motion` so that it opens
+:func:`write_bvh` writes any :class:`~animsynth.motion.Motion` so that it opens
 in Blender: one BVH joint per skeleton joint (ASF bone), ``OFFSET`` = where
 the joint starts relative to its parent (the parent bone's direction x
 length), an ``End Site`` at the tip of every leaf, root channels
@@ -25,10 +25,10 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..kinematics import dof_values_from_local, local_rotations, root_translation
+from ..motion import Motion
 from ..skeleton import Joint, Skeleton
-from .amc import Motion
 from .atomic import atomic_write_text
-from .errors import MotionFormatError, parse_float
+from .errors import MotionFormatError, parse_float, read_text_lines
 
 _CH = {"Xposition": "tx", "Yposition": "ty", "Zposition": "tz",
        "Xrotation": "rx", "Yrotation": "ry", "Zrotation": "rz"}
@@ -85,13 +85,11 @@ def write_bvh(path, motion: Motion, scale: float = 1.0) -> None:
 def read_bvh(path, fps: float | None = None) -> Motion:
     """Read a BVH file into a generic skeleton and motion.
 
-    Raises :class:`MotionFormatError` (file and line) on malformed input.
+    Raises :class:`MotionFormatError` (file and line) on malformed input,
+    including bytes that are not UTF-8, a frame count below 1 and a frame time
+    that is not positive. A leading UTF-8 byte-order mark is ignored.
     """
-    try:
-        with open(path, encoding="utf-8") as f:
-            raw = f.read().splitlines()
-    except OSError as exc:
-        raise MotionFormatError(path, None, f"cannot open: {exc.strerror}") from None
+    raw = read_text_lines(path)
     toks: list[tuple[str, int]] = []
     motion_line = None
     for ln, line in enumerate(raw, start=1):
@@ -135,6 +133,8 @@ def read_bvh(path, fps: float | None = None) -> Motion:
                     k = int(c)
                 except ValueError:
                     raise MotionFormatError(path, lnc, f"bad channel count {c!r}") from None
+                if k < 0:
+                    raise MotionFormatError(path, lnc, f"negative channel count {c!r}")
                 chans = [nxt()[0] for _ in range(k)]
                 bad = [c for c in chans if c not in _CH]
                 if bad:
@@ -184,13 +184,19 @@ def read_bvh(path, fps: float | None = None) -> Motion:
         nframes = int(nf_s)
     except ValueError:
         raise MotionFormatError(path, lnf, f"bad frame count {nf_s!r}") from None
+    if nframes < 1:
+        raise MotionFormatError(path, lnf, f"frame count must be at least 1, got {nframes}")
     ftime = parse_float(ft_s, path, lnt, "frame time")
+    if ftime <= 0:
+        raise MotionFormatError(path, lnt, f"frame time must be positive (seconds per frame), got {ft_s!r}")
     ncols = sum(len(c) for _, c in channels)
     rows = []
     for k in range(i, len(raw)):
         if not raw[k].strip():
             continue
         parts = raw[k].split()
+        if len(rows) == nframes:
+            raise MotionFormatError(path, k + 1, f"more frame rows than the {nframes} the header declares")
         if len(parts) != ncols:
             raise MotionFormatError(path, k + 1, f"{len(parts)} values, hierarchy declares {ncols} channels")
         rows.append([parse_float(p, path, k + 1) for p in parts])

@@ -40,3 +40,38 @@ def parse_float(token: str, path, line: int, what: str = "value") -> float:
     if value != value or value in (float("inf"), float("-inf")):
         raise MotionFormatError(path, line, f"non-finite {what} {token!r}")
     return value
+
+
+def read_text_lines(path) -> list[str]:
+    """The lines of a UTF-8 text file, with errors that name file and line.
+
+    A leading UTF-8 byte-order mark (written by some Windows editors) is an
+    encoding signature, not content, and is dropped. Bytes that are not UTF-8
+    raise :class:`MotionFormatError` naming the first bad line (the built-in
+    decoder would only give a byte offset).
+
+    Raises
+    ------
+    MotionFormatError
+        The file cannot be opened or is not UTF-8 text.
+    """
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read()
+    except OSError as exc:
+        raise MotionFormatError(path, None, f"cannot open: {exc.strerror or exc}") from None
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    # universal newlines (LF, CRLF, CR), as open(..., newline=None) reads them
+    data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise MotionFormatError(
+            path, line, f"not UTF-8 text (byte {data[exc.start:exc.start + 1]!r})"
+        ) from None
+    lines = text.split("\n")
+    if lines and lines[-1] == "":
+        lines.pop()
+    return lines

@@ -17,6 +17,7 @@ import glob
 import gzip
 import os
 import re
+import zlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,8 +37,12 @@ def _read_text(path) -> str:
         else:
             with open(p, "rb") as fh:
                 data = fh.read()
-    except OSError as exc:
-        raise MotionFormatError(path, None, f"cannot read: {exc}") from None
+    except (OSError, EOFError, zlib.error) as exc:
+        # gzip raises EOFError for a truncated stream, zlib.error for corrupt
+        # data and BadGzipFile (an OSError) for a file that is not gzip at all
+        what = "truncated or corrupt gzip data" if isinstance(exc, (EOFError, zlib.error, gzip.BadGzipFile)) \
+            else "cannot read"
+        raise MotionFormatError(path, None, f"{what}: {exc}") from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError:
@@ -76,6 +81,44 @@ def _slow_parse(path, lines):
     return verts, faces
 
 
+def _fast_parse(lines):
+    """Vectorised parse of a plain triangle OBJ, or None to use :func:`_slow_parse`.
+
+    It accepts exactly the files whose every ``v`` record has 3 numbers and
+    every ``f`` record 3 positive plain indices to vertices defined before
+    it, with finite coordinates. On anything else (polygons, ``i/t/n``
+    tokens, negative indices, ``w`` coordinates, junk) it returns None, so
+    the careful parser either reads the file or refuses it with file and
+    line: the two parsers never disagree on a file.
+    """
+    vrec: list[list[str]] = []
+    frec: list[list[str]] = []
+    defined: list[int] = []  # vertices defined before each face
+    for raw in lines:
+        tok = raw.split()
+        if not tok:
+            continue
+        if tok[0] == "v":
+            if len(tok) != 4:
+                return None
+            vrec.append(tok[1:])
+        elif tok[0] == "f":
+            if len(tok) != 4 or "/" in raw:
+                return None
+            frec.append(tok[1:])
+            defined.append(len(vrec))
+    try:
+        verts = np.array(vrec, dtype=float).reshape(-1, 3)
+        faces = np.array(frec, dtype=np.int64).reshape(-1, 3)
+    except ValueError:
+        return None
+    if not np.all(np.isfinite(verts)):
+        return None
+    if faces.size and (faces.min() < 1 or np.any(faces.max(axis=1) > np.array(defined))):
+        return None
+    return verts, faces - 1
+
+
 def read_obj(path) -> tuple[np.ndarray, np.ndarray]:
     """Read one OBJ (or OBJ.gz) file.
 
@@ -92,26 +135,13 @@ def read_obj(path) -> tuple[np.ndarray, np.ndarray]:
     """
     text = _read_text(path)
     lines = text.splitlines()
-    vlines = [ln[2:] for ln in lines if ln.startswith("v ")]
-    flines = [ln[2:] for ln in lines if ln.startswith("f ")]
-    verts = faces = None
-    try:
-        vtok = " ".join(vlines).split()
-        if len(vtok) == 3 * len(vlines) and all(ln.count("/") == 0 for ln in flines[:1]):
-            verts = np.array(vtok, dtype=float).reshape(-1, 3)
-            ftok = " ".join(flines).split()
-            if len(ftok) == 3 * len(flines):
-                faces = np.array(ftok, dtype=np.int64).reshape(-1, 3)
-                if faces.size and (faces.min() < 1 or faces.max() > len(verts)):
-                    faces = None
-                else:
-                    faces = faces - 1
-    except ValueError:
-        verts = faces = None
-    if verts is None or faces is None or not np.all(np.isfinite(verts)):
+    fast = _fast_parse(lines)
+    if fast is None:
         v, f = _slow_parse(path, lines)
         verts = np.array(v, float).reshape(-1, 3)
         faces = np.array(f, np.int64).reshape(-1, 3)
+    else:
+        verts, faces = fast
     if len(verts) == 0:
         raise MotionFormatError(path, None, "no vertices ('v' records)")
     return verts, faces

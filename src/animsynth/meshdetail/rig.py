@@ -269,7 +269,7 @@ def rig_from_cmu(skeleton: Skeleton) -> Rig:
 
 
 def cmu_motion_to_rig(motion, rig: Rig | None = None):
-    """Map a CMU-skeleton :class:`~animsynth.io.Motion` onto the 18-joint rig.
+    """Map a CMU-skeleton :class:`~animsynth.motion.Motion` onto the 18-joint rig.
 
     Each rig joint takes the *world* rotation of its CMU bone; local angles are
     ``W_parent^-1 W_j`` (so dropped bones such as the clavicles are folded into

@@ -221,7 +221,7 @@ class MotionFeatures:
 
 
 def motion_features(motion) -> MotionFeatures:
-    """Extract :class:`MotionFeatures` from an :class:`animsynth.io.Motion`."""
+    """Extract :class:`MotionFeatures` from an :class:`animsynth.motion.Motion`."""
     sk = motion.skeleton
     values = np.asarray(motion.values, float)
     if values.ndim != 2 or values.shape[0] < 2:

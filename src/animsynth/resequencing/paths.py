@@ -6,7 +6,7 @@ import numpy as np
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial.transform import Rotation
 
-from ..io.amc import Motion
+from ..motion import Motion
 from ..kinematics import local_rotations, root_translation
 from ..skeleton import ROT_DOFS, TRANS_DOFS
 from .embedding import DisconnectedGraphError

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..io.amc import Motion
+from ..motion import Motion
 from .distances import PAPER_WEIGHTS, l2_distances, lee_distances
 from .embedding import (DisconnectedGraphError, PrecomputedIsomap, graph_components, knn_graph,
                         min_connected_k, neighbor_ranks, residual_variance, spatio_temporal_distances,

@@ -13,7 +13,7 @@ import os
 import numpy as np
 import pandas as pd
 
-from ..io.amc import Motion
+from ..motion import Motion
 from ..io.atomic import atomic_write_text
 from ..tables import write_table
 from . import experiment as ex

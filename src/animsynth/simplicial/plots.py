@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
-from ..io.amc import Motion  # noqa: E402
+from ..motion import Motion  # noqa: E402
 from ..io.atomic import atomic_path  # noqa: E402
 
 _CLIP_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink")

@@ -21,7 +21,7 @@ depends on the motion history (it lags, swings and flares). Because the
 generator can re-simulate, it also gives ground truth for edited motions.
 
 Motion comes from :func:`procedural_motion` (seeded synthetic dance / walk on
-the 18-joint rig) or from any CMU-skeleton :class:`~animsynth.io.Motion`
+the 18-joint rig) or from any CMU-skeleton :class:`~animsynth.motion.Motion`
 mapped with :func:`animsynth.meshdetail.rig.cmu_motion_to_rig`.
 """
 

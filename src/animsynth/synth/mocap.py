@@ -28,7 +28,7 @@ from scipy.interpolate import CubicSpline
 from scipy.ndimage import gaussian_filter1d
 from scipy.spatial.transform import Rotation
 
-from ..io.amc import Motion
+from ..motion import Motion
 from ..kinematics import forward_kinematics
 from ..skeleton import Joint, Skeleton
 

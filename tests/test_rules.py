@@ -1,0 +1,214 @@
+"""The workflow's rules are ready for a cluster, and its scripts follow one style.
+
+* every rule (except local ones) declares ``threads`` and ``resources`` with
+  ``mem_mb`` and ``runtime`` (minutes), so a SLURM profile needs no per-rule
+  blocks;
+* every ``workflow/scripts/*.py`` marks each line that uses the ``snakemake``
+  object (injected by Snakemake's ``script:`` directive) with
+  ``# noqa: F821`` and no other line with it;
+* no tracker references (issue numbers) in code, config or docs.
+"""
+
+from __future__ import annotations
+
+import ast
+import io
+import re
+import subprocess
+import tokenize
+from pathlib import Path
+
+import pytest
+
+from conftest import REPO, SNAKEMAKE
+
+RULE_FILES = [REPO / "Snakefile", *sorted((REPO / "workflow" / "rules").glob("*.smk"))]
+SCRIPTS = sorted((REPO / "workflow" / "scripts").glob("*.py"))
+MARK = "# noqa: F821"
+
+
+def _indent(line: str) -> int:
+    return len(line) - len(line.lstrip(" "))
+
+
+def parse_rules(path: Path) -> dict[str, dict]:
+    """Each ``rule NAME:`` block of a Snakefile: its directives and resource names.
+
+    A block is every line indented deeper than its ``rule`` line (rules may sit
+    inside ``if``/``else``). Returns name -> {"file", "line", "directives":
+    {directive: [body lines]}}.
+    """
+    lines = path.read_text().splitlines()
+    rules = {}
+    for i, line in enumerate(lines):
+        m = re.match(r"^(\s*)rule\s+(\w+)\s*:", line)
+        if not m:
+            continue
+        base = len(m.group(1))
+        body = []
+        for nxt in lines[i + 1:]:
+            if nxt.strip() and _indent(nxt) <= base:
+                break
+            body.append(nxt)
+        body_indent = min((_indent(b) for b in body if b.strip()), default=base + 4)
+        directives: dict[str, list[str]] = {}
+        current = None
+        for b in body:
+            if not b.strip() or b.strip().startswith("#"):
+                continue
+            if _indent(b) == body_indent:
+                dm = re.match(r"\s*(\w+)\s*:(.*)$", b)
+                current = dm.group(1) if dm else None
+                if current:
+                    directives[current] = [dm.group(2).strip()] if dm.group(2).strip() else []
+            elif current:
+                directives[current].append(b.strip())
+        assert m.group(2) not in rules, f"rule {m.group(2)} defined twice in {path}"
+        rules[m.group(2)] = {"file": path.relative_to(REPO), "line": i + 1, "directives": directives}
+    return rules
+
+
+def all_rules() -> dict[str, dict]:
+    out = {}
+    for f in RULE_FILES:
+        for name, info in parse_rules(f).items():
+            assert name not in out, f"rule {name} defined in {out[name]['file']} and {f}"
+            out[name] = info
+    return out
+
+
+def _is_local(info) -> bool:
+    return info["directives"].get("localrule", [""])[0] == "True"
+
+
+def test_parser_reads_directives():
+    text = ("if X:\n\n    rule a:\n        input:\n            'x',\n        threads: 2\n        resources:\n"
+            "            mem_mb=100,\n            runtime=5,\n        script:\n            's.py'\n\nelse:\n\n"
+            "    rule b:\n        output:\n            'y',\n\n\nrule c:\n    output:\n        'z',\n    localrule: True\n")
+    p = REPO / "tests" / ".tmp_rules.smk"
+    p.write_text(text)
+    try:
+        rules = parse_rules(p)
+    finally:
+        p.unlink()
+    assert set(rules) == {"a", "b", "c"}
+    assert rules["a"]["directives"]["threads"] == ["2"]
+    assert rules["a"]["directives"]["resources"] == ["mem_mb=100,", "runtime=5,"]
+    assert "threads" not in rules["b"]["directives"] and _is_local(rules["c"])
+
+
+@pytest.mark.parametrize("cfg", ["config.yaml", "cmu.yaml"])
+def test_parser_sees_every_rule_snakemake_sees(cfg, tmp_path):
+    """The text parse cannot miss a rule: compare with ``snakemake --list-rules``."""
+    from conftest import copy_workflow
+
+    wd = copy_workflow(tmp_path)
+    args = [SNAKEMAKE, "--list-rules"] + ([] if cfg == "config.yaml" else ["--configfile", f"config/{cfg}"])
+    res = subprocess.run(args, cwd=wd, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+    listed = {ln.strip() for ln in res.stdout.splitlines() if re.fullmatch(r"\s*\w+\s*", ln)}
+    assert listed and listed <= set(all_rules()), listed - set(all_rules())
+
+
+def test_every_rule_has_threads_and_resources():
+    """threads, and resources with mem_mb and runtime, on every rule that runs a job."""
+    missing = []
+    for name, info in sorted(all_rules().items()):
+        if _is_local(info):
+            continue
+        d = info["directives"]
+        where = f"{info['file']}:{info['line']} rule {name}"
+        if "threads" not in d:
+            missing.append(f"{where}: no threads")
+        res = " ".join(d.get("resources", []))
+        for key in ("mem_mb", "runtime"):
+            if not re.search(rf"\b{key}\s*=", res):
+                missing.append(f"{where}: no resources {key}")
+    assert not missing, "rules not ready for a cluster:\n" + "\n".join(missing)
+
+
+def test_local_rules_run_nothing():
+    for name, info in all_rules().items():
+        if _is_local(info):
+            assert not {"script", "shell", "run", "notebook", "wrapper"} & set(info["directives"]), name
+
+
+def test_slurm_profile_has_no_per_rule_blocks():
+    import yaml
+
+    text = (REPO / "profiles" / "slurm" / "config.yaml").read_text()
+    prof = yaml.safe_load(text)
+    assert "set-resources" not in prof and "set-threads" not in prof
+    assert {"mem_mb", "runtime"} <= set(prof["default-resources"])
+    assert "lead adds" not in text and "placeholder" not in text.lower()
+
+
+# --- one style for scripts ----------------------------------------------------
+
+def script_style_problems(source: str) -> list[str]:
+    """Lines breaking the rule: a line using ``snakemake`` ends with the F821
+    marker, a line not using it has none, and no other ``noqa`` hides F821."""
+    # uses from the syntax tree (it sees names inside f-strings, as pyflakes does)
+    uses = {n.lineno for n in ast.walk(ast.parse(source)) if isinstance(n, ast.Name) and n.id == "snakemake"}
+    marked = {}
+    for tok in tokenize.generate_tokens(io.StringIO(source).readline):
+        if tok.type == tokenize.COMMENT and "noqa" in tok.string:
+            marked[tok.start[0]] = tok.string
+    problems = []
+    for ln in sorted(uses):
+        if marked.get(ln) != MARK:
+            problems.append(f"line {ln}: uses snakemake without '{MARK}'" +
+                            (f" (has {marked[ln]!r})" if ln in marked else ""))
+    for ln, c in sorted(marked.items()):
+        if ln not in uses and "F821" in c:
+            problems.append(f"line {ln}: '{c}' on a line that does not use snakemake")
+        if ln in uses and c != MARK:
+            continue  # reported above
+    return problems
+
+
+def test_script_style_checker_can_fail():
+    good = f"log = setup(snakemake)  {MARK}\nx = 1\n"
+    assert script_style_problems(good) == []
+    assert script_style_problems("log = setup(snakemake)\n")
+    assert script_style_problems(f"x = 1  {MARK}\n")
+    assert script_style_problems("f(snakemake)  # noqa\n")
+    # an f-string expression is a use; a string or comment mentioning snakemake is not
+    assert script_style_problems("t = f'{snakemake.params.x} data'\n")
+    assert script_style_problems("'''snakemake'''\n# snakemake\n") == []
+
+
+@pytest.mark.parametrize("script", SCRIPTS, ids=[s.name for s in SCRIPTS])
+def test_script_follows_the_snakemake_marker_style(script):
+    problems = script_style_problems(script.read_text())
+    assert not problems, f"{script.relative_to(REPO)}:\n" + "\n".join(problems)
+
+
+# --- no tracker references ---------------------------------------------------
+
+# "issue 3", "issues 3-4", "(issue 5)", "Target (issue)"; not upstream bugs such as "scipy issue 21279"
+TRACKER = re.compile(r"\bissues?\s*#?\s*\d{1,3}\b|\(issues?\b|\bthe issue's\b|\bmethod issues\b", re.I)
+TEXT_SUFFIXES = {".py", ".smk", ".yaml", ".yml", ".md", ".rst", ".toml", ".cfg", ".txt", ".sh", ""}
+
+
+def _tracked_text_files():
+    res = subprocess.run(["git", "ls-files"], cwd=REPO, capture_output=True, text=True)
+    if res.returncode != 0:
+        pytest.skip("not a git checkout")
+    for rel in res.stdout.splitlines():
+        p = REPO / rel
+        if p.suffix in TEXT_SUFFIXES and p.is_file() and p.name != "test_rules.py" and "tests/data" not in rel:
+            yield rel, p
+
+
+def test_no_tracker_references():
+    hits = []
+    for rel, p in _tracked_text_files():
+        try:
+            text = p.read_text()
+        except UnicodeDecodeError:
+            continue
+        for k, line in enumerate(text.splitlines(), start=1):
+            if TRACKER.search(line):
+                hits.append(f"{rel}:{k}: {line.strip()[:100]}")
+    assert not hits, "tracker references (name things by what they are):\n" + "\n".join(hits)
