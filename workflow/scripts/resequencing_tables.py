@@ -8,11 +8,11 @@ from animsynth.resequencing.verdicts import all_verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)
-inp, out = snakemake.input, snakemake.output
-cfg = with_defaults(snakemake.params.cfg)
-pub_cfg = snakemake.params.published
-trials = snakemake.params.trials
+log = setup_logging(snakemake)  # noqa: F821
+inp, out = snakemake.input, snakemake.output  # noqa: F821
+cfg = with_defaults(snakemake.params.cfg)  # noqa: F821
+pub_cfg = snakemake.params.published  # noqa: F821
+trials = snakemake.params.trials  # noqa: F821
 
 
 def cat(paths):

@@ -136,7 +136,7 @@ def linearize_quaternions(q, sign_mode: str = "continuous") -> np.ndarray:
 
     Notes
     -----
-    ``v_0 = 0`` follows the issue's formula; any constant ``v_0`` (e.g.
+    ``v_0 = 0`` follows the Lee & Shin running sum (it starts at zero); any constant ``v_0`` (e.g.
     ``log(q_0)``) shifts every frame of a joint by the same vector and leaves
     all inter-frame distances unchanged.
     """
