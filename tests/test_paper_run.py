@@ -65,7 +65,8 @@ def test_mesh_archive_is_unpacked_and_checked(tmp_path, corrupt):
     out = res.stdout + res.stderr
     if corrupt is None:
         assert res.returncode == 0, out[-4000:]
-        assert sorted(p.name for p in (wd / "resources" / "mesh" / "seq").iterdir())[0] == "mesh_0000.obj.gz"
+        got = sorted(p.name for p in (wd / "resources" / "mesh" / "seq").glob("*.obj.gz"))
+        assert got == [f"mesh_{i:04d}.obj.gz" for i in range(4)]
         assert (wd / "results" / "data" / "mesh_checksums.csv").read_text().count("\n") == 5
     else:
         assert res.returncode != 0
