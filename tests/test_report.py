@@ -3,7 +3,15 @@
 import pandas as pd
 import pytest
 
-from animsynth.report import aggregate_rule_benchmarks, build_summary, read_verdicts, rule_benchmark_summary
+from animsynth.report import (
+    aggregate_rule_benchmarks,
+    build_summary,
+    claims_rst,
+    claims_table,
+    family_benchmark_summary,
+    read_verdicts,
+    rule_benchmark_summary,
+)
 
 TSV = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n{s}\t0:00:01\t{m}\t200\t1\t1\t0\t0\t50\t{s}\n"
 
@@ -21,6 +29,11 @@ def test_rule_benchmarks(tmp_path):
     assert per.loc["data/parse_trial", "jobs"] == 2
     assert per.loc["data/parse_trial", "total_seconds"] == pytest.approx(4.0)
     assert per.loc["data/parse_trial", "peak_rss_mb"] == pytest.approx(120)
+    fam = family_benchmark_summary(jobs).set_index("family")
+    assert fam.loc["data", "jobs"] == 3
+    assert fam.loc["data", "wall_s"] == pytest.approx(4.5)
+    assert fam.loc["data", "cpu_s"] == pytest.approx(4.5)
+    assert fam.loc["data", "peak_rss_mb"] == pytest.approx(120)
 
 
 def test_summary_renders_tables_and_verdicts(tmp_path):
@@ -29,11 +42,51 @@ def test_summary_renders_tables_and_verdicts(tmp_path):
     v = tmp_path / "simplicial" / "verdicts.csv"
     v.parent.mkdir()
     pd.DataFrame({"claim": ["Delaunay beats k-NN"], "verdict": ["no"], "evidence": ["p=0.2"]}).to_csv(v, index=False)
-    md = build_summary([{"title": "Table II", "csv": str(t), "note": "synthetic"}], [v], "Data: synthetic.")
-    assert "| simplicial | Delaunay beats k-NN | no | p=0.2 |" in md
+    md = build_summary([{"title": "Table II", "csv": str(t), "note": "synthetic"}], [v], "Data: synthetic.",
+                       family_data={"simplicial": "synthetic mocap"})
+    assert md.index("## Claims of the four papers") < md.index("## Table II")
+    assert "| Gauch & Peters (simplicial complex) | Delaunay beats k-NN |  |  | synthetic mocap | **no** |" in md
     assert "## Table II" in md and "| w1 | 0.0123 |" in md
     bad = tmp_path / "x" / "verdicts.csv"
     bad.parent.mkdir()
     pd.DataFrame({"claim": ["c"]}).to_csv(bad, index=False)
     with pytest.raises(ValueError, match="lacks columns"):
         read_verdicts([bad])
+
+
+def _verdicts(tmp_path, family, rows):
+    p = tmp_path / family / "verdicts.csv"
+    p.parent.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame(rows).to_csv(p, index=False)
+    return p
+
+
+def test_claims_put_real_data_first_and_link_unique_report_files(tmp_path):
+    face = _verdicts(tmp_path, "facegraph", [
+        {"claim": "duration difference near 0", "paper_value": "0-0.11", "ours": "0.02", "data": "synthetic CK+-layout",
+         "verdict": "reproduced", "evidence": "e", "source": "facegraph/table1.csv"}])
+    simp = _verdicts(tmp_path, "simplicial", [
+        {"claim": "Delaunay better in 5 of 8 cells", "paper_value": "5/8", "ours": "3/8", "data": "CMU w1 w2 r1 r2",
+         "verdict": "not reproduced", "evidence": "e", "source": "simplicial/table2.csv"},
+        {"claim": "overall median A", "paper_value": "0.068 vs 0.079", "ours": "0.05 vs 0.04", "data": "",
+         "verdict": "contradicted", "evidence": "e", "source": "simplicial/verdicts.csv"}])
+    claims = claims_table([face, simp], {"simplicial": "CMU mocap from mirror"})
+    assert list(claims["family"]) == ["simplicial", "simplicial", "facegraph"]
+    assert list(claims["real"]) == [True, True, False]
+    assert claims.loc[1, "data"] == "CMU mocap from mirror"  # empty data filled from the family's source
+    prov = pd.DataFrame([{"family": "simplicial", "data": "CMU", "status": "ran"},
+                         {"family": "meshdetail", "data": "samba", "status": "skipped: absent"}])
+    rst = claims_rst(claims, prov, ["results/paper/simplicial/table2.csv", "results/paper/simplicial/verdicts.csv",
+                                    "results/paper/facegraph/verdicts.csv", "results/paper/facegraph/table1.csv"])
+    assert "`table2.csv`_" in rst and "`table1.csv`_" in rst
+    assert "``simplicial/verdicts.csv``" in rst  # verdicts.csv is not unique in the report: no link
+    assert rst.index("Claims on real data") < rst.index("Claims on synthetic data")
+    assert "skipped: absent" in rst
+    # it is valid reStructuredText once the report's link targets are appended
+    from docutils.core import publish_parts
+    from docutils.utils import Reporter
+
+    targets = "\n.. _table2.csv: javascript:void(0)\n.. _table1.csv: javascript:void(0)\n"
+    html = publish_parts(rst + targets, writer="html",
+                         settings_overrides={"report_level": Reporter.WARNING_LEVEL, "halt_level": Reporter.WARNING_LEVEL})
+    assert html["html_body"].count("<tr>") == 5  # two tables: header + 2 rows, header + 1 row

@@ -16,6 +16,16 @@ from .tables import to_markdown
 log = logging.getLogger("animsynth.report")
 
 VERDICT_COLUMNS = ["claim", "verdict", "evidence"]
+# The common verdict format of the families (optional beyond VERDICT_COLUMNS).
+CLAIM_COLUMNS = ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
+VERDICT_VOCABULARY = ("reproduced", "partly", "not reproduced", "contradicted", "within noise")
+# Which paper each family's verdicts speak for.
+FAMILY_PAPERS = {
+    "simplicial": "Gauch & Peters (simplicial complex)",
+    "resequencing": "Isomap / ST-Isomap re-sequencing",
+    "meshdetail": "Hybrid mesh animation",
+    "facegraph": "Serra et al. 2018 (facial motion graphs)",
+}
 
 
 def aggregate_rule_benchmarks(paths, root: str = "benchmarks/rules") -> pd.DataFrame:
@@ -55,6 +65,21 @@ def rule_benchmark_summary(df: pd.DataFrame) -> pd.DataFrame:
         "max_seconds": g["seconds"].max().round(2).values,
         "peak_rss_mb": g["max_rss_mb"].max().round(1).values,
     })
+
+
+def family_benchmark_summary(df: pd.DataFrame) -> pd.DataFrame:
+    """Per family (data, simplicial, ...): jobs, summed wall and CPU seconds, peak memory of one job."""
+    cols = ["family", "jobs", "wall_s", "cpu_s", "peak_rss_mb"]
+    if df.empty:
+        return pd.DataFrame(columns=cols)
+    g = df.groupby("family", sort=True)
+    return pd.DataFrame({
+        "family": list(g.groups),
+        "jobs": g.size().values,
+        "wall_s": g["seconds"].sum().round(1).values,
+        "cpu_s": g["cpu_time_s"].sum().round(1).values,
+        "peak_rss_mb": g["max_rss_mb"].max().round(1).values,
+    })[cols]
 
 
 def run_benchmarks(files) -> pd.DataFrame:
@@ -97,19 +122,143 @@ def read_verdicts(paths) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=["family"] + VERDICT_COLUMNS)
 
 
-def build_summary(sections: list[dict], verdict_paths, source_note: str) -> str:
-    """Markdown summary: verdicts first, then every table, each rendered from its CSV.
+def is_synthetic(data: str) -> bool:
+    """Does a verdict's ``data`` text name synthetic (generated) data?"""
+    return "synthetic" in str(data).lower()
+
+
+def claims_table(paths, family_data: dict[str, str] | None = None) -> pd.DataFrame:
+    """Every claim of the four papers, one row each, from the families' ``verdicts.csv``.
+
+    Parameters
+    ----------
+    paths : iterable of path
+        ``<family>/verdicts.csv`` files (the family is the parent folder's name).
+    family_data : dict, optional
+        {family: what it ran on}; fills ``data`` where a verdict row leaves it empty.
+
+    Returns
+    -------
+    claims : DataFrame
+        Columns ``paper, family, claim, paper_value, ours, data, verdict,
+        evidence, source, real`` (``real`` is False for synthetic data), real
+        data first, then by family in the order given.
+    """
+    family_data = family_data or {}
+    frames = []
+    for p in map(str, paths):
+        df = pd.read_csv(p, keep_default_na=False, dtype=str)
+        missing = [c for c in VERDICT_COLUMNS if c not in df]
+        if missing:
+            raise ValueError(f"{p}: verdict table lacks columns {missing}")
+        fam = Path(p).parent.name
+        for c in CLAIM_COLUMNS:
+            if c not in df:
+                df[c] = ""
+        df = df[CLAIM_COLUMNS].copy()
+        df.loc[df["data"].str.strip() == "", "data"] = family_data.get(fam, "")
+        df.insert(0, "family", fam)
+        df.insert(0, "paper", FAMILY_PAPERS.get(fam, fam))
+        df["order"] = len(frames)
+        frames.append(df)
+    cols = ["paper", "family", *CLAIM_COLUMNS, "real"]
+    if not frames:
+        return pd.DataFrame(columns=cols)
+    out = pd.concat(frames, ignore_index=True)
+    out["real"] = ~out["data"].map(is_synthetic)
+    out = out.sort_values(["real", "order"], ascending=[False, True], kind="stable")
+    return out[cols].reset_index(drop=True)
+
+
+def _claims_rows_md(df: pd.DataFrame) -> str:
+    view = pd.DataFrame({
+        "paper": df["paper"],
+        "claim": df["claim"],
+        "paper's number": df["paper_value"],
+        "ours": df["ours"],
+        "data": df["data"],
+        "verdict": df["verdict"].map(lambda v: f"**{v}**" if v else v),
+        "table / figure": df["source"].map(lambda s: f"[{s}]({s})" if s else ""),
+    })
+    return to_markdown(view)
+
+
+def claims_markdown(claims: pd.DataFrame, provenance: pd.DataFrame | None = None) -> str:
+    """The claims section of ``summary.md``: real-data claims first, synthetic ones apart."""
+    out = ["## Claims of the four papers", ""]
+    if provenance is not None and not provenance.empty:
+        out += ["What each part ran on:", "", to_markdown(provenance), ""]
+    for title, mask in (("On real data", claims["real"]), ("On synthetic data", ~claims["real"])):
+        part = claims[mask.astype(bool)] if len(claims) else claims
+        out += [f"### {title}", ""]
+        if part.empty:
+            out += ["(none in this run)", ""]
+        else:
+            counts = part["verdict"].value_counts()
+            out += [", ".join(f"{counts[v]} {v}" for v in counts.index) + ".", "", _claims_rows_md(part), ""]
+    return "\n".join(out)
+
+
+def _rst_cell(s: str) -> str:
+    return " ".join(str(s).split()).replace("|", "/").replace("*", "\\*").replace("`", "'")
+
+
+def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_outputs=()) -> str:
+    """The report's home page (reStructuredText): what ran on what, then every claim.
+
+    A claim's table or figure becomes a link into the report when a rule's
+    ``report(...)`` output ends with it and its file name is unique among the
+    report's files (the report names its entries by file name only).
+    """
+    names: dict[str, list[str]] = {}
+    for path in map(str, report_outputs):
+        names.setdefault(Path(path).name, []).append(path)
+
+    def link(src: str) -> str:
+        if not src:
+            return ""
+        paths = names.get(Path(src).name, [])
+        if len(paths) == 1 and paths[0].endswith(src):
+            return f"`{Path(src).name}`_"
+        return f"``{_rst_cell(src)}``"
+
+    out = []
+    if provenance is not None and not provenance.empty:
+        out += ["What each part ran on", "~~~~~~~~~~~~~~~~~~~~~", ""]
+        for _, r in provenance.iterrows():
+            out.append(f"- **{_rst_cell(r['family'])}**: {_rst_cell(r['data'])} ({_rst_cell(r['status'])})")
+        out.append("")
+    for title, mask in (("Claims on real data", claims["real"]), ("Claims on synthetic data", ~claims["real"])):
+        part = claims[mask.astype(bool)] if len(claims) else claims
+        out += [title, "~" * len(title), ""]
+        if part.empty:
+            out += ["(none in this run)", ""]
+            continue
+        out += [".. list-table::", "   :header-rows: 1", "   :widths: 14 26 12 16 12 8 12", "",
+                "   * - paper", "     - claim", "     - paper's number", "     - ours", "     - data",
+                "     - verdict", "     - table / figure"]
+        for _, r in part.iterrows():
+            cells = [_rst_cell(r["paper"]), _rst_cell(r["claim"]), _rst_cell(r["paper_value"]), _rst_cell(r["ours"]),
+                     _rst_cell(r["data"]), f"**{_rst_cell(r['verdict'])}**" if r["verdict"] else "", link(r["source"])]
+            out.append(f"   * - {cells[0]}".rstrip())
+            out += [f"     - {c}".rstrip() for c in cells[1:]]
+        out.append("")
+    return "\n".join(out) + "\n"
+
+
+def build_summary(sections: list[dict], verdict_paths, source_note: str,
+                  provenance: pd.DataFrame | None = None, family_data: dict[str, str] | None = None) -> str:
+    """Markdown summary: the papers' claims first (real data, then synthetic), then every table.
 
     ``sections``: dicts with ``title``, ``csv`` and optional ``note`` (what it
     reproduces and on which data), in order.
     """
     out = ["# animsynth: reproduction summary", "", source_note, ""]
-    verdicts = read_verdicts(verdict_paths)
-    out += ["## Verdicts (generated from the tables below)", ""]
-    if verdicts.empty:
-        out += ["(no verdicts were produced)", ""]
+    claims = claims_table(verdict_paths, family_data)
+    if claims.empty:
+        out += ["## Claims of the four papers", "", "(no verdicts were produced)", ""]
     else:
-        out.append(to_markdown(verdicts))
+        out.append(claims_markdown(claims, provenance))
     for s in sections:
         df = pd.read_csv(s["csv"], keep_default_na=False, na_values=[""])
         out += [f"## {s['title']}", "", f"`{s['csv']}`", ""]

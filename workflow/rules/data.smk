@@ -130,3 +130,56 @@ rule datasets_table:
 
 
 DATA_TARGETS = ["results/data/datasets.csv"] + [trial_npz(t) for t in USED_TRIALS]
+
+
+# ---- mesh sequence of the hybrid mesh experiments --------------------------
+# mesh_dir is a folder of OBJ / OBJ.gz frames, an archive of one (.zip,
+# .tar.gz) or a URL of such an archive; archives are unpacked into
+# resources/mesh/<name>/. With mesh_sha256 set, every frame is checked against
+# that list before any experiment reads it, and a mismatch names the frame.
+MESH_SRC = config.get("mesh_dir")
+MESH_SUMS = config.get("mesh_sha256")
+MESH_FRAMES = MESH_SRC
+if MESH_SRC and (is_url(MESH_SRC) or is_archive(MESH_SRC)):
+    MESH_FRAMES = f"resources/mesh/{mesh_source_name(MESH_SRC)}"
+
+    rule mesh_fetch:
+        output:
+            directory(MESH_FRAMES),
+        params:
+            source=MESH_SRC,
+        log:
+            L("data/mesh_fetch.log"),
+        benchmark:
+            B("data/mesh_fetch.tsv")
+        threads: 1
+        resources:
+            mem_mb=1000,
+            runtime=30,
+        conda:
+            "../envs/animsynth.yaml"
+        script:
+            "../scripts/data_mesh_fetch.py"
+
+
+MESH_CHECK = [R("data/mesh_checksums.csv")] if MESH_SRC and MESH_SUMS else []
+if MESH_CHECK:
+
+    rule mesh_checksums:
+        input:
+            frames=MESH_FRAMES,
+            sums=MESH_SUMS,
+        output:
+            R("data/mesh_checksums.csv"),
+        log:
+            L("data/mesh_checksums.log"),
+        benchmark:
+            B("data/mesh_checksums.tsv")
+        threads: 1
+        resources:
+            mem_mb=1000,
+            runtime=10,
+        conda:
+            "../envs/animsynth.yaml"
+        script:
+            "../scripts/data_mesh_checksums.py"

@@ -7,7 +7,7 @@ MESH_DIR = config.get("mesh_dir")
 MD_MODEL_KEYS = ("level", "latent_dim", "iterations", "dynamics_weight", "ridge_alpha", "joint_param", "detail")
 MD_MODEL_CFG = {k: MD[k] for k in MD_MODEL_KEYS}
 # mesh frames: mesh_dir, or the synthetic character (with its ground truth)
-MD_MAIN_DIR = MESH_DIR if MESH_DIR else "results/meshdetail/character/main"
+MD_MAIN_DIR = MESH_FRAMES if MESH_DIR else "results/meshdetail/character/main"
 MD_TRUTH = [] if MESH_DIR else ["results/meshdetail/character/truth.npz"]
 
 MD_DATA = dict(
@@ -54,6 +54,7 @@ rule meshdetail_load:
     input:
         main=MD_MAIN_DIR,
         truth=MD_TRUTH,
+        checked=MESH_CHECK,
     output:
         seq=MD_DATA["seq"],
         edits=MD_DATA["edits"],

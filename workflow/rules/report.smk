@@ -1,23 +1,36 @@
-# One summary for all four systems, and benchmark aggregation.
+# One summary for all four systems, the report's home page, benchmark aggregation.
+# Each family's .smk defines <FAMILY>_SUMMARY (tables for summary.md) and
+# <FAMILY>_VERDICTS (its verdicts.csv files); they are collected here for the
+# families that run (see FAMILY_RAN in common.smk).
 import os
 import re
-
-# Each family's .smk defines <FAMILY>_SUMMARY (tables for results/summary.md)
-# and <FAMILY>_VERDICTS (its verdicts.csv files); they are collected here.
 
 DATA_SUMMARY = [
     {
         "title": "Gauch & Peters Table I: datasets",
-        "csv": "results/data/datasets.csv",
+        "csv": R("data/datasets.csv"),
         "note": "Subsets, pose dimension (56 = 62 DOF minus the root), lengths and total nodes.",
     }
 ]
-SUMMARY_SECTIONS = DATA_SUMMARY + SIMPLICIAL_SUMMARY + RESEQUENCING_SUMMARY + FACEGRAPH_SUMMARY + MESHDETAIL_SUMMARY
+FAMILY_SUMMARIES = {
+    "data": DATA_SUMMARY,
+    "simplicial": SIMPLICIAL_SUMMARY,
+    "resequencing": RESEQUENCING_SUMMARY,
+    "facegraph": FACEGRAPH_SUMMARY,
+    "meshdetail": MESHDETAIL_SUMMARY,
+}
+FAMILY_VERDICTS = {
+    "simplicial": SIMPLICIAL_VERDICTS,
+    "resequencing": RESEQUENCING_VERDICTS,
+    "facegraph": FACEGRAPH_VERDICTS,
+    "meshdetail": MESHDETAIL_VERDICTS,
+}
+SUMMARY_SECTIONS = [s for fam, ss in FAMILY_SUMMARIES.items() if FAMILY_RAN[fam] for s in ss]
 # Machine-dependent tables (wall/CPU time: *_timing.csv, timing.csv) are named
 # in the summary but not rendered, so that summary.md, like every other table,
 # is byte-identical between two runs of one config.
 SUMMARY_TIMING = [s["csv"] for s in SUMMARY_SECTIONS if re.search(r"(^|_)timing\.csv$", os.path.basename(s["csv"]))]
-VERDICT_FILES = SIMPLICIAL_VERDICTS + RESEQUENCING_VERDICTS + FACEGRAPH_VERDICTS + MESHDETAIL_VERDICTS
+VERDICT_FILES = [v for fam, vs in FAMILY_VERDICTS.items() if FAMILY_RAN[fam] for v in vs]
 BENCH_SCRIPTS = sorted(glob_wildcards("benchmarks/bench_{name}.py").name)
 
 
@@ -26,25 +39,34 @@ rule summary:
         tables=[s["csv"] for s in SUMMARY_SECTIONS],
         verdicts=VERDICT_FILES,
     output:
-        report(
-            "results/summary.md",
+        summary=report(
+            R("summary.md"),
             caption="../report/summary.rst",
             category="0. Summary",
         ),
+        claims=report(
+            R("claims.csv"),
+            caption="../report/claims.rst",
+            category="0. Summary",
+        ),
+        home=R("claims.rst"),
     params:
         sections=[s for s in SUMMARY_SECTIONS if s["csv"] not in SUMMARY_TIMING],
         timing=SUMMARY_TIMING,
         source=SOURCE,
         mesh_dir=config["mesh_dir"],
         faces=config["facegraph"].get("ckplus_dir"),
+        provenance=provenance_rows(),
+        family_data={fam: label for fam, (label, _ok, _why) in FAMILY_STATUS.items()},
+        report_outputs=report_outputs,
     threads: 1
     resources:
         mem_mb=500,
         runtime=10,
     log:
-        "logs/report/summary.log",
+        L("report/summary.log"),
     benchmark:
-        "benchmarks/rules/report/summary.tsv"
+        B("report/summary.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -56,7 +78,7 @@ rule benchmarks:
         expand("benchmarks/bench_{name}.py", name=BENCH_SCRIPTS),
     output:
         report(
-            "results/benchmarks.csv",
+            R("benchmarks.csv"),
             caption="../report/benchmarks.rst",
             category="0. Summary",
         ),
@@ -66,9 +88,9 @@ rule benchmarks:
         mem_mb=1000,
         runtime=30,
     log:
-        "logs/report/benchmarks.log",
+        L("report/benchmarks.log"),
     benchmark:
-        "benchmarks/rules/report/benchmarks.tsv"
+        B("report/benchmarks.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -77,27 +99,34 @@ rule benchmarks:
 
 rule rule_benchmarks:
     input:
-        DATA_TARGETS + SIMPLICIAL_TARGETS + RESEQUENCING_TARGETS + FACEGRAPH_TARGETS + MESHDETAIL_TARGETS,
-        "results/summary.md",
+        family_targets(),
+        R("summary.md"),
     output:
-        jobs="results/rule_benchmarks.csv",
+        jobs=R("rule_benchmarks.csv"),
         per_rule=report(
-            "results/rule_benchmarks_per_rule.csv",
+            R("rule_benchmarks_per_rule.csv"),
             caption="../report/rule_benchmarks.rst",
             category="0. Summary",
         ),
+        per_family=report(
+            R("rule_benchmarks_per_family.csv"),
+            caption="../report/rule_benchmarks_per_family.rst",
+            category="0. Summary",
+        ),
+    params:
+        root=BENCH_ROOT,
     threads: 1
     resources:
         mem_mb=500,
         runtime=10,
     log:
-        "logs/report/rule_benchmarks.log",
+        L("report/rule_benchmarks.log"),
     benchmark:
-        "benchmarks/rules/report/rule_benchmarks.tsv"
+        B("report/rule_benchmarks.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
         "../scripts/report_rule_benchmarks.py"
 
 
-REPORT_TARGETS = ["results/summary.md", "results/benchmarks.csv", "results/rule_benchmarks.csv"]
+REPORT_TARGETS = [R("summary.md"), R("benchmarks.csv"), R("rule_benchmarks.csv")]

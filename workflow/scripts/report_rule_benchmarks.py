@@ -1,13 +1,18 @@
-"""Aggregate Snakemake's per-rule benchmark files (runtime, peak memory)."""
+"""Aggregate Snakemake's per-rule benchmark files (runtime, peak memory), per rule and per family."""
 import glob
+import os
 
-from animsynth.report import aggregate_rule_benchmarks, rule_benchmark_summary
+from animsynth.report import aggregate_rule_benchmarks, family_benchmark_summary, rule_benchmark_summary
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
-jobs = aggregate_rule_benchmarks(glob.glob("benchmarks/rules/**/*.tsv", recursive=True))
-write_table(jobs, snakemake.output.jobs, md=False)  # noqa: F821
-write_table(rule_benchmark_summary(jobs), snakemake.output.per_rule, md=True,  # noqa: F821
+out = snakemake.output  # noqa: F821
+root = snakemake.params.root  # noqa: F821
+jobs = aggregate_rule_benchmarks(glob.glob(os.path.join(root, "**", "*.tsv"), recursive=True), root=root)
+write_table(jobs, out.jobs, md=False)
+write_table(rule_benchmark_summary(jobs), out.per_rule, md=True,
             title="Runtime and peak memory per rule (this machine)")
-log.info("%d job benchmark files", len(jobs))
+write_table(family_benchmark_summary(jobs), out.per_family, md=True,
+            title="Wall time, CPU time and peak memory per family (this machine)")
+log.info("%d job benchmark files below %s", len(jobs), root)

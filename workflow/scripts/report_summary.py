@@ -1,15 +1,24 @@
-"""results/summary.md: every table (rendered from its CSV) and the verdicts."""
+"""summary.md (claims first, then every table), claims.csv and the report's home page (claims.rst)."""
+import pandas as pd
+
 from animsynth.io.atomic import atomic_write_text
-from animsynth.report import build_summary
+from animsynth.report import build_summary, claims_rst, claims_table
+from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
 p = snakemake.params  # noqa: F821
-note = (f"Mocap data: **{p.source}**. Meshes: **{p.mesh_dir or 'synthetic skirt character'}**. "
-        f"Faces: **{p.faces or 'synthetic CK+-layout database (not real CK+)'}**. "
-        "Every number below is computed by the workflow on that data; paper values are quoted beside ours where the paper gives them.")
+out = snakemake.output  # noqa: F821
+verdicts = list(snakemake.input.verdicts)  # noqa: F821
+provenance = pd.DataFrame(p.provenance, columns=["family", "data", "status"])
+note = ("What each part ran on: " + "; ".join(f"**{r.family}**: {r.data} ({r.status})" for r in provenance.itertuples())
+        + ". Every number below is computed by the workflow on that data; paper values are quoted beside ours"
+        " where the paper gives them.")
 if p.timing:
     note += (" Machine-dependent timing tables are not shown here (they differ between runs): "
              + ", ".join(f"`{t}`" for t in p.timing) + ".")
-atomic_write_text(snakemake.output[0], build_summary(p.sections, snakemake.input.verdicts, note))  # noqa: F821
-log.info("summary with %d tables and %d verdict files", len(p.sections), len(snakemake.input.verdicts))  # noqa: F821
+claims = claims_table(verdicts, p.family_data)
+write_table(claims, out.claims, md=False)
+atomic_write_text(out.home, claims_rst(claims, provenance, p.report_outputs))
+atomic_write_text(out.summary, build_summary(p.sections, verdicts, note, provenance, p.family_data))
+log.info("summary with %d tables, %d claims (%d on real data)", len(p.sections), len(claims), int(claims["real"].sum()))

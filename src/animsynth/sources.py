@@ -1,0 +1,246 @@
+"""Where real data come from: is a source reachable, and getting a mesh sequence.
+
+Two jobs, both used by the workflow before any experiment runs:
+
+* :func:`probe_source` answers, quickly and without raising, whether a data
+  source (a local folder, or a URL) can be read right now. The paper run uses
+  it to skip a family whose real data are unavailable, with one clear line,
+  instead of failing half-way through a download.
+* :func:`fetch_mesh_frames` and :func:`verify_mesh_frames` turn ``mesh_dir``
+  (a folder, a ``.zip`` / ``.tar.gz`` archive, or a URL of one) into a folder
+  of OBJ frames checked against a SHA-256 list (``sha256sum`` format, hashes of
+  the *uncompressed* OBJ files, so ``.obj.gz`` frames are hashed after
+  decompression). A mismatch names the frame.
+
+The standard library does all of this (``urllib``, ``zipfile``, ``tarfile``,
+``hashlib``); nothing here knows any animation method.
+"""
+
+from __future__ import annotations
+
+import gzip
+import hashlib
+import logging
+import os
+import re
+import shutil
+import tarfile
+import tempfile
+import urllib.error
+import urllib.request
+import zipfile
+from pathlib import Path
+
+import pandas as pd
+
+log = logging.getLogger("animsynth.sources")
+
+ARCHIVE_SUFFIXES = (".zip", ".tar.gz", ".tgz", ".tar")
+_FRAME_RX = re.compile(r"\.obj(\.gz)?$", re.IGNORECASE)
+
+
+class MeshSourceError(RuntimeError):
+    """A mesh source could not be read, unpacked or verified (the message names the file or frame)."""
+
+
+def is_url(s: str) -> bool:
+    return str(s).startswith(("http://", "https://", "ftp://", "file://"))
+
+
+def is_archive(s: str) -> bool:
+    return str(s).lower().endswith(ARCHIVE_SUFFIXES)
+
+
+def mesh_source_name(source: str) -> str:
+    """A folder name for an archive or URL: its file name without the archive suffix."""
+    name = str(source).rstrip("/").rsplit("/", 1)[-1]
+    for suf in ARCHIVE_SUFFIXES:
+        if name.lower().endswith(suf):
+            name = name[: -len(suf)]
+            break
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "mesh"
+
+
+def probe_source(source: str | os.PathLike | None, probe: str | None = None, timeout: float = 5.0) -> tuple[bool, str]:
+    """Can ``source`` be read now?
+
+    Parameters
+    ----------
+    source : str or path or None
+        A local folder or file, or a URL.
+    probe : str, optional
+        A path below ``source`` that must exist (for a folder) or answer (for
+        a URL), e.g. the first trial's AMC file. Without it a URL is asked for
+        itself.
+    timeout : float
+        Seconds to wait for a URL.
+
+    Returns
+    -------
+    ok : bool
+    reason : str
+        Empty when ``ok``; otherwise one line saying what is missing.
+    """
+    if not source:
+        return False, "no source configured"
+    s = str(source)
+    if is_url(s):
+        url = s.rstrip("/") + ("/" + probe.lstrip("/") if probe else "")
+        req = urllib.request.Request(url, method="HEAD")
+        try:
+            with urllib.request.urlopen(req, timeout=timeout):
+                return True, ""
+        except urllib.error.HTTPError as e:  # the server answered: reachable unless the file is missing
+            if e.code in (403, 405, 501):  # HEAD refused: the host is up
+                return True, ""
+            return False, f"{url} answered HTTP {e.code}"
+        except (urllib.error.URLError, OSError, ValueError) as e:
+            reason = getattr(e, "reason", e)
+            return False, f"{url} is not reachable ({reason})"
+    p = Path(s)
+    if not p.exists():
+        return False, f"{p} does not exist"
+    if probe and p.is_dir() and not (p / probe).exists():
+        return False, f"{p / probe} does not exist"
+    return True, ""
+
+
+def list_frames(folder: str | os.PathLike) -> list[Path]:
+    """OBJ / OBJ.gz files directly in ``folder``, sorted by name."""
+    return sorted(p for p in Path(folder).iterdir() if p.is_file() and _FRAME_RX.search(p.name))
+
+
+def _frames_folder(root: Path) -> Path:
+    """The folder below ``root`` holding the most OBJ frames (archives often nest one level)."""
+    best, n_best = None, 0
+    for d in [root, *sorted(p for p in root.rglob("*") if p.is_dir())]:
+        n = len(list_frames(d))
+        if n > n_best:
+            best, n_best = d, n
+    if best is None:
+        raise MeshSourceError(f"no .obj or .obj.gz frames found in {root}")
+    return best
+
+
+def _extract(archive: Path, dest: Path) -> None:
+    """Unpack ``archive`` into ``dest``, refusing members that would land outside it."""
+    dest = dest.resolve()
+    name = archive.name.lower()
+    try:
+        if name.endswith(".zip"):
+            with zipfile.ZipFile(archive) as z:
+                for m in z.namelist():
+                    target = (dest / m).resolve()
+                    if not str(target).startswith(str(dest) + os.sep) and target != dest:
+                        raise MeshSourceError(f"{archive}: member {m!r} would be written outside the target folder")
+                z.extractall(dest)
+        else:
+            with tarfile.open(archive, "r:*") as t:
+                t.extractall(dest, filter="data")  # refuses absolute paths, '..' and links out of dest
+    except (zipfile.BadZipFile, tarfile.TarError, EOFError, OSError) as e:
+        if isinstance(e, MeshSourceError):
+            raise
+        raise MeshSourceError(f"{archive}: cannot unpack ({e})") from e
+
+
+def fetch_mesh_frames(source: str, dest: str | os.PathLike, timeout: float = 120.0) -> list[Path]:
+    """Put the OBJ frames of ``source`` (an archive file, or a URL of one) into ``dest``.
+
+    The frames are copied flat into ``dest`` (created; must not hold frames
+    already). Everything is first unpacked in a temporary folder next to
+    ``dest``, so an interrupted fetch leaves no partial ``dest``.
+
+    Returns
+    -------
+    frames : list of Path
+        The frame files in ``dest``, sorted by name.
+    """
+    dest = Path(dest)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=dest.parent, prefix=".mesh-fetch-") as tmp:
+        tmp = Path(tmp)
+        if is_url(source):
+            fname = source.rstrip("/").rsplit("/", 1)[-1] or "mesh_archive"
+            archive = tmp / fname
+            log.info("downloading %s", source)
+            try:
+                with urllib.request.urlopen(source, timeout=timeout) as r, open(archive, "wb") as f:
+                    shutil.copyfileobj(r, f)
+            except (urllib.error.URLError, OSError, ValueError) as e:
+                raise MeshSourceError(f"{source}: download failed ({getattr(e, 'reason', e)})") from e
+        else:
+            archive = Path(source)
+            if not archive.is_file():
+                raise MeshSourceError(f"{archive}: no such archive")
+        if not is_archive(archive.name):
+            raise MeshSourceError(f"{source}: not an archive ({', '.join(ARCHIVE_SUFFIXES)}) nor a folder")
+        unpacked = tmp / "unpacked"
+        unpacked.mkdir()
+        _extract(archive, unpacked)
+        folder = _frames_folder(unpacked)
+        staged = tmp / "frames"
+        staged.mkdir()
+        for f in list_frames(folder):
+            shutil.move(str(f), staged / f.name)
+        if dest.exists():
+            shutil.rmtree(dest)
+        os.replace(staged, dest)
+    frames = list_frames(dest)
+    log.info("%d frames from %s in %s", len(frames), source, dest)
+    return frames
+
+
+def read_sha256_list(path: str | os.PathLike) -> dict[str, str]:
+    """Read a ``sha256sum``-style list (``<64 hex>  <file name>`` per line) into {name: hash}."""
+    out: dict[str, str] = {}
+    with open(path, encoding="utf-8") as f:
+        for ln, line in enumerate(f, 1):
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            parts = line.split(None, 1)
+            if len(parts) != 2 or not re.fullmatch(r"[0-9a-fA-F]{64}", parts[0]):
+                raise MeshSourceError(f"{path}:{ln}: expected '<sha256>  <file>', got {line[:60]!r}")
+            out[parts[1].lstrip("*").strip()] = parts[0].lower()
+    return out
+
+
+def _frame_hash(path: Path) -> str:
+    h = hashlib.sha256()
+    opener = gzip.open if path.name.lower().endswith(".gz") else open
+    try:
+        with opener(path, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                h.update(chunk)
+    except (OSError, EOFError) as e:
+        raise MeshSourceError(f"{path}: cannot read ({e})") from e
+    return h.hexdigest()
+
+
+def verify_mesh_frames(folder: str | os.PathLike, sums: dict[str, str]) -> pd.DataFrame:
+    """Check every frame of ``folder`` against ``sums`` (hashes of the uncompressed OBJ files).
+
+    Returns
+    -------
+    table : DataFrame
+        One row per listed frame: ``frame`` (name of the uncompressed OBJ),
+        ``file`` (as found), ``sha256``.
+
+    Raises
+    ------
+    MeshSourceError
+        Naming the first frame that is missing, unlisted or whose hash differs.
+    """
+    found = {re.sub(r"\.gz$", "", f.name, flags=re.IGNORECASE): f for f in list_frames(folder)}
+    extra = sorted(set(found) - set(sums))
+    if extra:
+        raise MeshSourceError(f"{folder}: frame {extra[0]} is not in the checksum list ({len(extra)} unlisted frames)")
+    rows = []
+    for name in sorted(sums):
+        if name not in found:
+            raise MeshSourceError(f"{folder}: frame {name} is missing (listed in the checksum list)")
+        got = _frame_hash(found[name])
+        if got != sums[name]:
+            raise MeshSourceError(f"{found[name]}: frame {name} has SHA-256 {got}, expected {sums[name]}")
+        rows.append({"frame": name, "file": found[name].name, "sha256": got})
+    return pd.DataFrame(rows, columns=["frame", "file", "sha256"])

@@ -1,0 +1,7 @@
+"""Unpack mesh_dir (an archive, or a URL of one) into resources/mesh/<name>/."""
+from animsynth.sources import fetch_mesh_frames
+from animsynth.workflow_utils import setup_logging
+
+log = setup_logging(snakemake)  # noqa: F821
+frames = fetch_mesh_frames(snakemake.params.source, snakemake.output[0])  # noqa: F821
+log.info("%d frames from %s", len(frames), snakemake.params.source)  # noqa: F821
