@@ -24,7 +24,7 @@ from threadpoolctl import threadpool_limits
 
 from animsynth.facegraph import FaceGraphBaseline, FaceGraphModel, FacePreprocessor, FaceSynthesizer
 from animsynth.facegraph.evaluate import evaluate_resynthesis
-from animsynth.facegraph.graph import (PoseStack, create_sample_graph_reference, create_sample_graphs,
+from animsynth.facegraph.samplegraphs import (PoseStack, create_sample_graph_reference, create_sample_graphs,
                                        region_data)
 from animsynth.synth.faces import generate_sequences
 

@@ -14,8 +14,9 @@ from animsynth.facegraph.evaluate import compare, velocity_angle_difference
 from animsynth.facegraph.experiments import (config_name, connectivity, data_note, run_configuration,
                                              uniqueness_tables)
 from animsynth.facegraph.geometry import apply_transform_2d, fit_transform_2d
-from animsynth.facegraph.graph import (PoseStack, RegionData, _rigid2d, create_sample_graphs, creation_compression,
-                                       merge_sample_graphs, region_data, sample_nodes)
+from animsynth.facegraph.merging import _rigid2d, merge_sample_graphs
+from animsynth.facegraph.samplegraphs import (PoseStack, RegionData, create_sample_graphs, creation_compression,
+                                              region_data, sample_nodes)
 from animsynth.facegraph.preprocess import FaceDatabase, fit_sigmoid_landmarks, sigmoid
 from animsynth.facegraph.regions import DEFAULT_REDUCED, DEFAULT_REGIONS, check_regions
 from animsynth.facegraph.search import step_halving_search
@@ -87,7 +88,7 @@ def test_algorithm1_toy_sequence_known_merges():
 
 def _reference_alg1(X, V, T, lam=1.0, eps=1e-2, Q=3):
     """Direct, unpruned Algorithm 1 for one sample (the library's reference implementation)."""
-    from animsynth.facegraph.graph import create_sample_graph_reference
+    from animsynth.facegraph.samplegraphs import create_sample_graph_reference
 
     return create_sample_graph_reference(X, V, T, lam=lam, eps=eps, max_entries=Q)
 

@@ -1,6 +1,6 @@
 """Face graph (Zhang et al. 2004) vs region graphs on the same re-synthesis queries."""
 from animsynth.facegraph.experiments import baseline_table, data_note
-from animsynth.facegraph.graph import load_graphs
+from animsynth.facegraph.regiongraph import load_graphs
 from animsynth.facegraph.preprocess import FaceDatabase
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging

@@ -2,7 +2,7 @@
 import json
 
 from animsynth.facegraph.experiments import run_configuration
-from animsynth.facegraph.graph import save_graphs
+from animsynth.facegraph.regiongraph import save_graphs
 from animsynth.facegraph.preprocess import FaceDatabase
 from animsynth.io.atomic import atomic_path, atomic_write_text
 from animsynth.workflow_utils import setup_logging

@@ -21,7 +21,8 @@ from threadpoolctl import threadpool_limits
 from ..io.ckplus import EMOTIONS, emotion_code
 from .baseline import FaceGraphBaseline
 from .evaluate import compare, evaluate_resynthesis, summarise
-from .graph import FaceGraphModel, RegionGraph
+from .model import FaceGraphModel
+from .regiongraph import RegionGraph
 from .preprocess import FaceDatabase
 from .synthesis import FaceSynthesizer, resample
 

@@ -11,7 +11,7 @@ from threadpoolctl import threadpool_limits
 
 from ..io.ckplus import emotion_code, read_ckplus
 from .experiments import graph_kwargs, synth_kwargs
-from .graph import FaceGraphModel
+from .model import FaceGraphModel
 from .preprocess import FacePreprocessor
 from .synthesis import FaceSynthesizer
 
