@@ -21,4 +21,6 @@ df = pd.DataFrame([{"subject": s.subject, "sequence": s.sequence, "emotion": s.l
                     "used": s.name in used} for s in seqs])
 write_table(df, snakemake.output.csv, title="Facial expression database (parsed by the CK+ loader)",
             note=f"Source: {db.source}. Sequences used: {len(db.names)} labelled, {int(db.lengths.sum())} frames; "
-                 f"sigmoid fits {pre.report_}.")
+                 f"Sigmoid fits per landmark: {pre.report_['fit']} by curve_fit, {pre.report_['grid']} kept the grid fit "
+                 f"(fallback share {100 * pre.report_['grid_fallback_share']:.1f} % of moving landmarks), "
+                 f"{pre.report_['static']} static.")

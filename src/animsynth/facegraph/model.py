@@ -217,6 +217,10 @@ class FaceGraphModel:
         import pandas as pd
 
         self._check()
+        bad = [db.names[k] for k in range(db.n_samples) if not np.all(np.isfinite(db.forward(k)))]
+        if bad or not np.all(np.isfinite(db.mean_neutral)):
+            raise ValueError(f"pre-processed database holds non-finite coordinates (samples {bad[:10]}); "
+                             "refusing to build graphs")
         cpu0, wall0 = time.process_time(), time.perf_counter()
         lam, eps = float(self.lam), float(self.velocity_eps)
         tol_c = float(self.tolerance if self.creation_tolerance is None else self.creation_tolerance)

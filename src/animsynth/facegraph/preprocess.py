@@ -336,6 +336,10 @@ class FacePreprocessor:
                         "improve on it, or fitted a step steeper than the grid's steepest onset (jitter of a "
                         "nearly still landmark)", counts["grid"])
         log.info("sigmoid fits: %s", counts)
+        for s, p in zip(seqs, aligned):
+            if not np.all(np.isfinite(p)) or np.abs(p).max() > 1e6:
+                raise ValueError(f"sequence {s.name}: pre-processing produced non-finite or huge coordinates "
+                                 f"(input range {np.abs(s.landmarks).max():.3g} px)")
         first = np.stack([p[0] for p in aligned])
         mean_neutral = _gpa_mean(first)
         # stage 2: per region, first pose -> mean neutral (similarity), applied to all poses
@@ -347,7 +351,9 @@ class FacePreprocessor:
             aligned[k] = p
         neutral = np.stack([p[0] for p in aligned])
         disp = np.concatenate([p - p[0] for p in aligned], axis=0)
-        self.report_ = dict(counts, n_sequences=len(seqs), n_skipped_short=len(short))
+        n_fit = max(1, counts["fit"] + counts["grid"])
+        self.report_ = dict(counts, n_sequences=len(seqs), n_skipped_short=len(short),
+                            grid_fallback_share=round(counts["grid"] / n_fit, 4))
         self.mean_neutral_ = mean_neutral
         return FaceDatabase(
             names=[s.name for s in seqs],
