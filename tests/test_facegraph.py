@@ -115,7 +115,7 @@ def test_sample_nodes_visits_and_peak_duration():
     nd = sample_nodes(rd, create_sample_graphs(stack, [1.0])[0, 0])
     assert nd.n == 3 and nd.count.tolist() == [6, 4, 1]
     assert nd.visit_node.tolist() == [0, 1, 2, 1, 0] and nd.visit_len.tolist() == [3, 2, 1, 2, 3]
-    assert nd.peak.tolist() == [False, False, True] and nd.peak_dur[2] == 1
+    assert nd.peak.tolist() == [False, False, True] and nd.peak_dur[2] == 6   # neutral-to-peak frames
     np.testing.assert_allclose(nd.disp[1, :, 0], 10.05)
 
 
@@ -194,8 +194,8 @@ def test_step_halving_search_on_known_curve():
 
 
 @pytest.mark.parametrize("creation, merge", [(30, 70), (60, 40)])
-def test_threshold_search_reaches_targets(db, creation, merge):
-    m = FaceGraphModel(creation, merge, tolerance=1.0, seed=1).fit(db)
+def test_global_threshold_search_reaches_targets(db, creation, merge):
+    m = FaceGraphModel(creation, merge, tolerance=1.0, seed=1, thresholds="global").fit(db)
     s = m.search_
     assert s.creation_converged.all() and s.merge_converged.all()
     assert np.all(np.abs(s.creation_achieved_pct - creation) <= 1.0)
@@ -203,7 +203,7 @@ def test_threshold_search_reaches_targets(db, creation, merge):
     for r, g in m.graphs_.items():  # achieved merge compression is that of the returned graph
         row = s.set_index("region").loc[r]
         assert row.merge_achieved_pct == pytest.approx(100 * (1 - g.n_nodes / row.sample_nodes))
-    assert set(m.timings_) == {"search_s", "build_s"}
+    assert m.timings_["creation_cpu_s"] > 0
 
 
 def test_fixed_thresholds_skip_search(db, model):

@@ -137,7 +137,7 @@ class FaceGraphModel:
         R, S = len(regions), len(stack.lengths)
         target = float(self.creation_compression)
         if self.creation_thresholds is not None:
-            Tc = np.repeat(np.array([float(self.creation_thresholds[r]) for r in regions])[:, None], S, 1)
+            Tc = np.stack([np.broadcast_to(np.asarray(self.creation_thresholds[r], float), (S,)) for r in regions])
             return Tc, np.zeros((R, S), int)
         t0 = np.array([np.quantile(_consecutive_similarity(rdata[r], lam, eps), target / 100.0) for r in regions])
         t0 = np.maximum(t0, 1e-6)
@@ -174,7 +174,8 @@ class FaceGraphModel:
         comp = np.full(S, np.nan)
         if self.merge_thresholds is not None or self.thresholds == "global":
             if self.merge_thresholds is not None:
-                T = float(self.merge_thresholds[r])
+                T = np.broadcast_to(np.asarray(self.merge_thresholds[r], float), (S,))
+                T = float(T[0]) if np.all(T == T[0]) else np.where(np.isfinite(T), T, 0.0)
             else:
                 def ev(T):
                     return np.array([100.0 * (1.0 - merge_sample_graphs(rd, nd, float(T[0]), order, lam, eps,
@@ -187,12 +188,13 @@ class FaceGraphModel:
                 T = float(res.threshold[0])
                 its[:] = int(res.iterations[0])
             m = Merger(rd, nd, lam, eps, self.procrustes)
+            Ts = np.broadcast_to(np.asarray(T, float), (S,))
             for s in order:
-                comp[s] = m.merge(int(s), T)
-            thr[:] = T
+                comp[s] = m.merge(int(s), float(Ts[s]))
+            thr[:] = Ts
             thr[order[0]] = np.nan
             comp[order[0]] = np.nan
-            return m.finish(T), thr, its, comp
+            return m.finish(T if np.ndim(T) == 0 else thr), thr, its, comp
         m = Merger(rd, nd, lam, eps, self.procrustes)
         m.merge(int(order[0]), 0.0)  # the seed sample's graph is the initial graph
         nn = _nn_similarity(nd, rd.red, np.random.default_rng(self.seed + 1))
