@@ -159,7 +159,14 @@ class FaceGraphModel:
             cache["T"] = T.copy()
             return cache["C"].ravel().copy()
 
-        T0 = np.repeat(t0[:, None], S, 1).ravel()
+        # start each sample at the quantile of its own consecutive-pose similarities
+        T0 = np.empty((R, S))
+        for i, r in enumerate(regions):
+            sim = _consecutive_similarity(rdata[r], lam, eps)
+            cuts = np.cumsum(rdata[r].forward * 2 - 2)[:-1]
+            for k, part in enumerate(np.split(sim, cuts)):
+                T0[i, k] = np.quantile(part, target / 100.0) if part.size else t0[i]
+        T0 = np.maximum(T0, 1e-6).ravel()
         res = step_halving_search(ev, target, tol, T0, T0 * STEP0_FRACTION, self.max_iterations,
                                   T0 * self.min_step_fraction)
         return res.threshold.reshape(R, S), res.iterations.reshape(R, S)
@@ -201,17 +208,25 @@ class FaceGraphModel:
         t = max(float(np.quantile(nn, target / 100.0)) if nn.size else 1.0, 1e-6)
         for s in order[1:]:
             s = int(s)
+            last = {}
 
-            def ev(T, s=s):
-                c = m.merge(s, float(T[0]), trial=True)
-                m.undo()
-                return np.array([c])
+            def ev(T, s=s, last=last):
+                if last:
+                    m.undo()
+                last["T"] = float(T[0])
+                last["c"] = m.merge(s, last["T"], trial=True)
+                return np.array([last["c"]])
 
             res = step_halving_search(ev, target, tol, t, t * STEP0_FRACTION, self.max_iterations,
                                       t * self.min_step_fraction)
             thr[s] = float(res.threshold[0])
             its[s] = int(res.iterations[0])
-            comp[s] = m.merge(s, thr[s])
+            if last["T"] == thr[s]:  # the last trial is the result: keep it
+                m.commit()
+                comp[s] = last["c"]
+            else:
+                m.undo()
+                comp[s] = m.merge(s, thr[s])
             t = max(thr[s], 1e-6)  # warm start for the next sample
         return m.finish(thr), thr, its, comp
 
