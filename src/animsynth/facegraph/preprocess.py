@@ -319,6 +319,7 @@ class FacePreprocessor:
             return apply_transform_2d(p, R, sc, t)
 
         counts = {"fit": 0, "static": 0, "grid": 0}
+        per_seq: dict[str, dict] = {}
         aligned = []
         for s in seqs:
             lm = np.asarray(s.landmarks, float)
@@ -329,6 +330,7 @@ class FacePreprocessor:
             y, status = fit_sigmoid_landmarks(lm - lm[0], self.sigmoid_min_range_px)
             for st in status:
                 counts[st] += 1
+            per_seq[s.name] = {k: status.count(k) for k in ("fit", "grid", "static")}
             p = lm[0] + y
             aligned.append(p if self.align_before_fit else rigid(p))
         if counts["grid"]:
@@ -355,6 +357,7 @@ class FacePreprocessor:
         self.report_ = dict(counts, n_sequences=len(seqs), n_skipped_short=len(short),
                             grid_fallback_share=round(counts["grid"] / n_fit, 4))
         self.mean_neutral_ = mean_neutral
+        self.sigmoid_status_ = per_seq  # sequence name -> landmark counts per fit status
         return FaceDatabase(
             names=[s.name for s in seqs],
             emotions=np.array([s.emotion for s in seqs], int),
