@@ -1,9 +1,9 @@
 """The facegraph experiments: Table 1 rows, face-graph baseline, uniqueness.
 
 Each function takes plain config dicts (the ``facegraph`` block of the
-workflow config) and returns tables whose non-timing numbers are rounded so
-that the same config gives byte-identical CSV files. Timing columns start
-with ``timing_`` and are machine-dependent.
+workflow config) and returns deterministic tables (numbers rounded so that the
+same config gives byte-identical CSV files) and, separately, timing tables
+(machine-dependent: CPU and wall time).
 """
 
 from __future__ import annotations
