@@ -39,16 +39,17 @@ def _consecutive_similarity(rd: RegionData, lam, eps) -> np.ndarray:
     return pose_similarity(rd.disp[i][:, r], rd.vel[i][:, r], rd.disp[i - 1][:, r], rd.vel[i - 1][:, r], lam, eps)
 
 
-def _nn_similarity(nodes: SampleNodes, red, rng, k: int = 256) -> np.ndarray:
-    """Plain distance sum from up to k random sample nodes to their nearest other node."""
+def _nn_similarity(nodes: SampleNodes, red, rng, k: int = 256, chunk: int = 32) -> np.ndarray:
+    """Plain distance sum from up to k random sample nodes to their nearest node of another sample."""
     q = rng.choice(nodes.n, size=min(k, nodes.n), replace=False)
     D = nodes.disp[:, red]
     out = []
-    for i in q:
-        d = np.sqrt(((D - D[i]) ** 2).sum(-1)).sum(-1)
-        d[nodes.sample == nodes.sample[i]] = np.inf  # other samples only
-        out.append(d.min())
-    out = np.asarray(out)
+    for a in range(0, len(q), chunk):
+        qq = q[a:a + chunk]
+        d = np.sqrt(((D[None] - D[qq][:, None]) ** 2).sum(-1)).sum(-1)     # (chunk, G)
+        d[nodes.sample[None, :] == nodes.sample[qq][:, None]] = np.inf      # other samples only
+        out.append(d.min(1))
+    out = np.concatenate(out) if out else np.zeros(0)
     return out[np.isfinite(out)]
 
 
