@@ -25,7 +25,10 @@ FG_DB_DIR = "resources/facegraph/ckplus_synthetic" if FG_SYNTHETIC else FG["ckpl
 FG_SOURCE = "synthetic CK+-layout database (animsynth.synth.faces)" if FG_SYNTHETIC else f"CK+ at {FG['ckplus_dir']}"
 FG_SEED_GRAPH = seed_for("facegraph", FG["seed"], "graph")
 FG_SHOWCASE_GRAPH = f"results/facegraph/graphs/{FG_SHOWCASE}.npz"
-# resources sized from measured use (70 sequences: graph jobs ~10 s CPU, < 400 MB; CK+ scale: ~5x) with headroom
+# Resources sized from measured use with headroom (rule benchmarks, 70 sequences / CK+ scale): peak RSS
+# synth_db 107 MB, prepare 147 / 161 MB (13 / 66 s CPU), graph 200-230 MB (5-12 s CPU), baseline 446 MB
+# (face graphs capped at baseline.max_nodes poses), table1/verdicts/uniqueness ~150 MB. Runtimes (minutes)
+# allow for a machine shared by several jobs (wall up to 20x CPU seen) and scale with the database size.
 FG_SCALE = max(1.0, FG["synthetic"]["n_sequences"] / 70.0) if FG_SYNTHETIC else 5.0
 
 
@@ -43,7 +46,7 @@ if FG_SYNTHETIC:
             seed=seed_for("facegraph", FG["seed"], "synthetic"),
         threads: 1
         resources:
-            mem_mb=lambda wc, attempt: int(500 * FG_SCALE * attempt),
+            mem_mb=lambda wc, attempt: 500 * attempt,
             runtime=lambda wc, attempt: int(10 * FG_SCALE * attempt),
         log:
             "logs/facegraph/synth_db.log",
@@ -72,7 +75,7 @@ rule facegraph_prepare:
         source=FG_SOURCE,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: int(1000 * FG_SCALE * attempt),
+        mem_mb=lambda wc, attempt: 1000 * attempt,
         runtime=lambda wc, attempt: int(20 * FG_SCALE * attempt),
     log:
         "logs/facegraph/prepare.log",
@@ -98,7 +101,7 @@ rule facegraph_graph:
         seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: int(1000 * FG_SCALE * attempt),
+        mem_mb=lambda wc, attempt: 1000 * attempt,
         runtime=lambda wc, attempt: int(20 * FG_SCALE * attempt),
     log:
         "logs/facegraph/graph/{fgcfg}.log",
@@ -202,7 +205,7 @@ rule facegraph_baseline:
         seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: int(3000 * FG_SCALE * attempt),
+        mem_mb=lambda wc, attempt: 3000 * attempt,
         runtime=lambda wc, attempt: int(30 * FG_SCALE * attempt),
     log:
         "logs/facegraph/baseline.log",
@@ -232,7 +235,7 @@ rule facegraph_uniqueness:
         seed=seed_for("facegraph", FG["seed"], "uniqueness"),
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: int(800 * FG_SCALE * attempt),
+        mem_mb=lambda wc, attempt: 800 * attempt,
         runtime=lambda wc, attempt: int(15 * FG_SCALE * attempt),
     log:
         "logs/facegraph/uniqueness.log",
@@ -274,7 +277,7 @@ rule facegraph_figures:
         graph_seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: int(1000 * FG_SCALE * attempt),
+        mem_mb=lambda wc, attempt: 1000 * attempt,
         runtime=lambda wc, attempt: int(15 * FG_SCALE * attempt),
     log:
         "logs/facegraph/figures.log",
@@ -305,7 +308,7 @@ rule facegraph_verdicts:
         order=[c["name"] for c in FG_TABLE_CONFIGS],
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: int(500 * FG_SCALE * attempt),
+        mem_mb=lambda wc, attempt: 500 * attempt,
         runtime=lambda wc, attempt: int(5 * FG_SCALE * attempt),
     log:
         "logs/facegraph/verdicts.log",
