@@ -431,10 +431,12 @@ def verdicts(table1: pd.DataFrame, baseline: pd.DataFrame, uniqueness: pd.DataFr
     dd = t["duration_diff"].astype(float)
     pd_ = t["paper_duration_diff"].astype(float)
     rd = t["random_duration_diff"].astype(float)
-    verdict = "reproduced" if dd.max() <= 0.25 else ("partly" if dd.max() <= 1.0 else "not reproduced")
+    near = dd <= 0.25  # the paper's largest mean difference is 0.11 frames
+    verdict = "reproduced" if near.all() else ("partly" if near.any() else "not reproduced")
     add("Synthesised sequences keep the original durations (duration difference near 0)",
         f"{_fmt(pd_.min())}-{_fmt(pd_.max())} frames" if pd_.notna().any() else "",
         f"{_fmt(dd.min())}-{_fmt(dd.max())} frames", verdict,
+        f"{int(near.sum())}/{len(t)} configurations within 0.25 frames. "
         f"Counterpart re-synthesis (own neutral and peak node) stretched to the peak nodes' stored duration: "
         f"mean |difference| {_fmt(dd.min())}-{_fmt(dd.max())} frames (sd up to {_fmt(t.duration_diff_sd.max())}); "
         f"a peak node that merged several samples' peaks stores their mean ({_fmt(t.shared_peak_pct.min())}-"
