@@ -26,8 +26,8 @@ FG_SOURCE = "synthetic CK+-layout database (animsynth.synth.faces)" if FG_SYNTHE
 FG_SEED_GRAPH = seed_for("facegraph", FG["seed"], "graph")
 FG_SHOWCASE_GRAPH = f"results/facegraph/graphs/{FG_SHOWCASE}.npz"
 # Resources sized from measured use with headroom (rule benchmarks, 70 sequences / CK+ scale): peak RSS
-# synth_db 107 MB, prepare 147 / 161 MB (13 / 66 s CPU), graph 200-230 MB (5-12 s CPU), baseline 446 MB
-# (face graphs capped at baseline.max_nodes poses), table1/verdicts/uniqueness ~150 MB. Runtimes (minutes)
+# synth_db 107 / 115 MB, prepare 147 / 161 MB (13 / 66 s CPU), graph 230 / 475 MB (5-12 / 10-20 s CPU),
+# baseline 446 / 685 MB (face graphs capped at baseline.max_nodes poses), table1/verdicts/uniqueness ~160 MB. Runtimes (minutes)
 # allow for a machine shared by several jobs (wall up to 20x CPU seen) and scale with the database size.
 FG_SCALE = max(1.0, FG["synthetic"]["n_sequences"] / 70.0) if FG_SYNTHETIC else 5.0
 
