@@ -2,7 +2,7 @@
 import numpy as np
 
 from animsynth.facegraph.experiments import synth_kwargs
-from animsynth.facegraph.graph import load_graphs
+from animsynth.facegraph.regiongraph import load_graphs
 from animsynth.facegraph.preprocess import FaceDatabase
 from animsynth.facegraph.synthesis import FaceSynthesizer
 from animsynth.facegraph.viz import draw_region_graphs, draw_trajectories, face_gif

@@ -1,22 +1,35 @@
-"""Aggregate the per-configuration runs into Table 1 and the threshold table."""
+"""Aggregate the per-configuration runs into Table 1 (or the sweep), its timing table and the thresholds."""
 import json
 
 import pandas as pd
 
-from animsynth.facegraph.experiments import assemble_table1, data_note
+from animsynth.facegraph.experiments import assemble_table1, assemble_timing, data_note
 from animsynth.facegraph.preprocess import FaceDatabase
-from animsynth.tables import write_table
+from animsynth.facegraph.settings import read_paper_table1
+from animsynth.io.atomic import atomic_write_text
+from animsynth.tables import to_markdown, write_table
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)
 runs = [json.load(open(p)) for p in snakemake.input.runs]
 db = FaceDatabase.load_npz(snakemake.input.db)
-table = assemble_table1([r["row"] for r in runs], snakemake.params.order)
+paper = read_paper_table1(snakemake.params.paper) if snakemake.params.paper else {}
+order = snakemake.params.order
+table = assemble_table1([r["row"] for r in runs], order, paper)
+timing = assemble_timing([r["timing"] for r in runs], order, paper)
 thr = pd.DataFrame([t for r in runs for t in r["thresholds"]])
-write_table(table, snakemake.output.csv, title="Table 1: region motion graphs per compression configuration",
-            note=f"{data_note(db.source)} {db.n_samples} sequences, {int(db.lengths.sum())} frames. paper_* columns "
-                 "are empty: the published values are not available to us. timing_* columns are wall-clock on this "
-                 "machine (machine-dependent); all other numbers are deterministic.")
+src = (f"published values from {snakemake.params.paper}" if paper else
+       "no published values available (paper_* columns empty)")
+note = (f"{data_note(db.source)} {db.n_samples} sequences, {int(db.lengths.sum())} poses. paper_*: {src}. "
+        "Node compression = 1 - region-graph nodes / poses (negative when the five region graphs hold more nodes "
+        "than poses); velocity angle 100 % = 90 degrees.")
+write_table(table, snakemake.output.csv, md=False)
+write_table(timing, snakemake.output.timing, md=False)
+# the rendered .md joins the (machine-dependent) timings to the deterministic table
+atomic_write_text(snakemake.output.md, to_markdown(table.merge(timing, on="config"), snakemake.params.title,
+                                                   note + " Times: CPU and wall on this machine (creation includes "
+                                                   "the threshold searches); the paper's in Matlab on an i7-4720HQ."))
 write_table(thr, snakemake.output.thresholds, title="Thresholds found per region and configuration",
-            note=data_note(db.source))
-log.info("table 1: %d rows", len(table))
+            note=f"{data_note(db.source)} Thresholds are medians over samples in per-sample mode; "
+                 "in_band_pct = share of samples whose own compression lies in the target band.")
+log.info("table: %d rows", len(table))

@@ -10,7 +10,8 @@ comparison and the uniqueness study.
 """
 
 from .baseline import FaceGraphBaseline
-from .graph import FaceGraphModel, RegionGraph, load_graphs, save_graphs
+from .model import FaceGraphModel
+from .regiongraph import RegionGraph, load_graphs, save_graphs
 from .preprocess import FaceDatabase, FacePreprocessor
 from .regions import DEFAULT_REDUCED, DEFAULT_REGIONS, DEFAULT_RIGID, REGION_NAMES
 from .similarity import node_similarity, pose_similarity, vinfl

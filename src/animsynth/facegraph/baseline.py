@@ -22,7 +22,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial.distance import cdist
 
-from .graph import EDGE_EPS
+from .regiongraph import EDGE_EPS
 from .preprocess import FaceDatabase
 from .regions import REGION_NAMES
 from .synthesis import resample

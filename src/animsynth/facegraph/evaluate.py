@@ -1,8 +1,17 @@
 """Re-synthesis evaluation behind Table 1 and the baseline comparison.
 
-Every database sample is re-synthesised from its own neutral node to a random
-valid peak node of its label and compared with the original (pre-processed,
-aligned) neutral -> peak sequence:
+As in the paper, every database sample is compared with its synthesised
+counterpart: the synthesis from the sample's own neutral node to the sample's
+own peak node in every region (same source and peak). Two extra columns show
+what the graph adds:
+
+* **random peak**: from the sample's neutral node to a random valid peak node
+  of its label (seeded), as a user asking for "a happy face" would get;
+* **linear**: straight-line interpolation from the neutral pose to the
+  sample's peak pose over the mean duration of the other samples of its label
+  (what one would do without a graph).
+
+Measures (per sample; tables report mean and standard deviation over samples):
 
 * **duration difference** (frames): ``|synthesised frames - original frames|``
   (its signed mean is reported too: negative = synthesis shorter);
@@ -10,12 +19,14 @@ aligned) neutral -> peak sequence:
   time span) to the original length; mean Euclidean distance over frames and
   the 68 landmarks;
 * **velocity-angle difference** (%): angle between the original and the
-  (resampled) synthesised landmark velocities, as a percentage of 180 degrees,
-  averaged over the frames and landmarks where both speeds exceed
-  ``min_speed`` px/frame (directions of still landmarks are noise).
+  (resampled) synthesised landmark velocities, as a percentage of 90 degrees
+  (the paper's definition: 0 % = same direction, 100 % = perpendicular,
+  opposite directions give 200 %), averaged over the frames and landmarks
+  where both speeds exceed ``min_speed`` px/frame (directions of still
+  landmarks are noise).
 
-Each measure is averaged per sample; tables report the mean and standard
-deviation over samples. Synthesis time is wall-clock (machine-dependent).
+Synthesis time is wall-clock (machine-dependent) and kept in ``timing_``
+columns.
 """
 
 from __future__ import annotations
@@ -36,8 +47,8 @@ def landmark_difference(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def velocity_angle_difference(a: np.ndarray, b: np.ndarray, min_speed: float = 0.05) -> float:
-    """Mean angle (% of 180 deg) between the velocities of two (T, L, 2)
-    sequences where both speeds exceed ``min_speed``; NaN if nowhere."""
+    """Mean angle (% of 90 deg: 100 = perpendicular) between the velocities of
+    two (T, L, 2) sequences where both speeds exceed ``min_speed``; NaN if nowhere."""
     if a.shape[0] < 2:
         return float("nan")
     va, vb = np.gradient(a, axis=0), np.gradient(b, axis=0)
@@ -46,7 +57,7 @@ def velocity_angle_difference(a: np.ndarray, b: np.ndarray, min_speed: float = 0
     if not ok.any():
         return float("nan")
     cos = (va * vb).sum(-1)[ok] / (na[ok] * nb[ok])
-    return float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).mean() / 180.0 * 100.0)
+    return float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).mean() / 90.0 * 100.0)
 
 
 def compare(original: np.ndarray, synthesised: np.ndarray, min_speed: float = 0.05) -> dict:
@@ -62,34 +73,61 @@ def compare(original: np.ndarray, synthesised: np.ndarray, min_speed: float = 0.
     }
 
 
+def linear_interpolation(peak: np.ndarray, n: int) -> np.ndarray:
+    """(n, L, 2) straight line from zero displacement (neutral) to ``peak`` (L, 2)."""
+    w = np.linspace(0.0, 1.0, max(int(n), 1))
+    return w[:, None, None] * np.asarray(peak, float)[None]
+
+
 def evaluate_resynthesis(db: FaceDatabase, synth: FaceSynthesizer, seed: int = 0, min_speed: float = 0.05,
-                         samples=None) -> pd.DataFrame:
+                         samples=None, extras: bool = True) -> pd.DataFrame:
     """Re-synthesise samples (default: all) -> one row per sample (see module docs).
 
-    The random peak choice (and noise, if the synthesiser has any) of sample
-    ``s`` uses ``numpy.random.default_rng([seed, s])``.
+    Columns: the counterpart's measures (``duration_diff`` ...), and with
+    ``extras`` the same measures prefixed ``random_`` and ``linear_``. The
+    random peak choice (and noise, if the synthesiser has any) of sample ``s``
+    uses ``numpy.random.default_rng([seed, s])``.
     """
     rows = []
     for s in (range(db.n_samples) if samples is None else samples):
-        rng = np.random.default_rng([int(seed), int(s)])
+        s = int(s)
         start = synth.start_nodes(sample=s)
+        own = {r: int(g.peak_of_sample[s]) for r, g in synth.graphs.items()}
         t0 = time.perf_counter()
-        anim = synth.synthesize([int(db.emotions[s])], start=start, rng=rng)
+        anim = synth.synthesize([int(db.emotions[s])], start=start, rng=np.random.default_rng([int(seed), s]),
+                                peak_nodes=own)
         dt = time.perf_counter() - t0
+        orig = db.forward(s)
         row = {"sample": db.names[s], "label": EMOTIONS[int(db.emotions[s])]}
-        row.update(compare(db.forward(s), anim.disp, min_speed))
+        row.update(compare(orig, anim.disp, min_speed))
+        if extras:
+            rnd = synth.synthesize([int(db.emotions[s])], start=start, rng=np.random.default_rng([int(seed), s]))
+            row.update({f"random_{k}": v for k, v in compare(orig, rnd.disp, min_speed).items()
+                        if k != "frames_original"})
+            same = np.flatnonzero((db.emotions == db.emotions[s]) & (np.arange(db.n_samples) != s))
+            n = int(np.rint(db.lengths[same].mean())) if same.size else int(db.lengths.mean())
+            lin = linear_interpolation(orig[-1], n)
+            row.update({f"linear_{k}": v for k, v in compare(orig, lin, min_speed).items()
+                        if k != "frames_original"})
         row["timing_synthesis_ms"] = 1000.0 * dt
         rows.append(row)
     return pd.DataFrame(rows)
 
 
+MEASURES = (("duration_diff", "duration_diff_frames"), ("duration_signed", "duration_signed_frames"),
+            ("landmark_diff_px", "landmark_diff_px"), ("velocity_angle_diff_pct", "velocity_angle_diff_pct"))
+
+
 def summarise(per_sample: pd.DataFrame) -> dict:
-    """Mean and std over samples of the per-sample measures."""
+    """Mean and std over samples of the per-sample measures (and of their ``random_`` /
+    ``linear_`` variants and the synthesis time where present)."""
     out = {}
-    for col, name in (("duration_diff", "duration_diff_frames"), ("duration_signed", "duration_signed_frames"),
-                      ("landmark_diff_px", "landmark_diff_px"),
-                      ("velocity_angle_diff_pct", "velocity_angle_diff_pct"),
-                      ("timing_synthesis_ms", "timing_synthesis_ms")):
+    cols = [(c, n) for c, n in MEASURES]
+    for pre in ("random_", "linear_"):
+        cols += [(pre + c, pre + n) for c, n in MEASURES if pre + c in per_sample]
+    if "timing_synthesis_ms" in per_sample:
+        cols.append(("timing_synthesis_ms", "timing_synthesis_ms"))
+    for col, name in cols:
         v = per_sample[col].to_numpy(float)
         v = v[np.isfinite(v)]
         out[name] = float(v.mean()) if v.size else float("nan")

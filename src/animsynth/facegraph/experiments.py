@@ -1,9 +1,9 @@
 """The facegraph experiments: Table 1 rows, face-graph baseline, uniqueness.
 
 Each function takes plain config dicts (the ``facegraph`` block of the
-workflow config) and returns tables whose non-timing numbers are rounded so
-that the same config gives byte-identical CSV files. Timing columns start
-with ``timing_`` and are machine-dependent.
+workflow config) and returns deterministic tables (numbers rounded so that the
+same config gives byte-identical CSV files) and, separately, timing tables
+(machine-dependent: CPU and wall time).
 """
 
 from __future__ import annotations
@@ -21,19 +21,16 @@ from threadpoolctl import threadpool_limits
 from ..io.ckplus import EMOTIONS, emotion_code
 from .baseline import FaceGraphBaseline
 from .evaluate import compare, evaluate_resynthesis, summarise
-from .graph import FaceGraphModel, RegionGraph
+from .model import FaceGraphModel
+from .regiongraph import RegionGraph
 from .preprocess import FaceDatabase
+from .settings import config_name
 from .synthesis import FaceSynthesizer, resample
 
 log = logging.getLogger("animsynth.facegraph.experiments")
 
 #: Rounding of reported (non-timing) numbers.
 DECIMALS = 4
-
-
-def config_name(creation: float, merge: float) -> str:
-    """Wildcard-safe name of a compression configuration, e.g. ``c50_m30``."""
-    return f"c{float(creation):g}_m{float(merge):g}"
 
 
 def graph_kwargs(graph_cfg: dict) -> dict:
@@ -43,6 +40,8 @@ def graph_kwargs(graph_cfg: dict) -> dict:
         "velocity_eps": float(graph_cfg.get("velocity_eps", 1e-2)),
         "max_iterations": int(graph_cfg.get("max_iterations", 40)),
         "procrustes": bool(graph_cfg.get("procrustes", True)),
+        "thresholds": str(graph_cfg.get("thresholds", "per_sample")),
+        "min_step_fraction": float(graph_cfg.get("min_step_fraction", 1e-3)),
     }
 
 
@@ -50,24 +49,36 @@ def synth_kwargs(synth_cfg: dict, noise: bool = True) -> dict:
     return {
         "savgol_window": int(synth_cfg.get("savgol_window", 7)),
         "savgol_order": int(synth_cfg.get("savgol_order", 2)),
-        "sigmoid_weight": float(synth_cfg.get("sigmoid_weight", 0.5)),
+        "sigmoid_weight": float(synth_cfg.get("sigmoid_weight", 1.0)),
         "noise_share": float(synth_cfg.get("noise_share", 0.0)) if noise else 0.0,
         "noise_hops": int(synth_cfg.get("noise_hops", 2)),
         "duration_noise": bool(synth_cfg.get("duration_noise", False)) if noise else False,
+        "peak_weights": tuple(synth_cfg.get("peak_weights", (0.3, 0.7))),
     }
+
+
+def model_for(conf: dict, cfg: dict, seed: int) -> FaceGraphModel:
+    """The estimator of one configuration (``conf`` from :func:`.settings.configurations`, fractions)."""
+    return FaceGraphModel(100.0 * conf["creation"], 100.0 * conf["merge"], seed=seed,
+                          creation_tolerance=100.0 * conf["creation_tolerance"],
+                          merge_tolerance=100.0 * conf["merge_tolerance"], **graph_kwargs(cfg.get("graph", {})))
 
 
 def _r(x):
     return float(np.round(float(x), DECIMALS)) if np.isfinite(x) else float("nan")
 
 
-ACCURACY_KEYS = ("duration_diff_frames", "duration_diff_frames_sd", "duration_signed_frames", "landmark_diff_px",
-                 "landmark_diff_px_sd", "velocity_angle_diff_pct", "velocity_angle_diff_pct_sd")
+ACCURACY_KEYS = {  # Table 1 / baseline column -> summary key
+    "duration_diff": "duration_diff_frames", "duration_diff_sd": "duration_diff_frames_sd",
+    "duration_signed": "duration_signed_frames",
+    "landmark_diff_px": "landmark_diff_px", "landmark_diff_sd": "landmark_diff_px_sd",
+    "velocity_angle_diff_pct": "velocity_angle_diff_pct", "velocity_angle_diff_sd": "velocity_angle_diff_pct_sd",
+}
 
 
-def _accuracy(sm) -> dict:
+def _accuracy(sm, prefix: str = "") -> dict:
     """The re-synthesis accuracy measures of a summary, rounded (same columns in Table 1 and the baseline)."""
-    return {k: _r(sm[k]) for k in ACCURACY_KEYS}
+    return {prefix + k: _r(sm.get(prefix + v, np.nan)) for k, v in ACCURACY_KEYS.items()}
 
 
 def original_nbytes(db: FaceDatabase) -> int:
@@ -75,14 +86,16 @@ def original_nbytes(db: FaceDatabase) -> int:
     return int(db.lengths.sum()) * 68 * 2 * 4
 
 
-def run_configuration(db: FaceDatabase, creation: float, merge: float, cfg: dict, seed: int):
+def run_configuration(db: FaceDatabase, conf: dict, cfg: dict, seed: int):
     """Build the region graphs for one compression configuration and evaluate them.
 
-    Returns (row dict for Table 1, per-region threshold table, fitted model, per-sample table).
+    ``conf``: a dict of :func:`.settings.configurations` (fractions). Returns
+    (Table 1 row, timing row, per-region threshold table, fitted model,
+    per-sample table). Only the timing row holds machine-dependent numbers.
     """
     ev = cfg.get("evaluation", {})
     with threadpool_limits(1):
-        model = FaceGraphModel(creation, merge, seed=seed, **graph_kwargs(cfg.get("graph", {}))).fit(db)
+        model = model_for(conf, cfg, seed).fit(db)
         synth = FaceSynthesizer(model.graphs_, **synth_kwargs(cfg.get("synthesis", {}), noise=bool(ev.get("noise", False))))
         per = evaluate_resynthesis(db, synth, seed=seed, min_speed=float(ev.get("min_speed", 0.05)))
     sm = summarise(per)
@@ -92,29 +105,38 @@ def run_configuration(db: FaceDatabase, creation: float, merge: float, cfg: dict
     nodes = sum(g.n_nodes for g in graphs.values())
     s = model.search_
     row = {
-        "config": config_name(creation, merge),
-        "creation_target_pct": float(creation),
-        "merge_target_pct": float(merge),
-        "creation_achieved_pct": _r(s["creation_achieved_pct"].mean()),
-        "merge_achieved_pct": _r(s["merge_achieved_pct"].mean()),
+        "config": conf["name"],
+        "creation_target": conf["creation"], "creation_tolerance": conf["creation_tolerance"],
+        "merge_target": conf["merge"], "merge_tolerance": conf["merge_tolerance"],
+        "threshold_mode": str(s["threshold_mode"].iloc[0]),
+        "creation_achieved": _r(s["creation_achieved_pct"].mean() / 100.0),
+        "merge_achieved": _r(s["merge_achieved_pct"].mean() / 100.0),
+        "creation_in_band_pct": _r(s["creation_in_band_pct"].mean()),
+        "merge_in_band_pct": _r(s["merge_in_band_pct"].mean()),
         "thresholds_converged": bool(s["creation_converged"].all() and s["merge_converged"].all()),
+        "poses": frames,
         "nodes": int(nodes),
         "edges": int(sum(g.n_edges for g in graphs.values())),
         "strong_components_max": conn["strong_components_max"],
         "reachable_peaks_mean": _r(conn["reachable_peaks_mean"]),
-        "node_compression_pct": _r(100.0 * (1.0 - nodes / (len(graphs) * frames))),
+        "shared_peak_pct": _r(100.0 * np.mean([g.peak_dur_n[g.peak_of_sample] > 1 for g in graphs.values()])),
+        "node_compression_pct": _r(100.0 * (1.0 - nodes / frames)),
         "data_compression_pct": _r(100.0 * (1.0 - sum(g.nbytes() for g in graphs.values()) / original_nbytes(db))),
-        **_accuracy(sm),
-        "timing_creation_s": float(model.timings_["build_s"]),
-        "timing_search_s": float(model.timings_["search_s"]),
-        "timing_synthesis_ms": float(sm["timing_synthesis_ms"]),
-        "timing_synthesis_ms_sd": float(sm["timing_synthesis_ms_sd"]),
+        **_accuracy(sm), **_accuracy(sm, "random_"), **_accuracy(sm, "linear_"),
+    }
+    timing = {
+        "config": conf["name"],
+        "creation_cpu_s": float(model.timings_["creation_cpu_s"]),
+        "creation_wall_s": float(model.timings_["creation_wall_s"]),
+        "synthesis_ms": float(sm["timing_synthesis_ms"]),
+        "synthesis_ms_sd": float(sm["timing_synthesis_ms_sd"]),
     }
     thr = s.copy()
     thr.insert(0, "config", row["config"])
-    for c in ("creation_threshold", "creation_achieved_pct", "merge_threshold", "merge_achieved_pct"):
+    for c in ("creation_threshold", "creation_achieved_pct", "merge_threshold", "merge_achieved_pct",
+              "creation_in_band_pct", "merge_in_band_pct"):
         thr[c] = thr[c].map(lambda v: float(np.round(v, 6)))
-    return row, thr, model, per
+    return row, timing, thr, model, per
 
 
 def connectivity(db: FaceDatabase, graphs: dict[str, RegionGraph]) -> dict:
@@ -134,30 +156,49 @@ def connectivity(db: FaceDatabase, graphs: dict[str, RegionGraph]) -> dict:
     return {"strong_components_max": max(comps), "reachable_peaks_mean": float(np.mean(reach))}
 
 
-#: Table 1 column order; ``paper_*`` columns are filled only where the paper's value is known.
-TABLE1_COLUMNS = [
-    "config", "creation_target_pct", "merge_target_pct", "creation_achieved_pct", "merge_achieved_pct",
-    "thresholds_converged", "nodes", "edges", "strong_components_max", "reachable_peaks_mean",
-    "node_compression_pct", "data_compression_pct",
-    "duration_diff_frames", "duration_diff_frames_sd", "duration_signed_frames", "landmark_diff_px",
-    "landmark_diff_px_sd", "velocity_angle_diff_pct", "velocity_angle_diff_pct_sd",
-    "paper_node_compression_pct", "paper_data_compression_pct", "paper_duration_diff_frames",
-    "paper_landmark_diff_px", "paper_velocity_angle_diff_pct",
-    "timing_creation_s", "timing_search_s", "timing_synthesis_ms", "timing_synthesis_ms_sd",
-]
+#: Table 1 measures shown with the published value beside ours.
+_PAPER_BESIDE = ["node_compression_pct", "data_compression_pct", "duration_diff", "duration_diff_sd",
+                 "landmark_diff_px", "landmark_diff_sd", "velocity_angle_diff_pct", "velocity_angle_diff_sd"]
+#: Table 1 column order (deterministic: no timings); ``paper_*`` from the published table (empty if unknown).
+TABLE1_COLUMNS = (
+    ["paper_row", "config", "creation_target", "creation_tolerance", "merge_target", "merge_tolerance",
+     "threshold_mode", "creation_achieved", "merge_achieved", "creation_in_band_pct", "merge_in_band_pct",
+     "thresholds_converged", "poses", "nodes", "edges", "strong_components_max", "reachable_peaks_mean",
+     "shared_peak_pct"]
+    + [c for k in _PAPER_BESIDE for c in (k, "paper_" + k)]
+    + ["duration_signed"]
+    + [p + k for p in ("random_", "linear_") for k in ACCURACY_KEYS]
+)
+#: ``table1_timing.csv`` columns (machine-dependent; CPU and wall time, the paper's beside).
+TIMING_COLUMNS = ["config", "creation_cpu_s", "creation_wall_s", "paper_creation_time_s", "synthesis_ms",
+                  "synthesis_ms_sd", "paper_synthesis_time_s", "paper_synthesis_time_sd"]
 
 
 def assemble_table1(rows: list[dict], order: list[str], paper: dict | None = None) -> pd.DataFrame:
-    """Rows in config order; ``paper``: config name -> {column: value} (unknown values stay empty)."""
+    """Rows in config order; ``paper``: config name -> published values (:func:`.settings.read_paper_table1`)."""
     by = {r["config"]: dict(r) for r in rows}
     out = []
     for name in order:
         r = by[name]
-        for c in TABLE1_COLUMNS:
-            if c.startswith("paper_"):
-                r[c] = (paper or {}).get(name, {}).get(c[len("paper_"):], np.nan)
+        pv = (paper or {}).get(name, {})
+        r["paper_row"] = pv.get("row", np.nan)
+        for k in _PAPER_BESIDE:
+            r["paper_" + k] = pv.get(k, np.nan)
         out.append(r)
     return pd.DataFrame(out)[TABLE1_COLUMNS]
+
+
+def assemble_timing(rows: list[dict], order: list[str], paper: dict | None = None) -> pd.DataFrame:
+    by = {r["config"]: dict(r) for r in rows}
+    out = []
+    for name in order:
+        r = by[name]
+        pv = (paper or {}).get(name, {})
+        r["paper_creation_time_s"] = pv.get("creation_time_s", np.nan)
+        r["paper_synthesis_time_s"] = pv.get("synthesis_time_s", np.nan)
+        r["paper_synthesis_time_sd"] = pv.get("synthesis_time_sd", np.nan)
+        out.append(r)
+    return pd.DataFrame(out)[TIMING_COLUMNS]
 
 
 # ---------------------------------------------------------------------------
@@ -168,18 +209,32 @@ def _query_samples(db: FaceDatabase, max_queries: int | None, seed: int) -> np.n
     return np.sort(np.random.default_rng(seed).choice(S, size=int(max_queries), replace=False))
 
 
+def face_graph_nbytes(n_poses: int, n_parts: int) -> int:
+    """Memory of complete face graph(s) on ``n_poses`` poses as float32 weights
+    (N^2 per graph) plus the poses (float32) - what :meth:`FaceGraphBaseline.nbytes` reports."""
+    return int(4 * (n_parts * n_poses * n_poses + n_poses * 68 * 2))
+
+
 def baseline_table(db: FaceDatabase, graphs: dict[str, RegionGraph], cfg: dict, seed: int,
-                   showcase: str) -> pd.DataFrame:
-    """Face graph (holistic, per region; each weight power) vs region graphs on the same queries."""
+                   showcase: str) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Face graph (holistic, per region; each weight power) vs region graphs on the same queries.
+
+    Every query re-synthesises a database sample from its neutral pose to its
+    own peak (the Table 1 counterpart). A face graph with more poses than
+    ``baseline.max_nodes`` is not built: its memory is computed from its size
+    and its path time extrapolated (Dijkstra on a complete graph is O(N^2)) from
+    a complete graph on a seeded subset of ``max_nodes`` poses; the ``built``
+    column says which. Returns (deterministic table, timing table).
+    """
     bcfg = cfg.get("baseline", {})
     ev = cfg.get("evaluation", {})
     min_speed = float(ev.get("min_speed", 0.05))
+    max_nodes = bcfg.get("max_nodes")
     queries = _query_samples(db, bcfg.get("max_queries"), seed)
-    rows = []
+    rows, trows = [], []
     with threadpool_limits(1):
-        # region graphs: same evaluation as Table 1, plus path-finding time alone
         synth = FaceSynthesizer(graphs, **synth_kwargs(cfg.get("synthesis", {}), noise=bool(ev.get("noise", False))))
-        per = evaluate_resynthesis(db, synth, seed=seed, min_speed=min_speed, samples=queries)
+        per = evaluate_resynthesis(db, synth, seed=seed, min_speed=min_speed, samples=queries, extras=False)
         pf = []
         for s in queries:
             start = synth.start_nodes(sample=int(s))
@@ -189,46 +244,71 @@ def baseline_table(db: FaceDatabase, graphs: dict[str, RegionGraph], cfg: dict, 
             pf.append(time.perf_counter() - t0)
         sm = summarise(per)
         nodes = sum(g.n_nodes for g in graphs.values())
-        rows.append(_baseline_row(f"region graphs ({showcase})", "5 region graphs", nodes,
-                                  sum(g.n_edges for g in graphs.values()),
-                                  sum(g.nbytes() for g in graphs.values()), sm, pf, len(queries), np.nan))
+        name = f"region graphs ({showcase})"
+        rows.append(_baseline_row(name, "5 region graphs", nodes, sum(g.n_edges for g in graphs.values()),
+                                  sum(g.nbytes() for g in graphs.values()), sm, len(queries), True))
+        trows.append(_timing_row(name, "5 region graphs", pf, False, np.nan))
         o = db.offsets
+        N = int(db.lengths.sum())
         for per_region in (False, True):
+            kind = "per region (5 graphs)" if per_region else "holistic (1 graph)"
+            parts = 5 if per_region else 1
             for power in bcfg.get("weight_powers", [1, 2]):
+                wname = "L2" if float(power) == 1.0 else f"L2^{float(power):g}"
+                name = f"face graph, Zhang et al. 2004 ({wname})"
+                if max_nodes is not None and N > int(max_nodes):
+                    sub = _subset_database(db, int(max_nodes), seed)
+                    base = FaceGraphBaseline(power=float(power), per_region=per_region).fit(sub)
+                    so = sub.offsets
+                    times = [base.synthesize(int(so[k]), int(so[k + 1] - 1))[1]
+                             for k in range(min(sub.n_samples, len(queries)))]
+                    scale = (N / sub.lengths.sum()) ** 2
+                    rows.append(_baseline_row(name, kind, N, parts * N * (N - 1), face_graph_nbytes(N, parts),
+                                              {}, len(queries), False))
+                    trows.append(_timing_row(name, kind, np.asarray(times) * scale, True, 1.9))
+                    del base
+                    continue
                 base = FaceGraphBaseline(power=float(power), per_region=per_region).fit(db)
                 recs, times = [], []
                 for s in queries:
-                    rng = np.random.default_rng([int(seed), int(s)])
-                    same = np.flatnonzero(db.emotions == db.emotions[s])
-                    tgt = int(same[rng.integers(same.size)])
-                    anim, secs, _ = base.synthesize(int(o[s]), int(o[tgt + 1] - 1))
-                    rec = compare(db.forward(int(s)), anim, min_speed)
-                    rec["timing_synthesis_ms"] = 1000.0 * secs
-                    recs.append(rec)
+                    anim, secs, _ = base.synthesize(int(o[s]), int(o[s + 1] - 1))
+                    recs.append(compare(db.forward(int(s)), anim, min_speed))
                     times.append(secs)
-                sm = summarise(pd.DataFrame(recs))
-                kind = "per region (5 graphs)" if per_region else "holistic (1 graph)"
-                wname = "L2" if float(power) == 1.0 else f"L2^{float(power):g}"
-                rows.append(_baseline_row(f"face graph, Zhang et al. 2004 ({wname})", kind, base.n_nodes_,
-                                          base.n_edges, base.nbytes(), sm, times, len(queries), 1.9))
+                rows.append(_baseline_row(name, kind, base.n_nodes_, base.n_edges, base.nbytes(),
+                                          summarise(pd.DataFrame(recs)), len(queries), True))
+                trows.append(_timing_row(name, kind, times, False, 1.9))
                 del base
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows), pd.DataFrame(trows)
 
 
-def _baseline_row(method, structure, nodes, edges, nbytes, sm, times, n_queries, paper_s) -> dict:
-    t = np.asarray(times, float) * 1000.0
+def _subset_database(db: FaceDatabase, max_poses: int, seed: int) -> FaceDatabase:
+    """Whole samples (seeded order) holding at most ``max_poses`` poses."""
+    order = np.random.default_rng(seed).permutation(db.n_samples)
+    keep = order[np.cumsum(db.lengths[order]) <= max_poses]
+    keep = np.sort(keep if keep.size >= 2 else order[:2])
+    o = db.offsets
+    return FaceDatabase([db.names[k] for k in keep], db.emotions[keep], db.lengths[keep],
+                        np.concatenate([db.disp[o[k]:o[k + 1]] for k in keep]), db.neutral[keep], db.mean_neutral,
+                        db.regions, db.reduced, db.source)
+
+
+def _baseline_row(method, structure, nodes, edges, nbytes, sm, n_queries, built) -> dict:
     return {
         "method": method,
         "structure": structure,
         "queries": int(n_queries),
+        "built": bool(built),
         "nodes": int(nodes),
         "edges": int(edges),
         "memory_mb": _r(nbytes / 1e6),
         **_accuracy(sm),
-        "paper_pathfinding_s": paper_s,
-        "timing_pathfinding_ms": float(t.mean()),
-        "timing_pathfinding_ms_sd": float(t.std()),
     }
+
+
+def _timing_row(method, structure, times, estimated, paper_s) -> dict:
+    t = np.asarray(times, float) * 1000.0
+    return {"method": method, "structure": structure, "pathfinding_ms": float(t.mean()),
+            "pathfinding_ms_sd": float(t.std()), "estimated": bool(estimated), "paper_pathfinding_s": paper_s}
 
 
 # ---------------------------------------------------------------------------
@@ -301,68 +381,157 @@ def _fmt(v) -> str:
     return f"{float(v):.3g}"
 
 
-def verdicts(table1: pd.DataFrame, baseline: pd.DataFrame, uniqueness: pd.DataFrame, source: str) -> pd.DataFrame:
-    """Claims of the paper checked against our tables (deterministic columns only).
+VERDICT_COLUMNS = ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
 
-    Columns: claim, verdict, evidence.
-    """
+
+def _rank_trend(x, y, samples: dict | None, order: list[str], n_boot: int = 200, seed: int = 0):
+    """Spearman rho of y over x (configurations) and the share of bootstrap
+    resamples of the database samples (same resample in every configuration)
+    in which rho stays > 0."""
     from scipy.stats import spearmanr
 
+    rho, p = spearmanr(x, y)
+    share = np.nan
+    if samples and all(n in samples for n in order):
+        M = np.stack([samples[n]["landmark_diff_px"].to_numpy(float) for n in order])  # (configs, S)
+        rng = np.random.default_rng(seed)
+        pos = 0
+        for _ in range(n_boot):
+            idx = rng.integers(M.shape[1], size=M.shape[1])
+            r, _ = spearmanr(x, np.nanmean(M[:, idx], 1))
+            pos += bool(r > 0)
+        share = pos / n_boot
+    return float(rho), float(p), share
+
+
+def verdicts(table1: pd.DataFrame, baseline: pd.DataFrame, uniqueness: pd.DataFrame, source: str,
+             samples: dict | None = None) -> pd.DataFrame:
+    """The paper's claims checked against our deterministic tables (common verdict columns).
+
+    ``samples``: configuration name -> per-sample table (for the bootstrap of the trend verdict).
+    """
     rows = []
     t = table1
-    conv = t["thresholds_converged"].astype(bool)
-    rows.append({
-        "claim": "Thresholds can be chosen by a target compression: the step-halving search reaches every "
-                 "creation/merge target within the tolerance",
-        "verdict": "yes" if conv.all() else ("partly" if conv.any() else "no"),
-        "evidence": f"{int(conv.sum())}/{len(t)} configurations converged for all 5 regions; achieved creation "
-                    f"{_fmt(t.creation_achieved_pct.min())}-{_fmt(t.creation_achieved_pct.max())} %, merge "
-                    f"{_fmt(t.merge_achieved_pct.min())}-{_fmt(t.merge_achieved_pct.max())} % ({source})",
-    })
-    pos = t["data_compression_pct"] > 0
-    rows.append({
-        "claim": "Region graphs have a smaller memory footprint than the original landmark data",
-        "verdict": "yes" if pos.all() else ("partly" if pos.any() else "no"),
-        "evidence": f"data compression > 0 in {int(pos.sum())}/{len(t)} configurations (range "
-                    f"{_fmt(t.data_compression_pct.min())} to {_fmt(t.data_compression_pct.max())} %; node "
-                    f"compression {_fmt(t.node_compression_pct.min())}-{_fmt(t.node_compression_pct.max())} %)",
-    })
-    rho, p = spearmanr(t["node_compression_pct"], t["landmark_diff_px"]) if len(t) > 2 else (np.nan, np.nan)
-    rows.append({
-        "claim": "Compression trades accuracy: landmark difference grows with node compression",
-        "verdict": "yes" if (rho > 0 and p < 0.05) else ("no" if np.isfinite(rho) else "not tested"),
-        "evidence": f"Spearman rho={_fmt(rho)} (p={_fmt(p)}) over {len(t)} configurations; landmark difference "
-                    f"{_fmt(t.landmark_diff_px.min())}-{_fmt(t.landmark_diff_px.max())} px",
-    })
+    data = f"{'synthetic CK+-layout' if source.startswith('synthetic') else source}, {len(t)} configurations"
+
+    def add(claim, paper_value, ours, verdict, evidence, src):
+        rows.append({"claim": claim, "paper_value": paper_value, "ours": ours, "data": data, "verdict": verdict,
+                     "evidence": evidence, "source": src})
+
+    cb = t["creation_in_band_pct"].astype(float)
+    mb = t["merge_in_band_pct"].astype(float)
+    ok = (cb >= 95) & (mb >= 95)
+    add("Thresholds optimised per sample reach the target compression band",
+        "targets with tolerances, e.g. creation 0.2 +/- 0.1, merge 0.7 +/- 0.3",
+        f"samples in band: creation {_fmt(cb.min())}-{_fmt(cb.max())} %, merge {_fmt(mb.min())}-{_fmt(mb.max())} %",
+        "reproduced" if ok.all() else ("partly" if ok.any() else "not reproduced"),
+        f"{int(ok.sum())}/{len(t)} configurations have >= 95 % of the samples of every region inside both bands "
+        "(step-halving search per sample; a sample whose compression jumps over a narrow band cannot hit it).",
+        "facegraph/thresholds.csv")
+    dd = t["duration_diff"].astype(float)
+    pd_ = t["paper_duration_diff"].astype(float)
+    rd = t["random_duration_diff"].astype(float)
+    near = dd <= 0.25  # the paper's largest mean difference is 0.11 frames
+    verdict = "reproduced" if near.all() else ("partly" if near.any() else "not reproduced")
+    add("Synthesised sequences keep the original durations (duration difference near 0)",
+        f"{_fmt(pd_.min())}-{_fmt(pd_.max())} frames" if pd_.notna().any() else "",
+        f"{_fmt(dd.min())}-{_fmt(dd.max())} frames", verdict,
+        f"{int(near.sum())}/{len(t)} configurations within 0.25 frames. "
+        f"Counterpart re-synthesis (own neutral and peak node) stretched to the peak nodes' stored duration: "
+        f"mean |difference| {_fmt(dd.min())}-{_fmt(dd.max())} frames (sd up to {_fmt(t.duration_diff_sd.max())}); "
+        f"a peak node that merged several samples' peaks stores their mean ({_fmt(t.shared_peak_pct.min())}-"
+        f"{_fmt(t.shared_peak_pct.max())} % of sample-region peaks are shared, rising with compression). "
+        f"A random same-label peak gives {_fmt(rd.min())}-{_fmt(rd.max())} frames.", "facegraph/table1.csv")
+    lm = t["landmark_diff_px"].astype(float)
+    inside = (lm >= 1.4) & (lm <= 2.5)
+    pl = t["paper_landmark_diff_px"].astype(float)
+    add("Landmark difference of re-synthesised sequences lies in the paper's 1.4-2.5 px band",
+        f"{_fmt(pl.min())}-{_fmt(pl.max())} px" if pl.notna().any() else "1.4-2.5 px",
+        f"{_fmt(lm.min())}-{_fmt(lm.max())} px",
+        "reproduced" if inside.all() else ("partly" if inside.any() else "not reproduced"),
+        f"{int(inside.sum())}/{len(t)} configurations inside 1.4-2.5 px; ours "
+        f"{'below' if lm.max() < 1.4 else 'above' if lm.min() > 2.5 else 'around'} the band on these data "
+        f"(linear neutral-to-peak interpolation: {_fmt(t.linear_landmark_diff_px.min())}-"
+        f"{_fmt(t.linear_landmark_diff_px.max())} px).", "facegraph/table1.csv")
+    order = t["config"].tolist()
+    rho, p, share = (_rank_trend(t["node_compression_pct"].astype(float), lm, samples, order)
+                     if len(t) > 2 else (np.nan, np.nan, np.nan))
+    prho = np.nan
+    if pl.notna().sum() > 2:
+        from scipy.stats import spearmanr
+
+        prho = float(spearmanr(t["paper_node_compression_pct"].astype(float), pl)[0])
+    if not np.isfinite(rho):
+        verdict = "not reproduced"
+    elif rho > 0 and p < 0.05 and (np.isnan(share) or share >= 0.95):
+        verdict = "reproduced"
+    elif rho > 0:
+        verdict = "within noise"
+    else:
+        verdict = "contradicted" if p < 0.05 else "not reproduced"
+    add("Landmark error rises with compression",
+        f"Spearman rho {_fmt(prho)} over the published rows" if np.isfinite(prho) else "",
+        f"Spearman rho {_fmt(rho)} (p={_fmt(p)})", verdict,
+        f"Rank correlation of landmark difference with node compression over {len(t)} configurations; "
+        f"rho > 0 in {_fmt(100 * share) if np.isfinite(share) else 'n/a'} % of 200 bootstrap resamples of the "
+        "database samples.", "facegraph/table1.csv")
+    nc = t["node_compression_pct"].astype(float)
+    pn = t["paper_node_compression_pct"].astype(float)
+    if pn.notna().any():
+        diff = (nc - pn).abs()
+        add("Node compression for the published targets (may be negative: more nodes than poses)",
+            f"{_fmt(pn.min())} to {_fmt(pn.max())} %", f"{_fmt(nc.min())} to {_fmt(nc.max())} %",
+            "reproduced" if (diff <= 10).all() else ("partly" if (diff <= 10).any() else "not reproduced"),
+            f"|ours - paper| <= 10 points in {int((diff <= 10).sum())}/{len(t)} configurations (median "
+            f"{_fmt(diff.median())} points). With node compression = 1 - nodes / poses and stage compressions "
+            "1 - nodes / poses (creation) and 1 - final / sample nodes (merge), five region graphs hold at least "
+            "5 (1 - c_max)(1 - m_max) nodes per pose (c_max, m_max: upper band ends), e.g. >= 2.4 poses for "
+            "0.1 +/- 0.1, 0.2 +/- 0.2, where the paper prints -54 % (1.54); its stage compressions must be measured "
+            "differently, which the text does not let us determine. Where in a wide band a sample lands depends on "
+            "the search start.", "facegraph/table1.csv")
     region = baseline[baseline.method.str.startswith("region graphs")].iloc[0]
     face = baseline[baseline.method.str.startswith("face graph")]
     smaller = face.memory_mb > region.memory_mb
-    rows.append({
-        "claim": "Region graphs need less memory than the face graph of Zhang et al. 2004",
-        "verdict": "yes" if smaller.all() else ("partly" if smaller.any() else "no"),
-        "evidence": f"region graphs {_fmt(region.memory_mb)} MB vs face graph {_fmt(face.memory_mb.min())}-"
-                    f"{_fmt(face.memory_mb.max())} MB (float32)",
-    })
-    dur_better = face.duration_diff_frames > region.duration_diff_frames
-    lm_better = face.landmark_diff_px > region.landmark_diff_px
-    rows.append({
-        "claim": "Region graphs reproduce database sequences (duration and landmarks) better than the face graph",
-        "verdict": "yes" if (dur_better & lm_better).all() else ("partly" if (dur_better | lm_better).any() else "no"),
-        "evidence": f"region graphs: duration {_fmt(region.duration_diff_frames)} frames, landmarks "
-                    f"{_fmt(region.landmark_diff_px)} px; " + "; ".join(
-                        f"{m.split('(')[-1].rstrip(')')} {s.split(' ')[0]}: {_fmt(d)} frames, {_fmt(lm)} px"
-                        for m, s, d, lm in zip(face.method, face.structure, face.duration_diff_frames,
-                                               face.landmark_diff_px)),
-    })
+    add("Region graphs need less memory than the face graph (Zhang et al. 2004)", "",
+        f"{_fmt(region.memory_mb)} MB vs {_fmt(face.memory_mb.min())}-{_fmt(face.memory_mb.max())} MB",
+        "reproduced" if smaller.all() else ("partly" if smaller.any() else "not reproduced"),
+        "float32 storage of what synthesis needs; complete face graphs hold N^2 weights"
+        + ("" if face.built.all() else " (graphs too large to build: memory computed from their size)") + ".",
+        "facegraph/baseline.csv")
+    work_region = float(region.edges + region.nodes * np.log2(max(region.nodes, 2)))
+    work_face = (face.edges + face.nodes * np.log2(face.nodes.clip(lower=2))).astype(float)
+    add("Path finding on region graphs is faster than on the face graph", "face graph ~1.9 s per path",
+        f"Dijkstra work (E + N log N) {_fmt(work_region)} vs {_fmt(work_face.min())}-{_fmt(work_face.max())}",
+        "reproduced" if (work_face > 10 * work_region).all() else "partly",
+        "Compared on graph size (deterministic); measured path times are in facegraph/baseline_timing.csv.",
+        "facegraph/baseline.csv")
+    built = face[face.built]
+    if len(built):
+        better = built.landmark_diff_px > region.landmark_diff_px
+        add("Region graphs reproduce database sequences more accurately than the face graph", "",
+            f"region graphs {_fmt(region.landmark_diff_px)} px vs face graph {_fmt(built.landmark_diff_px.min())}-"
+            f"{_fmt(built.landmark_diff_px.max())} px",
+            "reproduced" if better.all() else ("partly" if better.any() else "contradicted"),
+            "Same queries (neutral to own peak); the face graph's shortest path on the database poses can follow "
+            "the sample itself, so it is a strong baseline for re-synthesis.", "facegraph/baseline.csv")
+    lin = t["linear_landmark_diff_px"].astype(float)
+    add("The graph adds over straight neutral-to-peak interpolation (landmark difference)", "",
+        f"graph {_fmt(lm.median())} px vs linear {_fmt(lin.median())} px (medians)",
+        "reproduced" if (lm < lin).all() else ("partly" if (lm < lin).any() else "not reproduced"),
+        f"Graph counterpart below the linear baseline in {int((lm < lin).sum())}/{len(t)} configurations; "
+        f"velocity angle {_fmt(t.velocity_angle_diff_pct.median())} % vs {_fmt(t.linear_velocity_angle_diff_pct.median())} %. "
+        "The reference is the pre-processed sequence, whose eq.-1 fit (one timing for x and y) moves every landmark "
+        "on a straight line, so straight interpolation to the true peak pose has no direction error by construction; "
+        "it also knows the peak pose, which the graph must find.",
+        "facegraph/table1.csv")
     u = uniqueness.reset_index(drop=True)
     plain, noisy, full = u.iloc[0], u.iloc[2], u.iloc[3]
-    rows.append({
-        "claim": "Coherent (node and duration) noise makes repeated runs of one label sequence distinct",
-        "verdict": "yes" if noisy.distinct == noisy.runs and noisy.distinct > plain.distinct else
-                   ("partly" if noisy.distinct > plain.distinct else "no"),
-        "evidence": f"{plain.labels}, same peak nodes in every run: {int(plain.distinct)}/{int(plain.runs)} distinct "
-                    f"without noise, {int(noisy.distinct)}/{int(noisy.runs)} with node + duration noise (mean pairwise "
-                    f"distance {_fmt(noisy.distance_mean_px)} px); with random peaks too: "
-                    f"{int(full.distinct)}/{int(full.runs)} ({_fmt(full.distance_mean_px)} px)",
-    })
-    return pd.DataFrame(rows)[["claim", "verdict", "evidence"]]
+    add("Coherent (node and duration) noise makes repeated runs of one label sequence distinct", "",
+        f"{int(noisy.distinct)}/{int(noisy.runs)} distinct",
+        "reproduced" if noisy.distinct == noisy.runs and noisy.distinct > plain.distinct else
+        ("partly" if noisy.distinct > plain.distinct else "not reproduced"),
+        f"{plain.labels}, same peak nodes: {int(plain.distinct)}/{int(plain.runs)} distinct without noise, "
+        f"{int(noisy.distinct)}/{int(noisy.runs)} with node + duration noise (mean pairwise distance "
+        f"{_fmt(noisy.distance_mean_px)} px); random peaks too: {int(full.distinct)}/{int(full.runs)}.",
+        "facegraph/uniqueness.csv")
+    return pd.DataFrame(rows)[VERDICT_COLUMNS]

@@ -319,6 +319,7 @@ class FacePreprocessor:
             return apply_transform_2d(p, R, sc, t)
 
         counts = {"fit": 0, "static": 0, "grid": 0}
+        per_seq: dict[str, dict] = {}
         aligned = []
         for s in seqs:
             lm = np.asarray(s.landmarks, float)
@@ -329,6 +330,7 @@ class FacePreprocessor:
             y, status = fit_sigmoid_landmarks(lm - lm[0], self.sigmoid_min_range_px)
             for st in status:
                 counts[st] += 1
+            per_seq[s.name] = {k: status.count(k) for k in ("fit", "grid", "static")}
             p = lm[0] + y
             aligned.append(p if self.align_before_fit else rigid(p))
         if counts["grid"]:
@@ -336,6 +338,10 @@ class FacePreprocessor:
                         "improve on it, or fitted a step steeper than the grid's steepest onset (jitter of a "
                         "nearly still landmark)", counts["grid"])
         log.info("sigmoid fits: %s", counts)
+        for s, p in zip(seqs, aligned):
+            if not np.all(np.isfinite(p)) or np.abs(p).max() > 1e6:
+                raise ValueError(f"sequence {s.name}: pre-processing produced non-finite or huge coordinates "
+                                 f"(input range {np.abs(s.landmarks).max():.3g} px)")
         first = np.stack([p[0] for p in aligned])
         mean_neutral = _gpa_mean(first)
         # stage 2: per region, first pose -> mean neutral (similarity), applied to all poses
@@ -347,8 +353,11 @@ class FacePreprocessor:
             aligned[k] = p
         neutral = np.stack([p[0] for p in aligned])
         disp = np.concatenate([p - p[0] for p in aligned], axis=0)
-        self.report_ = dict(counts, n_sequences=len(seqs), n_skipped_short=len(short))
+        n_fit = max(1, counts["fit"] + counts["grid"])
+        self.report_ = dict(counts, n_sequences=len(seqs), n_skipped_short=len(short),
+                            grid_fallback_share=round(counts["grid"] / n_fit, 4))
         self.mean_neutral_ = mean_neutral
+        self.sigmoid_status_ = per_seq  # sequence name -> landmark counts per fit status
         return FaceDatabase(
             names=[s.name for s in seqs],
             emotions=np.array([s.emotion for s in seqs], int),

@@ -11,7 +11,7 @@ from threadpoolctl import threadpool_limits
 
 from ..io.ckplus import emotion_code, read_ckplus
 from .experiments import graph_kwargs, synth_kwargs
-from .graph import FaceGraphModel
+from .model import FaceGraphModel
 from .preprocess import FacePreprocessor
 from .synthesis import FaceSynthesizer
 
@@ -19,10 +19,13 @@ log = logging.getLogger("animsynth.facegraph.quick")
 
 
 def synthesise_from_labels(labels, out: str, ckplus_dir: str | None = None, seed: int = 0,
-                           creation: float = 50.0, merge: float = 50.0) -> str:
+                           creation: float = 20.0, merge: float = 70.0, creation_tolerance: float = 10.0,
+                           merge_tolerance: float = 20.0) -> str:
     """Build region graphs from a CK+ folder (default: a fresh synthetic CK+-layout
     database) and synthesise ``labels`` (e.g. ``["fear", "surprise", "happy"]``).
 
+    ``creation`` / ``merge`` and their tolerances are in %; the defaults are the
+    paper's configuration 0.2 +/- 0.1, 0.7 +/- 0.2.
     Writes ``out``: an animated GIF of the 68 landmarks, or a CSV (frame,
     landmark, x, y) if ``out`` ends in ``.csv``. Returns a one-line summary.
     """
@@ -38,7 +41,8 @@ def synthesise_from_labels(labels, out: str, ckplus_dir: str | None = None, seed
         seqs = read_ckplus(root)
         db = FacePreprocessor().fit_transform(seqs, source=str(ckplus_dir or "synthetic CK+-layout data"))
     with threadpool_limits(1):
-        model = FaceGraphModel(creation, merge, seed=seed, **graph_kwargs({})).fit(db)
+        model = FaceGraphModel(creation, merge, seed=seed, creation_tolerance=creation_tolerance,
+                               merge_tolerance=merge_tolerance, **graph_kwargs({})).fit(db)
         synth = FaceSynthesizer(model.graphs_, **synth_kwargs({"noise_share": 0.2, "duration_noise": True}))
         anim = synth.synthesize(list(labels), rng=np.random.default_rng(seed))
     pos = anim.positions(db.mean_neutral)

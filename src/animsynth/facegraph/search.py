@@ -6,9 +6,10 @@ grows with the threshold. The search walks the threshold towards the target:
 * start at ``t0`` with step ``step0``;
 * build, measure the compression ``c``; stop when ``|c - target| <= tol``;
 * if ``c < target`` raise the threshold by the step, else lower it;
-* whenever the direction reverses (the target was stepped over) halve the
-  step; a step that would make the threshold negative is halved until it
-  does not.
+* whenever the direction reverses (the compression passed the target band)
+  halve the step; a step that would make the threshold negative is halved
+  until it does not;
+* stop (not converged) when the step falls below ``min_step``.
 
 It runs element-wise on arrays (one threshold per region) so the creation
 search of all regions shares one vectorised build per iteration. If the
@@ -33,11 +34,14 @@ class SearchResult:
     history: list = field(default_factory=list)  # (iteration, thresholds, compressions)
 
 
-def step_halving_search(evaluate, target: float, tol: float, t0, step0, max_iter: int = 40) -> SearchResult:
+def step_halving_search(evaluate, target: float, tol: float, t0, step0, max_iter: int = 40,
+                        min_step=0.0) -> SearchResult:
     """Find thresholds whose compression (``evaluate(T) -> array``, in %) is
-    within ``tol`` of ``target`` (%). ``t0``/``step0``: arrays or scalars."""
+    within ``tol`` of ``target`` (%). ``t0``/``step0``/``min_step``: arrays or
+    scalars (one element per independent search)."""
     T = np.atleast_1d(np.asarray(t0, float)).copy()
     step = np.broadcast_to(np.atleast_1d(np.asarray(step0, float)), T.shape).copy()
+    min_step = np.broadcast_to(np.asarray(min_step, float), T.shape)
     if np.any(T < 0) or np.any(step <= 0):
         raise ValueError("t0 must be >= 0 and step0 > 0")
     prev_dir = np.zeros(T.shape, int)
@@ -61,6 +65,9 @@ def step_halving_search(evaluate, target: float, tol: float, t0, step0, max_iter
         direction = np.where(c < target, 1, -1)
         flip = active & (prev_dir != 0) & (direction != prev_dir)
         step[flip] /= 2.0
+        done |= active & (step < min_step)
+        if done.all():
+            break
         move = active & ~done
         for i in np.flatnonzero(move):
             while T[i] + direction[i] * step[i] < 0:

@@ -18,20 +18,30 @@ For every requested label, in every region graph:
 
 **Motion recovery.**
 
-1. *Velocity-based pose expansion with clamping.* Each non-final path node
-   ``k`` becomes ``round(mean consecutive-merge count)`` frames that start at
-   its mean displacement and move towards the next path node at the node's
-   mean landmark speed; each landmark's travel is clamped to the distance to
-   the next node, so no frame overshoots it.
-2. *Duration from peak statistics.* The peak node is held for
-   ``round(mean peak duration)`` frames (with duration noise: a normal draw
-   with the stored std), at least one.
+1. *Velocity-based pose expansion with clamping.* Each path node ``k``
+   becomes ``round(mean consecutive-merge count)`` frames centred on its mean
+   displacement (the node's centre), spaced by the node's mean landmark speed
+   along the direction to the next path node; each landmark's offset is
+   clamped to half the distance to the neighbouring path node, so no frame
+   passes the midpoint between two nodes.
+2. *Duration from the peak node.* Each peak node stores the neutral-to-peak
+   durations of the samples peaking in it (mean and spread). A segment ending
+   in peak node(s) is stretched (linear resampling in time) to that duration,
+   the mean over the regions' peak nodes, drawn from N(mean, std) with
+   duration noise. A peak-to-peak segment lasts ``0.3 x`` the previous peak's
+   duration ``+ 0.7 x`` the next one's (``peak_weights``).
 3. *Region length normalisation.* Regions give paths of different lengths;
-   every region is resampled (linear interpolation in time) to the mean length
-   of the regions whose path moves (all regions if none does).
+   every region is first resampled to the longest one, then the segment to the
+   duration of step 2.
 4. *Smoothing.* A Savitzky-Golay filter along time, then per segment and per
    landmark a sigmoid (eq. 1, shared timing for x and y, fitted by grid and
-   exact amplitudes) which is blended in with ``sigmoid_weight``.
+   exact amplitudes); ``sigmoid_weight = 1`` (default) replaces the motion by
+   the sigmoid fit, smaller values blend it in.
+
+**Coherent noise.** A share of the interior path nodes is replaced by random
+nodes within ``noise_hops`` hops (undirected) that share a label with the
+path's source or sink: the label(s) peaking in the end nodes (or, for a
+neutral source, the sink's peak labels).
 
 The regions are assembled into a (frames, 68, 2) displacement animation that
 is added to a neutral face.
@@ -48,7 +58,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.special import expit
 
 from ..io.ckplus import EMOTIONS, emotion_code
-from .graph import RegionGraph
+from .regiongraph import RegionGraph
 from .preprocess import sigmoid_grid_fit
 
 log = logging.getLogger("animsynth.facegraph.synthesis")
@@ -139,18 +149,20 @@ class FaceSynthesizer:
         Savitzky-Golay smoothing (step 4); the window is shrunk to the
         animation length when needed (odd), smoothing is skipped below order + 2 frames.
     sigmoid_weight : float in [0, 1]
-        Blend of the per-segment sigmoid fit into the smoothed motion (step 4).
+        Blend of the per-segment sigmoid fit into the smoothed motion (step 4); 1 = fully applied.
     noise_share : float in [0, 1]
         Share of interior path nodes replaced by coherent noise.
     noise_hops : int
         Neighbourhood radius (hops) of the replacement nodes.
     duration_noise : bool
-        Draw the peak duration from N(mean, std) instead of using the mean.
+        Draw the segment duration from N(mean, std) of the peak node instead of using the mean.
+    peak_weights : (float, float)
+        Duration of a peak-to-peak segment: weights of the previous and the next peak's duration.
     """
 
     def __init__(self, graphs: dict[str, RegionGraph], savgol_window: int = 7, savgol_order: int = 2,
-                 sigmoid_weight: float = 0.5, noise_share: float = 0.0, noise_hops: int = 2,
-                 duration_noise: bool = False):
+                 sigmoid_weight: float = 1.0, noise_share: float = 0.0, noise_hops: int = 2,
+                 duration_noise: bool = False, peak_weights=(0.3, 0.7)):
         if not 0.0 <= sigmoid_weight <= 1.0:
             raise ValueError("sigmoid_weight must be in [0, 1]")
         if not 0.0 <= noise_share <= 1.0:
@@ -164,6 +176,10 @@ class FaceSynthesizer:
         self.noise_share = float(noise_share)
         self.noise_hops = int(noise_hops)
         self.duration_noise = bool(duration_noise)
+        pw = tuple(float(w) for w in peak_weights)
+        if len(pw) != 2 or min(pw) < 0 or abs(sum(pw) - 1.0) > 1e-9:
+            raise ValueError("peak_weights must be two non-negative weights summing to 1")
+        self.peak_weights = pw
 
     # ------------------------------------------------------------------
     def start_nodes(self, sample: int | None = None) -> dict[str, int]:
@@ -198,38 +214,46 @@ class FaceSynthesizer:
         k = int(round(self.noise_share * interior.size))
         if k == 0:
             return path
+        labels = int(g.peak_mask[path[0]]) | int(g.peak_mask[path[-1]])
+        if labels == 0:
+            labels = int(g.label_mask[path[-1]])
         for i in np.sort(rng.choice(interior, size=k, replace=False)):
             u = path[i]
             nb = hop_neighbours(g, u, self.noise_hops)
-            nb = nb[(g.label_mask[nb] & g.label_mask[u]) != 0]
+            nb = nb[(g.label_mask[nb].astype(int) & labels) != 0]
             if nb.size:
                 path[i] = nb[rng.integers(nb.size)]
         return path
 
-    def _expand(self, g: RegionGraph, path: np.ndarray, first: bool, rng) -> np.ndarray:
-        """Steps 1-2 for one region path -> (frames, Lf, 2)."""
+    def _expand(self, g: RegionGraph, path: np.ndarray, first: bool) -> np.ndarray:
+        """Step 1 for one region path -> (frames, Lf, 2), ending on the path's last node."""
         D = g.disp
-        end = path[-1]
-        mu, sd = g.peak_dur_mean[end], g.peak_dur_std[end]
-        if not np.isfinite(mu):
-            mu, sd = float(np.rint(g.merge_count[end])), 0.0
-        h = rng.normal(mu, sd) if (self.duration_noise and sd > 0) else mu
-        h = max(1, int(np.rint(h)))
-        hold = np.repeat(D[end][None], h, axis=0)
         if len(path) == 1:
-            return hold
-        src, dst = path[:-1], path[1:]
-        n = np.maximum(1, np.rint(g.merge_count[src]).astype(int))
+            return D[path][:1].copy()
+        m = len(path)
+        nxt = np.r_[path[1:], path[-1]]
+        prv = np.r_[path[0], path[:-1]]
+        ahead = D[nxt] - D[path]                                  # (m, Lf, 2)
+        ahead[-1] = D[path[-1]] - D[path[-2]]                      # last node: keep the arrival direction
+        length = np.sqrt((ahead ** 2).sum(-1))
+        unit = np.where(length[..., None] > 0, ahead / np.where(length > 0, length, 1.0)[..., None], 0.0)
+        half_next = 0.5 * np.sqrt(((D[nxt] - D[path]) ** 2).sum(-1))   # (m, Lf); 0 for the last node
+        half_prev = 0.5 * np.sqrt(((D[path] - D[prv]) ** 2).sum(-1))   # 0 for the first node
+        n = np.maximum(1, np.rint(g.merge_count[path]).astype(int))
+        n[-1] = 1  # the path ends on the peak pose itself
         if not first:
-            n[0] = 0  # the previous segment already held this node
-        delta = D[dst] - D[src]                                  # (m, Lf, 2)
-        length = np.sqrt((delta ** 2).sum(-1))                   # (m, Lf)
-        unit = np.where(length[..., None] > 0, delta / np.where(length > 0, length, 1.0)[..., None], 0.0)
-        ks = np.repeat(np.arange(len(src)), n)
+            n[0] = 0  # the previous segment ended on this node
+        ks = np.repeat(np.arange(m), n)
         js = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
-        travel = np.minimum(js[:, None] * g.speed[src[ks]], length[ks])  # clamped at the next node
-        frames = D[src[ks]] + travel[..., None] * unit[ks]
-        return np.concatenate([frames, hold], axis=0)
+        off = (js - (n[ks] - 1) / 2.0)[:, None] * g.speed[path[ks]]      # (frames, Lf), centred on the node
+        off = np.clip(off, -half_prev[ks], half_next[ks])
+        return D[path[ks]] + off[..., None] * unit[ks]
+
+    def _duration(self, g: RegionGraph, node: int, rng):
+        mu, sd = g.peak_dur_mean[node], g.peak_dur_std[node]
+        if not np.isfinite(mu):
+            return np.nan, 0.0
+        return float(mu), float(sd) if np.isfinite(sd) else 0.0
 
     def _smooth(self, disp: np.ndarray, segments: list) -> np.ndarray:
         T = disp.shape[0]
@@ -250,7 +274,8 @@ class FaceSynthesizer:
         return out
 
     # ------------------------------------------------------------------
-    def synthesize(self, labels, start: dict | None = None, rng=None, peak_rng=None) -> Animation:
+    def synthesize(self, labels, start: dict | None = None, rng=None, peak_rng=None,
+                   peak_nodes: dict | None = None) -> Animation:
         """Animation through the peaks of ``labels`` (names or CK+ codes), in order.
 
         Parameters
@@ -260,6 +285,9 @@ class FaceSynthesizer:
         rng : numpy Generator or int seed (peak choice and noise)
         peak_rng : numpy Generator or int seed, optional
             Separate generator for the peak-node choice (then ``rng`` drives only the noise).
+        peak_nodes : dict region -> node, optional
+            Peak node of the first label per region instead of a random one
+            (re-synthesis of a database sample: its own peak nodes).
         """
         rng = np.random.default_rng(rng)
         peak_rng = rng if peak_rng is None else np.random.default_rng(peak_rng)
@@ -272,8 +300,9 @@ class FaceSynthesizer:
         raw = {r: [] for r in self.graphs}
         jumps = []
         t0 = 0
+        prev_dur = None
         for si, code in enumerate(codes):
-            trajs, moving = {}, []
+            trajs, moving, durs = {}, [], []
             for r, g in self.graphs.items():
                 peaks = g.peak_nodes(code)
                 if peaks.size == 0:
@@ -292,21 +321,40 @@ class FaceSynthesizer:
                     cur[r] = alt
                     dist, pred = dijkstra(g.csr(), directed=True, indices=cur[r], return_predecessors=True)
                     reach = peaks[np.isfinite(dist[peaks])]
-                target = int(reach[peak_rng.integers(reach.size)])
+                if peak_nodes is not None and si == 0:
+                    target = int(peak_nodes[r])
+                    if target not in set(reach.tolist()):
+                        raise SynthesisError(f"region {r!r}: requested peak node {target} is not a reachable "
+                                             f"{EMOTIONS[code]!r} peak node")
+                else:
+                    target = int(reach[peak_rng.integers(reach.size)])
                 p = _path(pred, cur[r], target)
                 raw[r].append(p)
                 if self.noise_share > 0:
                     p = self._coherent_noise(g, p, rng)
                 paths[r].append(p)
-                trajs[r] = self._expand(g, p, si == 0, rng)
+                trajs[r] = self._expand(g, p, si == 0)
+                durs.append(self._duration(g, target, rng))
                 if len(p) > 1:
                     moving.append(r)
                 cur[r] = target
-            use = moving or list(trajs)
-            n = max(1, int(np.rint(np.mean([len(trajs[r]) for r in use]))))
+            # step 3: every region to the longest region path
+            longest = max(len(t) for t in trajs.values())
+            # step 2: the segment lasts the peak nodes' neutral-to-peak duration
+            mus = np.array([d[0] for d in durs])
+            sds = np.array([d[1] for d in durs])
+            if np.isfinite(mus).any():
+                mu, sd = float(np.nanmean(mus)), float(np.nanmean(np.where(np.isfinite(mus), sds, np.nan)))
+                d = rng.normal(mu, sd) if (self.duration_noise and sd > 0) else mu
+                if si > 0 and prev_dur is not None:
+                    d = self.peak_weights[0] * prev_dur + self.peak_weights[1] * d
+                n = max(1, int(np.rint(d)))
+                prev_dur = d
+            else:
+                n = longest
             seg = np.zeros((n, 68, 2))
             for r, g in self.graphs.items():
-                seg[:, g.landmarks] = resample(trajs[r], n)
+                seg[:, g.landmarks] = resample(resample(trajs[r], longest), n)
             parts.append(seg)
             segments.append((t0, t0 + n, EMOTIONS[code]))
             t0 += n

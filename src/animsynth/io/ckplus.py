@@ -15,7 +15,8 @@ The official layout (Lucey et al. 2010), which :func:`read_ckplus` reads as is::
   lines are ignored.
 * Only some sequences are labelled: their ``Emotion/<subject>/<sequence>/``
   folder holds exactly one ``..._emotion.txt`` file whose single number is an
-  integral code 0-7 (:data:`EMOTIONS`) for the frame in its name, which is the
+  integral code 1-7 (:data:`EMOTIONS`; 0 = neutral is not a label and is
+  refused) for the frame in its name, which is the
   peak (in CK+ the last) frame. If the emotion frame is not the last landmark
   frame, the sequence is cut at the emotion frame and a warning is logged; an
   emotion frame without a landmark file is an error.
@@ -23,6 +24,10 @@ The official layout (Lucey et al. 2010), which :func:`read_ckplus` reads as is::
   folder inside ``Landmarks/`` or ``Emotion/`` is an error naming it, so a
   damaged copy never yields silently wrong data. Other top-level folders
   (``cohn-kanade-images``, ``FACS``) are not read.
+
+* Landmark coordinates must lie in the image (0-720 x 0-576 px) give or take
+  a margin of 150 px; a UTF-8 byte-order mark is stripped; undecodable bytes
+  are reported with their line.
 
 Every problem raises :class:`~animsynth.io.errors.MotionFormatError` with the
 file (and the 1-based line for content errors).
@@ -116,22 +121,38 @@ def _read_lines(path) -> list[str]:
     except OSError as exc:
         raise MotionFormatError(path, None, f"cannot read: {exc}") from None
     try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise MotionFormatError(path, None, "not a text file (undecodable bytes)") from None
+        text = data.decode("utf-8-sig")  # a UTF-8 byte-order mark is stripped
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise MotionFormatError(path, line, f"undecodable bytes (not UTF-8 text) at byte {exc.start}") from None
     return text.splitlines()
 
 
+#: CK+ images are at most 720 x 576 pixels; coordinates may lie this far outside (landmark fits at the border).
+IMAGE_MAX_PX = (720.0, 576.0)
+IMAGE_MARGIN_PX = 150.0
+
+
 def read_landmarks(path) -> np.ndarray:
-    """One CK+ landmark file -> (68, 2) float array; strict (see module docs)."""
+    """One CK+ landmark file -> (68, 2) float array; strict (see module docs).
+
+    Coordinates outside the image (0-720 x 0-576 px) by more than
+    :data:`IMAGE_MARGIN_PX` are refused with the file and line.
+    """
     pts = []
+    lo = -IMAGE_MARGIN_PX
     for ln, raw in enumerate(_read_lines(path), start=1):
         tok = raw.split()
         if not tok:
             continue
         if len(tok) != 2:
             raise MotionFormatError(path, ln, f"expected 2 numbers 'x y', got {len(tok)} field(s): {raw.strip()!r}")
-        pts.append([parse_float(t, path, ln, "landmark coordinate") for t in tok])
+        xy = [parse_float(t, path, ln, "landmark coordinate") for t in tok]
+        for v, hi, axis in ((xy[0], IMAGE_MAX_PX[0], "x"), (xy[1], IMAGE_MAX_PX[1], "y")):
+            if not lo <= v <= hi + IMAGE_MARGIN_PX:
+                raise MotionFormatError(path, ln, f"landmark {axis} = {v:g} px lies outside the image "
+                                                  f"(0-{hi:g} px, margin {IMAGE_MARGIN_PX:g} px)")
+        pts.append(xy)
         if len(pts) > N_LANDMARKS:
             raise MotionFormatError(path, ln, f"more than {N_LANDMARKS} landmark rows")
     if len(pts) != N_LANDMARKS:
@@ -150,7 +171,9 @@ def read_emotion(path) -> int:
                                 f"expected exactly one emotion code, found {len(values)}")
     ln, v = values[0]
     if v != round(v) or not 0 <= v < len(EMOTIONS):
-        raise MotionFormatError(path, ln, f"emotion code must be an integer 0-{len(EMOTIONS) - 1}, got {v:g}")
+        raise MotionFormatError(path, ln, f"emotion code must be an integer 1-{len(EMOTIONS) - 1}, got {v:g}")
+    if v == 0:
+        raise MotionFormatError(path, ln, "emotion code 0 (neutral) is not an expression label; CK+ labels are 1-7")
     return int(round(v))
 
 

@@ -22,9 +22,20 @@ Model (all random choices from one seeded ``numpy.random.Generator``):
   jaw drops in both, the cheeks+jaw barely move in anger). Per-sequence
   intensity, per-AU jitter, per-subject AU style and occasional dropped minor
   AUs vary the peaks.
-* **Timing.** Every AU follows a sigmoid onset normalised to 0 at the first
-  (neutral) frame and 1 at the last (peak) frame, like CK+; the onset centre
-  and steepness vary per sequence and each AU gets a small lag.
+* **Timing.** Every AU follows an onset profile normalised to 0 at the first
+  (neutral) frame and 1 at the last (peak) frame, like CK+. The profile is
+  drawn per sequence from ``onset_shapes``: a sigmoid, an ease-in/out with
+  overshoot (a damped oscillation settling on the peak), a two-phase onset (two
+  sigmoids), or a cubic ease starting late; centre and steepness vary per
+  sequence and each AU gets a small lag. The sigmoid pre-processing therefore
+  does not fit every sequence exactly.
+* **Paths, asymmetry, intensity, blinks.** Landmarks do not move on straight
+  lines: each AU's displacement gets a sideways bend proportional to
+  ``w (1 - w)`` of its onset ``w`` (``curvature``, random sign per AU). Each
+  subject has a left/right intensity asymmetry (``asymmetry``), each sequence
+  a log-normal intensity factor (``intensity_sd``), and with probability
+  ``blink_probability`` a sequence contains a blink (eyelids closing and
+  re-opening over a few frames, before the peak).
 * **Nuisances.** Small rigid head motion (rotation, translation, scale that
   drift with the expression plus a slow wobble) and i.i.d. landmark jitter.
 * **Database.** About 20 subjects and 70 labelled sequences whose emotion mix
@@ -174,30 +185,76 @@ def _sigmoid_weights(tau, centre, steep):
     return (s - s0) / (s1 - s0)
 
 
+ONSET_SHAPES = ("sigmoid", "overshoot", "two_phase", "ease")
+_UPPER_LIDS = [37, 38, 43, 44]
+_LOWER_LIDS = [40, 41, 46, 47]
+
+
+def onset_profile(shape: str, tau: np.ndarray, centre: float, steep: float) -> np.ndarray:
+    """Onset weight over normalised time ``tau`` (0 at the first frame, 1 at the last)."""
+    if shape == "sigmoid":
+        return _sigmoid_weights(tau, centre, steep)
+    if shape == "two_phase":
+        w = 0.55 * _sigmoid_weights(tau, 0.6 * centre, 1.5 * steep) + 0.45 * _sigmoid_weights(
+            tau, min(0.9, centre + 0.3), 1.5 * steep)
+        return (w - w[0]) / (w[-1] - w[0])
+    x = np.clip((tau - (centre - 0.3)) / max(1.3 - centre, 1e-3), 0.0, None)
+    if shape == "overshoot":
+        a, b = 4.0, 9.0  # damped oscillation settling on the peak
+        w = 1.0 - np.exp(-a * x) * (np.cos(b * x) + a / b * np.sin(b * x))
+        return w / w[-1] if abs(w[-1]) > 1e-9 else w
+    if shape == "ease":
+        u = np.clip(x / max(x[-1], 1e-9), 0.0, 1.0)
+        return u * u * (3.0 - 2.0 * u)
+    raise ValueError(f"unknown onset shape {shape!r}; expected one of {list(ONSET_SHAPES)}")
+
+
+def _perp(field: np.ndarray) -> np.ndarray:
+    return np.stack([-field[:, 1], field[:, 0]], 1)
+
+
 def expression_sequence(neutral: np.ndarray, face_scale: float, emotion: str | None, n_frames: int,
                         rng: np.random.Generator, style: dict | None = None, jitter_px: float = 0.6,
-                        head_rotation_deg: float = 1.5, head_translation_px: float = 3.0) -> np.ndarray:
+                        head_rotation_deg: float = 1.5, head_translation_px: float = 3.0, curvature: float = 0.35,
+                        onset_shapes=ONSET_SHAPES, intensity_sd: float = 0.2,
+                        blink_probability: float = 0.4) -> np.ndarray:
     """(n_frames, 68, 2) landmarks going from ``neutral`` to the peak of ``emotion``.
 
     ``emotion=None`` gives an unlabelled sequence (a random mild mix of AUs).
+    ``style``: per-subject AU gains (int keys) and ``"asym"`` (left/right asymmetry).
     """
+    style = style or {}
     tau = np.linspace(0.0, 1.0, n_frames)
     centre = rng.uniform(0.35, 0.6)
     steep = rng.uniform(8.0, 14.0)
+    shape = str(onset_shapes[int(rng.integers(len(onset_shapes)))])
     disp = np.zeros((n_frames, 68, 2))
     if emotion is None:
         pool = [1, 2, 4, 6, 7, 12, 15, 17, 25]
         aus = {int(a): float(rng.uniform(0.2, 0.5)) for a in rng.choice(pool, size=2, replace=False)}
     else:
         aus = EMOTION_AUS[emotion]
-    gain = rng.uniform(0.7, 1.15)
+    gain = float(np.exp(rng.normal(0.0, intensity_sd))) * 0.93
     for au, w in aus.items():
         if w < 0.7 and rng.random() < 0.2:
             continue  # minor AU left out of this performance
-        amp = gain * w * rng.uniform(0.8, 1.2) * (style or {}).get(int(str(au).rstrip("R")), 1.0)
+        amp = gain * w * rng.uniform(0.8, 1.2) * style.get(int(str(au).rstrip("R")), 1.0)
         lag = rng.normal(0.0, 0.05)
-        wt = _sigmoid_weights(tau, np.clip(centre + lag, 0.15, 0.85), steep * rng.uniform(0.8, 1.25))
-        disp += wt[:, None, None] * (amp * face_scale * au_field(au))[None]
+        wt = onset_profile(shape, tau, float(np.clip(centre + lag, 0.15, 0.85)), steep * rng.uniform(0.8, 1.25))
+        field = amp * face_scale * au_field(au)
+        bend = curvature * rng.choice([-1.0, 1.0]) * 4.0 * wt * (1.0 - wt)
+        disp += wt[:, None, None] * field[None] + bend[:, None, None] * _perp(field)[None]
+    # per-subject asymmetry: image-left landmarks stronger, image-right weaker (or the reverse)
+    side = np.sign(neutral[:, 0] - neutral[:, 0].mean())
+    disp *= (1.0 + float(style.get("asym", 0.0)) * side)[None, :, None]
+    if rng.random() < blink_probability and n_frames >= 6:
+        tb = rng.uniform(0.15, 0.7) * (n_frames - 1)
+        width = rng.uniform(0.8, 1.6)
+        bump = np.exp(-0.5 * ((np.arange(n_frames) - tb) / width) ** 2)
+        bump -= bump[-1]
+        height = np.abs(neutral[_LOWER_LIDS, 1] - neutral[_UPPER_LIDS, 1])
+        disp[:, _UPPER_LIDS, 1] += 0.8 * bump[:, None] * height[None]
+        disp[:, _LOWER_LIDS, 1] -= 0.1 * bump[:, None] * height[None]
     # rigid head motion about the face centre, drifting with the expression
     wh = _sigmoid_weights(tau, centre, steep)
     phase = rng.uniform(0, 2 * np.pi)
@@ -242,7 +299,9 @@ def _lengths(rng, n, total, lo, hi):
 def generate_sequences(n_subjects: int = 20, n_sequences: int = 70, total_frames: int = 1800,
                        n_unlabelled: int = 4, min_frames: int = 10, max_frames: int = 60, seed: int = 0,
                        jitter_px: float = 0.6, head_rotation_deg: float = 1.5,
-                       head_translation_px: float = 3.0) -> list[CKSequence]:
+                       head_translation_px: float = 3.0, curvature: float = 0.35, onset_shapes=ONSET_SHAPES,
+                       asymmetry: float = 0.2, intensity_sd: float = 0.2,
+                       blink_probability: float = 0.4) -> list[CKSequence]:
     """Generate the synthetic database in memory (see module docs)."""
     if n_subjects < 1 or n_sequences < 1:
         raise ValueError("need at least one subject and one labelled sequence")
@@ -260,6 +319,7 @@ def generate_sequences(n_subjects: int = 20, n_sequences: int = 70, total_frames
     for sid in ids:
         face, sc = subject_face(rng)
         style = {au: float(rng.normal(1.0, 0.1)) for au in _AU_LEFT}
+        style["asym"] = float(rng.normal(0.0, asymmetry))
         subjects.append((f"S{sid:03d}", face, sc, style))
     per_subject: dict[int, list[int]] = {i: [] for i in range(n_subjects)}
     for k in range(len(emotions)):
@@ -270,7 +330,8 @@ def generate_sequences(n_subjects: int = 20, n_sequences: int = 70, total_frames
         for q, k in enumerate(ks, start=1):
             emo = emotions[k]
             lms = expression_sequence(face, sc, emo, int(lengths[k]), rng, style, jitter_px,
-                                      head_rotation_deg, head_translation_px)
+                                      head_rotation_deg, head_translation_px, curvature, tuple(onset_shapes),
+                                      intensity_sd, blink_probability)
             out.append(CKSequence(name, f"{q:03d}", lms, None if emo is None else EMOTIONS.index(emo),
                                   np.arange(1, int(lengths[k]) + 1)))
     return out
