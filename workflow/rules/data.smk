@@ -92,6 +92,7 @@ rule datasets_table:
     params:
         subsets=SUBSETS,
         source=SOURCE,
+        paper_table1=config.get("simplicial", {}).get("paper_table1"),
     log:
         "logs/data/datasets_table.log",
     benchmark:
