@@ -178,3 +178,16 @@ def test_ensemble_tables_and_verdicts_on_toy_data(tmp_path):
     assert "ensemble members" in overall["evidence"]
     assert v["claim"].str.contains("five of the eight").any()
     assert v["claim"].str.contains("paper's range").any()
+
+
+@pytest.mark.parametrize("method", ["delaunay", "knn"])
+def test_single_path_fast_route_equals_follow_field(method):
+    clips = _loop_data(seed=4)
+    X = np.vstack(clips)
+    V = training_vectors(clips, "half")
+    f = VectorField(method, 6).fit(X, V)
+    for start in (X[5], X[5] + 0.013, np.array([2.5, -2.5])):  # on a training point, inside, outside the hull
+        one = follow_field(f, start, 60)
+        b = follow_batch(f, start[None], 60)
+        np.testing.assert_allclose(b.points[:, 0], one.points, rtol=0, atol=1e-9)
+        assert (b.fallback[:, 0] == one.fallback).all()
