@@ -120,12 +120,80 @@ def follow_batch(fields, starts, steps: int, which=None) -> BatchPaths:
         raise ValueError(f"follow_batch: 'which' must be {P} indices into {len(stack.fields)} fields")
     if P == 1 and _SinglePath.supports(stack):
         return _SinglePath(stack).follow(x[0], steps)
+    if P > 1 and _SinglePath.supports(stack) and stack.fields[0].method == "delaunay":
+        return _follow_delaunay_many(stack, x, steps)
     pts = np.empty((steps + 1, P, x.shape[1]))
     fb = np.zeros((steps, P), bool)
     pts[0] = x
     hint = np.full(P, -1)
     for t in range(steps):
         v, fb[t] = stack.evaluate(x, which, hint)
+        x = x + v
+        pts[t + 1] = x
+    if not np.all(np.isfinite(pts)):
+        raise FloatingPointError("follow_batch produced a non-finite point")
+    return BatchPaths(pts, fb)
+
+
+def _follow_delaunay_many(stack: FieldStack, x, steps: int) -> BatchPaths:
+    """Many paths through one Delaunay field (1/D^2 weights, full-rank triangulation), lean vectorised steps.
+
+    Each point is walked from the simplex it was in one step earlier (as in
+    :meth:`SafeDelaunay.find` with a hint) and weighted with ``m / D^2`` over
+    that simplex's vertices, with a handful of array operations per step.
+    Points not found strictly inside a simplex within a few face crossings,
+    and exact hits on a training point, take the general route
+    (:meth:`FieldStack.evaluate`), so every path gets the steps
+    :func:`follow_field` would give it (to float rounding).
+    """
+    from .geometry import HINT_EPS, HINT_WALK
+
+    f = stack.fields[0]
+    tri = f.triangulation_
+    TT = tri._barycentric_transform()
+    nbr = tri._tri.neighbors
+    simp = tri.simplices_
+    pts_u, vec, cnt = f.points_, f.vectors_, f.counts_
+    r = pts_u.shape[1]
+    P = x.shape[0]
+    pts = np.empty((steps + 1, P, r))
+    fb = np.zeros((steps, P), bool)
+    pts[0] = x
+    s = np.full(P, -1)
+    zero = np.zeros(P, int)
+    v = np.empty_like(x)
+    for t in range(steps):
+        ok = np.zeros(P, bool)
+        idx = np.flatnonzero(s >= 0)
+        for _ in range(HINT_WALK):
+            if not idx.size:
+                break
+            T = TT[s[idx]]
+            b = np.einsum("mij,mj->mi", T[:, :r, :], x[idx] - T[:, r, :])
+            full = np.concatenate([b, 1.0 - b.sum(axis=1, keepdims=True)], axis=1)
+            bmin = full.min(axis=1)
+            good = bmin > HINT_EPS
+            ok[idx[good]] = True
+            rest = ~good & np.isfinite(bmin)
+            idx = idx[rest]
+            s[idx] = nbr[s[idx], np.argmin(full[rest], axis=1)]
+            idx = idx[s[idx] >= 0]
+        oi = np.flatnonzero(ok)
+        if oi.size:
+            verts = simp[s[oi]]
+            diff = pts_u[verts] - x[oi, None, :]
+            d2 = np.einsum("mkd,mkd->mk", diff, diff)
+            hit = (d2 <= f.hit_tol_ ** 2).any(axis=1)
+            if hit.any():
+                ok[oi[hit]] = False
+                oi, verts, d2 = oi[~hit], verts[~hit], d2[~hit]
+            w = cnt[verts] / d2
+            v[oi] = np.einsum("mk,mkd->md", w, vec[verts]) / w.sum(axis=1, keepdims=True)
+        bad = np.flatnonzero(~ok)
+        if bad.size:
+            hb = np.full(bad.size, -1)
+            v[bad], fb[t, bad] = stack.evaluate(x[bad], zero[:bad.size], hb)
+            s[bad] = hb
         x = x + v
         pts[t + 1] = x
     if not np.all(np.isfinite(pts)):
