@@ -68,8 +68,7 @@ def build_verdicts(*, table2: pd.DataFrame, table2_ens: pd.DataFrame, members: p
         rows.append({"claim": claim_txt, "paper_value": paper_value, "ours": ours, "data": data_txt or data,
                      "verdict": verdict, "evidence": evidence, "source": source})
 
-    want_a_lower = {"delaunay_better": True, "knn_better": False}.get(claim.replace(a, "delaunay", 1)
-                                                                     if a != "delaunay" else claim)
+    want_a_lower = True if claim == f"{a}_better" else False if claim == f"{b}_better" else None
     t2 = table2.set_index(["metric", "method"])
     te = table2_ens.set_index(["metric", "dataset"])
     pa = paired.set_index("metric")
