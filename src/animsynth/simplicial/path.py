@@ -119,7 +119,9 @@ def follow_batch(fields, starts, steps: int, which=None) -> BatchPaths:
     if which.shape != (P,) or (P and (which.min() < 0 or which.max() >= len(stack.fields))):
         raise ValueError(f"follow_batch: 'which' must be {P} indices into {len(stack.fields)} fields")
     if P == 1 and _SinglePath.supports(stack):
-        return _SinglePath(stack).follow(x[0], steps)
+        if getattr(stack, "_single", None) is None:  # scalar tables, built once per stack
+            stack._single = _SinglePath(stack)
+        return stack._single.follow(x[0], steps)
     if P > 1 and _SinglePath.supports(stack) and stack.fields[0].method == "delaunay":
         return _follow_delaunay_many(stack, x, steps)
     pts = np.empty((steps + 1, P, x.shape[1]))
@@ -268,15 +270,22 @@ class _SinglePath:
         """The Delaunay step unrolled for the paper's 2-D latent space (same arithmetic as the general step)."""
         from .geometry import HINT_EPS
 
-        T, simp, nbr, Pl, Vl, ml, hit2 = self.T, self.simp, self.nbr, self.P, self.V, self.m, self.hit2
+        if getattr(self, "_packed", None) is None:
+            # per simplex: transform, centre, neighbours and vertices; per vertex: position, multiplier, vector
+            self._packed = (
+                [(a00, a01, a10, a11, c0, c1, n[0], n[1], n[2], v[0], v[1], v[2])
+                 for ((a00, a01), (a10, a11), (c0, c1)), n, v in zip(self.T, self.nbr, self.simp)],
+                [(p[0], p[1], m, w[0], w[1]) for p, m, w in zip(self.P, self.m, self.V)])
+        TS, PV = self._packed
+        hit2, max_walk = self.hit2, self.MAX_WALK
         x0_, x1_ = float(x0[0]), float(x0[1])
         s = -1
-        out = pts[:, 0, :]
+        xs = [(x0_, x1_)]
         for t in range(steps):
             found = False
             if s >= 0:
-                for _ in range(self.MAX_WALK):
-                    (a00, a01), (a10, a11), (c0, c1) = T[s]
+                for _ in range(max_walk):
+                    a00, a01, a10, a11, c0, c1, n0, n1, n2, i0, i1, i2 = TS[s]
                     y0, y1 = x0_ - c0, x1_ - c1
                     b0 = a00 * y0 + a01 * y1
                     b1 = a10 * y0 + a11 * y1
@@ -287,33 +296,33 @@ class _SinglePath:
                         break
                     if bm != bm:
                         break
-                    s = nbr[s][0 if bm == b0 else (1 if bm == b1 else 2)]
+                    s = n0 if bm == b0 else (n1 if bm == b1 else n2)
                     if s < 0:
                         break
-            v0 = v1 = 0.0
             if found:
-                wsum = 0.0
-                for vi in simp[s]:
-                    p0, p1 = Pl[vi]
-                    e0, e1 = p0 - x0_, p1 - x1_
-                    d2 = e0 * e0 + e1 * e1
-                    if d2 <= hit2:
-                        found = False
-                        break
-                    w = ml[vi] / d2
-                    wsum += w
-                    vv = Vl[vi]
-                    v0 += w * vv[0]
-                    v1 += w * vv[1]
+                p0, p1, m0, u0, w0 = PV[i0]
+                q0, q1, m1, u1, w1 = PV[i1]
+                r0, r1, m2, u2, w2 = PV[i2]
+                e0, e1 = p0 - x0_, p1 - x1_
+                da = e0 * e0 + e1 * e1
+                e0, e1 = q0 - x0_, q1 - x1_
+                db = e0 * e0 + e1 * e1
+                e0, e1 = r0 - x0_, r1 - x1_
+                dc = e0 * e0 + e1 * e1
+                found = da > hit2 and db > hit2 and dc > hit2
             if found:
-                v0, v1 = v0 / wsum, v1 / wsum
+                wa, wb, wc = m0 / da, m1 / db, m2 / dc
+                wsum = wa + wb + wc
+                v0 = (wa * u0 + wb * u1 + wc * u2) / wsum
+                v1 = (wa * w0 + wb * w1 + wc * w2) / wsum
             else:
                 x = np.array((x0_, x1_))
                 s = self.f.triangulation_.find_one(x)
                 v, fb[t, 0] = self.f(x)
                 v0, v1 = float(v[0]), float(v[1])
             x0_, x1_ = x0_ + v0, x1_ + v1
-            out[t + 1, 0], out[t + 1, 1] = x0_, x1_
+            xs.append((x0_, x1_))
+        pts[:, 0, :] = xs
         if not np.all(np.isfinite(pts)):
             raise FloatingPointError("follow_batch produced a non-finite point")
         return BatchPaths(pts, fb)
