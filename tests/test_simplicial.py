@@ -332,9 +332,14 @@ def test_run_fold_and_tables_on_toy_data():
     assert (df["steps"] == 60).all() and (df["latent_dim"] == 2).all()
     # a latent loop traversed with the printed 1/2 covers about half the arc
     assert df["length_ratio"].between(0.3, 0.7).all()
-    t2 = ex.table2(df, ["w1"], paper={"w1": {"delaunay_error_a": 1.5}})
-    assert t2["dataset"].tolist() == ["w1", "all"] and t2.loc[0, "paper_delaunay_error_a"] == 1.5
-    assert np.isnan(t2.loc[0, "paper_knn_error_f"])
+    paper = pd.DataFrame([{"metric": "error_a", "method": "delaunay", "w1": 1.5, "all": 2.0}])
+    t2 = ex.table2(df, ["w1"], paper=paper)
+    assert list(t2.columns) == ["metric", "method", "w1", "all", "paper_w1", "paper_all"]
+    assert t2[["metric", "method"]].values.tolist() == [["error_a", "delaunay"], ["error_a", "knn"],
+                                                        ["error_f", "delaunay"], ["error_f", "knn"]]
+    assert t2.loc[0, "paper_w1"] == 1.5 and np.isnan(t2.loc[1, "paper_w1"]) and np.isnan(t2.loc[3, "paper_all"])
+    d = df[df["method"] == "knn"]
+    assert t2.loc[3, "w1"] == pytest.approx(d["error_f_norm"].median())
     pc = ex.paired_comparison(df, n_boot=200, seed=1)
     assert set(pc["verdict"]) <= {"delaunay_better", "knn_better", "no_significant_difference"}
     again = ex.paired_comparison(df, n_boot=200, seed=1)
@@ -356,10 +361,4 @@ def test_target_variant_and_verdicts():
     tgt = b[b["generation"] == "target"]
     assert (tgt["fallback_steps"] == 0).all() and tgt["target_reached"].isin([True, False]).all()
     bs = ex.summarise_variants(b, "delaunay_idw_d2", ["w1"], n_boot=100)
-    main = d[d["derivative"] == "half"]
-    pc = ex.paired_comparison(main, n_boot=100)
-    v = ex.build_verdicts(pc, ds, main, bs, b, claim="delaunay_better", main_derivative="half",
-                          baseline="delaunay_idw_d2")
-    assert list(v.columns) == ["claim", "verdict", "evidence"]
-    assert v["claim"].str.contains("half speed").any()
-    assert v["claim"].str.contains("Best beyond").any()
+    assert "half" in ds["derivative"].tolist()

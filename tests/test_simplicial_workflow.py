@@ -9,9 +9,11 @@ import pandas as pd
 import pytest
 
 from animsynth.simplicial import experiment as ex
+from animsynth.simplicial.verdicts import VERDICT_COLUMNS
 
 OUTPUTS = [
     "results/simplicial/folds.csv", "results/simplicial/table2.csv", "results/simplicial/table2.md",
+    "results/simplicial/table2_ensemble.csv", "results/simplicial/fold_ensemble.csv", "results/simplicial/members.csv",
     "results/simplicial/paired.csv", "results/simplicial/derivative.csv", "results/simplicial/beyond.csv",
     "results/simplicial/verdicts.csv",
 ] + [f"results/simplicial/figures/fig{n}_{w}.png" for n, w in (
@@ -28,14 +30,20 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
     folds = pd.read_csv(wd / "results/simplicial/folds.csv")
     assert list(folds.columns) == ex.FOLD_COLUMNS
     n_folds = sum(1 for _ in (wd / "results/simplicial/folds").glob("*.json"))
-    assert len(folds) == n_folds and set(folds["method"]) == {"delaunay", "knn"}
+    assert len(folds) == 2 * n_folds and set(folds["method"]) == {"delaunay", "knn"}
     assert np.isfinite(folds[["error_a", "error_f", "error_a_norm", "error_f_norm"]].to_numpy(float)).all()
+    members = pd.read_csv(wd / "results/simplicial/members.csv")
+    assert len(members) == len(folds) * int(folds["n_members"].iloc[0]) and folds["n_members"].iloc[0] > 1
     t2 = pd.read_csv(wd / "results/simplicial/table2.csv")
-    assert t2["dataset"].tolist()[-1] == "all"
+    assert t2[["metric", "method"]].values.tolist() == [["error_a", "delaunay"], ["error_a", "knn"],
+                                                        ["error_f", "delaunay"], ["error_f", "knn"]]
+    assert list(t2.columns)[-1] == "paper_all"
     v = pd.read_csv(wd / "results/simplicial/verdicts.csv")
-    assert list(v.columns) == ["claim", "verdict", "evidence"] and len(v) >= 8
+    assert list(v.columns) == VERDICT_COLUMNS and len(v) >= 8
+    assert set(v["verdict"]) <= {"reproduced", "partly", "not reproduced", "contradicted", "within noise"}
+    assert not v["evidence"].str.contains("not available").any()
     row = json.loads(next((wd / "results/simplicial/folds").glob("*.json")).read_text())
-    assert set(row) == set(ex.FOLD_COLUMNS)
+    assert set(row["rows"][0]) == set(ex.FOLD_COLUMNS) and set(row["members"][0]) == set(ex.MEMBER_COLUMNS)
     assert (wd / "results/simplicial/figures/fig7_walk.bvh").read_text().startswith("HIERARCHY")
 
 

@@ -117,7 +117,7 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "")
     return m
 
 
-def datasets_table(subsets: dict, motions: dict, source: str) -> pd.DataFrame:
+def datasets_table(subsets: dict, motions: dict, source: str, paper: dict | None = None) -> pd.DataFrame:
     """Gauch & Peters Table I for the selected data.
 
     Parameters
@@ -125,6 +125,11 @@ def datasets_table(subsets: dict, motions: dict, source: str) -> pd.DataFrame:
     subsets : name -> list of trial ids (in order)
     motions : trial id -> Motion
     source : ``synthetic``, ``cmu`` or ``user``
+    paper : name -> list of published lengths (see :func:`read_paper_table1`), optional
+        When given (even empty) the table gets ``paper_lengths``, ``paper_total_nodes``
+        and ``length_match`` (which trials match the paper's length at the same
+        position, and which stand in for another length); empty for subsets the
+        paper does not list.
     """
     rows = []
     for name, ids in subsets.items():
@@ -143,7 +148,49 @@ def datasets_table(subsets: dict, motions: dict, source: str) -> pd.DataFrame:
                 "total_nodes": int(sum(lengths)),
             }
         )
-    return pd.DataFrame(rows, columns=["dataset", "source", "trials", "dims", "n_sequences", "lengths", "total_nodes"])
+        if paper is not None:
+            pl = paper.get(name)
+            rows[-1]["paper_lengths"] = " ".join(map(str, pl)) if pl else ""
+            rows[-1]["paper_total_nodes"] = int(sum(pl)) if pl else None
+            rows[-1]["length_match"] = length_match(ids, lengths, pl) if pl else ""
+    cols = ["dataset", "source", "trials", "dims", "n_sequences", "lengths", "total_nodes"]
+    if paper is not None:
+        cols += ["paper_lengths", "paper_total_nodes", "length_match"]
+    return pd.DataFrame(rows, columns=cols)
+
+
+def length_match(ids, lengths, paper_lengths) -> str:
+    """``all N match`` or which trials match the published lengths (same position) and which stand in."""
+    same = [f"{t} ({n})" for t, n, p in zip(ids, lengths, paper_lengths) if n == p]
+    other = [f"{t} ({n}) for {p}" for t, n, p in zip(ids, lengths, paper_lengths) if n != p]
+    if len(paper_lengths) != len(ids):
+        other.append(f"paper lists {len(paper_lengths)} sequences, we use {len(ids)}")
+    if not other:
+        return f"all {len(ids)} match"
+    return ("match: " + ", ".join(same) + "; " if same else "") + "stand-ins: " + ", ".join(other)
+
+
+def read_paper_table1(path) -> dict:
+    """Published Table I lengths: ``{subset: [frames, ...]}``; empty when ``path`` is unset or absent.
+
+    The CSV has columns ``dataset`` and ``lengths`` (space-separated frame
+    counts). A malformed file raises ``ValueError`` naming the file and line.
+    """
+    if not path or not os.path.exists(path):
+        if path:
+            log.info("published Table I not found at %s: paper columns left empty", path)
+        return {}
+    df = pd.read_csv(path, dtype=str, keep_default_na=False)
+    for c in ("dataset", "lengths"):
+        if c not in df.columns:
+            raise ValueError(f"{path}: line 1: missing column {c!r}")
+    out = {}
+    for i, r in df.iterrows():
+        try:
+            out[r["dataset"].strip()] = [int(x) for x in r["lengths"].split()]
+        except ValueError:
+            raise ValueError(f"{path}: line {i + 2}: lengths must be integers, got {r['lengths']!r}") from None
+    return out
 
 
 #: Gauch & Peters Table I (frames per sequence), for the captions and tests.

@@ -115,6 +115,7 @@ rule datasets_table:
     params:
         subsets=SUBSETS,
         source=SOURCE,
+        paper_table1=config.get("simplicial", {}).get("paper_table1"),
     threads: 1
     resources:
         mem_mb=500,

@@ -1,8 +1,8 @@
-"""The derivative-variant grid or the beyond-the-paper grid for one subset -> CSV of fold rows."""
+"""The derivative-variant grid or the beyond-the-paper grid for one subset -> fold rows and ensemble member rows."""
 from animsynth.simplicial.jobs import grid_job
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
-wc = snakemake.wildcards  # noqa: F821
-grid_job(list(snakemake.input), list(snakemake.params.ids), wc.dataset, wc.grid, dict(snakemake.params.cfg),  # noqa: F821
-         snakemake.output[0])  # noqa: F821
+wc, p = snakemake.wildcards, snakemake.params  # noqa: F821
+grid_job(list(snakemake.input), list(p.ids), wc.dataset, wc.grid, dict(p.cfg), int(p.seed),  # noqa: F821
+         dict(snakemake.output.items()))  # noqa: F821

@@ -4,5 +4,7 @@ from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
 i, p = snakemake.input, snakemake.params  # noqa: F821
-summary_job(list(i.derivative), list(i.beyond), i.folds, i.paired, list(p.datasets), dict(p.cfg, seed_value=p.seed),
-            dict(snakemake.output.items()))  # noqa: F821
+summary_job({"folds": list(i.derivative), "members": list(i.derivative_members)},
+            {"folds": list(i.beyond), "members": list(i.beyond_members)},
+            {k: i[k] for k in ("folds", "members", "paired", "table2", "table2_ensemble")},
+            list(p.datasets), dict(p.cfg, seed_value=p.seed), dict(snakemake.output.items()))  # noqa: F821

@@ -1,4 +1,4 @@
-"""Aggregate fold JSONs -> folds.csv, Table II (csv+md), paired Delaunay-vs-k-NN test."""
+"""Aggregate fold JSONs -> folds/members CSVs, Table II (paper layout, units, ensemble), paired test."""
 from animsynth.simplicial.jobs import table_job
 from animsynth.workflow_utils import setup_logging
 

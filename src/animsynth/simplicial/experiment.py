@@ -21,6 +21,19 @@ reported
 
 ``length_ratio`` is the arc length of the generated latent path over that of
 the held-out latent path (about 0.5 means the walk covered half the motion).
+
+Ensembles of starts
+-------------------
+Field following is chaotic for some training vectors: moving the start by
+1e-9 of the latent diagonal can flip which method wins a fold. Every fold is
+therefore also run from an *ensemble*: member 0 starts at the held-out
+trial's first latent frame (the paper's start), members 1..N at seeded
+copies moved by ``jitter`` x the latent bounding-box diagonal in a random
+direction. All members of all variants of a fold that share the latent
+space are followed together (:func:`~animsynth.simplicial.path.follow_batch`).
+Member 0 gives the fold row; the members give the spread (IQR), the share of
+members in which one method beats another, and the separation growth
+``|x_j(T) - x_0(T)| / |x_j(0) - x_0(0)|`` (how fast nearby paths separate).
 """
 
 from __future__ import annotations
@@ -37,7 +50,7 @@ from .field import DERIVATIVES, VectorField, training_vectors
 from .geometry import SafeDelaunay, bbox_diagonal
 from .graph import MotionGraph
 from .metrics import error_a, error_f
-from .path import GeneratedPath, TargetPlanner, follow_field
+from .path import GeneratedPath, TargetPlanner, follow_batch, follow_field
 
 log = logging.getLogger("animsynth.simplicial.experiment")
 
@@ -51,10 +64,20 @@ FOLD_COLUMNS = [
     "components", "largest_component_frac", "undirected_connected", "h_connected",
     "n_edges", "n_clip_edges", "n_added_pairs", "n_tie_edges",
     "tri_status", "n_duplicates", "target_reached",
+    "fallback_share", "n_members", "ens_error_a_norm_median", "ens_error_a_norm_q25", "ens_error_a_norm_q75",
+    "ens_error_f_norm_median", "ens_error_f_norm_q25", "ens_error_f_norm_q75", "ens_fallback_share",
+    "sep_growth_log10", "sep_final_rel",
 ]
 
-#: Columns of the paper's Table II that we fill (per method).
-TABLE2_METRICS = ("error_a", "error_f", "error_a_norm", "error_f_norm")
+#: One row per ensemble member and variant of a fold.
+MEMBER_COLUMNS = [
+    "dataset", "held_out", "fold", "variant", "method", "k", "latent_dim", "derivative", "weights", "generation",
+    "member", "steps", "fallback_steps", "error_a_norm", "error_f_norm", "error_a_pose", "error_f_pose",
+    "sep_initial_rel", "sep_final_rel", "sep_max_rel",
+]
+
+#: Columns of the wide all-units table (per method).
+TABLE2_METRICS = ("error_a", "error_f", "error_a_norm", "error_f_norm", "error_a_pose", "error_f_pose")
 
 
 @dataclass(frozen=True)
@@ -133,10 +156,100 @@ def fit_pca(train: list, latent_dim: int) -> PCA:
     return PCA(n_components=latent_dim, svd_solver="full").fit(X)
 
 
+@dataclass
+class FoldContext:
+    """What every variant of one fold at one latent dimension shares."""
+
+    pca: PCA
+    clips: list
+    X: np.ndarray
+    lengths: list
+    T: np.ndarray
+    test: np.ndarray
+    tri: SafeDelaunay
+    diag: float
+    floor: float
+    vectors: dict = field(default_factory=dict)
+
+
+def prepare_fold(train: list, test, latent_dim: int, dup_tol: float = 1e-9, rank_tol: float = 1e-9,
+                 held_out: str = "") -> FoldContext:
+    """PCA on the training trials, latent clips, held-out latent path and the shared triangulation."""
+    test = np.asarray(test, float)
+    if test.ndim != 2 or test.shape[0] < 2:
+        raise ValueError(f"held-out trial {held_out!r} needs at least 2 frames")
+    pca = fit_pca(train, latent_dim)
+    clips = [pca.transform(np.asarray(t, float)) for t in train]
+    X = np.vstack(clips)
+    T = pca.transform(test)
+    tri = SafeDelaunay(dup_tol, rank_tol).fit(X)
+    floor = error_a(test, pca.inverse_transform(T))[0]  # Error A of the perfect latent path (PCA loss alone)
+    return FoldContext(pca, clips, X, [len(c) for c in clips], T, test, tri, bbox_diagonal(X), floor)
+
+
+def _variant_objects(ctx: FoldContext, variant: Variant, dup_tol: float, rank_tol: float):
+    if variant.derivative not in ctx.vectors:
+        ctx.vectors[variant.derivative] = training_vectors(ctx.clips, variant.derivative)
+    V = ctx.vectors[variant.derivative]
+    graph = MotionGraph(variant.method, variant.k, dup_tol, rank_tol).fit(ctx.X, V, ctx.lengths, triangulation=ctx.tri)
+    fld = VectorField(variant.method, variant.k, variant.weights, dup_tol, rank_tol).fit(ctx.X, V, triangulation=ctx.tri)
+    return V, graph, fld
+
+
+def _fold_row(ctx: FoldContext, variant: Variant, path: GeneratedPath, graph: MotionGraph, reached, *,
+              dataset: str, held_out: str, fold: int) -> dict:
+    T, X, pca, test, tri, diag = ctx.T, ctx.X, ctx.pca, ctx.test, ctx.tri, ctx.diag
+    a, t2g, g2t = error_a(T, path.points)
+    f = error_f(T, path.points)
+    gen_pose = pca.inverse_transform(path.points)
+    a_pose = error_a(test, gen_pose)[0]
+    f_pose = error_f(test, gen_pose)
+    conn = graph.connectivity()
+    norm = diag if diag > 0 else np.nan
+    return {
+        "dataset": dataset, "held_out": held_out, "fold": int(fold), "variant": variant.name,
+        "method": variant.method, "k": int(variant.k), "latent_dim": int(variant.latent_dim),
+        "derivative": variant.derivative, "weights": variant.weights, "generation": variant.generation,
+        "n_train_frames": int(X.shape[0]), "n_test_frames": int(len(T)),
+        "explained_var": float(np.sum(pca.explained_variance_ratio_)), "bbox_diag": diag,
+        "steps": path.steps, "fallback_steps": path.fallback_steps,
+        "error_a": a, "error_a_norm": a / norm, "error_f": f, "error_f_norm": f / norm,
+        "error_a_pose": a_pose, "error_f_pose": f_pose, "pose_floor": ctx.floor,
+        "error_a_true_to_gen": t2g, "error_a_gen_to_true": g2t,
+        "length_ratio": arc_length(path.points) / max(arc_length(T), 1e-300),
+        "components": conn["scc"], "largest_component_frac": conn["largest_scc_frac"],
+        "undirected_connected": conn["undirected_connected"], "h_connected": conn["h_connected"],
+        "n_edges": conn["n_edges"], "n_clip_edges": conn["n_clip_edges"], "n_added_pairs": conn["n_added_pairs"],
+        "n_tie_edges": conn["n_tie_edges"], "tri_status": tri.status_, "n_duplicates": tri.n_duplicates_,
+        "target_reached": reached,
+        "fallback_share": path.fallback_steps / path.steps if path.steps else 0.0,
+    }
+
+
+def _ensemble_columns(row: dict, members: pd.DataFrame) -> dict:
+    """Fill the ensemble columns of a fold row from its member rows."""
+    out = dict(row)
+    out["n_members"] = int(len(members))
+    for met in ("error_a_norm", "error_f_norm"):
+        v = members[met].to_numpy(float)
+        q25, q50, q75 = np.quantile(v, [0.25, 0.5, 0.75])
+        out[f"ens_{met}_median"], out[f"ens_{met}_q25"], out[f"ens_{met}_q75"] = float(q50), float(q25), float(q75)
+    st = members["steps"].to_numpy(float)
+    out["ens_fallback_share"] = float(members["fallback_steps"].sum() / st.sum()) if st.sum() else 0.0
+    jit = members[members["member"] > 0]
+    with np.errstate(divide="ignore", invalid="ignore"):  # jitter 0: no separation to grow
+        growth = jit["sep_final_rel"].to_numpy(float) / jit["sep_initial_rel"].to_numpy(float)
+    growth = growth[np.isfinite(growth) & (growth > 0)]
+    out["sep_growth_log10"] = float(np.median(np.log10(growth))) if growth.size else np.nan
+    out["sep_final_rel"] = float(jit["sep_final_rel"].median()) if len(jit) else np.nan
+    assert list(out) == FOLD_COLUMNS
+    return out
+
+
 def run_fold(train: list, test, variant: Variant, *, dataset: str = "", held_out: str = "", fold: int = 0,
              steps="held_out", dup_tol: float = 1e-9, rank_tol: float = 1e-9,
              max_all_pairs: int = 4000) -> FoldResult:
-    """Run one leave-one-sequence-out fold.
+    """Run one leave-one-sequence-out fold from the held-out start alone (one path).
 
     Parameters
     ----------
@@ -149,97 +262,228 @@ def run_fold(train: list, test, variant: Variant, *, dataset: str = "", held_out
         Path length for field following.
     """
     variant.check()
-    test = np.asarray(test, float)
-    if test.ndim != 2 or test.shape[0] < 2:
-        raise ValueError(f"held-out trial {held_out!r} needs at least 2 frames")
-    pca = fit_pca(train, variant.latent_dim)
-    clips = [pca.transform(np.asarray(t, float)) for t in train]
-    X = np.vstack(clips)
-    lengths = [len(c) for c in clips]
-    V = training_vectors(clips, variant.derivative)
-    T = pca.transform(test)
-    tri = SafeDelaunay(dup_tol, rank_tol).fit(X)
-    graph_method = variant.method
-    graph = MotionGraph(graph_method, variant.k, dup_tol, rank_tol).fit(X, V, lengths, triangulation=tri)
-    fld = VectorField(variant.method, variant.k, variant.weights, dup_tol, rank_tol).fit(X, V, triangulation=tri)
+    ctx = prepare_fold(train, test, variant.latent_dim, dup_tol, rank_tol, held_out)
+    V, graph, fld = _variant_objects(ctx, variant, dup_tol, rank_tol)
     extra = {}
     if variant.generation == "field":
-        path = follow_field(fld, T[0], steps_for(steps, len(T)))
+        path = follow_field(fld, ctx.T[0], steps_for(steps, len(ctx.T)))
         reached = ""
     else:
         planner = TargetPlanner(max_all_pairs).fit(graph)
-        path, info = planner.plan(T[0], T[-1])
+        path, info = planner.plan(ctx.T[0], ctx.T[-1])
         extra["plan"] = info
         reached = bool(info["reached"])
-    diag = bbox_diagonal(X)
-    a, t2g, g2t = error_a(T, path.points)
-    f = error_f(T, path.points)
-    gen_pose = pca.inverse_transform(path.points)
-    a_pose = error_a(test, gen_pose)[0]
-    f_pose = error_f(test, gen_pose)
-    floor = error_a(test, pca.inverse_transform(T))[0]  # Error A of the perfect latent path (PCA loss alone)
-    conn = graph.connectivity()
-    norm = diag if diag > 0 else np.nan
-    row = {
-        "dataset": dataset, "held_out": held_out, "fold": int(fold), "variant": variant.name,
-        "method": variant.method, "k": int(variant.k), "latent_dim": int(variant.latent_dim),
-        "derivative": variant.derivative, "weights": variant.weights, "generation": variant.generation,
-        "n_train_frames": int(X.shape[0]), "n_test_frames": int(len(T)),
-        "explained_var": float(np.sum(pca.explained_variance_ratio_)), "bbox_diag": diag,
-        "steps": path.steps, "fallback_steps": path.fallback_steps,
-        "error_a": a, "error_a_norm": a / norm, "error_f": f, "error_f_norm": f / norm,
-        "error_a_pose": a_pose, "error_f_pose": f_pose, "pose_floor": floor,
-        "error_a_true_to_gen": t2g, "error_a_gen_to_true": g2t,
-        "length_ratio": arc_length(path.points) / max(arc_length(T), 1e-300),
-        "components": conn["scc"], "largest_component_frac": conn["largest_scc_frac"],
-        "undirected_connected": conn["undirected_connected"], "h_connected": conn["h_connected"],
-        "n_edges": conn["n_edges"], "n_clip_edges": conn["n_clip_edges"], "n_added_pairs": conn["n_added_pairs"],
-        "n_tie_edges": conn["n_tie_edges"], "tri_status": tri.status_, "n_duplicates": tri.n_duplicates_,
-        "target_reached": reached,
-    }
-    assert list(row) == FOLD_COLUMNS
-    return FoldResult(row, pca, clips, T, path, graph, fld, V, extra)
+    row = _fold_row(ctx, variant, path, graph, reached, dataset=dataset, held_out=held_out, fold=fold)
+    one = pd.DataFrame([{"member": 0, "steps": path.steps, "fallback_steps": path.fallback_steps,
+                         "error_a_norm": row["error_a_norm"], "error_f_norm": row["error_f_norm"],
+                         "sep_initial_rel": 0.0, "sep_final_rel": 0.0}])
+    row = _ensemble_columns(row, one)
+    return FoldResult(row, ctx.pca, ctx.clips, ctx.T, path, graph, fld, V, extra)
+
+
+def jittered_starts(start, n_starts: int, jitter: float, scale: float, seed: int) -> np.ndarray:
+    """The held-out start and ``n_starts`` copies moved by ``jitter * scale`` in seeded random directions.
+
+    Returns
+    -------
+    ndarray (n_starts + 1, d); row 0 is ``start`` itself. A jitter of 0 gives identical rows.
+    """
+    start = np.asarray(start, float)
+    if int(n_starts) < 0 or not np.isfinite(jitter) or jitter < 0:
+        raise ValueError(f"config key 'simplicial.ensemble': n_starts must be >= 0 and jitter >= 0, "
+                         f"got {n_starts!r}, {jitter!r}")
+    u = np.random.default_rng(seed).normal(size=(int(n_starts), start.size))
+    u /= np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-300)
+    return np.vstack([start[None, :], start[None, :] + float(jitter) * float(scale) * u])
+
+
+def run_fold_ensemble(train: list, test, variants, *, n_starts: int = 16, jitter: float = 1e-6, seed: int = 0,
+                      dataset: str = "", held_out: str = "", fold: int = 0, steps="held_out",
+                      dup_tol: float = 1e-9, rank_tol: float = 1e-9, max_all_pairs: int = 4000,
+                      member_pose=False) -> tuple[list, pd.DataFrame]:
+    """One fold for several variants, each from the same ensemble of starts.
+
+    Variants that share a latent dimension share the PCA and the
+    triangulation; all their field-following paths (members x variants) are
+    advanced together, one vectorised field evaluation per step. The jitter
+    directions are seeded by ``seed`` and the latent dimension only, so every
+    variant (and every job) of a fold uses the same starts: member j of
+    Delaunay pairs with member j of k-NN.
+
+    Parameters
+    ----------
+    n_starts : int
+        Jittered copies besides the held-out start (members 1..n_starts).
+    jitter : float
+        Start displacement relative to the latent bounding-box diagonal.
+    member_pose : bool or collection of variant names
+        Also compute the pose-space errors of every member (of all variants, or of
+        the named ones); otherwise only member 0 has them (NaN for the others).
+
+    Returns
+    -------
+    rows : list of dict
+        One :data:`FOLD_COLUMNS` row per variant (member 0 plus ensemble columns).
+    members : DataFrame (:data:`MEMBER_COLUMNS`)
+    """
+    variants = [v.check() for v in variants]
+    rows, mrows = [], []
+    for dim in dict.fromkeys(v.latent_dim for v in variants):
+        group = [v for v in variants if v.latent_dim == dim]
+        ctx = prepare_fold(train, test, dim, dup_tol, rank_tol, held_out)
+        starts = jittered_starts(ctx.T[0], n_starts, jitter, ctx.diag, seed)
+        M = starts.shape[0]
+        objs = [_variant_objects(ctx, v, dup_tol, rank_tol) for v in group]
+        fld_idx = [i for i, v in enumerate(group) if v.generation == "field"]
+        paths: dict[int, list] = {}
+        if fld_idx:
+            n = steps_for(steps, len(ctx.T))
+            which = np.repeat(np.arange(len(fld_idx)), M)
+            bp = follow_batch([objs[i][2] for i in fld_idx], np.tile(starts, (len(fld_idx), 1)), n, which)
+            for j, i in enumerate(fld_idx):
+                paths[i] = [(bp.path(j * M + m), "") for m in range(M)]
+        for i, v in enumerate(group):
+            if v.generation == "target":
+                planner = TargetPlanner(max_all_pairs).fit(objs[i][1])
+                paths[i] = []
+                for m in range(M):
+                    pth, info = planner.plan(starts[m], ctx.T[-1])
+                    paths[i].append((pth, bool(info["reached"])))
+        norm = ctx.diag if ctx.diag > 0 else np.nan
+        for i, v in enumerate(group):
+            p0 = paths[i][0][0].points
+            vm = []
+            for m, (pth, _) in enumerate(paths[i]):
+                a = error_a(ctx.T, pth.points)[0]
+                f = error_f(ctx.T, pth.points)
+                if m == 0 or member_pose is True or (not isinstance(member_pose, bool) and v.name in member_pose):
+                    gp = ctx.pca.inverse_transform(pth.points)
+                    ap, fp = error_a(ctx.test, gp)[0], error_f(ctx.test, gp)
+                else:
+                    ap = fp = np.nan
+                L = min(len(p0), len(pth.points))
+                sep = np.linalg.norm(pth.points[:L] - p0[:L], axis=1) / norm
+                vm.append({"dataset": dataset, "held_out": held_out, "fold": int(fold), "variant": v.name,
+                           "method": v.method, "k": int(v.k), "latent_dim": int(v.latent_dim),
+                           "derivative": v.derivative, "weights": v.weights, "generation": v.generation,
+                           "member": m, "steps": pth.steps, "fallback_steps": pth.fallback_steps,
+                           "error_a_norm": a / norm, "error_f_norm": f / norm, "error_a_pose": ap, "error_f_pose": fp,
+                           "sep_initial_rel": float(sep[0]), "sep_final_rel": float(sep[-1]),
+                           "sep_max_rel": float(sep.max())})
+            vm = pd.DataFrame(vm, columns=MEMBER_COLUMNS)
+            row = _fold_row(ctx, v, paths[i][0][0], objs[i][1], paths[i][0][1], dataset=dataset, held_out=held_out,
+                            fold=fold)
+            rows.append(_ensemble_columns(row, vm))
+            mrows.append(vm)
+    return rows, pd.concat(mrows, ignore_index=True)
 
 
 def run_subset(trials: dict, variants, *, dataset: str, steps="held_out", dup_tol=1e-9, rank_tol=1e-9,
-               max_all_pairs: int = 4000) -> pd.DataFrame:
+               max_all_pairs: int = 4000, ensemble: dict | None = None, seed: int = 0,
+               member_pose=False):
     """All leave-one-out folds of one subset for every variant.
 
     Parameters
     ----------
     trials : dict trial id -> array (n, 56), in subset order (fold i holds trial i out)
     variants : iterable of Variant
+    ensemble : dict with ``n_starts`` and ``jitter``, optional
+        Without it every fold is one path from the held-out start (no members returned).
+    seed : int
+        Seeds the jitter (mixed with the held-out trial id).
+
+    Returns
+    -------
+    folds : DataFrame (:data:`FOLD_COLUMNS`), and with ``ensemble`` also members (:data:`MEMBER_COLUMNS`)
     """
+    from ..config import derive_seed
+
     ids = list(trials)
-    rows = []
-    for v in variants:
-        for i, tid in enumerate(ids):
-            train = [trials[t] for t in ids if t != tid]
-            res = run_fold(train, trials[tid], v, dataset=dataset, held_out=tid, fold=i, steps=steps,
-                           dup_tol=dup_tol, rank_tol=rank_tol, max_all_pairs=max_all_pairs)
-            rows.append(res.row)
-    return pd.DataFrame(rows, columns=FOLD_COLUMNS)
+    variants = list(variants)
+    rows, members = [], []
+    if ensemble is None:
+        for v in variants:
+            for i, tid in enumerate(ids):
+                train = [trials[t] for t in ids if t != tid]
+                res = run_fold(train, trials[tid], v, dataset=dataset, held_out=tid, fold=i, steps=steps,
+                               dup_tol=dup_tol, rank_tol=rank_tol, max_all_pairs=max_all_pairs)
+                rows.append(res.row)
+        return pd.DataFrame(rows, columns=FOLD_COLUMNS)
+    for i, tid in enumerate(ids):
+        train = [trials[t] for t in ids if t != tid]
+        r, m = run_fold_ensemble(train, trials[tid], variants, n_starts=int(ensemble["n_starts"]),
+                                 jitter=float(ensemble["jitter"]), seed=derive_seed(seed, dataset, tid),
+                                 dataset=dataset, held_out=tid, fold=i, steps=steps, dup_tol=dup_tol,
+                                 rank_tol=rank_tol, max_all_pairs=max_all_pairs, member_pose=member_pose)
+        rows += r
+        members.append(m)
+    folds = pd.DataFrame(rows, columns=FOLD_COLUMNS)
+    return folds, pd.concat(members, ignore_index=True)[MEMBER_COLUMNS]
 
 
 def order_folds(df: pd.DataFrame, datasets) -> pd.DataFrame:
-    """Fixed row order: datasets in config order, then variant, then fold."""
+    """Fixed row order: datasets in config order, then variant, then fold (then member)."""
     order = {d: i for i, d in enumerate(datasets)}
-    df = df.assign(_d=df["dataset"].map(order)).sort_values(["_d", "variant", "fold"], kind="stable")
-    return df.drop(columns="_d").reset_index(drop=True)[FOLD_COLUMNS]
+    keys = ["_d", "variant", "fold"] + (["member"] if "member" in df.columns else [])
+    cols = MEMBER_COLUMNS if "member" in df.columns else FOLD_COLUMNS
+    df = df.assign(_d=df["dataset"].map(order)).sort_values(keys, kind="stable")
+    return df.drop(columns="_d").reset_index(drop=True)[cols]
 
 
 # ----------------------------------------------------------------------------
-# Table II and the paired comparison
+# Table II (the paper's layout), its ensemble spread, and the paired comparison
 # ----------------------------------------------------------------------------
-def table2(folds: pd.DataFrame, datasets, methods=("delaunay", "knn"), paper: dict | None = None) -> pd.DataFrame:
-    """Medians per subset and over all folds, laid out like the paper's Table II.
+#: Table II metrics: the paper's Error A and Error F (ours: normalised by the latent bbox diagonal).
+PAPER_METRICS = ("error_a", "error_f")
 
-    One row per subset plus ``all``; for every method the median Error A and
-    Error F (latent units and normalised), the number of folds, and the
-    paper's published value beside ours (``paper_<method>_error_a`` ...;
-    empty when not supplied).
+
+def stability(share: float) -> str:
+    """``stable`` when an ordering holds in every ensemble member (share 0 or 1), else the share."""
+    if share is None or not np.isfinite(share):
+        return "no ensemble"
+    if share in (0.0, 1.0):
+        return "stable"
+    return f"within start-noise (share {100 * share:.0f} %)"
+
+
+def table2(folds: pd.DataFrame, datasets, methods=("delaunay", "knn"), paper: pd.DataFrame | None = None,
+           col: str = "{metric}_norm") -> pd.DataFrame:
+    """Medians over the folds laid out as the paper's Table II.
+
+    One row per metric (``error_a``, ``error_f``) x method; columns the
+    subsets and ``all`` with our medians (``col``: bounding-box-normalised by
+    default), then ``paper_<subset>`` with the published value (empty when
+    ``paper`` is None or lacks the cell).
+
+    Parameters
+    ----------
+    folds : fold rows (member 0 = the held-out start)
+    paper : DataFrame with ``metric, method`` and one column per subset, optional
     """
-    paper = paper or {}
+    cols = list(datasets) + ["all"]
+    pap = None
+    if paper is not None and len(paper):
+        pap = paper.set_index(["metric", "method"])
+    rows = []
+    for met in PAPER_METRICS:
+        c = col.format(metric=met)
+        for m in methods:
+            r = {"metric": met, "method": m}
+            fm = folds[folds["method"] == m]
+            for d in cols:
+                s = fm if d == "all" else fm[fm["dataset"] == d]
+                r[d] = float(s[c].median()) if len(s) else np.nan
+            for d in cols:
+                val = np.nan
+                if pap is not None and (met, m) in pap.index and d in pap.columns:
+                    val = float(pap.loc[(met, m), d])
+                r[f"paper_{d}"] = val
+            rows.append(r)
+    return pd.DataFrame(rows, columns=["metric", "method"] + cols + [f"paper_{d}" for d in cols])
+
+
+def table2_units(folds: pd.DataFrame, datasets, methods=("delaunay", "knn")) -> pd.DataFrame:
+    """Table II in every unit: one row per subset (+ ``all``), per method the median of each metric."""
     rows = []
     for name in list(datasets) + ["all"]:
         sub = folds if name == "all" else folds[folds["dataset"] == name]
@@ -248,12 +492,103 @@ def table2(folds: pd.DataFrame, datasets, methods=("delaunay", "knn"), paper: di
             s = sub[sub["method"] == m]
             for met in TABLE2_METRICS:
                 r[f"{m}_{met}"] = float(s[met].median()) if len(s) else np.nan
-        for m in methods:
-            for met in ("error_a", "error_f"):
-                val = (paper.get(name) or {}).get(f"{m}_{met}")
-                r[f"paper_{m}_{met}"] = np.nan if val is None else float(val)
+            r[f"{m}_fallback_share"] = float(s["fallback_steps"].sum() / s["steps"].sum()) if len(s) else np.nan
         rows.append(r)
     return pd.DataFrame(rows)
+
+
+def member_medians(members: pd.DataFrame, datasets, key: str, values, metric: str) -> dict:
+    """Per ensemble member: the median over folds of ``metric`` per (value of ``key``, subset or ``all``).
+
+    Returns
+    -------
+    dict (value, subset) -> ndarray (n_members,)
+    """
+    out = {}
+    for v in values:
+        mv = members[members[key] == v]
+        for d in list(datasets) + ["all"]:
+            s = mv if d == "all" else mv[mv["dataset"] == d]
+            out[(v, d)] = s.groupby("member")[metric].median().sort_index().to_numpy(float)
+    return out
+
+
+def _spread(x):
+    if len(x) == 0:
+        return np.nan, np.nan, np.nan
+    q25, q50, q75 = np.quantile(x, [0.25, 0.5, 0.75])
+    return float(q50), float(q25), float(q75)
+
+
+def table2_ensemble(members: pd.DataFrame, datasets, methods=("delaunay", "knn"),
+                    paper: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Table II over the ensemble of starts: per metric x subset, each member's Table II cell.
+
+    For every member j the cell is the median over the subset's folds (as in
+    the paper); the row gives the median and IQR of that cell over members for
+    both methods, the share of members in which the first method is lower
+    (``a_lower_share``), whether that ordering is stable, the paper's ordering
+    and the share of members that agree with it, and the fallback share of the
+    first method (steps outside the hull, all members).
+    """
+    a, b = methods
+    pap = paper.set_index(["metric", "method"]) if paper is not None and len(paper) else None
+    rows = []
+    for met in PAPER_METRICS:
+        mm = member_medians(members, datasets, "method", methods, f"{met}_norm")
+        for d in list(datasets) + ["all"]:
+            xa, xb = mm[(a, d)], mm[(b, d)]
+            r = {"metric": met, "dataset": d, "n_members": int(min(len(xa), len(xb)))}
+            for m, x in ((a, xa), (b, xb)):
+                r[f"{m}_median"], r[f"{m}_q25"], r[f"{m}_q75"] = _spread(x)
+            n = r["n_members"]
+            share = float(np.mean(xa[:n] < xb[:n])) if n else np.nan
+            r["a_lower_share"] = share
+            r["ordering"] = (f"{a}<{b}" if share > 0.5 else f"{b}<{a}" if share < 0.5 else "tie") if n else ""
+            r["stability"] = stability(share)
+            pa = pb = np.nan
+            if pap is not None and (met, a) in pap.index and (met, b) in pap.index and d in pap.columns:
+                pa, pb = float(pap.loc[(met, a), d]), float(pap.loc[(met, b), d])
+            r[f"paper_{a}"], r[f"paper_{b}"] = pa, pb
+            if np.isfinite(pa) and np.isfinite(pb) and n:
+                r["paper_ordering"] = f"{a}<{b}" if pa < pb else f"{b}<{a}" if pb < pa else "tie"
+                r["agree_share"] = share if pa < pb else (1.0 - share if pb < pa else np.nan)
+            else:
+                r["paper_ordering"], r["agree_share"] = "", np.nan
+            s = members[(members["method"] == a) & ((members["dataset"] == d) | (d == "all"))]
+            r[f"{a}_fallback_share"] = float(s["fallback_steps"].sum() / s["steps"].sum()) if len(s) else np.nan
+            rows.append(r)
+    return pd.DataFrame(rows)
+
+
+def fold_ensemble(members: pd.DataFrame, datasets, methods=("delaunay", "knn")) -> pd.DataFrame:
+    """Per fold and metric: median and IQR over members per method, share of members with the first method lower,
+    and each method's fallback share (held-out start, and over all members)."""
+    a, b = methods
+    rows = []
+    for (d, fold), s in members.groupby(["dataset", "fold"], sort=False):
+        for met in PAPER_METRICS:
+            c = f"{met}_norm"
+            r = {"dataset": d, "fold": int(fold), "held_out": s["held_out"].iloc[0], "metric": met}
+            xs = {}
+            for m in methods:
+                sm = s[s["method"] == m].sort_values("member")
+                xs[m] = sm[c].to_numpy(float)
+                r[f"{m}_start"] = float(sm.loc[sm["member"] == 0, c].iloc[0]) if (sm["member"] == 0).any() else np.nan
+                r[f"{m}_median"], r[f"{m}_q25"], r[f"{m}_q75"] = _spread(xs[m])
+            n = min(len(xs[a]), len(xs[b]))
+            share = float(np.mean(xs[a][:n] < xs[b][:n])) if n else np.nan
+            r["a_lower_share"], r["stability"] = share, stability(share)
+            for m in methods:
+                sm = s[s["method"] == m]
+                z = sm[sm["member"] == 0]
+                r[f"{m}_fallback_share_start"] = float(z["fallback_steps"].sum() / max(z["steps"].sum(), 1))
+                r[f"{m}_fallback_share_members"] = float(sm["fallback_steps"].sum() / max(sm["steps"].sum(), 1))
+            rows.append(r)
+    out = pd.DataFrame(rows)
+    order = {d: i for i, d in enumerate(datasets)}
+    return out.assign(_d=out["dataset"].map(order)).sort_values(["_d", "fold", "metric"], kind="stable").drop(
+        columns="_d").reset_index(drop=True)
 
 
 def paired_comparison(folds: pd.DataFrame, a: str = "delaunay", b: str = "knn",
@@ -346,10 +681,12 @@ def beyond_variants(cfg: dict, base_k: int, derivative: str) -> list[Variant]:
 
 def summarise_variants(folds: pd.DataFrame, baseline: str, datasets,
                        metrics=("error_a_pose", "error_f_pose", "error_a_norm", "error_f_norm"),
-                       n_boot: int = 2000, seed: int = 0) -> pd.DataFrame:
-    """One row per variant: medians over all folds, per-subset median of the first metric,
-    and the paired comparison with ``baseline`` on the first metric."""
+                       n_boot: int = 2000, seed: int = 0, members: pd.DataFrame | None = None) -> pd.DataFrame:
+    """One row per variant: medians over all folds (held-out start), per-subset median of the first metric,
+    the paired comparison with ``baseline`` on the first metric, and with ``members`` the share of ensemble
+    members in which the variant's all-fold median is below the baseline's (``lower_share_vs_baseline``)."""
     first = metrics[0]
+    mm = members if members is not None and len(members) else None
     rows = []
     for name, s in folds.groupby("variant", sort=False):
         r = {"variant": name}
@@ -362,7 +699,9 @@ def summarise_variants(folds: pd.DataFrame, baseline: str, datasets,
             r[f"{first}_{d}"] = float(s.loc[s["dataset"] == d, first].median()) if (s["dataset"] == d).any() else np.nan
         r["pose_floor"] = float(s["pose_floor"].median())
         r["fallback_steps"] = float(s["fallback_steps"].median())
+        r["fallback_share"] = float(s["fallback_steps"].sum() / max(s["steps"].sum(), 1))
         r["length_ratio"] = float(s["length_ratio"].median())
+        r["sep_growth_log10"] = float(s["sep_growth_log10"].median())
         if name != baseline:
             pc = paired_comparison(folds, name, baseline, metrics=(first,), n_boot=n_boot, seed=seed, key="variant")
             pr = pc.iloc[0]
@@ -373,21 +712,35 @@ def summarise_variants(folds: pd.DataFrame, baseline: str, datasets,
             r["rel_change_vs_baseline"] = 0.0
             r["p_vs_baseline"] = np.nan
             r["better_folds_vs_baseline"] = 0
+        r["lower_share_vs_baseline"] = np.nan
+        r["share_metric"] = ""
+        r["members"] = int(members[members["variant"] == name]["member"].nunique()) if mm is not None else 0
+        if mm is not None and name != baseline:
+            from .verdicts import member_share
+
+            same_dim = int(r["latent_dim"]) == int(folds.loc[folds["variant"] == baseline, "latent_dim"].iloc[0])
+            for met in (first, "error_a_norm") if same_dim else (first,):
+                sh = member_share(members, name, baseline, met)
+                if np.isfinite(sh):
+                    r["lower_share_vs_baseline"], r["share_metric"] = sh, met
+                    break
         rows.append(r)
     out = pd.DataFrame(rows)
     return out.sort_values([first, "variant"], kind="stable").reset_index(drop=True)
 
 
 def derivative_summary(folds: pd.DataFrame, methods=("delaunay", "knn"), claim: str = "delaunay_better",
-                       n_boot: int = 2000, seed: int = 0) -> pd.DataFrame:
-    """Per derivative: medians per method, the Delaunay-vs-k-NN ordering and whether it matches ``claim``."""
+                       n_boot: int = 2000, seed: int = 0, members: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Per derivative: medians per method (held-out start), the Delaunay-vs-k-NN ordering, whether it matches
+    ``claim``, and with ``members`` its share over the ensemble of starts and each method's separation growth."""
     a, b = methods
     rows = []
     for d, s in folds.groupby("derivative", sort=False):
         r = {"derivative": d, "folds": int(len(s) // 2)}
         for m in methods:
             sm = s[s["method"] == m]
-            for met in ("error_a_norm", "error_f_norm", "error_a_pose", "length_ratio", "fallback_steps"):
+            for met in ("error_a_norm", "error_f_norm", "error_a_pose", "length_ratio", "fallback_steps",
+                        "sep_growth_log10", "sep_final_rel"):
                 r[f"{m}_{met}"] = float(sm[met].median())
         pc = paired_comparison(s, a, b, metrics=("error_a_norm", "error_f_norm"), n_boot=n_boot, seed=seed)
         for _, p in pc.iterrows():
@@ -396,6 +749,16 @@ def derivative_summary(folds: pd.DataFrame, methods=("delaunay", "knn"), claim: 
             r[f"{a}_lower_{tag}"] = bool(p["median_a"] < p["median_b"])
         r["ordering"] = ordering(r[f"{a}_lower_a"], r[f"{a}_lower_f"], a, b)
         r["reproduces_claim"] = claim_matches(claim, r[f"{a}_lower_a"], r[f"{a}_lower_f"])
+        for tag, met in (("a", "error_a_norm"), ("f", "error_f_norm")):
+            share = np.nan
+            if members is not None and len(members):
+                md = members[members["derivative"] == d]
+                mm = member_medians(md, [], "method", methods, met)
+                x, y = mm[(a, "all")], mm[(b, "all")]
+                n = min(len(x), len(y))
+                share = float(np.mean(x[:n] < y[:n])) if n else np.nan
+            r[f"{a}_lower_share_{tag}"] = share
+            r[f"stability_{tag}"] = stability(share)
         rows.append(r)
     return pd.DataFrame(rows)
 
@@ -433,133 +796,11 @@ def to_jsonable(row: dict) -> dict:
     return out
 
 
+
+
 __all__ = [
-    "FOLD_COLUMNS", "FoldResult", "Variant", "beyond_variants", "derivative_summary",
-    "build_verdicts", "derivative_variants", "fit_pca", "order_folds", "paired_comparison", "run_fold", "run_subset",
-    "steps_for", "summarise_variants", "table2", "to_jsonable",
+    "FOLD_COLUMNS", "MEMBER_COLUMNS", "FoldResult", "Variant", "beyond_variants", "derivative_summary",
+    "derivative_variants", "fit_pca", "fold_ensemble", "jittered_starts", "member_medians", "order_folds",
+    "paired_comparison", "prepare_fold", "run_fold", "run_fold_ensemble", "run_subset", "stability", "steps_for",
+    "summarise_variants", "table2", "table2_ensemble", "table2_units", "to_jsonable",
 ]
-
-
-# ----------------------------------------------------------------------------
-# Verdicts: the claims this family checks, decided from the numbers
-# ----------------------------------------------------------------------------
-def _fmt(x, nd=3):
-    return "nan" if x is None or not np.isfinite(x) else f"{x:.{nd}g}"
-
-
-def build_verdicts(paired: pd.DataFrame, deriv: pd.DataFrame, folds: pd.DataFrame, beyond: pd.DataFrame | None,
-                   beyond_folds: pd.DataFrame | None, *, claim: str, main_derivative: str, baseline: str,
-                   alpha: float = 0.05) -> pd.DataFrame:
-    """Rows ``claim, verdict, evidence`` generated from the result tables.
-
-    Parameters
-    ----------
-    paired : output of :func:`paired_comparison` on the main folds
-    deriv : output of :func:`derivative_summary`
-    folds : main fold table (delaunay and knn, main derivative)
-    beyond, beyond_folds : output of :func:`summarise_variants` and its fold rows (optional)
-    claim : {"delaunay_better", "knn_better", "unknown"}
-        The ordering the paper concludes (config ``simplicial.paper_claim``).
-    """
-    rows = []
-
-    def add(c, v, e):
-        rows.append({"claim": c, "verdict": v, "evidence": e})
-
-    pa = paired.set_index("metric")
-    claim_txt = {"delaunay_better": "Delaunay gives lower errors than k-NN",
-                 "knn_better": "k-NN gives lower errors than Delaunay",
-                 "unknown": "(paper ordering not configured)"}[claim]
-    for met, lab in (("error_a_norm", "Error A"), ("error_f_norm", "Error F")):
-        if met not in pa.index:
-            continue
-        r = pa.loc[met]
-        a_lower = r["median_a"] < r["median_b"]
-        if claim == "unknown":
-            v = "unknown"
-        else:
-            match = a_lower == (claim == "delaunay_better")
-            sig = np.isfinite(r["p_value"]) and r["p_value"] < alpha
-            v = ("reproduced" if sig else "same direction, not significant") if match else (
-                "contradicted" if sig else "opposite direction, not significant")
-        add(f"Paper conclusion on {lab} ({claim_txt}), derivative '{main_derivative}', all folds",
-            v, f"median {lab}/bbox diag: delaunay {_fmt(r['median_a'])}, knn {_fmt(r['median_b'])}; "
-               f"Wilcoxon p={_fmt(r['p_value'])} over {int(r['n_pairs'])} paired folds; "
-               f"95% bootstrap CI of median(delaunay-knn) [{_fmt(r['ci_low'])}, {_fmt(r['ci_high'])}]; "
-               f"delaunay lower in {int(r['a_better_folds'])}/{int(r['n_pairs'])} folds")
-    for met, lab in (("error_a_norm", "Error A"), ("error_f_norm", "Error F")):
-        if met in pa.index:
-            r = pa.loc[met]
-            add(f"Delaunay and k-NN differ on {lab} (paired, alpha={alpha})",
-                "yes" if (np.isfinite(r["p_value"]) and r["p_value"] < alpha) else "no",
-                f"Wilcoxon signed-rank p={_fmt(r['p_value'])}, verdict {r['verdict']}")
-    for _, r in deriv.iterrows():
-        add(f"Derivative '{r['derivative']}' reproduces the paper's ordering ({claim_txt})",
-            r["reproduces_claim"],
-            f"ordering {r['ordering']}; median Error A/diag delaunay {_fmt(r['delaunay_error_a_norm'])} vs knn "
-            f"{_fmt(r['knn_error_a_norm'])} (p={_fmt(r['p_value_a'])}); Error F/diag {_fmt(r['delaunay_error_f_norm'])} "
-            f"vs {_fmt(r['knn_error_f_norm'])} (p={_fmt(r['p_value_f'])})")
-    dd = deriv.set_index("derivative")
-    if {"half", "forward"} <= set(dd.index):
-        h = dd.loc["half", "delaunay_length_ratio"], dd.loc["half", "knn_length_ratio"]
-        f = dd.loc["forward", "delaunay_length_ratio"], dd.loc["forward", "knn_length_ratio"]
-        half_ok = all(0.35 <= x <= 0.65 for x in h)
-        fwd_ok = all(0.75 <= x <= 1.33 for x in f)
-        add("The printed 1/2 makes the field traverse the data at half speed (likely a typo)",
-            "supported" if half_ok and fwd_ok else "not supported",
-            f"median generated/held-out arc length: half {_fmt(h[0])} (delaunay), {_fmt(h[1])} (knn); "
-            f"forward {_fmt(f[0])}, {_fmt(f[1])}; median Error A/diag half {_fmt(dd.loc['half', 'delaunay_error_a_norm'])}"
-            f"/{_fmt(dd.loc['half', 'knn_error_a_norm'])} vs forward {_fmt(dd.loc['forward', 'delaunay_error_a_norm'])}"
-            f"/{_fmt(dd.loc['forward', 'knn_error_a_norm'])} (delaunay/knn)")
-        rep = [d for d, v in dd["reproduces_claim"].items() if v == "yes"]
-        sig = [d for d in rep if min(dd.loc[d, "p_value_a"], dd.loc[d, "p_value_f"]) < alpha]
-        add("Which derivative variant reproduces the paper's conclusion",
-            ", ".join(rep) if rep else "none",
-            "variants whose Delaunay-vs-k-NN ordering of median Error A and Error F both match the configured claim; "
-            + (f"significant (Wilcoxon p < {alpha}) for: {', '.join(sig)}" if sig else
-               f"none of these orderings is significant (Wilcoxon p >= {alpha}), so the ordering is within noise"))
-    for m, s in folds.groupby("method", sort=False):
-        one = int((s["components"] == 1).sum())
-        add(f"G' ({m}) is strongly connected in every fold", "yes" if one == len(s) else "no",
-            f"{one}/{len(s)} folds with one strongly connected component (max {int(s['components'].max())}); "
-            f"undirected connected in {int(s['undirected_connected'].sum())}/{len(s)}; "
-            f"H connected in {int(s['h_connected'].sum())}/{len(s)}")
-    if beyond is not None and len(beyond):
-        b = beyond.set_index("variant")
-        metric = "error_a_pose"
-        base = float(b.loc[baseline, metric]) if baseline in b.index else np.nan
-        best = beyond.iloc[0]
-        add("Best beyond-the-paper variant (median pose-space Error A)", str(best["variant"]),
-            f"{_fmt(best[metric])} deg vs paper baseline {baseline} {_fmt(base)} deg "
-            f"({_fmt(100 * best['rel_change_vs_baseline'])}% change, Wilcoxon p={_fmt(best['p_vs_baseline'])}, "
-            f"lower in {int(best['better_folds_vs_baseline'])}/{int(best['folds'])} folds); PCA floor "
-            f"{_fmt(best['pose_floor'])} vs {_fmt(float(b.loc[baseline, 'pose_floor']) if baseline in b.index else np.nan)} "
-            f"deg, so most of a gain from a higher latent dimension is reconstruction, not generation")
-        d0 = int(beyond["latent_dim"].min())
-        for tgt, fld in ((f"target_delaunay_d{d0}", f"delaunay_idw_d{d0}"),):
-            if tgt in b.index and fld in b.index:
-                for met, lab in (("error_a_norm", "Error A"), ("error_f_norm", "Error F")):
-                    t, f_ = float(b.loc[tgt, met]), float(b.loc[fld, met])
-                    pc = paired_comparison(beyond_folds, tgt, fld, metrics=(met,), key="variant").iloc[0]
-                    add(f"Target-directed shortest paths in G' beat field following on {lab} (Delaunay)",
-                        "yes" if (t < f_ and pc["p_value"] < alpha) else "no",
-                        f"median {met}: target {_fmt(t)} vs field {_fmt(f_)}, Wilcoxon p={_fmt(pc['p_value'])}")
-        dims = sorted(beyond["latent_dim"].unique())
-        if len(dims) > 1:
-            per = beyond[(beyond["method"] == "delaunay") & (beyond["weights"] == "idw") & (beyond["generation"] == "field")]
-            per = per.set_index("latent_dim")
-            add("Higher latent dimension lowers pose-space Error A (Delaunay 1/D^2)",
-                "yes" if per[metric].idxmin() != dims[0] else "no",
-                "; ".join(f"d={int(d)}: {_fmt(r[metric])} deg (PCA floor {_fmt(r['pose_floor'])} deg)"
-                          for d, r in per.sort_index().iterrows())
-                + "; the floor is the error of a perfect latent path, i.e. PCA reconstruction loss")
-        for var, ref, lab in ((f"delaunay_bary_d{d0}", f"delaunay_idw_d{d0}", "Barycentric weights beat 1/D^2 weights"),
-                              (next((v for v in b.index if v.startswith("kdelaunay") and v.endswith(f"_d{d0}")
-                                     and f"kdelaunay{int(b.loc[baseline, 'k']) if baseline in b.index else 16}_" in v), ""),
-                               f"delaunay_idw_d{d0}", "k-Delaunay beats Delaunay")):
-            if var in b.index and ref in b.index:
-                pc = paired_comparison(beyond_folds, var, ref, metrics=("error_a_norm",), key="variant").iloc[0]
-                add(f"{lab} (Error A, latent dim {d0})",
-                    "yes" if (pc["median_a"] < pc["median_b"] and pc["p_value"] < alpha) else "no",
-                    f"median Error A/diag {_fmt(pc['median_a'])} vs {_fmt(pc['median_b'])}, Wilcoxon p={_fmt(pc['p_value'])}")
-    return pd.DataFrame(rows, columns=["claim", "verdict", "evidence"])

@@ -10,7 +10,7 @@ from .path import follow_field
 
 
 def generate_from_trials(clips, method: str = "delaunay", k: int = 16, latent_dim: int = 2, steps: int = 300,
-                         start=None, derivative: str = "forward", weights: str = "idw", seed: int = 0):
+                         start=None, derivative: str = "half", weights: str = "idw", seed: int = 0):
     """Generate joint angles with the Gauch & Peters vector field.
 
     Parameters
@@ -24,7 +24,12 @@ def generate_from_trials(clips, method: str = "delaunay", k: int = 16, latent_di
     start : array (D,), optional
         Start pose (joint angles); default the first frame of the first clip.
     derivative : {"half", "forward", "central"}
-        Training vectors (``half`` is the paper's printed formula).
+        Training vectors. Default ``half``, the paper's printed ``(x[i+1]-x[i])/2``
+        and the default of every entry point (config, CLI): it is what the paper
+        states, and on CMU it is the only variant whose Delaunay-vs-k-NN ordering
+        survives a 1e-6 nudge of the start (see docs/config_simplicial.md). It
+        moves half a frame per step, so ``steps`` steps cover about ``steps / 2``
+        frames of motion.
     seed : int
         Unused by the deterministic field; kept so every generator takes a seed.
 

@@ -9,8 +9,9 @@ Duplicate points
     points' bounding box) are merged into one *unique point* (union-find over
     ``cKDTree.query_pairs``); its representative is the lowest index of the
     group. Qhull only ever sees unique points. Callers (the vector field)
-    average the training vectors of a group, which is exactly what 1/D^2
-    weights over the group would give (all members are at the same distance).
+    average the training vectors of a group and weigh the group by its size
+    m (``m / D^2``), which is exactly what 1/D^2 weights over the original
+    points give (all members are at the same distance).
 Rank-deficient input (collinear / coplanar points, fewer than d+1 points)
     The affine rank ``r`` of the unique points is measured with an SVD
     (singular values below ``rank_tol * s_max`` count as zero). When
@@ -45,6 +46,10 @@ log = logging.getLogger("animsynth.simplicial.geometry")
 
 #: barycentric slack (relative) below which a coordinate still counts as inside
 BARY_EPS = 1e-10
+#: a point counts as strictly inside its hint simplex when every barycentric coordinate exceeds this
+HINT_EPS = 1e-9
+#: face-crossing steps tried from the hint simplex before a full search
+HINT_WALK = 4
 
 
 def unique_pairs(pairs, n: int | None = None) -> np.ndarray:
@@ -253,12 +258,19 @@ class SafeDelaunay:
         resid = np.linalg.norm(c - y @ self.basis_.T, axis=1)
         return y, resid
 
-    def find(self, q):
+    def find(self, q, hint=None):
         """Locate query points.
 
         Parameters
         ----------
         q : array (m, d)
+        hint : array (m,) of int, optional
+            A simplex to try first for every point (-1 = none), e.g. where the
+            point was one step earlier. A point *strictly* inside its hint
+            simplex (every barycentric coordinate > ``HINT_EPS``) is located
+            there without a search; that is the only simplex containing it, so
+            the answer is the same as without the hint. scipy's
+            ``find_simplex`` has no warm start, hence this check by hand.
 
         Returns
         -------
@@ -287,7 +299,41 @@ class SafeDelaunay:
             bary[inside, 1] = t[inside]
             return s, bary
         tri = self._tri
-        s_all = tri.find_simplex(y)
+        s_all = np.full(m, -1, int)
+        todo = np.arange(m)
+        if hint is not None:
+            # warm start: the hint simplex, then up to HINT_WALK steps across the face opposite the most
+            # negative barycentric coordinate (scipy's directed walk, vectorised over points)
+            h = np.asarray(hint, int).copy()
+            cand = np.flatnonzero((h >= 0) & on_hull)
+            TT = self._barycentric_transform()
+            nbr = tri.neighbors
+            done = np.zeros(m, bool)
+            for _ in range(HINT_WALK):
+                if not cand.size:
+                    break
+                T = TT[h[cand]]
+                b = np.einsum("mij,mj->mi", T[:, :r, :], y[cand] - T[:, r, :])
+                full = np.concatenate([b, 1.0 - b.sum(axis=1, keepdims=True)], axis=1)
+                bmin = full.min(axis=1)
+                keep = bmin > HINT_EPS
+                s_all[cand[keep]] = h[cand[keep]]
+                done[cand[keep]] = True
+                rest = ~keep & np.isfinite(bmin)
+                cand, full = cand[rest], full[rest]
+                h[cand] = nbr[h[cand], np.argmin(full, axis=1)]
+                cand = cand[h[cand] >= 0]
+            todo = np.flatnonzero(~done)
+        if todo.size and self._hull_eq is not None:
+            # scipy's find_simplex is slow for points outside the hull (about 0.4 ms each in scipy 1.17):
+            # points outside a hull facet by more than the tolerance are outside, without a search
+            A, c = self._hull_eq
+            out_h = np.any(y[todo] @ A.T + c > self.tol_, axis=1)
+            todo = todo[~out_h]
+        if todo.size == m:
+            s_all = tri.find_simplex(y)
+        elif todo.size:
+            s_all[todo] = tri.find_simplex(y[todo])
         bad = np.flatnonzero((s_all < 0) & on_hull)
         if bad.size and self._hull_eq is not None:
             A, c = self._hull_eq
@@ -302,15 +348,50 @@ class SafeDelaunay:
         ok = s_all >= 0
         s[ok] = s_all[ok]
         if ok.any():
-            T = tri.transform[s[ok]]  # (mk, r+1, r)
+            T = self._barycentric_transform()[s[ok]]  # (mk, r+1, r)
             b = np.einsum("mij,mj->mi", T[:, :r, :], y[ok] - T[:, r, :])
             bary[ok, :r] = b
             bary[ok, r] = 1.0 - b.sum(axis=1)
+            if m > 1:
+                # A point on a shared face lies in several simplices, and scipy's walk (which starts where the
+                # previous point of the batch ended) may pick any of them. Such points are located again one
+                # by one, so the answer never depends on the other points of a batch.
+                edge = np.flatnonzero(ok)[bary[ok].min(axis=1) <= HINT_EPS]
+                for i in edge:
+                    j = self.find_one(q[i] if np.ndim(q) == 2 else q)
+                    s[i] = j
+                    if j >= 0:
+                        Tj = self._barycentric_transform()[j]
+                        bj = Tj[:r, :] @ (y[i] - Tj[r, :])
+                        bary[i, :r], bary[i, r] = bj, 1.0 - bj.sum()
         return s, bary
+
+    def _barycentric_transform(self) -> np.ndarray:
+        """scipy's ``Delaunay.transform`` (r+1, r per simplex), computed once with one stacked inverse.
+
+        scipy computes it simplex by simplex on first use (over a second for
+        2,500 triangles on a busy machine); ``np.linalg.inv`` on the stacked
+        (m, r, r) matrices gives the same array in milliseconds. Degenerate
+        simplices get NaN rows, as in scipy.
+        """
+        T = getattr(self, "_transform", None)
+        if T is None:
+            pts = self._tri.points
+            simp = self._tri.simplices
+            r = pts.shape[1]
+            last = pts[simp[:, r]]
+            M = np.transpose(pts[simp[:, :r]] - last[:, None, :], (0, 2, 1))  # columns = edge vectors
+            T = np.full((simp.shape[0], r + 1, r), np.nan)
+            det = np.linalg.det(M)
+            ok = np.isfinite(det) & (np.abs(det) > 0)
+            T[ok, :r, :] = np.linalg.inv(M[ok])
+            T[:, r, :] = last
+            self._transform = T
+        return T
 
     def _exact_locate(self, y) -> int:
         """Simplex with the largest minimum barycentric coordinate, if >= -eps."""
-        T = self._tri.transform
+        T = self._barycentric_transform()
         r = self.rank_
         b = np.einsum("mij,mj->mi", T[:, :r, :], y[None, :] - T[:, r, :])
         full = np.concatenate([b, 1.0 - b.sum(axis=1, keepdims=True)], axis=1)

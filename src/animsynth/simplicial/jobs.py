@@ -13,10 +13,12 @@ import os
 import numpy as np
 import pandas as pd
 
+from ..config import derive_seed
 from ..motion import Motion
 from ..io.atomic import atomic_write_text
 from ..tables import write_table
 from . import experiment as ex
+from .settings import paper_claim_from, read_paper_table2
 
 log = logging.getLogger("animsynth.simplicial.jobs")
 
@@ -44,108 +46,174 @@ def main_variant(cfg: dict, method: str) -> ex.Variant:
                       derivative=cfg["derivative"], weights=cfg["weights"] if method == "delaunay" else "idw").check()
 
 
-def run_main_fold(paths, ids, dataset: str, method: str, fold: str, cfg: dict):
-    """One dataset x method x fold job of the main table; returns the FoldResult."""
+def run_main_fold(paths, ids, dataset: str, fold: str, cfg: dict, seed: int):
+    """One dataset x fold job of the main table: every method from the same ensemble of starts, followed together.
+
+    Returns
+    -------
+    rows : list of dict (one per method), members : DataFrame
+    """
     angles, _ = load_trials(paths, ids)
     if fold not in angles:
         raise ValueError(f"fold {fold!r} is not a trial of subset {dataset!r} ({ids})")
     train = [angles[t] for t in ids if t != fold]
-    res = ex.run_fold(train, angles[fold], main_variant(cfg, method), dataset=dataset, held_out=fold,
-                      fold=ids.index(fold), steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]),
-                      rank_tol=float(cfg["rank_tol"]))
-    for note in res.field.triangulation_.notes_:
-        log.info("fold %s/%s/%s: %s", dataset, method, fold, note)
-    log.info("fold %s/%s/%s: error_a=%.4g error_f=%.4g steps=%d fallback=%d SCC=%d", dataset, method, fold,
-             res.row["error_a"], res.row["error_f"], res.row["steps"], res.row["fallback_steps"], res.row["components"])
-    return res
+    ens = cfg["ensemble"]
+    variants = [main_variant(cfg, m) for m in cfg["methods"]]
+    rows, members = ex.run_fold_ensemble(
+        train, angles[fold], variants, n_starts=int(ens["n_starts"]), jitter=float(ens["jitter"]),
+        seed=derive_seed(seed, dataset, fold), dataset=dataset, held_out=fold, fold=ids.index(fold),
+        steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]), rank_tol=float(cfg["rank_tol"]))
+    for r in rows:
+        log.info("fold %s/%s/%s: error_a_norm=%.4g error_f_norm=%.4g steps=%d fallback=%d (%.0f %%) SCC=%d; "
+                 "ensemble of %d: error_a_norm median %.4g IQR %.4g-%.4g, separation growth 10^%.2f", dataset,
+                 r["method"], fold, r["error_a_norm"], r["error_f_norm"], r["steps"], r["fallback_steps"],
+                 100 * r["fallback_share"], r["components"], r["n_members"], r["ens_error_a_norm_median"],
+                 r["ens_error_a_norm_q25"], r["ens_error_a_norm_q75"], r["sep_growth_log10"])
+    return rows, members
 
 
-def write_fold_json(path, row: dict) -> None:
-    atomic_write_text(path, json.dumps(ex.to_jsonable(row), indent=1) + "\n")
+def write_fold_json(path, rows: list, members: pd.DataFrame) -> None:
+    payload = {"rows": [ex.to_jsonable(r) for r in rows],
+               "members": [ex.to_jsonable(r) for r in members.to_dict("records")]}
+    atomic_write_text(path, json.dumps(payload, indent=0) + "\n")
 
 
-def read_fold_jsons(paths) -> pd.DataFrame:
-    rows = []
+def read_fold_jsons(paths) -> tuple[pd.DataFrame, pd.DataFrame]:
+    rows, members = [], []
     for p in paths:
         with open(p, encoding="utf-8") as f:
-            rows.append(json.load(f))
-    return pd.DataFrame(rows, columns=ex.FOLD_COLUMNS)
+            d = json.load(f)
+        rows += d["rows"]
+        members += d["members"]
+    return pd.DataFrame(rows, columns=ex.FOLD_COLUMNS), pd.DataFrame(members, columns=ex.MEMBER_COLUMNS)
 
 
-TABLE2_NOTE = (
-    "Medians over leave-one-sequence-out folds (4 per subset; `all` = all folds). Error A: mean closest-point "
-    "distance between held-out and generated latent polylines, averaged over both directions; Error F: closest "
-    "approach of the generated path to the held-out final point. Latent units, and `_norm` = divided by the "
-    "diagonal of the fold's latent bounding box. `paper_*` columns: the paper's published Table II values{paper}."
-)
+def _fallback_note(folds: pd.DataFrame, method: str = "delaunay") -> str:
+    s = folds[(folds["method"] == method) & (folds["fallback_steps"] > 0)]
+    if not len(s):
+        return f"{method} never left the hull (no k-NN fallback steps)."
+    parts = [f"{r['dataset']}/{r['held_out']} {100 * r['fallback_share']:.0f} %" for _, r in s.iterrows()]
+    return f"Share of {method} steps outside the hull (k-NN fallback), held-out start, per fold: " + ", ".join(parts) + "."
 
 
 def table_job(fold_paths, datasets, methods, cfg: dict, out: dict) -> None:
-    """folds.csv, table2.csv/.md and paired.csv/.md from the fold JSONs."""
-    folds = ex.order_folds(read_fold_jsons(fold_paths), datasets)
+    """folds.csv, members.csv, table2 (paper layout), table2_units, table2_ensemble, fold_ensemble, paired."""
+    folds, members = read_fold_jsons(fold_paths)
+    folds = ex.order_folds(folds, datasets)
+    members = ex.order_folds(members, datasets)
     write_table(folds, out["folds"], md=False)
-    paper = cfg.get("paper_table2") or {}
+    write_table(members, out["members"], md=False)
+    paper = read_paper_table2(cfg.get("paper_table2"))
+    src = (f"`paper_*`: the paper's Table II, read from {cfg.get('paper_table2')} (its `knn16` row is our `knn`)"
+           if paper is not None else f"`paper_*` empty: no published values file at {cfg.get('paper_table2')!r}")
+    ens = cfg["ensemble"]
+    fb = _fallback_note(folds, methods[0])
     t2 = ex.table2(folds, datasets, methods, paper)
-    has_paper = any(bool(v) for v in paper.values())
-    note = TABLE2_NOTE.format(paper=" (from config `simplicial.paper_table2`)" if has_paper else
-                              " - EMPTY: the paper's values were not available to us and are not invented; "
-                              "fill `simplicial.paper_table2` from the paper to show them")
-    write_table(t2, out["table2"], md=True, title="Gauch & Peters Table II (reproduction)", note=note)
+    write_table(t2, out["table2"], md=True, title="Gauch & Peters Table II (reproduction)", note=(
+        "Medians over the leave-one-sequence-out folds (one per trial of a subset; `all` = all folds), from the held-out "
+        "trial's first latent frame as in the paper. Error A: mean closest-point distance between held-out and "
+        "generated latent polylines, both directions averaged; Error F: closest approach of the generated path to "
+        "the held-out final point; both divided by the diagonal of the fold's latent bounding box (the paper does "
+        f"not state its unit). {src}. Spread over {int(ens['n_starts'])} jittered starts: table2_ensemble.csv. "
+        f"Other units: table2_units.csv. {fb}"))
+    write_table(ex.table2_units(folds, datasets, methods), out["table2_units"], md=False)
+    t2e = ex.table2_ensemble(members, datasets, methods, paper)
+    write_table(t2e, out["table2_ensemble"], md=True, title="Table II over the ensemble of starts", note=(
+        f"Every cell of Table II recomputed for each of {int(ens['n_starts']) + 1} starts per fold (the held-out "
+        f"start and {int(ens['n_starts'])} copies moved by {float(ens['jitter']):g} of the latent diagonal): median "
+        f"and IQR over members, `a_lower_share` = share of members in which {methods[0]} has the lower cell, "
+        f"`stability` = stable only when that holds in every member, `agree_share` = share agreeing with the "
+        f"paper's ordering. {fb}"))
+    fe = ex.fold_ensemble(members, datasets, methods)
+    write_table(fe, out["fold_ensemble"], md=False)
     pc = ex.paired_comparison(folds, methods[0], methods[1], n_boot=int(cfg["bootstrap"]), seed=int(cfg["seed_value"]),
                               alpha=float(cfg["alpha"]))
     write_table(pc, out["paired"], md=True, title=f"Paired comparison {methods[0]} vs {methods[1]} over folds",
-                note="Wilcoxon signed-rank test (two-sided) on per-fold differences; bootstrap percentile CI "
-                     "of the median difference (a - b < 0: a has the lower error). `_pose` metrics are in degrees "
-                     "of joint angle (inverse PCA of the generated path vs the held-out trial).")
+                note="Wilcoxon signed-rank test (two-sided) on per-fold differences (held-out start); bootstrap "
+                     "percentile CI of the median difference (a - b < 0: a has the lower error). `_pose` metrics "
+                     "are in degrees of joint angle (inverse PCA of the generated path vs the held-out trial).")
 
 
-def grid_job(paths, ids, dataset: str, grid: str, cfg: dict, out_csv) -> None:
-    """The derivative-variant grid or the beyond-the-paper grid for one subset."""
-    angles, _ = load_trials(paths, ids)
+def grid_variants(grid: str, cfg: dict) -> list:
     if grid == "derivative":
-        variants = ex.derivative_variants(cfg["derivatives"], cfg["methods"], int(cfg["k"]), int(cfg["latent_dim"]),
-                                          cfg["weights"])
-    elif grid == "beyond":
-        variants = ex.beyond_variants(cfg["beyond"], int(cfg["k"]), cfg["beyond"]["derivative"])
-    else:
-        raise ValueError(f"unknown grid {grid!r}")
-    df = ex.run_subset(angles, variants, dataset=dataset, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]),
-                       rank_tol=float(cfg["rank_tol"]),
-                       max_all_pairs=int(cfg.get("beyond", {}).get("max_all_pairs", 4000)))
-    log.info("%s grid on %s: %d variants x %d folds", grid, dataset, len(variants), len(ids))
-    write_table(df, out_csv, md=False)
+        return ex.derivative_variants(cfg["derivatives"], cfg["methods"], int(cfg["k"]), int(cfg["latent_dim"]),
+                                      cfg["weights"])
+    if grid == "beyond":
+        return ex.beyond_variants(cfg["beyond"], int(cfg["k"]), cfg["beyond"]["derivative"])
+    raise ValueError(f"unknown grid {grid!r}")
 
 
-def summary_job(deriv_paths, beyond_paths, folds_csv, paired_csv, datasets, cfg: dict, out: dict) -> None:
+def grid_job(paths, ids, dataset: str, grid: str, cfg: dict, seed: int, out: dict) -> None:
+    """The derivative-variant grid or the beyond-the-paper grid for one subset (fold rows and member rows)."""
+    angles, _ = load_trials(paths, ids)
+    variants = grid_variants(grid, cfg)
+    # pose-space errors of every member where the verdicts compare across latent dimensions
+    d0 = min(v.latent_dim for v in variants)
+    pose = [v.name for v in variants if v.latent_dim != d0 or (v.method == "delaunay" and v.weights == "idw"
+                                                                and v.generation == "field")]
+    df, members = ex.run_subset(angles, variants, dataset=dataset, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]),
+                                rank_tol=float(cfg["rank_tol"]),
+                                max_all_pairs=int(cfg.get("beyond", {}).get("max_all_pairs", 4000)),
+                                ensemble=cfg["ensemble"], seed=seed, member_pose=pose if grid == "beyond" else False)
+    log.info("%s grid on %s: %d variants x %d folds x %d starts", grid, dataset, len(variants), len(ids),
+             int(cfg["ensemble"]["n_starts"]) + 1)
+    write_table(df, out["folds"], md=False)
+    write_table(members, out["members"], md=False)
+
+
+def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out: dict) -> None:
     """derivative.csv, beyond.csv, beyond_folds.csv, verdicts.csv and their figures."""
     from .plots import plot_beyond, plot_derivative
+    from .verdicts import build_verdicts
 
     def cat(paths):
         return pd.concat([pd.read_csv(p, keep_default_na=False, na_values=[""]) for p in paths], ignore_index=True)
 
-    dfold = ex.order_folds(cat(deriv_paths), datasets)
-    bfold = ex.order_folds(cat(beyond_paths), datasets)
+    def read(p):
+        return pd.read_csv(p, keep_default_na=False, na_values=[""])
+
+    dfold = ex.order_folds(cat(deriv_paths["folds"]), datasets)
+    dmem = ex.order_folds(cat(deriv_paths["members"]), datasets)
+    bfold = ex.order_folds(cat(beyond_paths["folds"]), datasets)
+    bmem = ex.order_folds(cat(beyond_paths["members"]), datasets)
     seed, n_boot, alpha = int(cfg["seed_value"]), int(cfg["bootstrap"]), float(cfg["alpha"])
     methods = tuple(cfg["methods"])
-    dsum = ex.derivative_summary(dfold, methods, cfg["paper_claim"], n_boot=n_boot, seed=seed)
+    paper = read_paper_table2(cfg.get("paper_table2"))
+    claim = paper_claim_from(paper, cfg["paper_claim"], methods)
+    ens = cfg["ensemble"]
+    dsum = ex.derivative_summary(dfold, methods, claim, n_boot=n_boot, seed=seed, members=dmem)
     write_table(dsum, out["derivative"], md=True, title="Training-vector derivative variants",
-                note="Medians over all folds. `half` = (x[i+1]-x[i])/2 as printed in the paper; `forward` = "
-                     "x[i+1]-x[i]; `central` = (x[i+1]-x[i-1])/2. `reproduces_claim` compares the Delaunay-vs-k-NN "
-                     f"ordering of median Error A and Error F with the configured paper claim ({cfg['paper_claim']}).")
+                note="Medians over all folds (held-out start). `half` = (x[i+1]-x[i])/2 as printed in the paper; "
+                     "`forward` = x[i+1]-x[i]; `central` = (x[i+1]-x[i-1])/2. `reproduces_claim` compares the "
+                     f"held-out-start ordering with the paper's conclusion ({claim}); `*_lower_share_a/f` = share of "
+                     f"the {int(ens['n_starts']) + 1} ensemble members (starts moved by {float(ens['jitter']):g} of the "
+                     "latent diagonal) in which the first method has the lower all-fold median; `stability_*` says "
+                     "stable only when that holds in every member. `*_sep_growth_log10` = median log10 of "
+                     "|x_j(T)-x_0(T)| / |x_j(0)-x_0(0)| (separation growth of nearby paths over the path); "
+                     "`*_sep_final_rel` = median final separation / latent diagonal.")
     d0 = int(cfg["beyond"]["latent_dims"][0])
     baseline = f"delaunay_idw_d{d0}"
-    bsum = ex.summarise_variants(bfold, baseline, datasets, n_boot=n_boot, seed=seed)
+    bsum = ex.summarise_variants(bfold, baseline, datasets, n_boot=n_boot, seed=seed, members=bmem)
     write_table(bfold, out["beyond_folds"], md=False)
     best = bsum.iloc[0]
     write_table(bsum, out["beyond"], md=True, title="Beyond the paper: variants ranked by median pose-space Error A",
                 note=f"Derivative '{cfg['beyond']['derivative']}'. error_*_pose: degrees of joint angle (comparable "
-                     f"across latent dimensions; pose_floor = the same error for a perfect latent path, i.e. PCA reconstruction loss); *_norm: latent units / bbox diagonal. Baseline {baseline} = the "
-                     f"paper's method. Best: {best['variant']} ({100 * best['rel_change_vs_baseline']:.1f}% vs baseline, "
-                     f"Wilcoxon p={best['p_vs_baseline']:.3g}).")
-    folds = pd.read_csv(folds_csv, keep_default_na=False, na_values=[""])
-    paired = pd.read_csv(paired_csv, keep_default_na=False, na_values=[""])
-    verdicts = ex.build_verdicts(paired, dsum, folds, bsum, bfold, claim=cfg["paper_claim"],
-                                 main_derivative=cfg["derivative"], baseline=baseline, alpha=alpha)
+                     "across latent dimensions; pose_floor = the same error for a perfect latent path, i.e. PCA "
+                     f"reconstruction loss); *_norm: latent units / bbox diagonal. Baseline {baseline} = the paper's "
+                     f"method. `lower_share_vs_baseline`: share of ensemble members in which the variant's all-fold "
+                     f"median (`share_metric`) is below the baseline's. Best: {best['variant']} "
+                     f"({100 * best['rel_change_vs_baseline']:.1f}% vs baseline, Wilcoxon p={best['p_vs_baseline']:.3g}).")
+    folds = read(main["folds"])
+    members = read(main["members"])
+    paired = read(main["paired"])
+    t2 = read(main["table2"])
+    t2e = read(main["table2_ensemble"])
+    n_folds = int(folds.groupby("method").size().max()) if len(folds) else 0
+    data = f"{cfg.get('data_label', '')} {' '.join(datasets)} ({n_folds} folds x {int(ens['n_starts']) + 1} starts)".strip()
+    verdicts = build_verdicts(table2=t2, table2_ens=t2e, members=members, paired=paired, deriv=dsum, folds=folds,
+                              beyond=bsum, beyond_folds=bfold, beyond_members=bmem, claim=claim,
+                              main_derivative=cfg["derivative"], baseline=baseline, datasets=datasets, data=data,
+                              methods=methods, magnitude_factor=float(cfg["magnitude_factor"]), alpha=alpha)
     write_table(verdicts, out["verdicts"], md=True, title="Simplicial family: claims and verdicts")
     plot_derivative(dfold, out["derivative_png"], methods)
     plot_beyond(bsum, bfold, out["beyond_png"], baseline)

@@ -104,7 +104,8 @@ def plot_paths(results, path, title: str) -> None:
         ax.plot(*G[-1, :2], "s", color="tab:red", ms=5)
         r = res.row
         ax.set_title(f"{r['held_out']}: A={r['error_a']:.3g} F={r['error_f']:.3g}\n"
-                     f"(norm A={r['error_a_norm']:.3g}, F={r['error_f_norm']:.3g}; fallback {r['fallback_steps']})",
+                     f"(norm A={r['error_a_norm']:.3g}, F={r['error_f_norm']:.3g}; k-NN fallback "
+                     f"{r['fallback_steps']}/{r['steps']} steps = {100 * r['fallback_share']:.0f} %)",
                      fontsize=8)
         ax.set_aspect("equal", adjustable="datalim")
     axes[0][0].legend(fontsize=7, loc="best")
