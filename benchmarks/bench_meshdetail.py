@@ -26,7 +26,7 @@ import numpy as np
 
 from animsynth.meshdetail.gp import GPRegression
 from animsynth.meshdetail.models import HybridModel, MeshContext, mean_vertex_error, reconstruction_seconds_per_frame
-from animsynth.meshdetail.rig import default_rig
+from animsynth.skinning import default_rig
 from animsynth.synth.character import SkirtParams, build_character, procedural_motion, simulate
 
 

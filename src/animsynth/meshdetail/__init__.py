@@ -14,6 +14,6 @@ plots        Fig. 5 panels and rendered frames
 
 from .gp import GPRegression, SharedGPDM
 from .models import HybridModel, MeshContext
-from .rig import JOINTS, PARENTS, Rig, default_rig
+from ..skinning import JOINTS, PARENTS, Rig, default_rig
 
 __all__ = ["GPRegression", "HybridModel", "JOINTS", "MeshContext", "PARENTS", "Rig", "SharedGPDM", "default_rig"]

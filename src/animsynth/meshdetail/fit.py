@@ -35,7 +35,7 @@ import numpy as np
 from scipy import sparse
 from threadpoolctl import threadpool_limits
 
-from .rig import Rig, joint_transforms, lbs, matrix_to_euler
+from ..skinning import Rig, inside_mesh, joint_transforms, lbs, matrix_to_euler, winding_number
 
 log = logging.getLogger("animsynth.meshdetail.fit")
 
@@ -304,3 +304,83 @@ def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.nd
         else:
             ends[j] = ends[j] + (starts[j] - rig.starts[j])
     return Rig(starts, ends, rig.names, rig.parents)
+
+
+def nearest_interior_point(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray, radius: float = 0.08,
+                           step: float = 0.02) -> np.ndarray | None:
+    """The interior point near ``point`` that is deep and close: on a grid of spacing ``step`` within
+    ``radius``, among points inside the closed mesh (winding number), the one maximising
+    ``clearance - distance to point`` (clearance = distance to the nearest mesh vertex). ``None`` if
+    no grid point is inside."""
+    from scipy.spatial import cKDTree
+
+    g = np.arange(-radius, radius + 1e-9, step)
+    G = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    G = G[np.linalg.norm(G, axis=1) <= radius] + point
+    ins = inside_mesh(G, vertices, faces)
+    if not ins.any():
+        return None
+    G = G[ins]
+    clear = cKDTree(vertices).query(G)[0]
+    return G[np.argmax(clear - np.linalg.norm(G - point, axis=1))]
+
+
+def place_joints(rig: Rig, weights, rest: np.ndarray, faces: np.ndarray, frames: np.ndarray | None,
+                 max_move: float = 0.08):
+    """Joint centres from the mesh motion, checked to lie inside the first-frame mesh.
+
+    Every non-root joint first gets its least-squares rotation centre
+    (:func:`refine_joints_from_motion`, on ``frames``, pass the training frames;
+    ``None`` skips it). A motion-based centre is kept only if it lies inside
+    the closed rest mesh (generalised winding number) and moved at most
+    ``max_move``; otherwise the initial position is kept if it is inside, and a
+    joint that is still outside goes to :func:`nearest_interior_point`. Segment
+    ends follow the child joints.
+
+    Returns
+    -------
+    rig : the placed Rig
+    table : pandas.DataFrame, one row per joint (initial/motion/final position,
+        winding number of the final centre, ``inside``, ``placement``, ``moved_mm``)
+    """
+    import pandas as pd
+
+    faces = np.asarray(faces, np.int64)
+    if frames is None:  # report only
+        wn = winding_number(rig.starts, rest, faces)
+        return rig, pd.DataFrame({"joint": list(rig.names), **{a: np.round(rig.starts[:, i], 4) for i, a in enumerate("xyz")},
+                                  "moved_mm": 0.0, "winding_number": np.round(wn, 3), "inside": np.abs(wn) > 0.5,
+                                  "placement": "given"})
+    moved = refine_joints_from_motion(rig, weights, rest, frames)
+    wn0 = winding_number(rig.starts, rest, faces)
+    wn1 = winding_number(moved.starts, rest, faces)
+    starts = rig.starts.copy()
+    how = []
+    for j in range(rig.n_joints):
+        d = np.linalg.norm(moved.starts[j] - rig.starts[j])
+        if d > 1e-9 and abs(wn1[j]) > 0.5 and d <= max_move:
+            starts[j], h = moved.starts[j], "rotation centre from motion"
+        elif abs(wn0[j]) > 0.5:
+            h = "initial (motion-based centre " + ("outside the mesh" if d > 1e-9 and abs(wn1[j]) <= 0.5 else
+                                                  f"moved > {1000 * max_move:.0f} mm" if d > max_move else
+                                                  "not determined by the motion") + ")"
+        else:
+            p = nearest_interior_point(rig.starts[j], rest, faces)
+            if p is None:
+                h = "initial, outside the mesh (no interior point within 8 cm)"
+                log.warning("joint %s lies outside the first-frame mesh", rig.names[j])
+            else:
+                starts[j], h = p, "nearest interior point (initial position outside the mesh)"
+        how.append(h)
+    ends = rig.ends.copy()
+    for j in range(rig.n_joints):
+        kids = [k for k, q in enumerate(rig.parents) if q == j]
+        ends[j] = starts[kids[0]] if len(kids) == 1 else rig.ends[j] + (starts[j] - rig.starts[j])
+    out = Rig(starts, ends, rig.names, rig.parents)
+    wn = winding_number(out.starts, rest, faces)
+    table = pd.DataFrame({
+        "joint": list(rig.names),
+        **{a: np.round(out.starts[:, i], 4) for i, a in enumerate("xyz")},
+        "moved_mm": np.round(1000 * np.linalg.norm(out.starts - rig.starts, axis=1), 1),
+        "winding_number": np.round(wn, 3), "inside": np.abs(wn) > 0.5, "placement": how})
+    return out, table
