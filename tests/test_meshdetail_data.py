@@ -72,3 +72,19 @@ def test_samba_skeleton_fits_the_whole_sequence(vlasic_dir):
     assert fit.residual_[train].mean() < 0.016
     assert fit.residual_[len(train):].mean() < 0.017
     assert fit.residual_.max() < 0.03 and np.all(np.isfinite(fit.angles_))
+
+
+def test_config_checks_name_the_key():
+    from animsynth.config import ConfigError
+    from animsynth.meshdetail.settings import check_meshdetail_config
+
+    md = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["meshdetail"]
+    check_meshdetail_config(md, None)
+    with pytest.raises(ConfigError, match="meshdetail.cv_folds"):
+        check_meshdetail_config({**md, "cv_folds": 100}, None)
+    samba = yaml.safe_load((REPO / "config" / "samba.yaml").read_text())["meshdetail"]["rig"]
+    joints = dict(samba["joints"])
+    check_meshdetail_config({**md, "rig": {**md["rig"], "joints": joints}}, "samba")
+    joints.pop("l_shin")
+    with pytest.raises(ConfigError, match=r"meshdetail.rig.joints' misses \['l_shin'\]"):
+        check_meshdetail_config({**md, "rig": {**md["rig"], "joints": joints}}, "samba")

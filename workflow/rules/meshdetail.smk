@@ -2,8 +2,11 @@
 # SGPLVM + GPDM). Data: the synthetic skirt character (mesh_dir: null)
 # or a folder of OBJ / OBJ.gz frames (config/samba.yaml). Every job gets only the
 # config keys it uses, so a changed value reruns exactly the affected jobs.
+from animsynth.meshdetail.settings import check_meshdetail_config
+
 MD = config["meshdetail"]
 MESH_DIR = config.get("mesh_dir")
+check_meshdetail_config(MD, MESH_DIR)
 MD_MODEL_KEYS = (
     "level", "latent_dim", "iterations", "dynamics_weight", "ridge_alphas", "joint_param", "detail", "decimation",
     "rbf_neighbors", "cv_folds",

@@ -1,22 +1,20 @@
-"""Fine detail: decimation to a control mesh, smooth up-sampling, detail frames and
+"""Fine detail: control meshes, RBF reconstruction, detail frames and
 differential (Laplacian) coordinates.
 
-* **Decimation** is a vertex subset chosen once on the rest (first-frame) mesh
-  by farthest-point sampling, so it is consistent across all frames and the
-  levels are nested (the 5 % set is inside the 10 % set ...).
-* **Up-sampling** (control mesh -> fine mesh) interpolates a per-vertex field
-  (detail displacements) with the *biharmonic* interpolant on the mesh graph:
-  the fine values minimise ``|L f|²`` (uniform graph Laplacian ``L``) subject to
-  the control values. It is an RBF-like smooth interpolant (the biharmonic
-  equation's Green's function is the thin-plate RBF) measured *along the
-  surface*, so detail does not leak across gaps between surfaces that are close
-  in space (skirt hem and legs). The map is a precomputed dense
-  ``(V, C)`` matrix: reconstruction is one matrix product per frame.
+* **Control mesh** (:class:`ControlMesh`): the paper's decimation — quadric
+  edge collapses of the first frame, recorded and replayed on every frame
+  (``fast-simplification``) — or, as a labelled variant, a farthest-point
+  vertex subset of the first frame. Both are the same for all frames.
+* **Reconstruction** (:class:`RBFUpsampler`): the full mesh's detail is the
+  thin-plate RBF interpolant of the control detail (the local interpolant of
+  :class:`scipy.interpolate.RBFInterpolator`), precomputed once as a sparse
+  ``(V, C)`` map, so each frame costs one sparse product.
 * **Detail frames**: detail ``d = p - p_skinned`` is stored in the rotating frame
-  of each vertex's dominant joint (``R_dom(t)^T d``), so it is a function of the
-  joint angles and not of the global orientation.
-* **Laplacian coordinates** ``δ = L p`` on a k-nearest-neighbour graph of the
-  control vertices; decoding solves ``min |L p - (L p_s + δ)|² + eps |p - p_s|²``.
+  of each control vertex's dominant joint (``R_dom(t)^T d``), so it is a
+  function of the joint angles and not of the global orientation.
+* **Laplacian coordinates** (:class:`LaplacianCoder`) on the control mesh's
+  triangles (cotangent Laplacian), decoded with one sparse factorisation
+  reused for every frame.
 """
 
 from __future__ import annotations
@@ -68,55 +66,6 @@ def uniform_laplacian(edges: np.ndarray, n: int) -> sparse.csr_matrix:
     deg = np.asarray(A.sum(axis=1)).ravel()
     inv = np.where(deg > 0, 1.0 / np.maximum(deg, 1), 0.0)
     return (sparse.diags((deg > 0).astype(float)) - sparse.diags(inv) @ A).tocsr()
-
-
-class Upsampler:
-    """Biharmonic interpolation from control vertices to the whole mesh.
-
-    Parameters
-    ----------
-    faces : (T, 3) mesh connectivity; n_vertices : int; control : control vertex indices.
-    reg : float
-        Tiny Tikhonov term so that parts without any control vertex get zero
-        (instead of a singular system).
-
-    The free-vertex system ``Q_ff f = -Q_fc c`` (``Q = L^T L``) is factorised
-    once (sparse LU). When the dense map ``B = -Q_ff^-1 Q_fc`` has at most (default 0:
-    never; measured slower) ``dense_max`` entries it is precomputed (one matrix product per call);
-    otherwise each call is one sparse product and one triangular solve for all
-    frames and coordinates at once.
-    """
-
-    def __init__(self, faces, n_vertices: int, control: np.ndarray, reg: float = 1e-8, dense_max: float = 0):
-        control = np.asarray(control, np.int64)
-        V = int(n_vertices)
-        self.control = control
-        self.n_vertices = V
-        self.free = None
-        if len(control) == V:
-            return
-        L = uniform_laplacian(mesh_edges(faces), V)
-        Q = (L.T @ L).tocsr()
-        self.free = np.setdiff1d(np.arange(V), control)
-        Qff = Q[self.free][:, self.free] + reg * sparse.eye(len(self.free))
-        self._Qfc = Q[self.free][:, control].tocsr()
-        self._lu = splu(Qff.tocsc())
-        self._B = None
-        if len(self.free) * len(control) <= dense_max:
-            self._B = -self._lu.solve(self._Qfc.toarray())
-
-    def __call__(self, values: np.ndarray) -> np.ndarray:
-        """Interpolate (..., C, k) control values to (..., V, k)."""
-        if self.free is None:
-            return values
-        v = np.moveaxis(np.asarray(values, float), -2, 0)  # (C, ..., k)
-        C = v.shape[0]
-        flat = v.reshape(C, -1)
-        f = self._B @ flat if self._B is not None else self._lu.solve(-(self._Qfc @ flat))
-        out = np.empty((self.n_vertices, flat.shape[1]))
-        out[self.control] = flat
-        out[self.free] = f
-        return np.moveaxis(out.reshape((self.n_vertices,) + v.shape[1:]), 0, -2)
 
 
 def dominant_rotations(W: np.ndarray, dom: np.ndarray) -> np.ndarray:

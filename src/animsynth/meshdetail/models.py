@@ -1,8 +1,8 @@
 """The hybrid mesh model (skinned skeleton + learned detail) and its baselines.
 
 :class:`MeshContext` holds what every model of one mesh sequence shares: the
-rest mesh, rig, skinning weights, the farthest-point order used for
-decimation and the cached up-samplers.
+rest mesh, rig, skinning weights, control meshes, RBF maps and Laplacian
+coders (each built once).
 
 :class:`HybridModel` is one configurable model:
 
@@ -10,16 +10,18 @@ decimation and the cached up-samplers.
   on ``[Y_S, Y_M]`` (latent dimension 4, X initialised from the PCA of ``Y_S``),
   then a GP regression ``Y_S -> X``; reconstruction is
   ``skinned pose + f_M(f_S^-1(y_S))``;
-* ``regressor="ridge"`` — the linear detail baseline (pose-space-deformation
-  family): ridge regression from standardised ``y_S`` to the detail;
+* ``regressor="gp_regression"`` — plain GP regression ``y_S -> Y_M`` (no latent space);
+* ``regressor="ridge_cv"`` — linear detail model (pose-space-deformation family):
+  ridge regression with the penalty chosen by blocked CV inside the training frames;
 * ``regressor="none"`` — LBS only;
-* ``target="full"`` — the GP learns the *full* deformation (vertex positions in
+* ``target="full"`` — the GP learns the *full* deformation (control positions in
   the root's frame) instead of the detail only (the paper's Fig. 5a baseline).
 
-``joint_param`` chooses the skeleton features (Euler angles, quaternions,
-exponential maps; ``y_S = [θ_t, θ_{t-1}]`` without the root) and ``detail``
-the detail encoding (``xyz`` displacements or ``laplacian`` differential
-coordinates on the control mesh), both in each vertex's dominant-joint frame.
+``joint_param`` chooses the skeleton features (exponential maps by default,
+the paper's final choice; Euler angles, quaternions; ``y_S = [θ_t, θ_{t-1}]``
+without the root) and ``detail`` the detail encoding (``xyz`` displacements
+or ``laplacian`` differential coordinates on the control mesh), both in each
+control vertex's dominant-joint frame.
 """
 
 from __future__ import annotations
