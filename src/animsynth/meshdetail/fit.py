@@ -258,10 +258,10 @@ class PoseFitter:
 
 
 def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.ndarray,
-                              min_weight: float = 0.7) -> Rig:
+                              min_weight: float = 0.5, return_status: bool = False):
     """Move every non-root joint start to its least-squares rotation centre.
 
-    Each body part (vertices whose weight for a joint is above ``min_weight``)
+    Each body part (the vertices a joint dominates, with weight >= ``min_weight``)
     gets a free rigid transform per frame (Kabsch). The joint between part
     ``p`` (parent) and part ``j`` is the rest-pose point ``c`` minimising
     ``sum_t |T_p(t) c - T_j(t) c|²`` — the point that both parts carry along
@@ -269,19 +269,25 @@ def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.nd
     pull towards the initial position for directions the motion leaves
     undetermined, e.g. along a hinge axis). Segment ends move with the
     joint starts of the children they point at.
+
+    Returns the refined Rig (and, with ``return_status``, a list with one
+    status per joint: ``"moved"``, ``"root"``, ``"too few rigid vertices"``
+    or ``"moved too far"``).
     """
     Wt = weights.toarray() if sparse.issparse(weights) else np.asarray(weights, float)
     frames = np.asarray(frames, float)
     J = rig.n_joints
     T = [None] * J
+    dom = np.argmax(Wt, axis=1)
     for j in range(J):
-        idx = np.flatnonzero(Wt[:, j] >= min_weight)
+        idx = np.flatnonzero((dom == j) & (Wt[:, j] >= min_weight))
         if len(idx) >= 4:
             R, t = _kabsch(rest[idx], frames[:, idx], np.ones(len(idx)), translate=True)
             T[j] = (R, t)
     starts = rig.starts.copy()
     ends = rig.ends.copy()
     scale = np.linalg.norm(rest.max(0) - rest.min(0))
+    status = ["root" if p < 0 else "too few rigid vertices" for p in rig.parents]
     for j, p in enumerate(rig.parents):
         if p < 0 or T[j] is None or T[p] is None:
             continue
@@ -294,7 +300,9 @@ def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.nd
         c = np.linalg.solve(A.T @ A + lam * np.eye(3), A.T @ b + lam * c0)
         if np.linalg.norm(c - c0) < 0.1 * scale:
             starts[j] = c
+            status[j] = "moved"
         else:
+            status[j] = "moved too far"
             log.warning("joint %s: motion-based centre moved %.3f, kept the initial position", rig.names[j],
                         np.linalg.norm(c - c0))
     for j, p in enumerate(rig.parents):
@@ -303,7 +311,8 @@ def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.nd
             ends[j] = starts[kids[0]]
         else:
             ends[j] = ends[j] + (starts[j] - rig.starts[j])
-    return Rig(starts, ends, rig.names, rig.parents)
+    out = Rig(starts, ends, rig.names, rig.parents)
+    return (out, status) if return_status else out
 
 
 def nearest_interior_point(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray, radius: float = 0.08,
@@ -351,7 +360,7 @@ def place_joints(rig: Rig, weights, rest: np.ndarray, faces: np.ndarray, frames:
         return rig, pd.DataFrame({"joint": list(rig.names), **{a: np.round(rig.starts[:, i], 4) for i, a in enumerate("xyz")},
                                   "moved_mm": 0.0, "winding_number": np.round(wn, 3), "inside": np.abs(wn) > 0.5,
                                   "placement": "given"})
-    moved = refine_joints_from_motion(rig, weights, rest, frames)
+    moved, status = refine_joints_from_motion(rig, weights, rest, frames, return_status=True)
     wn0 = winding_number(rig.starts, rest, faces)
     wn1 = winding_number(moved.starts, rest, faces)
     starts = rig.starts.copy()
@@ -363,7 +372,9 @@ def place_joints(rig: Rig, weights, rest: np.ndarray, faces: np.ndarray, frames:
         elif abs(wn0[j]) > 0.5:
             h = "initial (motion-based centre " + ("outside the mesh" if d > 1e-9 and abs(wn1[j]) <= 0.5 else
                                                   f"moved > {1000 * max_move:.0f} mm" if d > max_move else
-                                                  "not determined by the motion") + ")"
+                                                  {"root": "n/a: root", "moved too far": "moved too far",
+                                                   "too few rigid vertices": "n/a: < 4 dominated vertices with weight "
+                                                   ">= 0.5 on a part"}.get(status[j], status[j])) + ")"
         else:
             p = nearest_interior_point(rig.starts[j], rest, faces)
             if p is None:
