@@ -1,5 +1,7 @@
 # Hybrid mesh animation (skinned 18-joint skeleton + learned time-varying detail,
-# SGPLVM + GPDM). Data: the synthetic skirt character (mesh_dir: null)
+# SGPLVM + GPDM). Resources: peak memory measured on samba (9,971 vertices,
+# 175 frames: rig 0.85 GB, main/resolution 0.75 GB) with headroom; runtime in
+# minutes, from the samba run on a heavily loaded 2-core machine x 2-3. Data: the synthetic skirt character (mesh_dir: null)
 # or a folder of OBJ / OBJ.gz frames (config/samba.yaml). Every job gets only the
 # config keys it uses, so a changed value reruns exactly the affected jobs.
 from animsynth.meshdetail.settings import check_meshdetail_config
@@ -115,8 +117,8 @@ rule meshdetail_rig:
         train_fraction=MD["train_fraction"],
     threads: 1
     resources:
-        mem_mb=3000,
-        runtime=30,
+        mem_mb=2000,
+        runtime=20,
     log:
         "logs/meshdetail/rig.log",
     benchmark:
@@ -156,8 +158,8 @@ rule meshdetail_main:
         render_frames=MD["render_frames"],
     threads: 1
     resources:
-        mem_mb=3000,
-        runtime=60,
+        mem_mb=2000,
+        runtime=30,
     log:
         "logs/meshdetail/main.log",
     benchmark:
@@ -189,8 +191,8 @@ rule meshdetail_resolution:
         train_fraction=MD["train_fraction"],
     threads: 1
     resources:
-        mem_mb=4000,
-        runtime=60,
+        mem_mb=2000,
+        runtime=20,
     log:
         "logs/meshdetail/resolution.log",
     benchmark:
@@ -216,8 +218,8 @@ rule meshdetail_representations:
         train_fraction=MD["train_fraction"],
     threads: 1
     resources:
-        mem_mb=3000,
-        runtime=30,
+        mem_mb=1500,
+        runtime=10,
     log:
         "logs/meshdetail/representations.log",
     benchmark:
@@ -262,8 +264,8 @@ rule meshdetail_figures:
         ),
     threads: 1
     resources:
-        mem_mb=1500,
-        runtime=10,
+        mem_mb=1000,
+        runtime=5,
     log:
         "logs/meshdetail/figures.log",
     benchmark:
