@@ -43,6 +43,11 @@ def verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame, gen:
     def compare(claim, better, worse, paper_value, source="meshdetail/fig5c.csv", note=""):
         m, sd, share, k = block_margin(fig5c, better, worse)
         b, w = fig5c[better].mean(), fig5c[worse].mean()
+        g = fig5c.groupby("block")[[better, worse]].mean()
+        lost = [int(x) for x in g.index[(g[worse] - g[better]).to_numpy() <= 0]]
+        if lost and len(lost) < k:
+            note = f"; not better on block(s) {lost} (block 0 holds the rest frame, where LBS is exact)" \
+                if better != "lbs_mm" and worse == "lbs_mm" and 0 in lost else f"; not better on block(s) {lost}" + note
         v = _compare_verdict(m, sd, share)
         rows.append({"claim": claim, "paper_value": paper_value,
                      "ours": f"{f(b)} vs {f(w)} mm held-out", "data": f"{data} (blocked CV, {k} blocks)",
