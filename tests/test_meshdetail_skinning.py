@@ -148,3 +148,16 @@ def test_pose_fit_with_heat_weights_on_bent_cylinder():
     P = lbs(W, V, joint_transforms(rig, *forward(rig, np.zeros((3, 3)), ang)))
     fit = PoseFitter(iterations=10).fit(rig, W, V, P)
     assert fit.residual_.max() < 1e-6
+
+
+def test_rbf_upsampler_on_coplanar_control_points_interpolates():
+    """A flat patch (all control points in z = 0) makes the local systems singular; it must still interpolate."""
+    rng = np.random.default_rng(4)
+    ctrl = np.c_[rng.uniform(-1, 1, (60, 2)), np.zeros(60)]
+    vals = rng.normal(size=(60, 2))
+    up = RBFUpsampler(ctrl, ctrl, neighbors=12)
+    np.testing.assert_allclose(up(vals), vals, atol=1e-6)
+    lin = ctrl[:, :2] @ [1.0, -2.0] + 0.5
+    fine = np.c_[rng.uniform(-0.5, 0.5, (30, 2)), np.zeros(30)]
+    np.testing.assert_allclose(RBFUpsampler(ctrl, fine, 12)(lin[:, None])[:, 0], fine[:, :2] @ [1.0, -2.0] + 0.5,
+                               atol=1e-6)

@@ -250,7 +250,10 @@ class RBFUpsampler:
     they agree). That class does not expose its interpolation weights, which
     are linear in the data; they are computed here once (one batched small
     solve per fine vertex) into a sparse ``(V, C)`` matrix so that every frame
-    is reconstructed with one sparse product ("factor once, reuse").
+    is reconstructed with one sparse product ("factor once, reuse"). Where a
+    neighbourhood is degenerate (coplanar control points: the linear part is
+    undetermined and the local system singular) the minimum-norm solution is
+    used for all vertices.
 
     Parameters
     ----------
@@ -281,7 +284,12 @@ class RBFUpsampler:
         b = np.zeros((V, k + 4))
         b[:, :k] = tps(np.linalg.norm(Yl, axis=-1))
         b[:, k] = 1.0  # query at the local origin: linear terms 0
-        w = np.linalg.solve(A, b[..., None])[..., 0][:, :k]
+        try:
+            w = np.linalg.solve(A, b[..., None])[..., 0][:, :k]
+        except np.linalg.LinAlgError:
+            # some neighbourhoods are degenerate (e.g. coplanar control points on a flat patch leave the
+            # linear polynomial undetermined): minimum-norm solutions, which still interpolate
+            w = (np.linalg.pinv(A, rcond=1e-12, hermitian=True) @ b[..., None])[..., 0][:, :k]
         self.B = sparse.csr_matrix((w.ravel(), nb.ravel(), np.arange(0, V * k + 1, k)), shape=(V, C))
 
     def __call__(self, values: np.ndarray) -> np.ndarray:
