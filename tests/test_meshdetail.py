@@ -5,11 +5,11 @@ from scipy import sparse
 from scipy.spatial.transform import Rotation
 
 from animsynth.kinematics import forward_kinematics
-from animsynth.meshdetail.detail import LaplacianCoder, Upsampler, farthest_point_order, level_indices
+from animsynth.meshdetail.detail import LaplacianCoder, farthest_point_order, level_indices
 from animsynth.meshdetail.fit import PoseFitter, refine_joints_from_motion
 from animsynth.meshdetail.gp import GPRegression, SharedGPDM
 from animsynth.meshdetail.models import HybridModel, MeshContext, mean_vertex_error, pose_features
-from animsynth.meshdetail.rig import (Rig, default_rig, forward, joint_transforms, lbs, pose_vertices, rebase,
+from animsynth.skinning import (Rig, default_rig, forward, joint_transforms, lbs, pose_vertices, rebase,
                                       rebase_pose, skinning_weights)
 
 
@@ -168,22 +168,17 @@ def test_gp_regression_gradient_and_fit():
 
 
 # ----------------------------------------------------------------------------- detail coding
-def test_upsampler_interpolates_and_reproduces_constants():
+def test_farthest_point_levels_are_nested_subsets():
     from animsynth.synth.character import build_character
 
     ch = build_character(default_rig(), resolution=0.5, skirt_rings=6, skirt_around=16)
     order = farthest_point_order(ch.rest, 200)
     ctrl = level_indices(order, len(ch.rest), 10)
     assert len(np.unique(ctrl)) == len(ctrl) == round(0.1 * len(ch.rest))
-    up = Upsampler(ch.faces, len(ch.rest), ctrl)
-    vals = np.random.default_rng(8).normal(size=(len(ctrl), 3))
-    np.testing.assert_allclose(up(vals)[ctrl], vals, atol=1e-12)
-    const = np.tile([1.0, -2.0, 0.5], (len(ctrl), 1))
-    np.testing.assert_allclose(up(const), np.tile([1.0, -2.0, 0.5], (len(ch.rest), 1)), atol=1e-5)
-    assert Upsampler(ch.faces, len(ch.rest), np.arange(len(ch.rest)))(vals) is vals
+    assert set(level_indices(order, len(ch.rest), 5)) <= set(ctrl)
 
 
-def test_laplacian_coder_roundtrip():
+def test_laplacian_coder_knn_roundtrip():
     rng = np.random.default_rng(9)
     pts = np.concatenate([rng.normal(size=(40, 3)), rng.normal(size=(30, 3)) + 20])  # two components
     c = LaplacianCoder(pts, k=5)
@@ -237,6 +232,10 @@ def test_hybrid_beats_lbs_on_training_frames(skirt_data):
     assert e_hyb.mean() < 0.5 * e_lbs.mean()
     assert np.mean(e_hyb < e_lbs) > 0.9
     assert hyb.gp_.X_.shape == (60, 4)
+    for reg in ("gp_regression", "ridge_cv"):  # the baselines learn the detail too
+        m = HybridModel(level=10, regressor=reg).fit(ctx, V[tr], rt[tr], A[tr])
+        assert mean_vertex_error(m.predict(ctx, rt[tr], A[tr]), V[tr]).mean() < 0.5 * e_lbs.mean()
+    assert m.ridge_.alpha_ in m.ridge_alphas
 
 
 def test_single_frame_prediction_matches_batch(skirt_data):
@@ -246,3 +245,19 @@ def test_single_frame_prediction_matches_batch(skirt_data):
     batch = m.predict(ctx, rt[:12], A[:12])
     one = m.predict(ctx, rt[11:12], A[11:12], prev_angles=A[10:11])
     np.testing.assert_allclose(one[0], batch[11], atol=1e-10)
+
+
+def test_verdict_is_within_noise_when_blocks_disagree():
+    import pandas as pd
+
+    from animsynth.meshdetail.verdicts import _compare_verdict, block_margin
+
+    block = np.repeat(np.arange(5), 4)
+    clear = pd.DataFrame({"block": block, "a": 1.0, "b": 2.0 + 0.01 * block})
+    m, sd, share, k = block_margin(clear, "a", "b")
+    assert k == 5 and share == 1.0 and _compare_verdict(m, sd, share) == "reproduced"
+    mixed = pd.DataFrame({"block": block, "a": 1.0, "b": np.where(block == 2, 0.5, 1.1)})
+    m, sd, share, _ = block_margin(mixed, "a", "b")
+    assert m < 0.1 and share == 0.8 and _compare_verdict(m, sd, share) == "within noise"
+    worse = pd.DataFrame({"block": block, "a": 3.0, "b": 1.0})
+    assert _compare_verdict(*block_margin(worse, "a", "b")[:3]) == "contradicted"

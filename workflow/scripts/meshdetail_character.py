@@ -1,7 +1,7 @@
 """Generate the synthetic skirt character: OBJ sequences of the clip and of its edits + truth.npz."""
 import os
 
-from animsynth.meshdetail.pipeline import make_character
+from animsynth.meshdetail.jobs import make_character
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821

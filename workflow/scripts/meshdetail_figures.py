@@ -1,4 +1,4 @@
-"""The three Fig. 5 panels and rendered frames (original, LBS, hybrid, linear) with an error colour map."""
+"""The three Fig. 5 panels and rendered frames (original, LBS, hybrid, CV ridge; held-out predictions) with an error colour map."""
 import numpy as np
 import pandas as pd
 
@@ -14,6 +14,6 @@ plots.plot_fig5c(pd.read_csv(i.fig5c), o.fig5c)
 seq = MeshSequence.load_npz(i.seq)
 with np.load(i.preds) as z:
     frames = [int(f) for f in z["frames"]]
-    preds = {k: z[k] for k in ("lbs", "hybrid", "linear")}
+    preds = {k: z[k] for k in ("lbs", "hybrid", "ridge_cv")}
 truth = seq.vertices[frames]
 plots.render_frames(o.frames, truth, seq.faces, preds, list(range(len(frames))), titles=frames)

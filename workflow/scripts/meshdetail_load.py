@@ -1,5 +1,5 @@
 """Parse the mesh sequence (OBJ / OBJ.gz frames, one topology) and edited sequences into npz caches."""
-from animsynth.meshdetail.pipeline import load_sequences
+from animsynth.meshdetail.jobs import load_sequences
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821

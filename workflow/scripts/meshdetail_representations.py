@@ -1,6 +1,6 @@
 """Joint parameterisation x detail encoding study."""
 from animsynth.meshdetail.experiments import run_representations
-from animsynth.meshdetail.pipeline import load_prepared
+from animsynth.meshdetail.jobs import load_prepared
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 

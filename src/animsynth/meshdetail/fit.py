@@ -35,7 +35,7 @@ import numpy as np
 from scipy import sparse
 from threadpoolctl import threadpool_limits
 
-from .rig import Rig, joint_transforms, lbs, matrix_to_euler
+from ..skinning import Rig, inside_mesh, joint_transforms, lbs, matrix_to_euler, winding_number
 
 log = logging.getLogger("animsynth.meshdetail.fit")
 
@@ -258,10 +258,10 @@ class PoseFitter:
 
 
 def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.ndarray,
-                              min_weight: float = 0.7) -> Rig:
+                              min_weight: float = 0.5, return_status: bool = False):
     """Move every non-root joint start to its least-squares rotation centre.
 
-    Each body part (vertices whose weight for a joint is above ``min_weight``)
+    Each body part (the vertices a joint dominates, with weight >= ``min_weight``)
     gets a free rigid transform per frame (Kabsch). The joint between part
     ``p`` (parent) and part ``j`` is the rest-pose point ``c`` minimising
     ``sum_t |T_p(t) c - T_j(t) c|²`` — the point that both parts carry along
@@ -269,19 +269,25 @@ def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.nd
     pull towards the initial position for directions the motion leaves
     undetermined, e.g. along a hinge axis). Segment ends move with the
     joint starts of the children they point at.
+
+    Returns the refined Rig (and, with ``return_status``, a list with one
+    status per joint: ``"moved"``, ``"root"``, ``"too few rigid vertices"``
+    or ``"moved too far"``).
     """
     Wt = weights.toarray() if sparse.issparse(weights) else np.asarray(weights, float)
     frames = np.asarray(frames, float)
     J = rig.n_joints
     T = [None] * J
+    dom = np.argmax(Wt, axis=1)
     for j in range(J):
-        idx = np.flatnonzero(Wt[:, j] >= min_weight)
+        idx = np.flatnonzero((dom == j) & (Wt[:, j] >= min_weight))
         if len(idx) >= 4:
             R, t = _kabsch(rest[idx], frames[:, idx], np.ones(len(idx)), translate=True)
             T[j] = (R, t)
     starts = rig.starts.copy()
     ends = rig.ends.copy()
     scale = np.linalg.norm(rest.max(0) - rest.min(0))
+    status = ["root" if p < 0 else "too few rigid vertices" for p in rig.parents]
     for j, p in enumerate(rig.parents):
         if p < 0 or T[j] is None or T[p] is None:
             continue
@@ -294,7 +300,9 @@ def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.nd
         c = np.linalg.solve(A.T @ A + lam * np.eye(3), A.T @ b + lam * c0)
         if np.linalg.norm(c - c0) < 0.1 * scale:
             starts[j] = c
+            status[j] = "moved"
         else:
+            status[j] = "moved too far"
             log.warning("joint %s: motion-based centre moved %.3f, kept the initial position", rig.names[j],
                         np.linalg.norm(c - c0))
     for j, p in enumerate(rig.parents):
@@ -303,4 +311,87 @@ def refine_joints_from_motion(rig: Rig, weights, rest: np.ndarray, frames: np.nd
             ends[j] = starts[kids[0]]
         else:
             ends[j] = ends[j] + (starts[j] - rig.starts[j])
-    return Rig(starts, ends, rig.names, rig.parents)
+    out = Rig(starts, ends, rig.names, rig.parents)
+    return (out, status) if return_status else out
+
+
+def nearest_interior_point(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray, radius: float = 0.08,
+                           step: float = 0.02) -> np.ndarray | None:
+    """The interior point near ``point`` that is deep and close: on a grid of spacing ``step`` within
+    ``radius``, among points inside the closed mesh (winding number), the one maximising
+    ``clearance - distance to point`` (clearance = distance to the nearest mesh vertex). ``None`` if
+    no grid point is inside."""
+    from scipy.spatial import cKDTree
+
+    g = np.arange(-radius, radius + 1e-9, step)
+    G = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    G = G[np.linalg.norm(G, axis=1) <= radius] + point
+    ins = inside_mesh(G, vertices, faces)
+    if not ins.any():
+        return None
+    G = G[ins]
+    clear = cKDTree(vertices).query(G)[0]
+    return G[np.argmax(clear - np.linalg.norm(G - point, axis=1))]
+
+
+def place_joints(rig: Rig, weights, rest: np.ndarray, faces: np.ndarray, frames: np.ndarray | None,
+                 max_move: float = 0.08):
+    """Joint centres from the mesh motion, checked to lie inside the first-frame mesh.
+
+    Every non-root joint first gets its least-squares rotation centre
+    (:func:`refine_joints_from_motion`, on ``frames``, pass the training frames;
+    ``None`` skips it). A motion-based centre is kept only if it lies inside
+    the closed rest mesh (generalised winding number) and moved at most
+    ``max_move``; otherwise the initial position is kept if it is inside, and a
+    joint that is still outside goes to :func:`nearest_interior_point`. Segment
+    ends follow the child joints.
+
+    Returns
+    -------
+    rig : the placed Rig
+    table : pandas.DataFrame, one row per joint (initial/motion/final position,
+        winding number of the final centre, ``inside``, ``placement``, ``moved_mm``)
+    """
+    import pandas as pd
+
+    faces = np.asarray(faces, np.int64)
+    if frames is None:  # report only
+        wn = winding_number(rig.starts, rest, faces)
+        return rig, pd.DataFrame({"joint": list(rig.names), **{a: np.round(rig.starts[:, i], 4) for i, a in enumerate("xyz")},
+                                  "moved_mm": 0.0, "winding_number": np.round(wn, 3), "inside": np.abs(wn) > 0.5,
+                                  "placement": "given"})
+    moved, status = refine_joints_from_motion(rig, weights, rest, frames, return_status=True)
+    wn0 = winding_number(rig.starts, rest, faces)
+    wn1 = winding_number(moved.starts, rest, faces)
+    starts = rig.starts.copy()
+    how = []
+    for j in range(rig.n_joints):
+        d = np.linalg.norm(moved.starts[j] - rig.starts[j])
+        if d > 1e-9 and abs(wn1[j]) > 0.5 and d <= max_move:
+            starts[j], h = moved.starts[j], "rotation centre from motion"
+        elif abs(wn0[j]) > 0.5:
+            h = "initial (motion-based centre " + ("outside the mesh" if d > 1e-9 and abs(wn1[j]) <= 0.5 else
+                                                  f"moved > {1000 * max_move:.0f} mm" if d > max_move else
+                                                  {"root": "n/a: root", "moved too far": "moved too far",
+                                                   "too few rigid vertices": "n/a: < 4 dominated vertices with weight "
+                                                   ">= 0.5 on a part"}.get(status[j], status[j])) + ")"
+        else:
+            p = nearest_interior_point(rig.starts[j], rest, faces)
+            if p is None:
+                h = "initial, outside the mesh (no interior point within 8 cm)"
+                log.warning("joint %s lies outside the first-frame mesh", rig.names[j])
+            else:
+                starts[j], h = p, "nearest interior point (initial position outside the mesh)"
+        how.append(h)
+    ends = rig.ends.copy()
+    for j in range(rig.n_joints):
+        kids = [k for k, q in enumerate(rig.parents) if q == j]
+        ends[j] = starts[kids[0]] if len(kids) == 1 else rig.ends[j] + (starts[j] - rig.starts[j])
+    out = Rig(starts, ends, rig.names, rig.parents)
+    wn = winding_number(out.starts, rest, faces)
+    table = pd.DataFrame({
+        "joint": list(rig.names),
+        **{a: np.round(out.starts[:, i], 4) for i, a in enumerate("xyz")},
+        "moved_mm": np.round(1000 * np.linalg.norm(out.starts - rig.starts, axis=1), 1),
+        "winding_number": np.round(wn, 3), "inside": np.abs(wn) > 0.5, "placement": how})
+    return out, table

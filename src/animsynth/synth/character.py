@@ -3,7 +3,7 @@ driven by motion, with a flared skirt simulated as damped second-order dynamics.
 
 The body (torso, head, neck, arms, hands, legs, feet) is a set of closed tubes
 around the rig's bone segments, skinned with the automatic weights of
-:func:`animsynth.meshdetail.rig.skinning_weights` (so, given the true rig, the
+:func:`animsynth.skinning.skinning_weights` (so, given the true rig, the
 body is exactly representable by linear blend skinning). The skirt is a
 flared cone hanging from the waist. Its vertices are particles:
 
@@ -22,7 +22,7 @@ generator can re-simulate, it also gives ground truth for edited motions.
 
 Motion comes from :func:`procedural_motion` (seeded synthetic dance / walk on
 the 18-joint rig) or from any CMU-skeleton :class:`~animsynth.motion.Motion`
-mapped with :func:`animsynth.meshdetail.rig.cmu_motion_to_rig`.
+mapped with :func:`animsynth.skinning.cmu_motion_to_rig`.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..meshdetail.rig import JOINTS, Rig, forward, joint_transforms, lbs, skinning_weights
+from ..skinning import JOINTS, Rig, forward, joint_transforms, lbs, skinning_weights
 
 log = logging.getLogger("animsynth.synth.character")
 

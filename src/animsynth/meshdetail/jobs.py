@@ -18,17 +18,20 @@ import os
 
 import numpy as np
 
+from ..io import read_amc, read_asf
+from ..io.atomic import atomic_path
 from ..io.obj import MeshSequence, read_obj_sequence, write_obj_sequence
-from .experiments import (Prepared, fit_skeleton, pack_weights, rig_fit_table, rig_from_joints, split_frames,
-                          unpack_weights)
-from .rig import Rig, cmu_motion_to_rig, default_rig, rebase, rebase_pose
+from ..skinning import Rig, cmu_motion_to_rig, default_rig, rebase, rebase_pose
+from ..synth.character import SkirtParams, build_character, edit_motion, procedural_motion, simulate
+from ..synth.mocap import cmu_like_skeleton, generate_motion
+from .experiments import (Prepared, fit_skeleton, joint_rotation_errors, pack_weights, rig_fit_table, rig_from_joints,
+                          split_frames, unpack_weights)
 
-log = logging.getLogger("animsynth.meshdetail.pipeline")
+log = logging.getLogger("animsynth.meshdetail.jobs")
 
 
 def driving_motion(cfg: dict, seed: int, speed: float = 1.0):
     """Rig and pose (root_t, angles) that drive the synthetic character."""
-    from ..synth.character import procedural_motion
 
     drv, fps, n = cfg["driver"], float(cfg["fps"]), int(cfg["frames"])
     if drv == "procedural":
@@ -36,16 +39,12 @@ def driving_motion(cfg: dict, seed: int, speed: float = 1.0):
         rt, A = procedural_motion(cfg["motion"], n, fps, seed, rig, speed=speed)
         return rig, rt, A
     if drv == "cmu_synthetic":
-        from ..synth.mocap import cmu_like_skeleton, generate_motion
-
         step = 120.0 / fps
         if abs(step - round(step)) > 1e-9:
             raise ValueError(f"config key 'meshdetail.character.fps': must divide 120 for the CMU-like generator, got {fps}")
         sk = cmu_like_skeleton("syn_skirt", seed)
         m = generate_motion(cfg["motion"], int(np.ceil(n * step * speed)) + 2, seed, sk, fps=120.0)
     elif drv == "amc":
-        from ..io import read_amc, read_asf
-
         if not cfg.get("asf") or not cfg.get("amc"):
             raise ValueError("config keys 'meshdetail.character.asf' and '.amc' are needed for driver 'amc'")
         m = read_amc(cfg["amc"], read_asf(cfg["asf"]), 120.0)
@@ -64,8 +63,6 @@ def driving_motion(cfg: dict, seed: int, speed: float = 1.0):
 
 def make_character(cfg: dict, seed: int, out_dir: str) -> dict:
     """Generate, simulate and write the synthetic skirt character (main clip + edits)."""
-    from ..synth.character import SkirtParams, build_character, edit_motion, simulate
-
     rig, rt, A = driving_motion(cfg, seed)
     ch = build_character(rig, cfg["resolution"], cfg["skirt_rings"], cfg["skirt_around"])
     sp = SkirtParams(hem_frequency=cfg["hem_frequency"], damping=cfg["damping"], substeps=cfg["substeps"])
@@ -86,8 +83,6 @@ def make_character(cfg: dict, seed: int, out_dir: str) -> dict:
         write_obj_sequence(os.path.join(out_dir, f"edit_{name}"), MeshSequence(Ve, ch.faces, fps=fps), gz=True)
         truth[f"root_t:{name}"] = ert
         truth[f"angles:{name}"] = rebase_pose(rig, ert, eA, A[0])
-    from ..io.atomic import atomic_path
-
     with atomic_path(os.path.join(out_dir, "truth.npz"), suffix=".npz") as tmp:
         np.savez_compressed(tmp, **truth)
     return {"vertices": int(len(ch.rest)), "frames": int(len(V))}
@@ -110,16 +105,18 @@ def load_sequences(main_dir: str, truth_npz: str | None, seq_out: str, edits_out
                 edits[f"vertices:{name}"] = e.vertices
                 edits[f"root_t:{name}"] = z[f"root_t:{name}"][: e.n_frames]
                 edits[f"angles:{name}"] = z[f"angles:{name}"][: e.n_frames]
-    from ..io.atomic import atomic_path
-
     with atomic_path(edits_out, suffix=".npz") as tmp:
         np.savez_compressed(tmp, names=np.array(json.dumps(sorted({k.split(":", 1)[1] for k in edits}))), **edits)
     return seq
 
 
-def fit_pose(seq_npz: str, truth_npz: str | None, rig_cfg: dict, out_npz: str):
-    """Embed the 18-joint skeleton, compute weights, fit every frame; returns the fit-quality table."""
+def fit_pose(seq_npz: str, truth_npz: str | None, rig_cfg: dict, train_fraction: float, out_npz: str):
+    """Embed the 18-joint skeleton, compute weights, fit every frame.
+
+    Returns (rig_fit table, joints table, skinning comparison table or None, description of the embedding).
+    """
     seq = MeshSequence.load_npz(seq_npz)
+    train, _ = split_frames(seq.n_frames, train_fraction)
     true_angles = labels = None
     if truth_npz:
         with np.load(truth_npz) as z:
@@ -136,16 +133,18 @@ def fit_pose(seq_npz: str, truth_npz: str | None, rig_cfg: dict, out_npz: str):
                              "(joint start positions in the first frame; see docs/config_meshdetail.md)")
         rig = rig_from_joints(rig_cfg["joints"], rig_cfg.get("ends") or {})
         refine = bool(rig_cfg["refine"])
-        method = "user-supplied embedding" + (" refined from the mesh motion" if refine else "")
-    rig, weights, fitter = fit_skeleton(seq.vertices, rig, refine=refine, weight_power=rig_cfg["weight_power"],
-                                        max_influences=rig_cfg["max_influences"], iterations=rig_cfg["fit_iterations"])
-    table = rig_fit_table(seq.vertices, rig, weights, fitter, true_angles, labels)
-    from ..io.atomic import atomic_path
-
+        method = "user-supplied embedding" + (", joints refined from the training frames' motion" if refine else "")
+    rig, weights, fitter, joints, comparison = fit_skeleton(
+        seq.vertices, seq.faces, rig, train, skinning=rig_cfg["skinning"], refine=refine,
+        max_influences=rig_cfg["max_influences"], iterations=rig_cfg["fit_iterations"], heat_c=rig_cfg["heat_c"],
+        weight_power=rig_cfg["weight_power"], compare=bool(rig_cfg["compare_skinning"]))
+    if true_angles is not None:
+        joints["rotation_error_mean_deg"] = np.round(joint_rotation_errors(fitter, true_angles), 4)
+    table = rig_fit_table(seq.vertices, rig, weights, fitter, train, labels)
     with atomic_path(out_npz, suffix=".npz") as tmp:
         np.savez_compressed(tmp, rig=np.array(rig.to_json()), root_t=fitter.root_t_, angles=fitter.angles_,
                             residual=fitter.residual_, method=np.array(method), **pack_weights(weights))
-    return table, method
+    return table, joints, comparison, method
 
 
 def load_prepared(seq_npz: str, pose_npz: str, edits_npz: str, train_fraction: float) -> Prepared:

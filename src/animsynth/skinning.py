@@ -27,7 +27,8 @@ import numpy as np
 from scipy import sparse
 from scipy.spatial.transform import Rotation
 
-from ..skeleton import Joint, Skeleton
+from .kinematics import forward_kinematics
+from .skeleton import Joint, Skeleton
 
 #: The 18 joints, parents before children.
 JOINTS = (
@@ -255,7 +256,7 @@ def dominant_joint(weights) -> np.ndarray:
 # --------------------------------------------------------------------------- CMU mapping
 def rig_from_cmu(skeleton: Skeleton) -> Rig:
     """An 18-joint rig from a CMU (ASF) skeleton's rest pose, in metres."""
-    from ..kinematics import forward_kinematics
+
 
     zero = np.zeros((1, skeleton.n_dof))
     starts = forward_kinematics(skeleton, zero, ends=False)[0] * skeleton.length_to_m
@@ -279,7 +280,7 @@ def cmu_motion_to_rig(motion, rig: Rig | None = None):
     -------
     rig, root_t (F, 3) metres, angles (F, 18, 3) radians
     """
-    from ..kinematics import forward_kinematics
+
 
     sk = motion.skeleton
     rig = rig or rig_from_cmu(sk)
@@ -314,3 +315,213 @@ def rebase_pose(rig: Rig, root_t: np.ndarray, angles: np.ndarray, angles0: np.nd
     for j, p in enumerate(rig.parents):
         L[:, j] = Wn[:, j] if p < 0 else np.swapaxes(Wn[:, p], -1, -2) @ Wn[:, j]
     return np.unwrap(matrix_to_euler(L), axis=0)
+
+
+# --------------------------------------------------------------------------- inside test
+def winding_number(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, chunk: int = 32) -> np.ndarray:
+    """Generalised winding number of query points with respect to a triangle mesh.
+
+    ``w(q) = sum_f Ω_f(q) / 4π`` with the signed solid angle ``Ω_f`` of each
+    triangle (Van Oosterom & Strackee 1983). For a closed, consistently
+    oriented mesh ``w`` is 1 inside and 0 outside (-1 inside for inward
+    normals); for meshes with small holes it degrades gracefully (values in
+    between). Written with numpy because it is a dozen lines for a handful of
+    query points (the joint centres), while the library versions need extra
+    dependencies (libigl) or a ray-casting backend (trimesh with embree/rtree).
+
+    Parameters
+    ----------
+    points : (Q, 3) query points
+    vertices : (V, 3), faces : (T, 3) the mesh
+
+    Returns
+    -------
+    (Q,) winding numbers
+    """
+    P = np.atleast_2d(np.asarray(points, float))
+    tri = np.asarray(vertices, float)[np.asarray(faces, np.int64)]  # (T, 3, 3)
+    out = np.empty(len(P))
+    for q0 in range(0, len(P), chunk):
+        R = tri[None] - P[q0:q0 + chunk, None, None, :]  # (q, T, 3, 3)
+        a, b, c = R[:, :, 0], R[:, :, 1], R[:, :, 2]
+        la, lb, lc = (np.linalg.norm(x, axis=-1) for x in (a, b, c))
+        det = np.einsum("qti,qti->qt", a, np.cross(b, c))
+        den = (la * lb * lc + np.einsum("qti,qti->qt", a, b) * lc + np.einsum("qti,qti->qt", b, c) * la
+               + np.einsum("qti,qti->qt", c, a) * lb)
+        out[q0:q0 + chunk] = np.sum(2.0 * np.arctan2(det, den), axis=1) / (4.0 * np.pi)
+    return out
+
+
+def inside_mesh(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Boolean (Q,): is each point inside the closed mesh (``|winding number| > 0.5``)."""
+    return np.abs(winding_number(points, vertices, faces)) > 0.5
+
+
+# --------------------------------------------------------------------------- bone heat
+def _closest_on_segments(P: np.ndarray, A: np.ndarray, B: np.ndarray):
+    """Closest points (V, J, 3) on segments A[j]-B[j] to points P (V, 3), and their distances (V, J)."""
+    AB = B - A
+    L2 = np.maximum(np.sum(AB * AB, axis=1), 1e-12)
+    u = np.clip(np.einsum("vjk,jk->vj", P[:, None, :] - A[None], AB) / L2, 0.0, 1.0)
+    C = A[None] + u[..., None] * AB[None]
+    return C, np.linalg.norm(P[:, None, :] - C, axis=-1)
+
+
+def _segments_hit_mesh(origins: np.ndarray, targets: np.ndarray, origin_ids: np.ndarray, vertices: np.ndarray,
+                       faces: np.ndarray, eps: float = 1e-6) -> np.ndarray:
+    """Does the open segment origin->target cross a mesh triangle not incident to the origin vertex?
+
+    Möller-Trumbore intersection against the triangles near each segment
+    (triangle centroids within half the segment length plus the largest
+    triangle radius of its midpoint, found with a k-d tree).
+    """
+    from scipy.spatial import cKDTree
+
+    tri = vertices[faces]
+    cen = tri.mean(axis=1)
+    rad = float(np.max(np.linalg.norm(tri - cen[:, None], axis=-1)))
+    mid = 0.5 * (origins + targets)
+    half = 0.5 * np.linalg.norm(targets - origins, axis=1)
+    cand = cKDTree(cen).query_ball_point(mid, half + rad)
+    seg = np.repeat(np.arange(len(origins)), [len(c) for c in cand])
+    if len(seg) == 0:
+        return np.zeros(len(origins), bool)
+    f = np.concatenate([np.asarray(c, np.int64) for c in cand])
+    keep = ~np.any(faces[f] == origin_ids[seg, None], axis=1)
+    seg, f = seg[keep], f[keep]
+    o, d = origins[seg], targets[seg] - origins[seg]
+    v0, e1, e2 = tri[f, 0], tri[f, 1] - tri[f, 0], tri[f, 2] - tri[f, 0]
+    pv = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, pv)
+    ok = np.abs(det) > 1e-15
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    tv = o - v0
+    u = np.einsum("ij,ij->i", tv, pv) * inv
+    qv = np.cross(tv, e1)
+    v = np.einsum("ij,ij->i", d, qv) * inv
+    t = np.einsum("ij,ij->i", e2, qv) * inv
+    hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > eps) & (t < 1 - eps)
+    out = np.zeros(len(origins), bool)
+    out[seg[hit]] = True
+    return out
+
+
+def bone_heat_weights(vertices: np.ndarray, faces: np.ndarray, rig: Rig, c: float = 1.0, max_influences: int = 4,
+                      visibility_candidates: int = 4, min_weight: float = 0.01) -> sparse.csr_matrix:
+    """Skinning weights by bone heat diffusion (Baran & Popović 2007, "Pinocchio").
+
+    For every bone ``i`` solve ``(-Δ + H) w_i = H p_i`` on the surface, where
+    ``Δ`` is the cotangent Laplace-Beltrami operator (``-Δ = M^-1 L`` with the
+    stiffness ``L`` and lumped mass ``M`` from :mod:`robust_laplacian`, which
+    stays well-behaved on imperfect meshes), ``p_ij = 1`` if bone ``i`` is the
+    nearest bone *visible* from vertex ``j`` (the segment to its closest bone
+    point crosses no other part of the surface; the ``visibility_candidates``
+    nearest bones are tried in order), and ``H_jj = c / d_j²`` with ``d_j`` the
+    distance to that bone (``H_jj = 0`` if none is visible). Multiplied by
+    ``M`` the system ``(L + M H) w_i = M H p_i`` is symmetric positive
+    definite; it is factorised once and solved for all bones. Rows sum to one
+    by construction (``L 1 = 0``); weights below ``min_weight`` are dropped,
+    each vertex keeps its ``max_influences`` largest, and rows are renormalised.
+
+    Parameters
+    ----------
+    vertices : (V, 3), faces : (T, 3) the rest (first-frame) mesh
+    rig : Rig (segments ``starts[j]``-``ends[j]``)
+    c : float
+        Heat-source strength (the paper's ``c = 1``).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix (V, J)
+    """
+    import robust_laplacian
+    from scipy.sparse.linalg import splu
+
+    Vx = np.asarray(vertices, float)
+    Fc = np.asarray(faces, np.int64)
+    J = rig.n_joints
+    C, D = _closest_on_segments(Vx, rig.starts, rig.ends)
+    order = np.argsort(D, axis=1)[:, :max(1, min(visibility_candidates, J))]
+    nearest = np.full(len(Vx), -1)
+    todo = np.arange(len(Vx))
+    for k in range(order.shape[1]):
+        b = order[todo, k]
+        blocked = _segments_hit_mesh(Vx[todo], C[todo, b], todo, Vx, Fc)
+        nearest[todo[~blocked]] = b[~blocked]
+        todo = todo[blocked]
+        if not len(todo):
+            break
+    has = nearest >= 0
+    d = np.where(has, D[np.arange(len(Vx)), np.maximum(nearest, 0)], np.inf)
+    h = np.where(has, c / np.maximum(d, 1e-4) ** 2, 0.0)
+    L, M = robust_laplacian.mesh_laplacian(Vx, Fc)
+    MH = sparse.diags(M.diagonal() * h)
+    lu = splu((L + MH).tocsc())
+    rhs = np.zeros((len(Vx), J))
+    rhs[np.flatnonzero(has), nearest[has]] = (M.diagonal() * h)[has]
+    w = lu.solve(rhs)
+    w[w < min_weight] = 0.0
+    k = min(max_influences, J)
+    if k < J:
+        cut = np.argsort(-w, axis=1)[:, k:]
+        np.put_along_axis(w, cut, 0.0, axis=1)
+    s = w.sum(axis=1, keepdims=True)
+    empty = s[:, 0] <= 0
+    if np.any(empty):  # unreachable parts: nearest bone
+        w[empty] = 0.0
+        w[empty, np.argmin(D[empty], axis=1)] = 1.0
+        s = w.sum(axis=1, keepdims=True)
+    return sparse.csr_matrix(w / s)
+
+
+def refit_weights(weights, rest: np.ndarray, T: np.ndarray, frames: np.ndarray, parents=None,
+                  max_influences: int = 4) -> sparse.csr_matrix:
+    """Per-vertex non-negative, sum-to-one skinning weights fitted to posed frames.
+
+    For vertex ``i`` the candidate bones are those with a nonzero weight in
+    ``weights`` (plus their parents and children when ``parents`` is given);
+    its new weights minimise ``sum_t |sum_j w_j T_j(t) v_i - p_i(t)|²`` subject to
+    ``w >= 0`` and ``sum w = 1`` (:func:`scipy.optimize.nnls` with the
+    sum-to-one row appended with a large weight, then renormalised); if more
+    than ``max_influences`` come out nonzero, the largest are refitted alone.
+    Pass the **training** frames only.
+
+    Parameters
+    ----------
+    weights : (V, J) initial weights (their support)
+    rest : (V, 3); T : (F, J, 3, 4) joint transforms of the frames; frames : (F, V, 3)
+    parents : sequence of J parent indices (-1 for the root), optional
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix (V, J)
+    """
+    from scipy.optimize import nnls
+
+    W0 = weights.toarray() if sparse.issparse(weights) else np.asarray(weights, float)
+    V, J = W0.shape
+    nb = [np.array([j], int) for j in range(J)]
+    if parents is not None:
+        for j, p in enumerate(parents):
+            if p >= 0:
+                nb[j] = np.append(nb[j], p)
+                nb[p] = np.append(nb[p], j)
+    T = np.asarray(T, float)
+    frames = np.asarray(frames, float)
+    F = len(T)
+    Y = frames.transpose(1, 0, 2).reshape(V, F * 3)
+    big = 1e3 * np.sqrt(F)
+    out = np.zeros_like(W0)
+    for i in range(V):
+        sup = np.unique(np.concatenate([nb[j] for j in np.flatnonzero(W0[i] > 0)]))
+        Ts = T[:, sup]
+        X = (np.einsum("fjab,b->jfa", Ts[..., :3], rest[i]) + Ts[..., 3].transpose(1, 0, 2)).reshape(len(sup), -1)
+        b = np.concatenate([Y[i], [big]])
+        w, _ = nnls(np.vstack([X.T, np.full((1, len(sup)), big)]), b)
+        if np.count_nonzero(w) > max_influences:
+            keep = np.argsort(-w)[:max_influences]
+            sup, X = sup[keep], X[keep]
+            w, _ = nnls(np.vstack([X.T, np.full((1, len(sup)), big)]), b)
+        s = w.sum()
+        out[i, sup] = w / s if s > 0 else W0[i, sup] / max(W0[i, sup].sum(), 1e-12)
+    return sparse.csr_matrix(out)
