@@ -4,7 +4,7 @@ the measured comparison of our SGPLVM+GPDM with GPy (the library evaluated first
 Each row's ``ratio`` compares against a baseline measured in the same run:
 
 * ``train_s_per_100_frames`` (5 % control level): our shared GPDM + inverse GP,
-  target < 30 s (the issue's); the paper's reported ~30 min is quoted as the
+  target < 30 s (ours); the paper's reported ~30 min is quoted as the
   reference value (it cannot be measured here);
 * ``..._vs_gpy`` (only when GPy is installed, ``pip install GPy==1.15.0``; not
   a runtime dependency): GPy's MRD (shared GPLVM, no dynamics) with the same

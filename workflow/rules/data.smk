@@ -26,9 +26,9 @@ if SOURCE == "synthetic":
             mem_mb=500,
             runtime=10,
         log:
-            "logs/data/synth_trial/{trial}.log",
+            L("data/synth_trial/{trial}.log"),
         benchmark:
-            "benchmarks/rules/data/synth_trial/{trial}.tsv"
+            B("data/synth_trial/{trial}.tsv")
         conda:
             "../envs/animsynth.yaml"
         script:
@@ -51,9 +51,9 @@ else:
             mem_mb=500,
             runtime=20,
         log:
-            "logs/data/download_trial/{trial}.log",
+            L("data/download_trial/{trial}.log"),
         benchmark:
-            "benchmarks/rules/data/download_trial/{trial}.tsv"
+            B("data/download_trial/{trial}.tsv")
         conda:
             "../envs/animsynth.yaml"
         script:
@@ -71,9 +71,9 @@ else:
             mem_mb=500,
             runtime=20,
         log:
-            "logs/data/download_bvh_trial/{trial}.log",
+            L("data/download_bvh_trial/{trial}.log"),
         benchmark:
-            "benchmarks/rules/data/download_bvh_trial/{trial}.tsv"
+            B("data/download_bvh_trial/{trial}.tsv")
         conda:
             "../envs/animsynth.yaml"
         script:
@@ -84,7 +84,7 @@ rule parse_trial:
     input:
         unpack(raw_trial_files),
     output:
-        "results/data/trials/{trial}.npz",
+        R("data/trials/{trial}.npz"),
     params:
         fps=config["fps"],
     threads: 1
@@ -92,9 +92,9 @@ rule parse_trial:
         mem_mb=500,
         runtime=10,
     log:
-        "logs/data/parse_trial/{trial}.log",
+        L("data/parse_trial/{trial}.log"),
     benchmark:
-        "benchmarks/rules/data/parse_trial/{trial}.tsv"
+        B("data/parse_trial/{trial}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -106,12 +106,12 @@ rule datasets_table:
         lambda wc: [trial_npz(t) for ids in SUBSETS.values() for t in ids],
     output:
         csv=report(
-            "results/data/datasets.csv",
+            R("data/datasets.csv"),
             caption="../report/data_datasets.rst",
             category="1. Data",
             labels={"table": "Gauch & Peters Table I"},
         ),
-        md="results/data/datasets.md",
+        md=R("data/datasets.md"),
     params:
         subsets=SUBSETS,
         source=SOURCE,
@@ -121,16 +121,16 @@ rule datasets_table:
         mem_mb=500,
         runtime=10,
     log:
-        "logs/data/datasets_table.log",
+        L("data/datasets_table.log"),
     benchmark:
-        "benchmarks/rules/data/datasets_table.tsv"
+        B("data/datasets_table.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
         "../scripts/data_datasets_table.py"
 
 
-DATA_TARGETS = ["results/data/datasets.csv"] + [trial_npz(t) for t in USED_TRIALS]
+DATA_TARGETS = [R("data/datasets.csv")] + [trial_npz(t) for t in USED_TRIALS]
 
 
 # ---- mesh sequence of the hybrid mesh experiments --------------------------

@@ -24,7 +24,7 @@ FG_SYNTHETIC = FG["ckplus_dir"] is None
 FG_DB_DIR = "resources/facegraph/ckplus_synthetic" if FG_SYNTHETIC else FG["ckplus_dir"]
 FG_SOURCE = "synthetic CK+-layout database (animsynth.synth.faces)" if FG_SYNTHETIC else f"CK+ at {FG['ckplus_dir']}"
 FG_SEED_GRAPH = seed_for("facegraph", FG["seed"], "graph")
-FG_SHOWCASE_GRAPH = f"results/facegraph/graphs/{FG_SHOWCASE}.npz"
+FG_SHOWCASE_GRAPH = R(f"facegraph/graphs/{FG_SHOWCASE}.npz")
 # Resources sized from measured use with headroom (rule benchmarks, 70 sequences / CK+ scale): peak RSS
 # synth_db 107 / 115 MB, prepare 147 / 161 MB (13 / 66 s CPU), graph 230 / 475 MB (5-12 / 10-20 s CPU),
 # baseline 446 / 685 MB (face graphs capped at baseline.max_nodes poses), table1/verdicts/uniqueness ~160 MB. Runtimes (minutes)
@@ -49,9 +49,9 @@ if FG_SYNTHETIC:
             mem_mb=lambda wc, attempt: 500 * attempt,
             runtime=lambda wc, attempt: int(10 * FG_SCALE * attempt),
         log:
-            "logs/facegraph/synth_db.log",
+            L("facegraph/synth_db.log"),
         benchmark:
-            "benchmarks/rules/facegraph/synth_db.tsv"
+            B("facegraph/synth_db.tsv")
         conda:
             "../envs/animsynth.yaml"
         script:
@@ -62,14 +62,14 @@ rule facegraph_prepare:
     input:
         db=FG_DB_DIR,
     output:
-        npz="results/facegraph/preprocessed.npz",
+        npz=R("facegraph/preprocessed.npz"),
         csv=report(
-            "results/facegraph/database.csv",
+            R("facegraph/database.csv"),
             caption="../report/facegraph_database.rst",
             category="Facegraph",
             subcategory="Data",
         ),
-        md="results/facegraph/database.md",
+        md=R("facegraph/database.md"),
     params:
         cfg=FG["preprocess"],
         source=FG_SOURCE,
@@ -78,9 +78,9 @@ rule facegraph_prepare:
         mem_mb=lambda wc, attempt: 1000 * attempt,
         runtime=lambda wc, attempt: int(20 * FG_SCALE * attempt),
     log:
-        "logs/facegraph/prepare.log",
+        L("facegraph/prepare.log"),
     benchmark:
-        "benchmarks/rules/facegraph/prepare.tsv"
+        B("facegraph/prepare.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -89,12 +89,12 @@ rule facegraph_prepare:
 
 rule facegraph_graph:
     input:
-        "results/facegraph/preprocessed.npz",
+        R("facegraph/preprocessed.npz"),
     output:
-        graphs="results/facegraph/graphs/{fgcfg}.npz",
-        run="results/facegraph/runs/{fgcfg}.json",
-        samples="results/facegraph/runs/{fgcfg}_samples.csv",
-        sample_thresholds="results/facegraph/runs/{fgcfg}_thresholds.csv",
+        graphs=R("facegraph/graphs/{fgcfg}.npz"),
+        run=R("facegraph/runs/{fgcfg}.json"),
+        samples=R("facegraph/runs/{fgcfg}_samples.csv"),
+        sample_thresholds=R("facegraph/runs/{fgcfg}_thresholds.csv"),
     params:
         conf=lambda wc: FG_CONFIG_MAP[wc.fgcfg],
         cfg={k: FG[k] for k in ("graph", "synthesis", "evaluation")},
@@ -104,9 +104,9 @@ rule facegraph_graph:
         mem_mb=lambda wc, attempt: 1000 * attempt,
         runtime=lambda wc, attempt: int(20 * FG_SCALE * attempt),
     log:
-        "logs/facegraph/graph/{fgcfg}.log",
+        L("facegraph/graph/{fgcfg}.log"),
     benchmark:
-        "benchmarks/rules/facegraph/graph/{fgcfg}.tsv"
+        B("facegraph/graph/{fgcfg}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -115,24 +115,24 @@ rule facegraph_graph:
 
 rule facegraph_table1:
     input:
-        runs=[f"results/facegraph/runs/{c['name']}.json" for c in FG_TABLE_CONFIGS],
-        db="results/facegraph/preprocessed.npz",
+        runs=[R(f"facegraph/runs/{c['name']}.json") for c in FG_TABLE_CONFIGS],
+        db=R("facegraph/preprocessed.npz"),
     output:
         csv=report(
-            "results/facegraph/table1.csv",
+            R("facegraph/table1.csv"),
             caption="../report/facegraph_table1.rst",
             category="Facegraph",
             subcategory="Table 1",
         ),
-        md="results/facegraph/table1.md",
-        timing="results/facegraph/table1_timing.csv",
+        md=R("facegraph/table1.md"),
+        timing=R("facegraph/table1_timing.csv"),
         thresholds=report(
-            "results/facegraph/thresholds.csv",
+            R("facegraph/thresholds.csv"),
             caption="../report/facegraph_thresholds.rst",
             category="Facegraph",
             subcategory="Table 1",
         ),
-        thresholds_md="results/facegraph/thresholds.md",
+        thresholds_md=R("facegraph/thresholds.md"),
     params:
         order=[c["name"] for c in FG_TABLE_CONFIGS],
         paper=FG["paper_table1"],
@@ -142,9 +142,9 @@ rule facegraph_table1:
         mem_mb=500,
         runtime=5,
     log:
-        "logs/facegraph/table1.log",
+        L("facegraph/table1.log"),
     benchmark:
-        "benchmarks/rules/facegraph/table1.tsv"
+        B("facegraph/table1.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -155,19 +155,19 @@ if FG_SWEEP_CONFIGS:
 
     rule facegraph_sweep:
         input:
-            runs=[f"results/facegraph/runs/{c['name']}.json" for c in FG_SWEEP_CONFIGS],
-            db="results/facegraph/preprocessed.npz",
+            runs=[R(f"facegraph/runs/{c['name']}.json") for c in FG_SWEEP_CONFIGS],
+            db=R("facegraph/preprocessed.npz"),
         output:
             csv=report(
-                "results/facegraph/sweep.csv",
+                R("facegraph/sweep.csv"),
                 caption="../report/facegraph_table1.rst",
                 category="Facegraph",
                 subcategory="Table 1",
             ),
-            md="results/facegraph/sweep.md",
-            timing="results/facegraph/sweep_timing.csv",
-            thresholds="results/facegraph/sweep_thresholds.csv",
-            thresholds_md="results/facegraph/sweep_thresholds.md",
+            md=R("facegraph/sweep.md"),
+            timing=R("facegraph/sweep_timing.csv"),
+            thresholds=R("facegraph/sweep_thresholds.csv"),
+            thresholds_md=R("facegraph/sweep_thresholds.md"),
         params:
             order=[c["name"] for c in FG_SWEEP_CONFIGS],
             paper=None,
@@ -177,9 +177,9 @@ if FG_SWEEP_CONFIGS:
             mem_mb=500,
             runtime=5,
         log:
-            "logs/facegraph/sweep.log",
+            L("facegraph/sweep.log"),
         benchmark:
-            "benchmarks/rules/facegraph/sweep.tsv"
+            B("facegraph/sweep.tsv")
         conda:
             "../envs/animsynth.yaml"
         script:
@@ -188,17 +188,17 @@ if FG_SWEEP_CONFIGS:
 
 rule facegraph_baseline:
     input:
-        db="results/facegraph/preprocessed.npz",
+        db=R("facegraph/preprocessed.npz"),
         graphs=FG_SHOWCASE_GRAPH,
     output:
         csv=report(
-            "results/facegraph/baseline.csv",
+            R("facegraph/baseline.csv"),
             caption="../report/facegraph_baseline.rst",
             category="Facegraph",
             subcategory="Baseline",
         ),
-        md="results/facegraph/baseline.md",
-        timing="results/facegraph/baseline_timing.csv",
+        md=R("facegraph/baseline.md"),
+        timing=R("facegraph/baseline_timing.csv"),
     params:
         cfg={k: FG[k] for k in ("baseline", "synthesis", "evaluation")},
         showcase=FG_SHOWCASE,
@@ -208,9 +208,9 @@ rule facegraph_baseline:
         mem_mb=lambda wc, attempt: 3000 * attempt,
         runtime=lambda wc, attempt: int(30 * FG_SCALE * attempt),
     log:
-        "logs/facegraph/baseline.log",
+        L("facegraph/baseline.log"),
     benchmark:
-        "benchmarks/rules/facegraph/baseline.tsv"
+        B("facegraph/baseline.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -219,17 +219,17 @@ rule facegraph_baseline:
 
 rule facegraph_uniqueness:
     input:
-        db="results/facegraph/preprocessed.npz",
+        db=R("facegraph/preprocessed.npz"),
         graphs=FG_SHOWCASE_GRAPH,
     output:
         csv=report(
-            "results/facegraph/uniqueness.csv",
+            R("facegraph/uniqueness.csv"),
             caption="../report/facegraph_uniqueness.rst",
             category="Facegraph",
             subcategory="Uniqueness",
         ),
-        md="results/facegraph/uniqueness.md",
-        pairs="results/facegraph/uniqueness_pairs.csv",
+        md=R("facegraph/uniqueness.md"),
+        pairs=R("facegraph/uniqueness_pairs.csv"),
     params:
         cfg={k: FG[k] for k in ("uniqueness", "synthesis")},
         seed=seed_for("facegraph", FG["seed"], "uniqueness"),
@@ -238,9 +238,9 @@ rule facegraph_uniqueness:
         mem_mb=lambda wc, attempt: 800 * attempt,
         runtime=lambda wc, attempt: int(15 * FG_SCALE * attempt),
     log:
-        "logs/facegraph/uniqueness.log",
+        L("facegraph/uniqueness.log"),
     benchmark:
-        "benchmarks/rules/facegraph/uniqueness.tsv"
+        B("facegraph/uniqueness.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -249,23 +249,23 @@ rule facegraph_uniqueness:
 
 rule facegraph_figures:
     input:
-        db="results/facegraph/preprocessed.npz",
+        db=R("facegraph/preprocessed.npz"),
         graphs=FG_SHOWCASE_GRAPH,
     output:
         graph=report(
-            "results/facegraph/region_graphs.png",
+            R("facegraph/region_graphs.png"),
             caption="../report/facegraph_region_graphs.rst",
             category="Facegraph",
             subcategory="Figures",
         ),
         trajectories=report(
-            "results/facegraph/trajectories.png",
+            R("facegraph/trajectories.png"),
             caption="../report/facegraph_trajectories.rst",
             category="Facegraph",
             subcategory="Figures",
         ),
         gif=report(
-            "results/facegraph/sequence.gif",
+            R("facegraph/sequence.gif"),
             caption="../report/facegraph_sequence.rst",
             category="Facegraph",
             subcategory="Figures",
@@ -280,9 +280,9 @@ rule facegraph_figures:
         mem_mb=lambda wc, attempt: 1000 * attempt,
         runtime=lambda wc, attempt: int(15 * FG_SCALE * attempt),
     log:
-        "logs/facegraph/figures.log",
+        L("facegraph/figures.log"),
     benchmark:
-        "benchmarks/rules/facegraph/figures.tsv"
+        B("facegraph/figures.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -291,18 +291,18 @@ rule facegraph_figures:
 
 rule facegraph_verdicts:
     input:
-        table1="results/facegraph/table1.csv",
-        baseline="results/facegraph/baseline.csv",
-        uniqueness="results/facegraph/uniqueness.csv",
-        samples=[f"results/facegraph/runs/{c['name']}_samples.csv" for c in FG_TABLE_CONFIGS],
+        table1=R("facegraph/table1.csv"),
+        baseline=R("facegraph/baseline.csv"),
+        uniqueness=R("facegraph/uniqueness.csv"),
+        samples=[R(f"facegraph/runs/{c['name']}_samples.csv") for c in FG_TABLE_CONFIGS],
     output:
         csv=report(
-            "results/facegraph/verdicts.csv",
+            R("facegraph/verdicts.csv"),
             caption="../report/facegraph_verdicts.rst",
             category="Facegraph",
             subcategory="Verdicts",
         ),
-        md="results/facegraph/verdicts.md",
+        md=R("facegraph/verdicts.md"),
     params:
         source=FG_SOURCE,
         order=[c["name"] for c in FG_TABLE_CONFIGS],
@@ -311,9 +311,9 @@ rule facegraph_verdicts:
         mem_mb=lambda wc, attempt: 500 * attempt,
         runtime=lambda wc, attempt: int(5 * FG_SCALE * attempt),
     log:
-        "logs/facegraph/verdicts.log",
+        L("facegraph/verdicts.log"),
     benchmark:
-        "benchmarks/rules/facegraph/verdicts.tsv"
+        B("facegraph/verdicts.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -321,35 +321,35 @@ rule facegraph_verdicts:
 
 
 FACEGRAPH_TARGETS = [
-    "results/facegraph/database.csv",
-    "results/facegraph/table1.csv",
-    "results/facegraph/thresholds.csv",
-    "results/facegraph/baseline.csv",
-    "results/facegraph/uniqueness.csv",
-    "results/facegraph/region_graphs.png",
-    "results/facegraph/trajectories.png",
-    "results/facegraph/sequence.gif",
-    "results/facegraph/verdicts.csv",
-] + (["results/facegraph/sweep.csv"] if FG_SWEEP_CONFIGS else [])
+    R("facegraph/database.csv"),
+    R("facegraph/table1.csv"),
+    R("facegraph/thresholds.csv"),
+    R("facegraph/baseline.csv"),
+    R("facegraph/uniqueness.csv"),
+    R("facegraph/region_graphs.png"),
+    R("facegraph/trajectories.png"),
+    R("facegraph/sequence.gif"),
+    R("facegraph/verdicts.csv"),
+] + ([R("facegraph/sweep.csv")] if FG_SWEEP_CONFIGS else [])
 _FG_DATA_NOTE = (
     "Synthetic CK+-layout data generated by the workflow, not CK+." if FG_SYNTHETIC else f"Data: {FG_SOURCE}."
 )
 FACEGRAPH_SUMMARY = [
     {
         "title": "Serra et al. 2018 Table 1: region motion graphs for the paper's 15 configurations",
-        "csv": "results/facegraph/table1.csv",
+        "csv": R("facegraph/table1.csv"),
         "note": f"{_FG_DATA_NOTE} paper_* columns: the published values (facegraph.paper_table1), empty if that "
         "file is missing. Creation/synthesis times (CPU and wall) are in table1_timing.csv.",
     },
     {
         "title": "Facegraph: face graph (Zhang et al. 2004) vs region graphs",
-        "csv": "results/facegraph/baseline.csv",
+        "csv": R("facegraph/baseline.csv"),
         "note": f"{_FG_DATA_NOTE} Path-finding times (and the paper's ~1.9 s) are in baseline_timing.csv.",
     },
     {
         "title": "Facegraph: distinct animations from one label sequence",
-        "csv": "results/facegraph/uniqueness.csv",
+        "csv": R("facegraph/uniqueness.csv"),
         "note": _FG_DATA_NOTE,
     },
 ]
-FACEGRAPH_VERDICTS = ["results/facegraph/verdicts.csv"]
+FACEGRAPH_VERDICTS = [R("facegraph/verdicts.csv")]

@@ -46,7 +46,7 @@ RESEQ_PATH_CFG = {
 RESEQ_TABLES_CFG = {
     k: RESEQ[k] for k in ("frame_step", "explanations", "verdict_share", "verdict_alpha", "lee")
 }
-RESEQ_WORK = "results/resequencing/work"
+RESEQ_WORK = R("resequencing/work")
 RESEQ_CONFIGS = [
     (d, m, x, g) for d in RESEQ_DATASETS for m in RESEQ_METHODS for x in RESEQ_METRICS for g in RESEQ_GDOF
 ]
@@ -64,9 +64,9 @@ rule resequencing_analyse:
         trial=lambda wc: RESEQ_TRIALS[wc.rsdata],
         cfg=RESEQ_ANALYSE_CFG,
     log:
-        "logs/resequencing/analyse/{rsdata}_{rsgdof}.log",
+        L("resequencing/analyse/{rsdata}_{rsgdof}.log"),
     benchmark:
-        "benchmarks/rules/resequencing/analyse/{rsdata}_{rsgdof}.tsv"
+        B("resequencing/analyse/{rsdata}_{rsgdof}.tsv")
     threads: 1
     resources:
         mem_mb=800,
@@ -87,9 +87,9 @@ rule resequencing_explain:
         trial=lambda wc: RESEQ_TRIALS[wc.rsdata],
         cfg=RESEQ_EXPLAIN_CFG,
     log:
-        "logs/resequencing/explain/{rsdata}.log",
+        L("resequencing/explain/{rsdata}.log"),
     benchmark:
-        "benchmarks/rules/resequencing/explain/{rsdata}.tsv"
+        B("resequencing/explain/{rsdata}.tsv")
     threads: 1
     resources:
         mem_mb=800,
@@ -105,18 +105,18 @@ rule resequencing_path:
         npz=lambda wc: trial_npz(RESEQ_TRIALS[wc.rsdata]),
         min_k=f"{RESEQ_WORK}/{{rsdata}}_{{rsgdof}}_min_k.csv",
     output:
-        csv="results/resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.csv",
-        bvh="results/resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.bvh",
-        gif="results/resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.gif",
+        csv=R("resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.csv"),
+        bvh=R("resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.bvh"),
+        gif=R("resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.gif"),
         smooth=f"{RESEQ_WORK}/{{rsdata}}_{{rsmethod}}_{{rsmetric}}_{{rsgdof}}_smoothness.csv",
         transitions=f"{RESEQ_WORK}/{{rsdata}}_{{rsmethod}}_{{rsmetric}}_{{rsgdof}}_transitions.csv",
     params:
         cfg=RESEQ_PATH_CFG,
         seed=lambda wc: seed_for("resequencing", "pairs", wc.rsdata),
     log:
-        "logs/resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.log",
+        L("resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.log"),
     benchmark:
-        "benchmarks/rules/resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.tsv"
+        B("resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.tsv")
     threads: 1
     resources:
         mem_mb=1000,
@@ -133,7 +133,7 @@ rule resequencing_fig2:
         min_k=expand(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{g}}_min_k.csv", g=RESEQ_GDOF),
     output:
         report(
-            "results/resequencing/figures/fig2_{rsdata}_{rsmethod}.png",
+            R("resequencing/figures/fig2_{rsdata}_{rsmethod}.png"),
             caption="../report/resequencing_fig2.rst",
             category="Re-sequencing",
             subcategory="Fig 2 embeddings",
@@ -141,9 +141,9 @@ rule resequencing_fig2:
     params:
         metrics=RESEQ_METRICS,
     log:
-        "logs/resequencing/fig2/{rsdata}_{rsmethod}.log",
+        L("resequencing/fig2/{rsdata}_{rsmethod}.log"),
     benchmark:
-        "benchmarks/rules/resequencing/fig2/{rsdata}_{rsmethod}.tsv"
+        B("resequencing/fig2/{rsdata}_{rsmethod}.tsv")
     threads: 1
     resources:
         mem_mb=600,
@@ -159,15 +159,15 @@ rule resequencing_fig3:
         expand(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{g}}_residual_variance.csv", g=RESEQ_GDOF),
     output:
         report(
-            "results/resequencing/figures/fig3_residual_variance_{rsdata}.png",
+            R("resequencing/figures/fig3_residual_variance_{rsdata}.png"),
             caption="../report/resequencing_fig3.rst",
             category="Re-sequencing",
             subcategory="Fig 3 residual variance",
         ),
     log:
-        "logs/resequencing/fig3/{rsdata}.log",
+        L("resequencing/fig3/{rsdata}.log"),
     benchmark:
-        "benchmarks/rules/resequencing/fig3/{rsdata}.tsv"
+        B("resequencing/fig3/{rsdata}.tsv")
     threads: 1
     resources:
         mem_mb=600,
@@ -189,57 +189,57 @@ rule resequencing_tables:
         transitions=[f"{RESEQ_WORK}/{d}_{m}_{x}_{g}_transitions.csv" for d, m, x, g in RESEQ_CONFIGS],
     output:
         table2=report(
-            "results/resequencing/table2_min_k.csv",
+            R("resequencing/table2_min_k.csv"),
             caption="../report/resequencing_table2.rst",
             category="Re-sequencing",
             subcategory="Table 2 minimum k",
         ),
-        table2_md="results/resequencing/table2_min_k.md",
+        table2_md=R("resequencing/table2_min_k.md"),
         explanations=report(
-            "results/resequencing/min_k_explanations.csv",
+            R("resequencing/min_k_explanations.csv"),
             caption="../report/resequencing_explanations.rst",
             category="Re-sequencing",
             subcategory="Table 2 minimum k",
         ),
-        explanations_md="results/resequencing/min_k_explanations.md",
+        explanations_md=R("resequencing/min_k_explanations.md"),
         flips=report(
-            "results/resequencing/sign_flips.csv",
+            R("resequencing/sign_flips.csv"),
             caption="../report/resequencing_sign_flips.rst",
             category="Re-sequencing",
             subcategory="Table 2 minimum k",
         ),
-        lee_weights="results/resequencing/lee_weights.csv",
+        lee_weights=R("resequencing/lee_weights.csv"),
         rv=report(
-            "results/resequencing/residual_variance.csv",
+            R("resequencing/residual_variance.csv"),
             caption="../report/resequencing_residual_variance.rst",
             category="Re-sequencing",
             subcategory="Fig 3 residual variance",
         ),
         smooth=report(
-            "results/resequencing/smoothness.csv",
+            R("resequencing/smoothness.csv"),
             caption="../report/resequencing_smoothness.rst",
             category="Re-sequencing",
             subcategory="Smoothness",
         ),
-        smooth_md="results/resequencing/smoothness.md",
-        smooth_paths="results/resequencing/smoothness_paths.csv",
-        smooth_transitions="results/resequencing/smoothness_transitions.csv",
+        smooth_md=R("resequencing/smoothness.md"),
+        smooth_paths=R("resequencing/smoothness_paths.csv"),
+        smooth_transitions=R("resequencing/smoothness_transitions.csv"),
         verdicts=report(
-            "results/resequencing/verdicts.csv",
+            R("resequencing/verdicts.csv"),
             caption="../report/resequencing_verdicts.rst",
             category="Re-sequencing",
             subcategory="Verdicts",
         ),
-        verdicts_md="results/resequencing/verdicts.md",
-        timing="results/resequencing/resequencing_timing.csv",
+        verdicts_md=R("resequencing/verdicts.md"),
+        timing=R("resequencing/resequencing_timing.csv"),
     params:
         cfg=RESEQ_TABLES_CFG,
         published=RESEQ["published"],
         trials={d: RESEQ_TRIALS[d] for d in RESEQ_DATASETS},
     log:
-        "logs/resequencing/tables.log",
+        L("resequencing/tables.log"),
     benchmark:
-        "benchmarks/rules/resequencing/tables.tsv"
+        B("resequencing/tables.tsv")
     threads: 1
     resources:
         mem_mb=600,
@@ -252,17 +252,17 @@ rule resequencing_tables:
 
 RESEQUENCING_TARGETS = (
     [
-        "results/resequencing/table2_min_k.csv",
-        "results/resequencing/min_k_explanations.csv",
-        "results/resequencing/sign_flips.csv",
-        "results/resequencing/residual_variance.csv",
-        "results/resequencing/smoothness.csv",
-        "results/resequencing/verdicts.csv",
+        R("resequencing/table2_min_k.csv"),
+        R("resequencing/min_k_explanations.csv"),
+        R("resequencing/sign_flips.csv"),
+        R("resequencing/residual_variance.csv"),
+        R("resequencing/smoothness.csv"),
+        R("resequencing/verdicts.csv"),
     ]
-    + [f"results/resequencing/figures/fig2_{d}_{m}.png" for d in RESEQ_DATASETS for m in RESEQ_METHODS]
-    + [f"results/resequencing/figures/fig3_residual_variance_{d}.png" for d in RESEQ_DATASETS]
+    + [R(f"resequencing/figures/fig2_{d}_{m}.png") for d in RESEQ_DATASETS for m in RESEQ_METHODS]
+    + [R(f"resequencing/figures/fig3_residual_variance_{d}.png") for d in RESEQ_DATASETS]
     + [
-        f"results/resequencing/paths/{d}_{m}_{x}_{g}.{ext}"
+        R(f"resequencing/paths/{d}_{m}_{x}_{g}.{ext}")
         for d, m, x, g in RESEQ_CONFIGS
         for ext in ("csv", "bvh", "gif")
     ]
@@ -273,16 +273,16 @@ RESEQUENCING_TARGETS = (
 RESEQUENCING_SUMMARY = [
     {
         "title": "Re-sequencing Table 2: smallest k giving one connected neighbourhood graph",
-        "csv": "results/resequencing/table2_min_k.csv",
+        "csv": R("resequencing/table2_min_k.csv"),
         "note": "Exact (MST bottleneck over neighbour ranks), cross-checked with connected_components, in both "
         "linearisation sign modes (continuous = our method; matrix_naive = reproduction of a probable artefact); "
         "min_k_paper from resequencing.published.table2 (empty when the file is absent).",
     },
     {
         "title": "Re-sequencing: smoothness of the re-sequenced motions",
-        "csv": "results/resequencing/smoothness.csv",
+        "csv": R("resequencing/smoothness.csv"),
         "note": "Transition counts over all pairs (end before start); per-transition smoothness means over the "
         "re-sequencing paths only; ratios against the original capture.",
     },
 ]
-RESEQUENCING_VERDICTS = ["results/resequencing/verdicts.csv"]
+RESEQUENCING_VERDICTS = [R("resequencing/verdicts.csv")]
