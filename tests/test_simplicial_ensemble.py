@@ -191,3 +191,12 @@ def test_single_path_fast_route_equals_follow_field(method):
         b = follow_batch(f, start[None], 60)
         np.testing.assert_allclose(b.points[:, 0], one.points, rtol=0, atol=1e-9)
         assert (b.fallback[:, 0] == one.fallback).all()
+
+
+def test_k_not_below_the_training_frames_is_refused_with_the_key(monkeypatch):
+    from animsynth.simplicial import jobs
+
+    trials = _trials(n=2, frames=10)
+    monkeypatch.setattr(jobs, "load_trials", lambda paths, ids: (trials, {}))
+    with pytest.raises(ValueError, match=r"'simplicial.k' = 16 must be below the 10 training frames of fold w1/t1"):
+        jobs.run_main_fold([], ["t0", "t1"], "w1", "t1", {"k": 16}, seed=1)

@@ -184,6 +184,9 @@ class VectorField:
         if self.tree_ is None:  # one k-d tree per triangulation, shared by every field built on it
             self.tree_ = tri._field_tree = cKDTree(self.points_)
         self.k_eff_ = int(min(self.k, u))
+        if self.k_eff_ < self.k:  # documented fallback: merged duplicates leave fewer distinct points than k
+            log.warning("VectorField: k = %d but only %d distinct points after merging duplicates; using k = %d",
+                        self.k, u, self.k_eff_)
         self.hit_tol_ = tri.tol_
         self.dim_ = x.shape[1]
         self.scale_ = bbox_diagonal(x)

@@ -57,6 +57,10 @@ def run_main_fold(paths, ids, dataset: str, fold: str, cfg: dict, seed: int):
     if fold not in angles:
         raise ValueError(f"fold {fold!r} is not a trial of subset {dataset!r} ({ids})")
     train = [angles[t] for t in ids if t != fold]
+    n_train = sum(len(a) for a in train)
+    if int(cfg["k"]) >= n_train:
+        raise ValueError(f"config key 'simplicial.k' = {cfg['k']} must be below the {n_train} training frames "
+                         f"of fold {dataset}/{fold}")
     ens = cfg["ensemble"]
     variants = [main_variant(cfg, m) for m in cfg["methods"]]
     rows, members = ex.run_fold_ensemble(
