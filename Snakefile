@@ -30,7 +30,14 @@ include: "workflow/rules/meshdetail.smk"
 include: "workflow/rules/report.smk"
 
 
+# Scale study (config/scale.yaml): opt-in; when enabled the run builds only its outputs.
+SCALE_ON = bool(config.get("scale", {}).get("enabled", False))
+if SCALE_ON:
+
+    include: "workflow/rules/scale.smk"
+
+
 rule all:
     input:
-        all_targets(),
+        SCALE_TARGETS if SCALE_ON else all_targets(),
     default_target: True

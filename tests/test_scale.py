@@ -220,3 +220,53 @@ def test_bad_input_gives_clear_errors():
     X[3, 1] = np.nan
     with pytest.raises(ValueError, match="frame 3 has a non-finite feature"):
         sparse.l2_neighbours(X, 5)
+
+
+# ----------------------------------------------------------------------------- workflow
+
+
+SMOKE = {
+    "scale": {
+        "enabled": True,
+        "trial_frames": 300,
+        "resequencing": {"sizes": [600, 1200], "n_landmarks": 60, "exact_max_frames": 800},
+        "simplicial": {"sizes": [200, 400], "path_steps": 50, "trial_frames": 100},
+        "facegraph": {"sizes": [8, 16]},
+        "meshdetail": {"sizes": [20, 40], "resolutions": [0.5], "iterations": 5},
+        "landmark_vs_exact": {"sizes": [600], "n_landmarks": [30, 60], "landmark_seeds": 2, "max_dim": 3, "pairs": 4},
+        "benchmark": {"frames": 2000},
+    }
+}
+
+
+@pytest.mark.workflow
+def test_scale_workflow_builds_curves_landmark_table_and_benchmark_rows(tmp_path):
+    import pandas as pd
+    import yaml
+
+    from conftest import copy_workflow, run_snakemake
+
+    wd = copy_workflow(tmp_path)
+    (wd / "config" / "scale_smoke.yaml").write_text(yaml.safe_dump(SMOKE, sort_keys=False))
+    res = run_snakemake(wd, "--configfile", "config/scale.yaml", "config/scale_smoke.yaml", timeout=1500)
+    assert res.returncode == 0, (res.stdout + res.stderr)[-5000:]
+    out = wd / "results" / "scale"
+    # only the scale outputs are built with the scale config
+    assert not (wd / "results" / "simplicial").exists()
+    curves = pd.read_csv(out / "cost_curves.csv")
+    assert list(curves.columns[:6]) == ["family", "step", "n", "cpu_s", "wall_s", "peak_mb"]
+    assert set(curves["family"]) == {"simplicial", "resequencing", "facegraph", "meshdetail"}
+    assert set(curves.loc[curves.family == "resequencing", "step"]) == {"neighbours", "min_k", "embedding", "path"}
+    emb = curves[(curves.family == "resequencing") & (curves.step == "embedding")].set_index("n")
+    assert emb.loc[600, "embedding_method"] == "exact" and emb.loc[1200, "embedding_method"] == "landmark"
+    assert (curves["peak_mb"] > 50).all()  # a Python process with numpy holds more than 50 MB
+    ex = pd.read_csv(out / "cost_exponents.csv")
+    assert (ex["sizes"] == 2).all()
+    lve = pd.read_csv(out / "landmark_vs_exact.csv")
+    assert len(lve) == 4 and (lve["min_k_dense"] == lve["min_k_sparse"]).all()
+    assert (lve["path_cost_max_rel_diff"] < 1e-9).all()
+    assert (lve["procrustes_2d"] < 0.1).all()
+    bench = pd.read_csv(out / "benchmarks.csv")
+    assert list(bench["benchmark"]) == ["reseq_2k_frames_total_s", "reseq_2k_frames_peak_mb"]
+    assert (bench["family"] == "resequencing").all()
+    assert (out / "cost_curves.png").stat().st_size > 5000
