@@ -159,10 +159,9 @@ def test_landmark_with_every_frame_a_landmark_is_exact_isomap():
     assert procrustes(Ye, li.embedding_)[2] < 1e-10
 
 
-@pytest.mark.parametrize("seed", [0, 1])
-@pytest.mark.parametrize("how", ["maxmin", "random"])
+@pytest.mark.parametrize("seed,how", [(0, "maxmin"), (1, "random")])
 def test_landmark_embedding_agrees_with_exact_on_small_data(seed, how):
-    X = _swiss_roll(1500, seed)
+    X = _swiss_roll(1000, seed)
     dist, idx = sparse.l2_neighbours(X, 10)
     G = sparse.sparse_knn_graph(dist, idx, 10)
     exact = landmark.embed(G, 2, method="exact")
