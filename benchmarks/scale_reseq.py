@@ -22,7 +22,7 @@ import sys
 from animsynth import scale
 
 DEFAULT_CFG = {"trial_frames": 1000,
-               "resequencing": {"metric": "l2", "method": "isomap", "n_candidates": 20, "n_landmarks": 500,
+               "resequencing": {"metric": "l2", "method": "isomap", "n_candidates": 20, "k": 10, "n_landmarks": 500,
                                 "landmarks": "maxmin", "exact_max_frames": 4000},
                "benchmark": {"target_cpu_s": 300, "target_peak_mb": 4000}}
 
@@ -31,7 +31,7 @@ def run(frames: int = 100_000, cfg: dict | None = None, seed: int = 0, cmu_mirro
     cfg = cfg or DEFAULT_CFG
     c = cfg["resequencing"]
     rows = scale.measure("resequencing_steps", n=int(frames), metric=c["metric"], method=c["method"],
-                         n_candidates=c["n_candidates"], embedding="landmark", exact_max_frames=c["exact_max_frames"],
+                         n_candidates=c["n_candidates"], k=c["k"], embedding="landmark", exact_max_frames=c["exact_max_frames"],
                          n_landmarks=c["n_landmarks"], landmarks=c["landmarks"], seed=seed,
                          trial_frames=cfg["trial_frames"], cmu_mirror=cmu_mirror)
     n = rows[0]["n"]
@@ -41,7 +41,7 @@ def run(frames: int = 100_000, cfg: dict | None = None, seed: int = 0, cmu_mirro
     peak = max(r["peak_mb"] for r in rows)
     steps = "; ".join(f"{r['step']} {r['cpu_s']:.1f} s CPU / {r['peak_mb']:.0f} MB" for r in rows)
     t_cpu, t_mb = float(cfg["benchmark"]["target_cpu_s"]), float(cfg["benchmark"]["target_peak_mb"])
-    info = {"metric": c["metric"], "method": c["method"], "min_k": rows[1].get("min_k"),
+    info = {"metric": c["metric"], "method": c["method"], "min_k": rows[1].get("min_k"), "k": rows[0].get("k"),
             "embedding_method": rows[2].get("embedding_method"), "steps": steps, "wall_s": round(wall, 2)}
     base = "dense N x N pipeline: not run (N^2 memory; ~28 GB at 22,000 frames)"
     return [

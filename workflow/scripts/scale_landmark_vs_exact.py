@@ -8,7 +8,7 @@ cfg = snakemake.params.cfg
 c, r = cfg["landmark_vs_exact"], cfg["resequencing"]
 seed = int(snakemake.params.seed)
 summary, rv = scale.landmark_vs_exact(int(snakemake.wildcards.scn), metric="l2", method="isomap",
-                                      n_candidates=r["n_candidates"], n_landmarks=c["n_landmarks"],
+                                      n_candidates=r["n_candidates"], k=r["k"], n_landmarks=c["n_landmarks"],
                                       seeds=[seed + s for s in range(int(c["landmark_seeds"]))],
                                       max_dim=c["max_dim"], pairs=c["pairs"], seed=seed,
                                       trial_frames=cfg["trial_frames"], cmu_mirror=snakemake.params.mirror)

@@ -16,7 +16,7 @@ seed = int(snakemake.params.seed)
 if fam == "resequencing":
     c = cfg["resequencing"]
     rows = scale.measure("resequencing_steps", n=n, metric=c["metric"], method=c["method"],
-                         n_candidates=c["n_candidates"], embedding=c["embedding"],
+                         n_candidates=c["n_candidates"], k=c["k"], embedding=c["embedding"],
                          exact_max_frames=c["exact_max_frames"], n_landmarks=c["n_landmarks"],
                          landmarks=c["landmarks"], seed=seed, trial_frames=cfg["trial_frames"],
                          cmu_mirror=snakemake.params.mirror)

@@ -146,6 +146,7 @@ class LandmarkIsomap:
     landmarks : "maxmin" or "random"
     seed : int, seeds the first MaxMin landmark / the random sample
     blas_threads : int or None, BLAS threads for the eigendecomposition
+    eigen_tol : float, components whose eigenvalue is <= eigen_tol x the largest get coordinate 0
 
     Attributes
     ----------
@@ -157,7 +158,8 @@ class LandmarkIsomap:
     """
 
     def __init__(self, n_components: int = 2, n_landmarks: int = 500, landmarks: str = "maxmin", seed: int = 0,
-                 blas_threads: int | None = 1):
+                 blas_threads: int | None = 1, eigen_tol: float = 1e-9):
+        self.eigen_tol = eigen_tol
         self.n_components = n_components
         self.n_landmarks = n_landmarks
         self.landmarks = landmarks
@@ -179,10 +181,18 @@ class LandmarkIsomap:
         with threadpool_limits(limits=self.blas_threads, user_api="blas"):
             lam, V = eigh(B, subset_by_index=[nl - d, nl - 1])
         lam, V = lam[::-1], V[:, ::-1]
-        if np.any(lam <= 0):
-            raise ValueError(f"landmark MDS has only {int(np.sum(lam > 0))} positive eigenvalues; "
-                             f"use fewer components or more landmarks")
-        Lsharp = V.T / np.sqrt(lam)[:, None]  # (d, nl)
+        if not lam[0] > 0:
+            raise ValueError("landmark MDS has no positive eigenvalue (all landmarks at one point?)")
+        # Directions with (numerically) zero or negative eigenvalues carry no
+        # geometry; triangulating along them divides rounding noise by
+        # sqrt(lambda). They get coordinate 0 (e.g. a chain-like graph is 1-D).
+        keep = lam > self.eigen_tol * lam[0]
+        if not keep.all():
+            log.info("landmark MDS: %d of %d components have eigenvalue <= %.0e x the largest; set to 0",
+                     int((~keep).sum()), d, self.eigen_tol)
+        Lsharp = np.zeros((d, nl))
+        Lsharp[keep] = V.T[keep] / np.sqrt(lam[keep])[:, None]  # (d, nl)
+        lam = np.where(keep, lam, 0.0)
         mu = D2.mean(axis=0)
         Y = np.empty((n, d))
         step = 20_000
