@@ -35,7 +35,7 @@ pytestmark = pytest.mark.slurm
 SCRIPTS = REPO / "tests" / "slurm"
 CLUSTER_TOOLS = ("munged", "slurmctld", "slurmd", "sbatch", "squeue", "sinfo", "scontrol", "srun")
 # Test-cluster settings on top of the profile: no slurmdbd here, so sacct does
-# not work and the plugin must poll squeue (MinJobAge=600 keeps finished jobs
+# not work and the plugin must poll squeue (MinJobAge=14400 keeps finished jobs
 # visible); poll every 2 s instead of 40 s; keep the SLURM logs to inspect.
 SLURM_TEST_ARGS = (
     "--slurm-status-command", "squeue",
@@ -123,7 +123,7 @@ def slurm_cluster(tmp_path_factory, request):
 
 
 def _squeue(env) -> dict[str, dict]:
-    """Every job slurmctld still knows (MinJobAge=600): id -> state, comment, limits."""
+    """Every job slurmctld still knows (MinJobAge=14400): id -> state, comment, limits."""
     res = subprocess.run(_timed(30, "squeue", "-h", "-t", "all", "-o", "%i|%T|%k|%l|%m|%C"),
                          env=env, capture_output=True, text=True, timeout=60)
     assert res.returncode == 0, res.stderr
