@@ -273,7 +273,9 @@ def test_scale_workflow_builds_curves_landmark_table_and_benchmark_rows(tmp_path
     assert emb.loc[600, "embedding_method"] == "exact" and emb.loc[1200, "embedding_method"] == "landmark"
     assert (curves["peak_mb"] > 50).all()  # a Python process with numpy holds more than 50 MB
     ex = pd.read_csv(out / "cost_exponents.csv")
-    assert (ex["sizes"] == 2).all()
+    emb_rows = ex["step"] == "embedding"  # exact at 600 frames, landmark at 1200: one point per curve
+    assert (ex.loc[~emb_rows, "sizes"] == 2).all() and (ex.loc[emb_rows, "sizes"] == 1).all()
+    assert ex.loc[emb_rows, "cpu_exponent"].isna().all() and ex.loc[~emb_rows, "cpu_exponent"].notna().all()
     lve = pd.read_csv(out / "landmark_vs_exact.csv")
     assert len(lve) == 4 and (lve["min_k_dense"] == lve["min_k_sparse"]).all()
     assert (lve["path_cost_max_rel_diff"] < 1e-9).all()

@@ -312,8 +312,11 @@ def fit_exponent(n, t) -> float:
 
 
 def exponents(curves: pd.DataFrame) -> pd.DataFrame:
-    """Fitted exponent of CPU time and of peak memory per family x step (and resolution)."""
-    keys = [c for c in ("family", "step", "resolution", "metric", "method") if c in curves.columns]
+    """Fitted exponent of CPU time and of peak memory per family x step (x resolution, metric, method,
+    embedding method); NaN where a curve has fewer than two sizes."""
+    # embedding_method: the re-sequencing embedding switches from exact to landmark at a size;
+    # one exponent across the switch would describe neither
+    keys = [c for c in ("family", "step", "resolution", "metric", "method", "embedding_method") if c in curves.columns]
     rows = []
     for key, g in curves.groupby(keys, dropna=False, sort=False):
         key = key if isinstance(key, tuple) else (key,)
@@ -334,7 +337,8 @@ def plot_curves(curves: pd.DataFrame, path) -> None:
     fig, axes = plt.subplots(1, max(1, len(fams)), figsize=(4.2 * max(1, len(fams)), 3.6), squeeze=False)
     for ax, fam in zip(axes[0], fams):
         g = curves[curves["family"] == fam]
-        keys = [c for c in ("step", "resolution", "metric", "method") if c in g.columns and g[c].notna().any()]
+        keys = [c for c in ("step", "resolution", "metric", "method", "embedding_method")
+                if c in g.columns and g[c].notna().any()]
         for key, h in g.groupby(keys, dropna=False, sort=False):
             key = key if isinstance(key, tuple) else (key,)
             h = h.sort_values("n")
