@@ -38,9 +38,16 @@ include: "workflow/rules/meshdetail.smk"
 include: "workflow/rules/report.smk"
 
 
+# Scale study (config/scale.yaml): opt-in; when enabled the run builds only its outputs.
+SCALE_ON = bool(config.get("scale", {}).get("enabled", False))
+if SCALE_ON:
+
+    include: "workflow/rules/scale.smk"
+
+
 # The target rule runs nothing: it is local, so it needs no threads/resources.
 rule all:
     input:
-        all_targets(),
+        SCALE_TARGETS if SCALE_ON else all_targets(),
     default_target: True
     localrule: True

@@ -24,7 +24,8 @@
 #   ProctrackType=proctrack/linuxproc, TaskPlugin=task/none,
 #   JobAcctGatherType=jobacct_gather/none, AccountingStorageType=accounting_storage/none;
 #   RealMemory from `slurmd -C` (more than that and the node drains);
-#   MinJobAge=600 so finished jobs stay visible to `squeue` (no sacct here).
+#   MinJobAge=14400 so finished jobs stay visible to `squeue` (no sacct here) for
+#   the whole tiny workflow run (the test lists every job it submitted).
 set -euo pipefail
 
 STATE=${1:?usage: setup_cluster.sh STATE_DIR}
@@ -178,7 +179,7 @@ SchedulerType=sched/backfill
 SelectType=select/cons_tres
 SelectTypeParameters=CR_Core_Memory
 DefMemPerCPU=512
-MinJobAge=600
+MinJobAge=14400
 ReturnToService=2
 SlurmdTimeout=300
 InactiveLimit=0
