@@ -7,8 +7,8 @@ results/benchmarks.csv:
 * ``reseq_<N>_frames_total_s``: CPU seconds of neighbours (index + features),
   exact minimum k, Landmark Isomap embedding and one Dijkstra path, measured in
   a fresh process (:func:`animsynth.scale.measure`). Target <= 300 s.
-  Baseline: the dense pipeline's cost extrapolated from the issue's
-  measurements is not run (28 GB at 22,000 frames); ``baseline`` says so.
+  Baseline: the dense pipeline (28 GB extrapolated at 22,000 frames from earlier
+  measurements) is not run; ``baseline`` says so.
 * ``reseq_<N>_frames_peak_mb``: the largest per-step peak resident memory of
   that process (interpreter and libraries included). Target <= 4,000 MB.
 

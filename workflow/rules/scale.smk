@@ -19,12 +19,12 @@ SCALE_POINTS = (
     + [("meshdetail", f"n{n}_r{r}") for n in SCALE["meshdetail"]["sizes"] for r in SCALE["meshdetail"]["resolutions"]]
 )
 SCALE_TARGETS = [
-    "results/scale/cost_curves.csv",
-    "results/scale/cost_exponents.csv",
-    "results/scale/cost_curves.png",
-    "results/scale/landmark_vs_exact.csv",
-    "results/scale/landmark_vs_exact_rv.csv",
-    "results/scale/benchmarks.csv",
+    R("scale/cost_curves.csv"),
+    R("scale/cost_exponents.csv"),
+    R("scale/cost_curves.png"),
+    R("scale/landmark_vs_exact.csv"),
+    R("scale/landmark_vs_exact_rv.csv"),
+    R("scale/benchmarks.csv"),
 ]
 
 
@@ -36,15 +36,15 @@ wildcard_constraints:
 
 rule scale_measure:
     output:
-        "results/scale/work/{scfamily}_{scpoint}.csv",
+        R("scale/work/{scfamily}_{scpoint}.csv"),
     params:
         cfg=SCALE,
         mirror=SCALE_MIRROR,
         seed=lambda wc: seed_for("scale", wc.scfamily, wc.scpoint),
     log:
-        "logs/scale/measure/{scfamily}_{scpoint}.log",
+        L("scale/measure/{scfamily}_{scpoint}.log"),
     benchmark:
-        "benchmarks/rules/scale/measure/{scfamily}_{scpoint}.tsv"
+        B("scale/measure/{scfamily}_{scpoint}.tsv")
     threads: 1
     resources:
         mem_mb=lambda wc: SCALE["resequencing"]["mem_mb"] if wc.scfamily == "resequencing" else 3000,
@@ -57,23 +57,23 @@ rule scale_measure:
 
 rule scale_curves:
     input:
-        [f"results/scale/work/{f}_{p}.csv" for f, p in SCALE_POINTS],
+        [R(f"scale/work/{f}_{p}.csv") for f, p in SCALE_POINTS],
     output:
-        curves="results/scale/cost_curves.csv",
+        curves=R("scale/cost_curves.csv"),
         exponents=report(
-            "results/scale/cost_exponents.csv",
+            R("scale/cost_exponents.csv"),
             caption="../report/scale_exponents.rst",
             category="6. Scale",
         ),
         plot=report(
-            "results/scale/cost_curves.png",
+            R("scale/cost_curves.png"),
             caption="../report/scale_cost_curves.rst",
             category="6. Scale",
         ),
     log:
-        "logs/scale/curves.log",
+        L("scale/curves.log"),
     benchmark:
-        "benchmarks/rules/scale/curves.tsv"
+        B("scale/curves.tsv")
     threads: 1
     resources:
         mem_mb=1000,
@@ -86,16 +86,16 @@ rule scale_curves:
 
 rule scale_landmark_vs_exact:
     output:
-        summary="results/scale/work/landmark_vs_exact_n{scn}.csv",
-        rv="results/scale/work/landmark_vs_exact_rv_n{scn}.csv",
+        summary=R("scale/work/landmark_vs_exact_n{scn}.csv"),
+        rv=R("scale/work/landmark_vs_exact_rv_n{scn}.csv"),
     params:
         cfg=SCALE,
         mirror=SCALE_MIRROR,
         seed=lambda wc: seed_for("scale", "landmark_vs_exact", wc.scn),
     log:
-        "logs/scale/landmark_vs_exact/n{scn}.log",
+        L("scale/landmark_vs_exact/n{scn}.log"),
     benchmark:
-        "benchmarks/rules/scale/landmark_vs_exact/n{scn}.tsv"
+        B("scale/landmark_vs_exact/n{scn}.tsv")
     threads: 1
     resources:
         mem_mb=3000,
@@ -108,19 +108,19 @@ rule scale_landmark_vs_exact:
 
 rule scale_landmark_table:
     input:
-        summary=expand("results/scale/work/landmark_vs_exact_n{n}.csv", n=SCALE["landmark_vs_exact"]["sizes"]),
-        rv=expand("results/scale/work/landmark_vs_exact_rv_n{n}.csv", n=SCALE["landmark_vs_exact"]["sizes"]),
+        summary=expand(R("scale/work/landmark_vs_exact_n{n}.csv"), n=SCALE["landmark_vs_exact"]["sizes"]),
+        rv=expand(R("scale/work/landmark_vs_exact_rv_n{n}.csv"), n=SCALE["landmark_vs_exact"]["sizes"]),
     output:
         summary=report(
-            "results/scale/landmark_vs_exact.csv",
+            R("scale/landmark_vs_exact.csv"),
             caption="../report/scale_landmark_vs_exact.rst",
             category="6. Scale",
         ),
-        rv="results/scale/landmark_vs_exact_rv.csv",
+        rv=R("scale/landmark_vs_exact_rv.csv"),
     log:
-        "logs/scale/landmark_table.log",
+        L("scale/landmark_table.log"),
     benchmark:
-        "benchmarks/rules/scale/landmark_table.tsv"
+        B("scale/landmark_table.tsv")
     threads: 1
     resources:
         mem_mb=1000,
@@ -136,7 +136,7 @@ rule scale_benchmark:
         "benchmarks/scale_reseq.py",
     output:
         report(
-            "results/scale/benchmarks.csv",
+            R("scale/benchmarks.csv"),
             caption="../report/scale_benchmarks.rst",
             category="6. Scale",
         ),
@@ -145,9 +145,9 @@ rule scale_benchmark:
         mirror=SCALE_MIRROR,
         seed=seed_for("scale", "benchmark"),
     log:
-        "logs/scale/benchmark.log",
+        L("scale/benchmark.log"),
     benchmark:
-        "benchmarks/rules/scale/benchmark.tsv"
+        B("scale/benchmark.tsv")
     threads: 1
     resources:
         mem_mb=SCALE["resequencing"]["mem_mb"],
