@@ -26,6 +26,9 @@ from .regiongraph import EDGE_EPS, RegionGraph
 from .samplegraphs import RegionData, SampleNodes
 from .similarity import vinfl
 
+#: ``np.add.reduce`` is what ``ndarray.sum`` calls, without its Python wrapper (same result).
+_sum = np.add.reduce
+
 
 # ---------------------------------------------------------------------------
 def _rigid2d(a: np.ndarray, b: np.ndarray):
@@ -127,8 +130,8 @@ class Merger:
                     cand = np.flatnonzero(frob2 <= T2 + 1e-12)  # eq. 3 >= distance sum >= Frobenius
                     if cand.size:
                         diff = Dred[cand].reshape(-1, Lr, 2) - qdr
-                        dist = np.sqrt((diff * diff).sum(-1))  # (c, Lr)
-                        ok = dist.sum(-1) <= T
+                        dist = np.sqrt(_sum(diff * diff, -1))  # (c, Lr)
+                        ok = _sum(dist, -1) <= T
                         if ok.any():
                             cand, dist = cand[ok], dist[ok]
                             if cand.size == 1:
@@ -140,12 +143,12 @@ class Merger:
                                 rows = np.repeat(np.arange(cand.size), [len(x) for x in lists])
                             # vinfl(qv, vin_mean[ent]) with the stored speeds (same arithmetic)
                             vb = vin_mean[ent]
-                            qn = np.sqrt((qv * qv).sum(-1))
+                            qn = np.sqrt(_sum(qv * qv, -1))
                             okv = (qn > eps) & (vin_nrm[ent] > eps)
                             den = np.where(okv, qn * vin_nrm[ent], 1.0)
-                            cos = np.where(okv, (qv * vb).sum(-1) / den, 1.0)
+                            cos = np.where(okv, _sum(qv * vb, -1) / den, 1.0)
                             vi = 1.0 - np.minimum(np.abs(cos), 1.0)
-                            sc = (dist[rows] * (1.0 + lam * vi)).sum(-1)
+                            sc = _sum(dist[rows] * (1.0 + lam * vi), -1)
                             j = int(np.argmin(sc))
                             if sc[j] <= T:
                                 best = int(cand[rows[j]])
@@ -155,12 +158,12 @@ class Merger:
                         # _rigid2d(M + qd, M + Dmean[best]), inlined
                         a = M + qd
                         b = M + Dmean[best]
-                        ma = np.add.reduce(a, 0) / Lf
-                        mb = np.add.reduce(b, 0) / Lf
+                        ma = _sum(a, 0) / Lf
+                        mb = _sum(b, 0) / Lf
                         a0 = a - ma
                         b0 = b - mb
-                        dot = float((a0 * b0).sum())
-                        cross = float((a0[:, 0] * b0[:, 1] - a0[:, 1] * b0[:, 0]).sum())
+                        dot = float(_sum(a0 * b0, None))
+                        cross = float(_sum(a0[:, 0] * b0[:, 1] - a0[:, 1] * b0[:, 0], None))
                         h = math.hypot(dot, cross)
                         cs, sn = (dot / h, cross / h) if h > 0 else (1.0, 0.0)
                         Ra = np.array([[cs, -sn], [sn, cs]])
@@ -196,7 +199,7 @@ class Merger:
                 vin_sum[e] = qv
                 vin_cnt[e] = 1.0
                 vin_mean[e] = qv
-                vin_nrm[e] = np.sqrt((qv * qv).sum(-1))
+                vin_nrm[e] = np.sqrt(_sum(qv * qv, -1))
                 if self._undo is not None:
                     self._undo["keys"].append(key)
                     if f < n0 and f not in self._undo["vin_of_len"]:
@@ -210,7 +213,7 @@ class Merger:
                 vin_cnt[e] += 1.0
                 vm = vin_sum[e] / vin_cnt[e]
                 vin_mean[e] = vm
-                vin_nrm[e] = np.sqrt((vm * vm).sum(-1))
+                vin_nrm[e] = np.sqrt(_sum(vm * vm, -1))
             self.visit_map[vi_] = f
             prev = f
         self.n, self.ne = n, ne
