@@ -171,7 +171,8 @@ class FaceGraphModel:
         if self.creation_thresholds is not None:
             Tc = np.stack([np.broadcast_to(np.asarray(self.creation_thresholds[r], float), (S,)) for r in regions])
             return Tc, np.zeros((R, S), int)
-        t0 = np.array([np.quantile(_consecutive_similarity(rdata[r], lam, eps), target / 100.0) for r in regions])
+        sims = [_consecutive_similarity(rdata[r], lam, eps) for r in regions]
+        t0 = np.array([np.quantile(sim, target / 100.0) for sim in sims])
         t0 = np.maximum(t0, 1e-6)
         if self.thresholds == "global":
             res = step_halving_search(
@@ -194,7 +195,7 @@ class FaceGraphModel:
         # start each sample at the quantile of its own consecutive-pose similarities
         T0 = np.empty((R, S))
         for i, r in enumerate(regions):
-            sim = _consecutive_similarity(rdata[r], lam, eps)
+            sim = sims[i]
             cuts = np.cumsum(rdata[r].forward * 2 - 2)[:-1]
             for k, part in enumerate(np.split(sim, cuts)):
                 T0[i, k] = np.quantile(part, target / 100.0) if part.size else t0[i]
