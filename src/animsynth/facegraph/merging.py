@@ -26,6 +26,9 @@ from .regiongraph import EDGE_EPS, RegionGraph
 from .samplegraphs import RegionData, SampleNodes
 from .similarity import vinfl
 
+#: ``np.add.reduce`` is what ``ndarray.sum`` calls, without its Python wrapper (same result).
+_sum = np.add.reduce
+
 
 # ---------------------------------------------------------------------------
 def _rigid2d(a: np.ndarray, b: np.ndarray):
@@ -68,6 +71,7 @@ class Merger:
         nv = len(nodes.visit_node)
         self.vin_sum = np.empty((nv, self.Lr, 2))
         self.vin_mean = np.empty_like(self.vin_sum)
+        self.vin_nrm = np.empty((nv, self.Lr))   # landmark speeds of vin_mean (for vinfl)
         self.vin_cnt = np.zeros(nv)
         self.vin_owner = np.empty(nv, int)
         self.vin_of: list[list[int]] = []
@@ -85,7 +89,7 @@ class Merger:
     def _touch_vin(self, e):
         u = self._undo
         if u is not None and e < u["ne"] and e not in u["vins"]:
-            u["vins"][e] = (self.vin_sum[e].copy(), self.vin_cnt[e], self.vin_mean[e].copy())
+            u["vins"][e] = (self.vin_sum[e].copy(), self.vin_cnt[e], self.vin_mean[e].copy(), self.vin_nrm[e].copy())
 
     def merge(self, s: int, threshold: float, trial: bool = False) -> float:
         """Merge sample ``s`` with ``threshold``; return its merge compression
@@ -105,6 +109,9 @@ class Merger:
         R = None
         tr = None
         prev = -1
+        vin_nrm = self.vin_nrm
+        procrustes = self.procrustes
+        Lf = M.shape[0]
         for vi_ in range(visit_first[s], visit_first[s + 1]):
             g = visit_node[vi_]
             qv = visit_vel[vi_]
@@ -115,40 +122,61 @@ class Merger:
                 qd = nodes.disp[g]
                 if R is not None:
                     qd = (M + qd) @ R.T + tr - M
-                qr = qd[red].ravel()
+                qdr = qd[red]
+                qr = qdr.ravel()
                 best = -1
                 if n:
                     frob2 = Dsq[:n] + qr @ qr - 2.0 * (Dred[:n] @ qr)
                     cand = np.flatnonzero(frob2 <= T2 + 1e-12)  # eq. 3 >= distance sum >= Frobenius
                     if cand.size:
-                        diff = Dred[cand].reshape(-1, Lr, 2) - qd[red]
-                        dist = np.sqrt((diff * diff).sum(-1))  # (c, Lr)
-                        ok = dist.sum(-1) <= T
+                        diff = Dred[cand].reshape(-1, Lr, 2) - qdr
+                        dist = np.sqrt(_sum(diff * diff, -1))  # (c, Lr)
+                        ok = _sum(dist, -1) <= T
                         if ok.any():
                             cand, dist = cand[ok], dist[ok]
                             if cand.size == 1:
-                                ent = np.asarray(vin_of[cand[0]])
+                                ent = vin_of[cand[0]]
                                 rows = np.zeros(len(ent), int)
                             else:
                                 lists = [vin_of[c] for c in cand]
                                 ent = np.concatenate(lists)
                                 rows = np.repeat(np.arange(cand.size), [len(x) for x in lists])
-                            sc = (dist[rows] * (1.0 + lam * vinfl(qv[None], vin_mean[ent], eps))).sum(-1)
+                            # vinfl(qv, vin_mean[ent]) with the stored speeds (same arithmetic)
+                            vb = vin_mean[ent]
+                            qn = np.sqrt(_sum(qv * qv, -1))
+                            okv = (qn > eps) & (vin_nrm[ent] > eps)
+                            den = np.where(okv, qn * vin_nrm[ent], 1.0)
+                            cos = np.where(okv, _sum(qv * vb, -1) / den, 1.0)
+                            vi = 1.0 - np.minimum(np.abs(cos), 1.0)
+                            sc = _sum(dist[rows] * (1.0 + lam * vi), -1)
                             j = int(np.argmin(sc))
                             if sc[j] <= T:
                                 best = int(cand[rows[j]])
                 c = nodes.count[g]
                 if best >= 0:
-                    if self.procrustes:
-                        Ra, ta = _rigid2d(M + qd, M + Dmean[best])
-                        qd = (M + qd) @ Ra.T + ta - M
+                    if procrustes:
+                        # _rigid2d(M + qd, M + Dmean[best]), inlined
+                        a = M + qd
+                        b = M + Dmean[best]
+                        ma = _sum(a, 0) / Lf
+                        mb = _sum(b, 0) / Lf
+                        a0 = a - ma
+                        b0 = b - mb
+                        dot = float(_sum(a0 * b0, None))
+                        cross = float(_sum(a0[:, 0] * b0[:, 1] - a0[:, 1] * b0[:, 0], None))
+                        h = math.hypot(dot, cross)
+                        cs, sn = (dot / h, cross / h) if h > 0 else (1.0, 0.0)
+                        Ra = np.array([[cs, -sn], [sn, cs]])
+                        ta = mb - Ra @ ma
+                        qd = a @ Ra.T + ta - M
                         qv = qv @ Ra.T
                         if R is None:
                             R, tr = Ra, ta
                         else:
                             R, tr = Ra @ R, Ra @ tr + ta
                     f = best
-                    self._touch_node(f)
+                    if self._undo is not None:
+                        self._touch_node(f)
                     Dsum[f] += c * qd
                     cnt[f] += c
                 else:
@@ -157,9 +185,11 @@ class Merger:
                     Dsum[f] = c * qd
                     cnt[f] = c
                     vin_of.append([])
-                Dmean[f] = Dsum[f] / cnt[f]
-                Dred[f] = Dmean[f][red].ravel()
-                Dsq[f] = Dred[f] @ Dred[f]
+                dm = Dsum[f] / cnt[f]
+                Dmean[f] = dm
+                dr = dm[red].ravel()
+                Dred[f] = dr
+                Dsq[f] = dr @ dr
                 node_map[g] = f
             key = (f, prev)
             e = vin_key.get(key)
@@ -169,6 +199,7 @@ class Merger:
                 vin_sum[e] = qv
                 vin_cnt[e] = 1.0
                 vin_mean[e] = qv
+                vin_nrm[e] = np.sqrt(_sum(qv * qv, -1))
                 if self._undo is not None:
                     self._undo["keys"].append(key)
                     if f < n0 and f not in self._undo["vin_of_len"]:
@@ -176,10 +207,13 @@ class Merger:
                 vin_of[f].append(e)
                 ne += 1
             else:
-                self._touch_vin(e)
+                if self._undo is not None:
+                    self._touch_vin(e)
                 vin_sum[e] += qv
                 vin_cnt[e] += 1.0
-                vin_mean[e] = vin_sum[e] / vin_cnt[e]
+                vm = vin_sum[e] / vin_cnt[e]
+                vin_mean[e] = vm
+                vin_nrm[e] = np.sqrt(_sum(vm * vm, -1))
             self.visit_map[vi_] = f
             prev = f
         self.n, self.ne = n, ne
@@ -198,8 +232,8 @@ class Merger:
             self.Dmean[f] = dsum / c
             self.Dred[f] = self.Dmean[f][red].ravel()
             self.Dsq[f] = self.Dred[f] @ self.Dred[f]
-        for e, (vs, vc, vm) in u["vins"].items():
-            self.vin_sum[e], self.vin_cnt[e], self.vin_mean[e] = vs, vc, vm
+        for e, (vs, vc, vm, vn) in u["vins"].items():
+            self.vin_sum[e], self.vin_cnt[e], self.vin_mean[e], self.vin_nrm[e] = vs, vc, vm, vn
         for key in u["keys"]:
             del self.vin_key[key]
         for f, ln in u["vin_of_len"].items():

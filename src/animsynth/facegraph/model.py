@@ -39,17 +39,48 @@ def _consecutive_similarity(rd: RegionData, lam, eps) -> np.ndarray:
     return pose_similarity(rd.disp[i][:, r], rd.vel[i][:, r], rd.disp[i - 1][:, r], rd.vel[i - 1][:, r], lam, eps)
 
 
-def _nn_similarity(nodes: SampleNodes, red, rng, k: int = 256, chunk: int = 32) -> np.ndarray:
-    """Plain distance sum from up to k random sample nodes to their nearest node of another sample."""
+def _landmark_distance_sum(D, a, b):
+    """Sum over landmarks of ``||D[a] - D[b]||`` (pairs), summed landmark by
+    landmark (the order of a reduction over the strided landmark axis of
+    ``D[None] - D[:, None]``, kept so that results do not change)."""
+    dist = np.sqrt(((D[a] - D[b]) ** 2).sum(-1))   # (pairs, L)
+    tot = dist[:, 0].copy()
+    for j in range(1, dist.shape[1]):
+        tot += dist[:, j]
+    return tot
+
+
+def _nn_similarity(nodes: SampleNodes, red, rng, k: int = 256) -> np.ndarray:
+    """Plain distance sum from up to k random sample nodes to their nearest node of another sample.
+
+    Exact but pruned (written by hand: the distance is a sum of per-landmark
+    Euclidean norms, which no scipy/scikit-learn neighbour search offers). With
+    ``f`` the Frobenius distance of two reduced poses and ``L`` the reduced
+    landmarks, ``f <= sum of landmark distances``; the Frobenius distances of
+    all pairs come from one matrix product, the exact sum to the
+    Frobenius-nearest node bounds the minimum from above, and the exact sum is
+    evaluated only for nodes whose ``f`` is within that bound (plus a rounding
+    margin), with the arithmetic of a full evaluation, so the result is
+    identical.
+    """
     q = rng.choice(nodes.n, size=min(k, nodes.n), replace=False)
     D = nodes.disp[:, red]
-    out = []
-    for a in range(0, len(q), chunk):
-        qq = q[a:a + chunk]
-        d = np.sqrt(((D[None] - D[qq][:, None]) ** 2).sum(-1)).sum(-1)     # (chunk, G)
-        d[nodes.sample[None, :] == nodes.sample[qq][:, None]] = np.inf      # other samples only
-        out.append(d.min(1))
-    out = np.concatenate(out) if out else np.zeros(0)
+    G, L = D.shape[0], D.shape[1]
+    if len(q) == 0:
+        return np.zeros(0)
+    flat = D.reshape(G, -1)
+    sq = (flat * flat).sum(-1)
+    frob2 = sq[q][:, None] + sq[None, :] - 2.0 * (flat[q] @ flat.T)       # (k, G)
+    other = nodes.sample[None, :] != nodes.sample[q][:, None]            # other samples only
+    frob2 = np.where(other, np.maximum(frob2, 0.0), np.inf)
+    has = np.isfinite(frob2).any(1)
+    q, frob2, sqq = q[has], frob2[has], sq[q[has]]
+    # exact sum to the Frobenius-nearest node: an upper bound of the minimum
+    ub = _landmark_distance_sum(D, frob2.argmin(1), q)
+    slack = 1e-9 * (sqq[:, None] + sq[None, :]) + 1e-12
+    rows, cols = np.nonzero(frob2 <= (ub * ub)[:, None] * (1.0 + 1e-9) + slack)
+    out = np.full(len(q), np.inf)
+    np.minimum.at(out, rows, _landmark_distance_sum(D, cols, q[rows]))
     return out[np.isfinite(out)]
 
 
@@ -140,7 +171,8 @@ class FaceGraphModel:
         if self.creation_thresholds is not None:
             Tc = np.stack([np.broadcast_to(np.asarray(self.creation_thresholds[r], float), (S,)) for r in regions])
             return Tc, np.zeros((R, S), int)
-        t0 = np.array([np.quantile(_consecutive_similarity(rdata[r], lam, eps), target / 100.0) for r in regions])
+        sims = [_consecutive_similarity(rdata[r], lam, eps) for r in regions]
+        t0 = np.array([np.quantile(sim, target / 100.0) for sim in sims])
         t0 = np.maximum(t0, 1e-6)
         if self.thresholds == "global":
             res = step_halving_search(
@@ -163,7 +195,7 @@ class FaceGraphModel:
         # start each sample at the quantile of its own consecutive-pose similarities
         T0 = np.empty((R, S))
         for i, r in enumerate(regions):
-            sim = _consecutive_similarity(rdata[r], lam, eps)
+            sim = sims[i]
             cuts = np.cumsum(rdata[r].forward * 2 - 2)[:-1]
             for k, part in enumerate(np.split(sim, cuts)):
                 T0[i, k] = np.quantile(part, target / 100.0) if part.size else t0[i]
