@@ -119,7 +119,7 @@ def test_st_lists_give_the_dense_st_isomap_graph(database):
     X = f.linearised(False)
     D = l2_distances(X)
     n = X.shape[0]
-    kw = dict(temporal_window=1, c_ctn=10.0, c_cctn=10.0, ctn_neighbors=4, ctn_min_gap=30, ctn_tolerance=2,
+    kw = dict(temporal_window=1, c_atn=10.0, c_ctn=10.0, ctn_neighbors=4, ctn_min_gap=30, ctn_tolerance=2,
               ctn_reach=6)
     Dst, _, ctn = spatio_temporal_distances(D, **kw)
     dist, idx = sparse.l2_neighbours(X, n - 1)  # all frames: the candidate search cannot miss a CTN
@@ -137,8 +137,8 @@ def test_st_temporal_neighbours_stay_inside_each_sequence(database):
     seq = np.concatenate([np.full(f.n_frames, s) for s, f in enumerate(database)])
     dist, idx = sparse.l2_neighbours(X, 20)
     pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)
-    sd, si, _ = sparse.st_neighbours(dist, idx, seq, c_ctn=1e6, c_cctn=10.0, pair_distance=pair)
-    # with a huge c_ctn the nearest is a temporal neighbour, never across a boundary (except
+    sd, si, _ = sparse.st_neighbours(dist, idx, seq, c_atn=1e6, c_ctn=10.0, pair_distance=pair)
+    # with a huge c_atn the nearest is a temporal neighbour, never across a boundary (except
     # for exact copies at distance 0: every linearised trial starts at the zero vector)
     first = si[:, 0]
     fine = dist[:, 0] > 0

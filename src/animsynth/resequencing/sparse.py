@@ -48,10 +48,10 @@ ST-Isomap
 :func:`st_neighbours` applies Jenkins & Mataric's adjustment
 (:func:`.embedding.spatio_temporal_distances`) to a neighbour list of a
 database of several sequences: temporal neighbours (same sequence, ``|i - j|
-<= temporal_window``) are added to the lists and divided by ``c_ctn``; common
+<= temporal_window``) are added to the lists and divided by ``c_atn``; common
 temporal neighbours are found among the candidates (non-trivial, within the
 frame's reach, persistent one frame earlier and later) and divided by
-``c_cctn``. Pairs not in a list keep their (larger) distance and are never
+``c_ctn``. Pairs not in a list keep their (larger) distance and are never
 adjusted, so the first ``m`` entries of the re-sorted lists are the exact
 adjusted neighbours. Sequence boundaries count as the ends of a sequence.
 
@@ -402,7 +402,7 @@ def sparse_min_connected_k(idx, n_components_check: bool = True) -> int:
 # ----------------------------------------------------------------------------- ST-Isomap
 
 
-def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_ctn: float = 10.0, c_cctn: float = 10.0,
+def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_atn: float = 10.0, c_ctn: float = 10.0,
                   ctn_neighbors: int = 4, ctn_min_gap: int = 30, ctn_tolerance: int = 2, ctn_reach: int = 6,
                   pair_distance=None):
     """ST-Isomap's adjustment (Jenkins & Mataric 2004) on a neighbour list of a database.
@@ -432,7 +432,7 @@ def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_ctn: float = 
     n, m = idx.shape
     if seq.shape != (n,) or np.any(np.diff(seq) < 0):
         raise ValueError("sequence must be (frames,) with each sequence's frames contiguous")
-    for name, v in (("c_ctn", c_ctn), ("c_cctn", c_cctn)):
+    for name, v in (("c_atn", c_atn), ("c_ctn", c_ctn)):
         if not (np.isfinite(v) and v >= 1.0):
             raise ValueError(f"{name} must be >= 1 (it divides distances), got {v}")
     if temporal_window < 1:
@@ -502,7 +502,7 @@ def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_ctn: float = 
         tj += [a + lag, a]
     ti = np.concatenate(ti) if ti else np.zeros(0, np.int64)
     tj = np.concatenate(tj) if tj else np.zeros(0, np.int64)
-    td = pair_distance(ti, tj) / c_ctn if ti.size else np.zeros(0)
+    td = pair_distance(ti, tj) / c_atn if ti.size else np.zeros(0)
     ci = np.concatenate([pairs[:, 0], pairs[:, 1]])
     cj = np.concatenate([pairs[:, 1], pairs[:, 0]])
 
@@ -511,9 +511,9 @@ def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_ctn: float = 
     cols = np.concatenate([idx.ravel(), tj, cj])
     vals = np.concatenate([dist.ravel(), td, np.zeros(ci.size)])
     kind = np.concatenate([np.zeros(n * m, np.int8), np.ones(ti.size, np.int8), np.full(ci.size, 2, np.int8)])
-    # a CTN pair's value: its base distance (from the list, or computed) / c_cctn
+    # a CTN pair's value: its base distance (from the list, or computed) / c_ctn
     if ci.size:
-        vals[kind == 2] = pair_distance(ci, cj) / c_cctn
+        vals[kind == 2] = pair_distance(ci, cj) / c_ctn
     # one entry per (row, col): the adjusted value wins over the listed one (it is smaller or equal)
     order = np.lexsort((-kind, cols, rows))
     r_s, c_s = rows[order], cols[order]
