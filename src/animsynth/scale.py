@@ -278,8 +278,8 @@ def meshdetail_steps(n: int, resolution: float = 1.0, seed: int = 0, level: floa
                      latent_dim: int = 4):
     """The hybrid (GP detail) model trained on ``n`` frames of the synthetic skirt character."""
     from .meshdetail.models import HybridModel, MeshContext
-    from .meshdetail.pipeline import driving_motion
-    from .meshdetail.rig import rebase, rebase_pose
+    from .meshdetail.jobs import driving_motion
+    from .skinning import rebase, rebase_pose
     from .synth.character import SkirtParams, build_character, simulate
 
     cfg = {"driver": "cmu_synthetic", "motion": "dance", "frames": int(n), "fps": 30.0}

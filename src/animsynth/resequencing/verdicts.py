@@ -173,6 +173,8 @@ def _decide(lo: int, hi: int, p: float, share: float, alpha: float) -> str:
         return "yes"
     if s <= 1 - share and p < alpha:
         return "opposite"
+    if p < alpha:  # significant, but the share needed for a clear win is not reached
+        return "lean" if s > 0.5 else "lean_opposite"
     return "noise"
 
 
@@ -196,8 +198,8 @@ def st_smoother_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: floa
                     "no pair where both methods re-sequence, so smoothness cannot be compared; " + counts, source)
     lo, hi, ties, p = paired_share(iso.loc[both, PRIMARY], st.loc[both, PRIMARY])
     dec = _decide(lo, hi, p, share, alpha)
-    verdict = {"yes": "reproduced", "opposite": "contradicted", "noise": "within noise",
-               "none": "within noise"}[dec]
+    verdict = {"yes": "reproduced", "opposite": "contradicted", "lean": "partly", "lean_opposite": "not reproduced",
+               "noise": "within noise", "none": "within noise"}[dec]
     others = []
     for c in SECONDARY:
         l2, h2, _, p2 = paired_share(iso.loc[both, c], st.loc[both, c])
