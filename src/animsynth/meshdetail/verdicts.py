@@ -53,7 +53,9 @@ def verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame, gen:
                      "ours": f"{f(b)} vs {f(w)} mm held-out", "data": f"{data} (blocked CV, {k} blocks)",
                      "verdict": v,
                      "evidence": f"held-out mean vertex error {f(b)} vs {f(w)} mm; margin {f(m)} mm, per-block spread "
-                                 f"(SD) {f(sd)} mm; better on {100 * share:.0f}% of {k} blocks" + note,
+                                 f"(SD) {f(sd)} mm; better on {100 * share:.0f}% of {k} blocks" + note
+                                 + "; the skin (weights, joints) is fitted once on the configured training split, so "
+                                   "only blocks outside it are unseen by the skin (every model shares this)",
                      "source": source})
 
     compare("Hybrid (LBS + learned detail) reconstructs held-out frames better than LBS alone (Fig. 5c)",
