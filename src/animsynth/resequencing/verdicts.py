@@ -62,8 +62,9 @@ def explanation_verdicts(grid: pd.DataFrame, published: pd.DataFrame | None, fra
     ``lee_max``.
     """
     claim0 = "the paper's Isomap-L2 min k (tens to about a hundred) is explained by"
+    which = "which candidate explanation matches the paper's Table 2 (Isomap-L2 min k, with Lee staying small)"
     if published is None or published.empty:
-        return [_row(f"{claim0} a candidate condition", "", "", data, "not reproduced",
+        return [_row(which, "", "", data, "not reproduced",
                      "the published Table 2 file was not available, so no candidate can be checked",
                      source)]
     pub = published[(published["method"] == "isomap")]
@@ -116,7 +117,7 @@ def explanation_verdicts(grid: pd.DataFrame, published: pd.DataFrame | None, fra
     best = max(scored[1:] or scored, key=lambda x: (x[0], x[1]))
     matching = [s[2] for s in scored[1:] if s[3] == "reproduced"]
     rows.insert(0, _row(
-        "which candidate explanation matches the paper's Table 2 (Isomap-L2 min k, with Lee staying small)",
+        which,
         paper_txt, best[4], data, best[3],
         ("matching: " + "; ".join(matching) if matching else f"no candidate matches on every motion; closest: {best[2]}")
         + f". Each candidate was tested the same way on every motion (factor {factor:g}, Lee <= {lee_max}).",
