@@ -235,7 +235,7 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
     ctld_log = (slurm_cluster["state"] / "log" / "slurmctld.log").read_text()
     accepted = set(re.findall(r"_slurm_rpc_submit_batch_job: JobId=(\d+)", ctld_log))
     assert slurm_ids <= accepted, (slurm_ids - accepted, ctld_log[-3000:])
-    # ... and ran it to completion, with the profile's per-rule resources.
+    # ... and ran it to completion, with the resources its rule declares.
     declared = _declared_sizes()
     jobs = {j: v for j, v in _squeue(env).items() if j not in before}
     assert set(jobs) == slurm_ids, (jobs, slurm_ids)
@@ -244,8 +244,6 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
         assert job["state"] == "COMPLETED", (jid, job)
         rule = re.match(r"rule_([a-z_0-9]+?)(?:_wildcards_|$)", job["comment"]).group(1)
         rules[rule] = rules.get(rule, 0) + 1
-        # rules the profile names get exactly its mem_mb / runtime / threads;
-        # the others whatever their rule or the profile's defaults say (not checked here)
         # the threads/mem_mb/runtime that the rule itself declares
         if rule in declared:
             mem, minutes, cpus = declared[rule]
