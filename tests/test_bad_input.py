@@ -234,6 +234,7 @@ def _cli_cases():
         ("bvh_ext", ["amc2bvh", "{asf}", "{amc}", "{out}.amc"], "out", "use a .bvh file name"),
         ("missing_amc", ["amc2bvh", "{asf}", "{dir}/nope.amc", "{out}.bvh"], "amc", "no such file"),
         ("labels_empty", ["face", "--labels", ",", "{out}.gif"], "--labels", "comma-separated"),
+        ("labels_unknown", ["face", "--labels", "fear,bored", "{out}.gif"], "--labels", "unknown CK+ emotion 'bored'"),
         ("ckplus_missing", ["face", "--labels", "fear", "--ckplus", "{dir}/nope", "{out}.gif"], "--ckplus", "no such folder"),
     ]
 

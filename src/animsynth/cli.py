@@ -114,9 +114,14 @@ def _existing_dir(text: str) -> str:
 
 
 def _labels(text: str) -> str:
+    from .io.ckplus import EMOTIONS
+
     parts = text.split(",")
     if not text.strip() or any(not p.strip() for p in parts):
         raise argparse.ArgumentTypeError(f"expected comma-separated labels such as fear,surprise,happy, got {text!r}")
+    unknown = [p.strip() for p in parts if p.strip() not in EMOTIONS[1:]]
+    if unknown:
+        raise argparse.ArgumentTypeError(f"unknown CK+ emotion {unknown[0]!r} (one of {', '.join(EMOTIONS[1:])})")
     return text
 
 
