@@ -257,7 +257,7 @@ def facegraph_steps(n: int, seed: int = 0, creation: float = 50.0, merge: float 
     including both threshold searches."""
     from threadpoolctl import threadpool_limits
 
-    from .facegraph.graph import FaceGraphModel
+    from .facegraph.model import FaceGraphModel
     from .facegraph.preprocess import FacePreprocessor
     from .synth.faces import generate_sequences
 
