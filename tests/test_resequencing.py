@@ -709,3 +709,11 @@ def test_smoothness_decision_separates_clear_wins_leans_and_noise():
     assert _decide(23, 49, 0.003, 0.75, 0.05) == "lean_opposite"
     assert _decide(9, 7, 0.8, 0.75, 0.05) == "noise"
     assert _decide(0, 0, 1.0, 0.75, 0.05) == "none"
+
+
+def test_explanation_claim_is_named_the_same_without_the_published_table():
+    from animsynth.resequencing.verdicts import explanation_verdicts
+
+    rows = explanation_verdicts(pd.DataFrame(), None, 1)
+    assert len(rows) == 1 and rows[0]["claim"].startswith("which candidate explanation matches")
+    assert rows[0]["verdict"] == "not reproduced" and "not available" in rows[0]["evidence"]
