@@ -42,7 +42,7 @@ from scipy.spatial.distance import pdist, squareform
 from sklearn.decomposition import KernelPCA
 from threadpoolctl import threadpool_limits
 
-from .embedding import DisconnectedGraphError
+from .embedding import DisconnectedGraphError, residual_variance
 
 log = logging.getLogger("animsynth.resequencing")
 
@@ -85,23 +85,10 @@ def _check_graph(graph):
 
 
 def residual_variance_pairs(geodesic, embedding, dims=None) -> np.ndarray:
-    """``1 - R^2`` between a square geodesic matrix and the embedding's pairwise distances,
-    for each leading dimension ``d`` in ``dims`` (default 1..d_max)."""
-    G = np.asarray(geodesic, float)
-    Y = np.asarray(embedding, float)
-    if not np.all(np.isfinite(G)):
-        raise DisconnectedGraphError("geodesic distances contain inf: the graph is disconnected")
-    dims = range(1, Y.shape[1] + 1) if dims is None else dims
-    g = squareform(0.5 * (G + G.T), checks=False)
-    out = []
-    for d in dims:
-        e = pdist(Y[:, :d])
-        if np.std(e) == 0 or np.std(g) == 0:
-            out.append(np.nan)
-            continue
-        r = np.corrcoef(g, e)[0, 1]
-        out.append(1.0 - r * r)
-    return np.asarray(out)
+    """``1 - R^2`` between a square geodesic matrix and the embedding's pairwise distances, for
+    each leading dimension ``d`` in ``dims`` (default 1..d_max): the exact Isomap measure
+    (:func:`.embedding.residual_variance`), applied here to the landmark pairs only."""
+    return residual_variance(geodesic, embedding, dims)
 
 
 def choose_landmarks(graph, n_landmarks: int, how: str = "maxmin", seed: int = 0):
