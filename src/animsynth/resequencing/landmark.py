@@ -38,7 +38,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import eigh
 from scipy.sparse.csgraph import connected_components, dijkstra
-from scipy.spatial.distance import pdist, squareform
 from sklearn.decomposition import KernelPCA
 from threadpoolctl import threadpool_limits
 
