@@ -282,6 +282,19 @@ def nontrivial_neighbors(D, m: int, min_gap: int, allowed=None) -> np.ndarray:
     return M
 
 
+def check_st_params(c_atn, c_ctn, temporal_window, ctn_neighbors, ctn_min_gap, ctn_tolerance, ctn_reach) -> None:
+    """Refuse ST-Isomap parameters that make no sense (shared by the dense and the sparse adjustment)."""
+    for name, v in (("c_atn", c_atn), ("c_ctn", c_ctn)):
+        if not (np.isfinite(v) and v >= 1.0):
+            raise ValueError(f"config key 'resequencing.stisomap.{name}' must be >= 1 (it divides distances), got {v}")
+    if temporal_window < 1:
+        raise ValueError(f"temporal_window must be >= 1, got {temporal_window}")
+    if ctn_min_gap < temporal_window:
+        raise ValueError(f"ctn_min_gap ({ctn_min_gap}) must be >= temporal_window ({temporal_window})")
+    if ctn_neighbors < 0 or ctn_tolerance < 0 or ctn_reach < 1:
+        raise ValueError("ctn_neighbors and ctn_tolerance must be >= 0, ctn_reach >= 1")
+
+
 def spatio_temporal_distances(D, temporal_window: int = 1, c_atn: float = 10.0, c_ctn: float = 10.0,
                               ctn_neighbors: int = 4, ctn_min_gap: int = 30, ctn_tolerance: int = 2,
                               ctn_reach: int = 6):
@@ -314,15 +327,7 @@ def spatio_temporal_distances(D, temporal_window: int = 1, c_atn: float = 10.0, 
     """
     D = check_distance_matrix(D)
     n = D.shape[0]
-    for name, v in (("c_atn", c_atn), ("c_ctn", c_ctn)):
-        if not (np.isfinite(v) and v >= 1.0):
-            raise ValueError(f"config key 'resequencing.stisomap.{name}' must be >= 1 (it divides distances), got {v}")
-    if temporal_window < 1:
-        raise ValueError(f"temporal_window must be >= 1, got {temporal_window}")
-    if ctn_min_gap < temporal_window:
-        raise ValueError(f"ctn_min_gap ({ctn_min_gap}) must be >= temporal_window ({temporal_window})")
-    if ctn_neighbors < 0 or ctn_tolerance < 0 or ctn_reach < 1:
-        raise ValueError("ctn_neighbors and ctn_tolerance must be >= 0, ctn_reach >= 1")
+    check_st_params(c_atn, c_ctn, temporal_window, ctn_neighbors, ctn_min_gap, ctn_tolerance, ctn_reach)
     idx = np.arange(n)
     lag = np.abs(idx[:, None] - idx[None, :])
     atn = temporal_adjacency(n, temporal_window)

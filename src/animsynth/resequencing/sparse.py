@@ -72,7 +72,7 @@ from scipy.sparse.csgraph import connected_components, minimum_spanning_tree
 from sklearn.neighbors import NearestNeighbors
 
 from .distances import PAPER_WEIGHTS, joint_weights
-from .embedding import DisconnectedGraphError
+from .embedding import DisconnectedGraphError, check_st_params
 from .features import MotionFeatures, angular_velocity
 from .paths import shortest_path_frames
 
@@ -432,15 +432,7 @@ def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_atn: float = 
     n, m = idx.shape
     if seq.shape != (n,) or np.any(np.diff(seq) < 0):
         raise ValueError("sequence must be (frames,) with each sequence's frames contiguous")
-    for name, v in (("c_atn", c_atn), ("c_ctn", c_ctn)):
-        if not (np.isfinite(v) and v >= 1.0):
-            raise ValueError(f"{name} must be >= 1 (it divides distances), got {v}")
-    if temporal_window < 1:
-        raise ValueError(f"temporal_window must be >= 1, got {temporal_window}")
-    if ctn_min_gap < temporal_window:
-        raise ValueError(f"ctn_min_gap ({ctn_min_gap}) must be >= temporal_window ({temporal_window})")
-    if ctn_neighbors < 0 or ctn_tolerance < 0 or ctn_reach < 1:
-        raise ValueError("ctn_neighbors and ctn_tolerance must be >= 0, ctn_reach >= 1")
+    check_st_params(c_atn, c_ctn, temporal_window, ctn_neighbors, ctn_min_gap, ctn_tolerance, ctn_reach)
     if pair_distance is None:
         raise ValueError("pair_distance is required (the base metric for arbitrary frame pairs)")
     frame = np.arange(n)
