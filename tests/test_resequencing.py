@@ -423,6 +423,29 @@ def test_study_end_to_end_small(walk):
     assert summ["resequencing_paths"].iloc[0] == (per_path["path_class"] == "resequences").sum()
 
 
+def test_analyse_switches_to_landmark_isomap_above_the_size_threshold(walk):
+    from scipy.spatial import procrustes
+
+    m = prepare_motion(walk, 150, 2)  # 75 frames
+    base = {"fixed_k_sweep": [], "max_dim": 3, "metrics": ["l2"]}
+    exact = analyse(m, "walk", "t", False, with_defaults(base))
+    # threshold below the frame count -> landmark; with every frame a landmark it is exact Isomap again
+    lm_cfg = with_defaults({**base, "embedding": {"exact_max_frames": 74, "n_landmarks": 75}})
+    lm = analyse(m, "walk", "t", False, lm_cfg)
+    assert set(exact[0]["embedding_method"]) == {"exact"} and set(lm[0]["embedding_method"]) == {"landmark"}
+    assert set(lm[1]["embedding_method"]) == {"landmark"}
+    assert (exact[0]["min_k"].to_numpy() == lm[0]["min_k"].to_numpy()).all()
+    for key in ("isomap_l2_xy", "stisomap_l2_xy"):
+        assert procrustes(exact[2][key], lm[2][key])[2] < 1e-6
+    np.testing.assert_allclose(exact[1]["residual_variance"], lm[1]["residual_variance"], atol=1e-5)
+    # 20 landmarks: an approximation that still follows the exact embedding
+    few = analyse(m, "walk", "t", False, with_defaults({**base, "embedding": {"method": "landmark", "n_landmarks": 20}}))
+    assert set(few[0]["embedding_method"]) == {"landmark"}
+    assert procrustes(exact[2]["isomap_l2_xy"], few[2]["isomap_l2_xy"])[2] < 0.1
+    with pytest.raises(ValueError, match="resequencing.embedding.method"):
+        analyse(m, "walk", "t", False, with_defaults({**base, "embedding": {"method": "fast"}}))
+
+
 def test_analyse_is_deterministic(walk):
     cfg = with_defaults({"fixed_k_sweep": [5], "max_dim": 3, "metrics": ["lee"]})
     m = prepare_motion(walk, 120, 2)

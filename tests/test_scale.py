@@ -11,7 +11,7 @@ from scipy.spatial import procrustes
 from animsynth.resequencing import landmark, sparse
 from animsynth.resequencing.distances import l2_distances, lee_distances
 from animsynth.resequencing.embedding import (DisconnectedGraphError, knn_graph, min_connected_k, neighbor_ranks,
-                                              spatio_temporal_distances)
+                                              spatio_temporal_distances, temporal_adjacency)
 from animsynth.resequencing.features import motion_features
 from animsynth.resequencing.paths import shortest_path_frames
 from animsynth.synth.mocap import KINDS, cmu_like_skeleton, generate_motion
@@ -130,6 +130,45 @@ def test_st_lists_give_the_dense_st_isomap_graph(database):
     for k in (2, 5):
         np.testing.assert_allclose(sparse.sparse_knn_graph(sd, si, k).toarray(), knn_graph(Dst, k).toarray(),
                                    rtol=1e-12)
+
+
+def test_sparse_st_isomap_keeps_the_adjacent_temporal_edges_like_the_dense_one(database):
+    f = database[0]
+    X = f.linearised(False)
+    n = X.shape[0]
+    kw = dict(temporal_window=1, c_atn=10.0, c_ctn=10.0, ctn_neighbors=4, ctn_min_gap=30, ctn_tolerance=2,
+              ctn_reach=6)
+    Dst = spatio_temporal_distances(l2_distances(X), **kw)[0]
+    dist, idx = sparse.l2_neighbours(X, n - 1)
+    pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)
+    sd, si, _ = sparse.st_neighbours(dist, idx, np.zeros(n, int), pair_distance=pair, **kw)
+    pairs, w = sparse.st_always_edges(np.zeros(n, int), 1, 10.0, pair)
+    assert pairs.shape == (n - 1, 2) and np.all(pairs[:, 1] - pairs[:, 0] == 1)
+    always = temporal_adjacency(n, 1)
+    # one sequence is a chain of always-present edges: connected at k = 1, as in the dense version
+    assert sparse.sparse_min_connected_k(si, always=pairs) == min_connected_k(Dst, always=always) == 1
+    for k in (1, 3):
+        np.testing.assert_allclose(sparse.sparse_knn_graph(sd, si, k, always=(pairs, w)).toarray(),
+                                   knn_graph(Dst, k, always=always).toarray(), rtol=1e-12)
+    # with 2 candidates per frame the lists alone may miss a temporal neighbour; the always edges never do
+    G = sparse.sparse_knn_graph(sd[:, :1], si[:, :1], 1, always=(pairs, w)).toarray()
+    assert np.all(G[np.arange(n - 1), np.arange(1, n)] > 0)
+    # two sequences: each chains itself, so min k is what joins them (not 1 unless a listed pair does)
+    X2 = np.vstack([database[0].linearised(False), database[1].linearised(False)])
+    seq = np.repeat([0, 1], [database[0].n_frames, database[1].n_frames])
+    d2, i2 = sparse.l2_neighbours(X2, 30)
+    p2 = sparse.temporal_pairs(seq, 1)
+    assert not np.any(seq[p2[:, 0]] != seq[p2[:, 1]]) and len(p2) == len(seq) - 2
+    k2 = sparse.sparse_min_connected_k(i2, always=p2)
+    assert k2 <= sparse.sparse_min_connected_k(i2)
+    from scipy.sparse.csgraph import connected_components
+    G2 = sparse.sparse_knn_graph(d2, i2, k2, always=(p2, np.ones(len(p2))))
+    assert connected_components(G2, directed=False)[0] == 1
+    if k2 > 1:
+        G1 = sparse.sparse_knn_graph(d2, i2, k2 - 1, always=(p2, np.ones(len(p2))))
+        assert connected_components(G1, directed=False)[0] > 1
+    with pytest.raises(ValueError, match="two different frames"):
+        sparse.sparse_min_connected_k(i2, always=[[0, 0]])
 
 
 def test_st_temporal_neighbours_stay_inside_each_sequence(database):
@@ -283,4 +322,10 @@ def test_scale_workflow_builds_curves_landmark_table_and_benchmark_rows(tmp_path
     bench = pd.read_csv(out / "benchmarks.csv")
     assert list(bench["benchmark"]) == ["reseq_2k_frames_total_s", "reseq_2k_frames_peak_mb"]
     assert (bench["family"] == "resequencing").all()
+    # the same rows, with the machine, join the project-wide benchmark table
+    project = pd.read_csv(wd / "results" / "benchmarks.csv")
+    joined = project[project["benchmark"].isin(bench["benchmark"])].set_index("benchmark")
+    assert list(joined.index) == list(bench["benchmark"])
+    assert (joined["family"] == "resequencing").all() and joined["machine"].str.contains("cores").all()
+    assert {"simplicial", "resequencing", "facegraph", "meshdetail"} <= set(project["family"])
     assert (out / "cost_curves.png").stat().st_size > 5000

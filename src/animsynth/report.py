@@ -82,6 +82,11 @@ def family_benchmark_summary(df: pd.DataFrame) -> pd.DataFrame:
     })[cols]
 
 
+def machine_label() -> str:
+    """Where a benchmark ran: architecture, core count and Python, e.g. ``x86_64 2 cores, CPython 3.12.3``."""
+    return f"{platform.machine()} {os.cpu_count()} cores, {platform.python_implementation()} {platform.python_version()}"
+
+
 def run_benchmarks(files) -> pd.DataFrame:
     """Import each ``benchmarks/bench_*.py`` and call its ``run()``; one row per measurement.
 
@@ -89,7 +94,7 @@ def run_benchmarks(files) -> pd.DataFrame:
     came from.
     """
     rows = []
-    machine = f"{platform.machine()} {os.cpu_count()} cores, {platform.python_implementation()} {platform.python_version()}"
+    machine = machine_label()
     for f in sorted(map(str, files)):
         name = Path(f).stem
         spec = importlib.util.spec_from_file_location(f"animsynth_bench_{name}", f)

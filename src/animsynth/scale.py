@@ -215,16 +215,18 @@ def resequencing_steps(n: int, metric: str = "l2", method: str = "isomap", n_can
             pair = lambda i, j: sp.lee_pair_metric(parts, i, j, kw["sqrt"])  # noqa: E731
         else:
             raise ValueError(f"unknown metric {metric!r} (l2, lee)")
+        always = None
         if method == "stisomap":
             st = dict(st or {})
             dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
+            always = sp.st_always_edges(seq, st.get("temporal_window", 1), st.get("c_atn", 10.0), pair)
         elif method != "isomap":
             raise ValueError(f"unknown method {method!r} (isomap, stisomap)")
     with S.step("min_k") as info:
-        kmin = sp.sparse_min_connected_k(idx)
+        kmin = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
         info["min_k"] = kmin
     kk = max(kmin, int(k or kmin))
-    G = sp.sparse_knn_graph(dist, idx, kk)
+    G = sp.sparse_knn_graph(dist, idx, kk, always=always)
     with S.step("embedding") as info:
         res = lm.embed(G, n_components, embedding, exact_max_frames, n_landmarks, landmarks, seed)
         info.update(embedding_method=res.method, rv_d2=float(res.residual_variance[min(1, n_components - 1)]))
@@ -385,7 +387,7 @@ def landmark_vs_exact(n: int, metric: str = "l2", method: str = "isomap", n_cand
     from .resequencing import landmark as lm
     from .resequencing import sparse as sp
     from .resequencing.distances import l2_distances
-    from .resequencing.embedding import knn_graph, min_connected_k, spatio_temporal_distances
+    from .resequencing.embedding import knn_graph, min_connected_k, spatio_temporal_distances, temporal_adjacency
     from .resequencing.features import motion_features
     from .resequencing.paths import shortest_path_frames
 
@@ -402,14 +404,18 @@ def landmark_vs_exact(n: int, metric: str = "l2", method: str = "isomap", n_cand
         if len(feats) != 1:
             raise ValueError("the dense ST-Isomap adjustment handles one sequence; use one trial for stisomap")
         st = dict(st or {})
-        dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=lambda i, j: np.linalg.norm(X[i] - X[j], axis=1),
-                                        **st)
+        pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)  # noqa: E731
+        dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
+        always = sp.st_always_edges(seq, st.get("temporal_window", 1), st.get("c_atn", 10.0), pair)
         D = spatio_temporal_distances(D, **st)[0]
-    kmin_sparse = sp.sparse_min_connected_k(idx)
-    kmin_dense = min_connected_k(D)
+        always_dense = temporal_adjacency(n, st.get("temporal_window", 1))
+    else:
+        always, always_dense = None, None
+    kmin_sparse = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
+    kmin_dense = min_connected_k(D, always=always_dense)
     kk = max(kmin_sparse, int(k or kmin_sparse))
-    G = sp.sparse_knn_graph(dist, idx, kk)
-    Gd = knn_graph(D, kk)
+    G = sp.sparse_knn_graph(dist, idx, kk, always=always)
+    Gd = knn_graph(D, kk, always=always_dense)
     rng = np.random.default_rng(seed)
     ab = [tuple(int(x) for x in rng.choice(n, 2, replace=False)) for _ in range(int(pairs))]
     cs = np.array([sp.shortest_path(G, a, b)[1] for a, b in ab])

@@ -32,6 +32,8 @@ SUMMARY_SECTIONS = [s for fam, ss in FAMILY_SUMMARIES.items() if FAMILY_RAN[fam]
 SUMMARY_TIMING = [s["csv"] for s in SUMMARY_SECTIONS if re.search(r"(^|_)timing\.csv$", os.path.basename(s["csv"]))]
 VERDICT_FILES = [v for fam, vs in FAMILY_VERDICTS.items() if FAMILY_RAN[fam] for v in vs]
 BENCH_SCRIPTS = sorted(glob_wildcards("benchmarks/bench_{name}.py").name)
+# With the scale study on, its 100,000-frame re-sequencing rows join benchmarks.csv.
+BENCH_EXTRA = [R("scale/benchmarks.csv")] if config.get("scale", {}).get("enabled", False) else []
 
 
 rule summary:
@@ -75,7 +77,8 @@ rule summary:
 
 rule benchmarks:
     input:
-        expand("benchmarks/bench_{name}.py", name=BENCH_SCRIPTS),
+        scripts=expand("benchmarks/bench_{name}.py", name=BENCH_SCRIPTS),
+        extra=BENCH_EXTRA,
     output:
         report(
             R("benchmarks.csv"),

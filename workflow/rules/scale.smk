@@ -25,6 +25,7 @@ SCALE_TARGETS = [
     R("scale/landmark_vs_exact.csv"),
     R("scale/landmark_vs_exact_rv.csv"),
     R("scale/benchmarks.csv"),
+    R("benchmarks.csv"),
 ]
 
 

@@ -1,9 +1,18 @@
-"""Run benchmarks/bench_*.py (ratios against in-run baselines) -> results/benchmarks.csv."""
+"""Run benchmarks/bench_*.py (ratios against in-run baselines) -> results/benchmarks.csv.
+
+Rows measured by other rules (the scale study's 100,000-frame re-sequencing
+benchmark, when it is on) are appended as they are.
+"""
+import pandas as pd
+
 from animsynth.report import run_benchmarks
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
-df = run_benchmarks(snakemake.input)  # noqa: F821
+df = run_benchmarks(snakemake.input.scripts)  # noqa: F821
+extra = [pd.read_csv(p) for p in snakemake.input.extra]  # noqa: F821
+if extra:
+    df = pd.concat([df, *extra], ignore_index=True)[list(df.columns)]
 write_table(df, snakemake.output[0], md=True, title="Benchmarks (machine-dependent)")  # noqa: F821
 log.info("%d benchmark rows", len(df))

@@ -3,6 +3,7 @@ import importlib.util
 
 import pandas as pd
 
+from animsynth.report import machine_label
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
@@ -13,7 +14,7 @@ spec.loader.exec_module(mod)
 cfg = snakemake.params.cfg  # noqa: F821
 rows = mod.run(frames=cfg["benchmark"]["frames"], cfg=cfg, seed=int(snakemake.params.seed),  # noqa: F821
                cmu_mirror=snakemake.params.mirror)  # noqa: F821
-df = pd.DataFrame(rows)
+df = pd.DataFrame(rows).assign(machine=machine_label())
 write_table(df, snakemake.output[0], title="Re-sequencing at scale (machine-dependent)")  # noqa: F821
 for r in rows:
     log.info("%s = %.4g %s (target %s, meets %s)", r["benchmark"], r["value"], r["unit"], r["target"], r["meets_target"])

@@ -54,6 +54,10 @@ frame's reach, persistent one frame earlier and later) and divided by
 ``c_ctn``. Pairs not in a list keep their (larger) distance and are never
 adjusted, so the first ``m`` entries of the re-sorted lists are the exact
 adjusted neighbours. Sequence boundaries count as the ends of a sequence.
+As in the dense version (``always=`` of :func:`.embedding.knn_graph`), the
+adjacent temporal neighbours are edges whatever k: :func:`st_always_edges`
+gives them, and :func:`sparse_min_connected_k` / :func:`sparse_knn_graph`
+take them as ``always=`` (so one sequence alone has minimum k 1).
 
 Paths
 -----
@@ -79,7 +83,8 @@ from .paths import shortest_path_frames
 log = logging.getLogger("animsynth.resequencing")
 
 __all__ = ["CandidateCountError", "concat_features", "l2_neighbours", "lee_index_vectors", "lee_pair_metric",
-           "lee_neighbours", "sparse_knn_graph", "sparse_min_connected_k", "st_neighbours", "shortest_path",
+           "lee_neighbours", "sparse_knn_graph", "sparse_min_connected_k", "st_always_edges", "st_neighbours",
+           "shortest_path", "temporal_pairs",
            "LEE_INDEX_RATIO"]
 
 #: Upper bound of lee / index-distance (squared metric): (pi/2)^2 (module docstring).
@@ -330,10 +335,21 @@ def _floor(dist):
     return d
 
 
-def sparse_knn_graph(dist, idx, k: int) -> csr_matrix:
+def _check_always_pairs(pairs, n: int) -> np.ndarray:
+    p = np.asarray(pairs, np.int64).reshape(-1, 2)
+    if p.size and (p.min() < 0 or p.max() >= n or np.any(p[:, 0] == p[:, 1])):
+        raise ValueError(f"always-present edges must join two different frames in [0, {n})")
+    return p
+
+
+def sparse_knn_graph(dist, idx, k: int, always=None) -> csr_matrix:
     """Undirected k-NN graph from a neighbour list: ``{i, j}`` when ``j`` is among ``i``'s
     first ``k`` or ``i`` among ``j``'s (the graph of :func:`.embedding.knn_graph`), weighted
     by the distances. Symmetric CSR ``(frames, frames)``.
+
+    ``always``: optional ``(pairs (E, 2), weights (E,))``, edges present whatever
+    ``k`` (ST-Isomap's adjacent temporal neighbours, :func:`st_always_edges`).
+    A pair that is also listed keeps the smaller of its two weights.
 
     Raises
     ------
@@ -350,6 +366,21 @@ def sparse_knn_graph(dist, idx, k: int) -> csr_matrix:
     rows = np.repeat(np.arange(n), k)
     cols = idx[:, :k].ravel()
     w = _floor(dist[:, :k]).ravel()
+    if always is not None:
+        ap = _check_always_pairs(always[0], n)
+        aw = np.asarray(always[1], float).ravel()
+        if aw.shape != (ap.shape[0],):
+            raise ValueError("always-present edges need one weight per pair")
+        rows, cols, w = np.concatenate([rows, ap[:, 0]]), np.concatenate([cols, ap[:, 1]]), np.concatenate([w, _floor(aw)])
+        # one weight per undirected pair: the smallest
+        a, b = np.minimum(rows, cols), np.maximum(rows, cols)
+        order = np.lexsort((w, b, a))
+        a, b, w = a[order], b[order], w[order]
+        first = np.ones(a.size, bool)
+        first[1:] = (a[1:] != a[:-1]) | (b[1:] != b[:-1])
+        a, b, w = a[first], b[first], w[first]
+        return coo_matrix((np.concatenate([w, w]), (np.concatenate([a, b]), np.concatenate([b, a]))),
+                          shape=(n, n)).tocsr()
     G = coo_matrix((np.concatenate([w, w]), (np.concatenate([rows, cols]), np.concatenate([cols, rows]))),
                    shape=(n, n)).tocsr()
     # duplicates (i in j's list and j in i's) were summed: take the single weight instead
@@ -361,11 +392,13 @@ def sparse_knn_graph(dist, idx, k: int) -> csr_matrix:
     return G
 
 
-def sparse_min_connected_k(idx, n_components_check: bool = True) -> int:
-    """Exact smallest k whose undirected k-NN graph is connected, from a neighbour list.
+def sparse_min_connected_k(idx, n_components_check: bool = True, always=None) -> int:
+    """Exact smallest k >= 1 whose undirected k-NN graph is connected, from a neighbour list.
 
     MST bottleneck over ``K_ij = min(r_i(j), r_j(i))`` on the sparse graph of
-    listed pairs (module docstring). 0 for one frame.
+    listed pairs (module docstring); ``always`` (int pairs ``(E, 2)``, e.g. the
+    first item of :func:`st_always_edges`) are edges at every k, as in
+    :func:`.embedding.min_connected_k`. 0 for one frame.
 
     Raises
     ------
@@ -380,6 +413,10 @@ def sparse_min_connected_k(idx, n_components_check: bool = True) -> int:
     rank = np.broadcast_to(np.arange(1, m + 1, dtype=float), (n, m)).ravel()
     rows = np.repeat(np.arange(n), m)
     cols = idx.ravel()
+    if always is not None:  # rank 0.5: present at every k >= 1 (a sparse matrix drops zeros)
+        ap = _check_always_pairs(always, n)
+        rank = np.concatenate([rank, np.full(ap.shape[0], 0.5)])
+        rows, cols = np.concatenate([rows, ap[:, 0]]), np.concatenate([cols, ap[:, 1]])
     # K_ij = min of the two ranks where both are listed
     i2 = np.minimum(rows, cols)
     j2 = np.maximum(rows, cols)
@@ -396,10 +433,47 @@ def sparse_min_connected_k(idx, n_components_check: bool = True) -> int:
             f"the graph of all {m} candidates per frame has {ncomp} components: the minimum connected k "
             f"is more than {m}; rebuild the neighbour lists with more candidates")
     mst = minimum_spanning_tree(K)
-    return int(round(mst.data.max()))
+    return max(1, int(math.ceil(mst.data.max()))) if mst.nnz else 1
 
 
 # ----------------------------------------------------------------------------- ST-Isomap
+
+
+def _check_sequence(sequence, n: int | None = None) -> np.ndarray:
+    seq = np.asarray(sequence, np.int64)
+    if seq.ndim != 1 or (n is not None and seq.shape != (n,)) or np.any(np.diff(seq) < 0):
+        raise ValueError("sequence must be (frames,) with each sequence's frames contiguous")
+    return seq
+
+
+def temporal_pairs(sequence, temporal_window: int = 1) -> np.ndarray:
+    """Adjacent temporal neighbours of a database: frame pairs ``(i, j)``, ``i < j``,
+    of one sequence with ``j - i <= temporal_window``. Int array ``(E, 2)``."""
+    seq = _check_sequence(sequence)
+    frame = np.arange(seq.size)
+    stop = np.searchsorted(seq, seq, side="right")
+    out = [np.zeros((0, 2), np.int64)]
+    for lag in range(1, int(temporal_window) + 1):
+        a = frame[frame + lag < stop]
+        out.append(np.stack([a, a + lag], 1))
+    return np.concatenate(out)
+
+
+def st_always_edges(sequence, temporal_window: int = 1, c_atn: float = 10.0, pair_distance=None):
+    """ST-Isomap's always-present edges: the adjacent temporal neighbours
+    (:func:`temporal_pairs`) weighted by their base distance divided by ``c_atn``,
+    the same weight :func:`st_neighbours` lists them with.
+
+    Returns ``(pairs (E, 2), weights (E,))`` for ``always=`` of
+    :func:`sparse_knn_graph` (and ``pairs`` for :func:`sparse_min_connected_k`).
+    """
+    if pair_distance is None:
+        raise ValueError("pair_distance is required (the base metric for arbitrary frame pairs)")
+    if not c_atn > 0:
+        raise ValueError(f"c_atn must be > 0, got {c_atn!r}")
+    p = temporal_pairs(sequence, temporal_window)
+    w = pair_distance(p[:, 0], p[:, 1]) / float(c_atn) if p.size else np.zeros(0)
+    return p, np.asarray(w, float)
 
 
 def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_atn: float = 10.0, c_ctn: float = 10.0,
@@ -428,10 +502,8 @@ def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_atn: float = 
     """
     dist = np.asarray(dist, float)
     idx = np.asarray(idx, np.int64)
-    seq = np.asarray(sequence, np.int64)
     n, m = idx.shape
-    if seq.shape != (n,) or np.any(np.diff(seq) < 0):
-        raise ValueError("sequence must be (frames,) with each sequence's frames contiguous")
+    seq = _check_sequence(sequence, n)
     check_st_params(c_atn, c_ctn, temporal_window, ctn_neighbors, ctn_min_gap, ctn_tolerance, ctn_reach)
     if pair_distance is None:
         raise ValueError("pair_distance is required (the base metric for arbitrary frame pairs)")
@@ -487,13 +559,9 @@ def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_atn: float = 
     n_ctn = int(pairs.shape[0])
 
     # --- temporal neighbours: every same-sequence pair within the window
-    ti, tj = [], []
-    for lag in range(1, temporal_window + 1):
-        a = frame[(frame + lag < stop)]
-        ti += [a, a + lag]
-        tj += [a + lag, a]
-    ti = np.concatenate(ti) if ti else np.zeros(0, np.int64)
-    tj = np.concatenate(tj) if tj else np.zeros(0, np.int64)
+    tp = temporal_pairs(seq, temporal_window)
+    ti = np.concatenate([tp[:, 0], tp[:, 1]])
+    tj = np.concatenate([tp[:, 1], tp[:, 0]])
     td = pair_distance(ti, tj) / c_atn if ti.size else np.zeros(0)
     ci = np.concatenate([pairs[:, 0], pairs[:, 1]])
     cj = np.concatenate([pairs[:, 1], pairs[:, 0]])

@@ -30,6 +30,7 @@ from .distances import PAPER_WEIGHTS, l2_distances, lee_distances
 from .embedding import (DisconnectedGraphError, PrecomputedIsomap, graph_components, knn_graph,
                         min_connected_k, neighbor_ranks, residual_variance, spatio_temporal_distances,
                         temporal_adjacency)
+from .landmark import EMBED_METHODS, embed
 from .features import SIGN_MODES, matrix_naive_quaternions, motion_features, sign_flips
 from .metrics import (Reference, TransitionReference, classify_path, jerk_magnitude, joint_quats, pass_jumps,
                       transition_measures)
@@ -53,6 +54,7 @@ DEFAULTS = {
     "linearisation": {"sign_mode": "continuous", "translation_scale": 1.0},
     "fixed_k_sweep": [10],
     "max_dim": 10,
+    "embedding": {"method": "auto", "exact_max_frames": 4000, "n_landmarks": 500, "landmarks": "maxmin", "seed": 0},
     "lee": {"weights": dict(PAPER_WEIGHTS), "nu": 0.01, "sqrt": False},
     "stisomap": {"temporal_window": 1, "c_atn": 10.0, "c_ctn": 10.0, "ctn_neighbors": 4,
                  "ctn_min_gap_s": 0.25, "ctn_tolerance": 2, "ctn_reach_s": 0.05},
@@ -178,6 +180,34 @@ def nontrivial_edge_fraction(graph, min_gap: int) -> float:
     return float(np.mean(np.abs(i - j) > min_gap))
 
 
+def fit_embedding(Dm, k: int, always, max_dim: int, emb_cfg: dict):
+    """Isomap of an (adjusted) distance matrix at ``k``: exact or landmark by size.
+
+    ``emb_cfg`` is the ``embedding`` config block: ``method`` "auto" runs exact
+    Isomap up to ``exact_max_frames`` frames and Landmark Isomap
+    (:func:`.landmark.embed`, geodesics from ``n_landmarks`` frames only) above.
+
+    Returns
+    -------
+    method : "exact" or "landmark" (what ran)
+    embedding : array (frames, max_dim)
+    graph : sparse (frames, frames), the k-NN graph (plus ``always`` edges)
+    residual_variance : array (max_dim,); on all frame pairs (exact) or landmark pairs
+    """
+    n = Dm.shape[0]
+    method = emb_cfg["method"]
+    if method not in EMBED_METHODS:
+        raise ValueError(f"config key 'resequencing.embedding.method' must be one of {EMBED_METHODS}, got {method!r}")
+    run = method if method != "auto" else ("exact" if n <= int(emb_cfg["exact_max_frames"]) else "landmark")
+    if run == "exact":
+        iso = PrecomputedIsomap(k, max_dim).fit(Dm, always=always)
+        return "exact", iso.embedding_, iso.graph_, residual_variance(iso.dist_matrix_, iso.embedding_)
+    graph = knn_graph(Dm, k, always=always)
+    res = embed(graph, max_dim, "landmark", n_landmarks=min(int(emb_cfg["n_landmarks"]), n),
+                landmarks=emb_cfg["landmarks"], seed=int(emb_cfg["seed"]))
+    return "landmark", res.embedding, graph, np.asarray(res.residual_variance)
+
+
 def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg: dict):
     """Min k, residual variance and 2-D embeddings of every method x metric of one dataset x global flag.
 
@@ -211,11 +241,11 @@ def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg:
             kmin, below, at, R = checked_min_k(Dm, always, f"{dataset}/{method}/{metric}")
             t_mink = time.perf_counter() - t0
             t0, c0 = time.perf_counter(), time.process_time()
-            iso = PrecomputedIsomap(kmin, max_dim).fit(Dm, always=always)
+            how, Y, graph, rv_min_k = fit_embedding(Dm, kmin, always, max_dim, cfg["embedding"])
             t_fit, c_fit = time.perf_counter() - t0, time.process_time() - c0
             key = f"{method}_{metric}"
-            emb[f"{key}_xy"] = iso.embedding_[:, :2]
-            gi, gj = iso.graph_.nonzero()
+            emb[f"{key}_xy"] = Y[:, :2]
+            gi, gj = graph.nonzero()
             up = gi < gj
             emb[f"{key}_edges"] = np.stack([gi[up], gj[up]], axis=1).astype(np.int32)
             emb[f"{key}_k"] = np.int64(kmin)
@@ -224,22 +254,23 @@ def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg:
                 "sign_mode": mode, "method": method, "metric": metric, "min_k": kmin,
                 "components_at_min_k_minus_1": below, "components_at_min_k": at,
                 "k_used": kmin, "ctn_pairs": n_ctn if method == "stisomap" else np.nan,
-                "nontrivial_edge_fraction": round(nontrivial_edge_fraction(iso.graph_, gap), 6),
+                "nontrivial_edge_fraction": round(nontrivial_edge_fraction(graph, gap), 6),
+                "embedding_method": how,
             })
-            fits = [("min_k", kmin, iso)]
+            fits = [("min_k", kmin, how, rv_min_k)]
             for kf in cfg["fixed_k_sweep"] or []:
                 kf = int(kf)
                 if kf > n - 1 or graph_components(Dm, kf, ranks=R, always=always) > 1:
                     log.warning("%s %s/%s: fixed k=%d leaves the graph disconnected (min k %d); skipped",
                                 dataset, method, metric, kf, kmin)
                     continue
-                fits.append(("fixed", kf, PrecomputedIsomap(kf, max_dim).fit(Dm, always=always)))
-            for k_mode, k, est in fits:
-                rv = residual_variance(est.dist_matrix_, est.embedding_)
+                how_f, _, _, rv_f = fit_embedding(Dm, kf, always, max_dim, cfg["embedding"])
+                fits.append(("fixed", kf, how_f, rv_f))
+            for k_mode, k, how_k, rv in fits:
                 for d, r in enumerate(rv, start=1):
                     rv_rows.append({"dataset": dataset, "global_dof": include_global, "method": method,
                                     "metric": metric, "k_mode": k_mode, "k": k, "dim": d,
-                                    "residual_variance": round(float(r), 6)})
+                                    "residual_variance": round(float(r), 6), "embedding_method": how_k})
             t_rows.append({"dataset": dataset, "global_dof": include_global, "method": method, "metric": metric,
                            "frames": n, "seconds_distances": t_dist, "seconds_min_k": t_mink,
                            "seconds_geodesics_embedding": t_fit, "cpu_seconds_geodesics_embedding": c_fit})
