@@ -88,3 +88,49 @@ def test_config_checks_name_the_key():
     joints.pop("l_shin")
     with pytest.raises(ConfigError, match=r"meshdetail.rig.joints' misses \['l_shin'\]"):
         check_meshdetail_config({**md, "rig": {**md["rig"], "joints": joints}}, "samba")
+
+
+def test_fold_rig_fitter_sees_only_the_fold_training_frames(tmp_path):
+    import yaml
+
+    from animsynth.meshdetail.experiments import run_main
+    from animsynth.meshdetail.jobs import fit_pose, fold_rig_fitter, load_prepared, load_sequences, make_character
+    from animsynth.io.obj import MeshSequence
+
+    cfg = dict(driver="procedural", motion="walk", frames=24, fps=30, asf=None, amc=None, edits=[],
+               resolution=0.4, skirt_rings=5, skirt_around=12, hem_frequency=1.1, damping=2.5, substeps=2)
+    make_character(cfg, 3, str(tmp_path / "ch"))
+    truth = str(tmp_path / "ch" / "truth.npz")
+    load_sequences(str(tmp_path / "ch" / "main"), truth, str(tmp_path / "seq.npz"), str(tmp_path / "edits.npz"), 30.0)
+    rig_cfg = dict(joints=None, ends={}, refine=True, weight_power=4.0, max_influences=4, fit_iterations=4,
+                   skinning="heat+refit", heat_c=1.0, compare_skinning=False)
+    fit_pose(str(tmp_path / "seq.npz"), truth, rig_cfg, 0.75, str(tmp_path / "pose.npz"))
+    d = load_prepared(str(tmp_path / "seq.npz"), str(tmp_path / "pose.npz"), str(tmp_path / "edits.npz"), 0.75)
+    refit = fold_rig_fitter(str(tmp_path / "seq.npz"), truth, rig_cfg)
+    _, w, _, ang = refit(d.train)
+    # the same training frames give the same skeleton step as the shared fit
+    np.testing.assert_allclose(w.toarray(), d.weights.toarray(), atol=1e-10)
+    np.testing.assert_allclose(ang, d.angles, atol=1e-8)
+    # wreck a frame outside the fold's training frames: that fold's weights do not move, others' do
+    seq = MeshSequence.load_npz(str(tmp_path / "seq.npz"))
+    seq.vertices[5] += np.random.default_rng(0).normal(0, 0.05, seq.vertices[5].shape)
+    seq.save_npz(str(tmp_path / "bad.npz"))
+    bad = fold_rig_fitter(str(tmp_path / "bad.npz"), truth, rig_cfg)
+    tr = np.setdiff1d(np.arange(24), np.arange(0, 8))
+    np.testing.assert_allclose(bad(tr)[1].toarray(), refit(tr)[1].toarray(), atol=1e-10)
+    assert np.abs(bad(d.train)[1].toarray() - w.toarray()).max() > 1e-3
+    # run_main refits per fold on exactly the other blocks
+    seen = []
+
+    def spy(train):
+        seen.append(np.asarray(train).copy())
+        return refit(train)
+
+    md = yaml.safe_load(open("config/config.yaml"))["meshdetail"]
+    mcfg = {k: md[k] for k in ("level", "latent_dim", "dynamics_weight", "ridge_alphas", "joint_param", "detail",
+                               "decimation", "rbf_neighbors")}
+    mcfg.update(iterations=3, cv_folds=3, level=25)
+    _, fig5c, gen, _ = run_main(d, mcfg, refit_rig=spy)
+    blocks = np.array_split(np.arange(24), 3)
+    assert [list(s) for s in seen] == [list(np.setdiff1d(np.arange(24), b)) for b in blocks]
+    assert np.isfinite(fig5c["lbs_mm"]).all() and len(gen) == 2

@@ -11,7 +11,7 @@ MESH_DIR = config.get("mesh_dir")
 check_meshdetail_config(MD, MESH_DIR)
 MD_MODEL_KEYS = (
     "level", "latent_dim", "iterations", "dynamics_weight", "ridge_alphas", "joint_param", "detail", "decimation",
-    "rbf_neighbors", "cv_folds",
+    "rbf_neighbors", "cv_folds", "cv_rig",
 )
 MD_MODEL_CFG = {k: MD[k] for k in MD_MODEL_KEYS}
 # mesh frames: mesh_dir, or the synthetic character (with its ground truth)
@@ -133,6 +133,7 @@ rule meshdetail_rig:
 rule meshdetail_main:
     input:
         **MD_DATA,
+        truth=MD_TRUTH,
     output:
         fig5a=report(
             R("meshdetail/fig5a.csv"),
@@ -155,6 +156,7 @@ rule meshdetail_main:
         preds=R("meshdetail/data/predictions.npz"),
     params:
         cfg=MD_MODEL_CFG,
+        rig=MD["rig"],
         train_fraction=MD["train_fraction"],
         render_frames=MD["render_frames"],
     threads: 1
@@ -292,6 +294,7 @@ rule meshdetail_verdicts:
         ),
     params:
         source=MD_SOURCE,
+        cv_rig=MD["cv_rig"],
     threads: 1
     resources:
         mem_mb=500,

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -249,8 +249,15 @@ def blocks(n: int, k: int) -> list:
     return np.array_split(np.arange(n), k)
 
 
-def run_main(d: Prepared, cfg: dict):
+def run_main(d: Prepared, cfg: dict, refit_rig=None):
     """Fig. 5a, Fig. 5c and the generalisation table under blocked cross-validation.
+
+    ``refit_rig`` (optional, e.g. :func:`.jobs.fold_rig_fitter`): a function
+    ``train -> (rig, weights, root_t, angles)``. When given, every fold redoes
+    the skeleton step (joint placement, skinning weights, pose fit) from its
+    own training blocks, so no held-out frame shapes the skin of the models
+    that are tested on it. Without it the fold models share ``d``'s skeleton
+    (fitted on ``d.train``, which overlaps the held-out blocks of early folds).
 
     Every model (LBS only, the paper's SGPLVM+GPDM hybrid, plain GP
     regression, CV-tuned ridge, the hybrid without the GPDM term) is trained
@@ -276,18 +283,24 @@ def run_main(d: Prepared, cfg: dict):
     for b, te in enumerate(folds):
         block[te] = b
         tr = np.setdiff1d(np.arange(n), te)
+        if refit_rig is None:
+            db, cb = d, ctx
+        else:
+            rig_b, w_b, rt_b, ang_b = refit_rig(tr)
+            db = replace(d, rig=rig_b, weights=w_b, root_t=rt_b, angles=ang_b, train=tr, test=te)
+            cb = context(db, (cfg["level"],), cfg)
         for k, over in _variants(cfg).items():
-            m = _fit(_model(cfg, **over), ctx, d, tr)
-            p = _predict(m, ctx, d, te)
+            m = _fit(_model(cfg, **over), cb, db, tr)
+            p = _predict(m, cb, db, te)
             e = mean_vertex_error(p, d.frames[te]) * MM
             oof[k][te] = e
             fold_test[k].append(e.mean())
-            fold_train[k].append(float(np.mean(mean_vertex_error(m.predict(ctx, d.root_t[tr], d.angles[tr]),
+            fold_train[k].append(float(np.mean(mean_vertex_error(m.predict(cb, db.root_t[tr], db.angles[tr]),
                                                                   d.frames[tr]) * MM)))
             if k in preds:
                 preds[k][te] = p
             for name, (fr, rt, ang) in d.edits.items():
-                edit_err[name][k].append(float(np.mean(_err(m, ctx, fr, rt, ang))))
+                edit_err[name][k].append(float(np.mean(_err(m, cb, fr, rt, ang))))
         log.info("fold %d/%d: held-out %s", b + 1, len(folds), {k: round(v[-1], 2) for k, v in fold_test.items()})
     r4 = lambda x: np.round(x, 4)  # noqa: E731
     fig5c = pd.DataFrame({"frame": np.arange(n), "block": block, **{MODEL_COLUMNS[k]: r4(oof[k]) for k in names}})

@@ -110,13 +110,11 @@ def load_sequences(main_dir: str, truth_npz: str | None, seq_out: str, edits_out
     return seq
 
 
-def fit_pose(seq_npz: str, truth_npz: str | None, rig_cfg: dict, train_fraction: float, out_npz: str):
-    """Embed the 18-joint skeleton, compute weights, fit every frame.
+def initial_rig(seq: MeshSequence, truth_npz: str | None, rig_cfg: dict):
+    """The skeleton of ``seq`` before fitting: the generator's rig (synthetic data) or the configured embedding.
 
-    Returns (rig_fit table, joints table, skinning comparison table or None, description of the embedding).
+    Returns (rig, refine, method description, true angles or None, vertex labels or None).
     """
-    seq = MeshSequence.load_npz(seq_npz)
-    train, _ = split_frames(seq.n_frames, train_fraction)
     true_angles = labels = None
     if truth_npz:
         with np.load(truth_npz) as z:
@@ -134,6 +132,34 @@ def fit_pose(seq_npz: str, truth_npz: str | None, rig_cfg: dict, train_fraction:
         rig = rig_from_joints(rig_cfg["joints"], rig_cfg.get("ends") or {})
         refine = bool(rig_cfg["refine"])
         method = "user-supplied embedding" + (", joints refined from the training frames' motion" if refine else "")
+    return rig, refine, method, true_angles, labels
+
+
+def fold_rig_fitter(seq_npz: str, truth_npz: str | None, rig_cfg: dict):
+    """A function ``train -> (rig, weights, root_t, angles)`` that redoes the whole skeleton
+    step (joint placement, weights, pose fit of every frame) from the given training frames
+    only, so a cross-validation fold's held-out frames never shape its skin."""
+    seq = MeshSequence.load_npz(seq_npz)
+    rig0, refine, _, _, _ = initial_rig(seq, truth_npz, rig_cfg)
+
+    def refit(train):
+        rig, weights, fitter, _, _ = fit_skeleton(
+            seq.vertices, seq.faces, rig0, np.asarray(train), skinning=rig_cfg["skinning"], refine=refine,
+            max_influences=rig_cfg["max_influences"], iterations=rig_cfg["fit_iterations"],
+            heat_c=rig_cfg["heat_c"], weight_power=rig_cfg["weight_power"], compare=False)
+        return rig, weights, fitter.root_t_, fitter.angles_
+
+    return refit
+
+
+def fit_pose(seq_npz: str, truth_npz: str | None, rig_cfg: dict, train_fraction: float, out_npz: str):
+    """Embed the 18-joint skeleton, compute weights, fit every frame.
+
+    Returns (rig_fit table, joints table, skinning comparison table or None, description of the embedding).
+    """
+    seq = MeshSequence.load_npz(seq_npz)
+    train, _ = split_frames(seq.n_frames, train_fraction)
+    rig, refine, method, true_angles, labels = initial_rig(seq, truth_npz, rig_cfg)
     rig, weights, fitter, joints, comparison = fit_skeleton(
         seq.vertices, seq.faces, rig, train, skinning=rig_cfg["skinning"], refine=refine,
         max_influences=rig_cfg["max_influences"], iterations=rig_cfg["fit_iterations"], heat_c=rig_cfg["heat_c"],
