@@ -477,6 +477,12 @@ def test_min_k_table_fills_published_values(tmp_path):
     assert t["sign_mode"].tolist() == ["continuous", "matrix_naive"] * 2
     assert t.loc[~t["global_dof"], "min_k_paper"].tolist() == [79, 79]
     assert t.loc[t["global_dof"], "min_k_paper"].isna().all()
+    # ours - paper beside the paper's value; empty where the paper has none
+    cols = list(t.columns)
+    assert cols[cols.index("min_k_paper") + 1] == "min_k_minus_paper"
+    assert t.loc[~t["global_dof"], "min_k_minus_paper"].tolist() == [3 - 79, 3 - 79]
+    assert t.loc[~t["global_dof"], "frames_minus_paper"].tolist() == [10 - 516, 10 - 516]
+    assert t.loc[t["global_dof"], "min_k_minus_paper"].isna().all()
     bad = _published()
     bad.loc[1, "method"] = "lle"
     bad.to_csv(f, index=False)

@@ -334,10 +334,13 @@ def test_run_fold_and_tables_on_toy_data():
     assert df["length_ratio"].between(0.3, 0.7).all()
     paper = pd.DataFrame([{"metric": "error_a", "method": "delaunay", "w1": 1.5, "all": 2.0}])
     t2 = ex.table2(df, ["w1"], paper=paper)
-    assert list(t2.columns) == ["metric", "method", "w1", "all", "paper_w1", "paper_all"]
+    assert list(t2.columns) == ["metric", "method", "w1", "all", "paper_w1", "paper_all", "w1_minus_paper",
+                                "all_minus_paper"]
     assert t2[["metric", "method"]].values.tolist() == [["error_a", "delaunay"], ["error_a", "knn"],
                                                         ["error_f", "delaunay"], ["error_f", "knn"]]
     assert t2.loc[0, "paper_w1"] == 1.5 and np.isnan(t2.loc[1, "paper_w1"]) and np.isnan(t2.loc[3, "paper_all"])
+    assert t2.loc[0, "w1_minus_paper"] == pytest.approx(t2.loc[0, "w1"] - 1.5)
+    assert np.isnan(t2.loc[1, "w1_minus_paper"])
     d = df[df["method"] == "knn"]
     assert t2.loc[3, "w1"] == pytest.approx(d["error_f_norm"].median())
     pc = ex.paired_comparison(df, n_boot=200, seed=1)

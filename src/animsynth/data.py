@@ -126,7 +126,8 @@ def datasets_table(subsets: dict, motions: dict, source: str, paper: dict | None
     motions : trial id -> Motion
     source : ``synthetic``, ``cmu`` or ``user``
     paper : name -> list of published lengths (see :func:`read_paper_table1`), optional
-        When given (even empty) the table gets ``paper_lengths``, ``paper_total_nodes``
+        When given (even empty) the table gets ``paper_lengths``, ``paper_total_nodes``,
+        ``total_nodes_minus_paper`` (ours - paper)
         and ``length_match`` (which trials match the paper's length at the same
         position, and which stand in for another length); empty for subsets the
         paper does not list.
@@ -152,10 +153,11 @@ def datasets_table(subsets: dict, motions: dict, source: str, paper: dict | None
             pl = paper.get(name)
             rows[-1]["paper_lengths"] = " ".join(map(str, pl)) if pl else ""
             rows[-1]["paper_total_nodes"] = int(sum(pl)) if pl else None
+            rows[-1]["total_nodes_minus_paper"] = int(sum(lengths)) - int(sum(pl)) if pl else None
             rows[-1]["length_match"] = length_match(ids, lengths, pl) if pl else ""
     cols = ["dataset", "source", "trials", "dims", "n_sequences", "lengths", "total_nodes"]
     if paper is not None:
-        cols += ["paper_lengths", "paper_total_nodes", "length_match"]
+        cols += ["paper_lengths", "paper_total_nodes", "total_nodes_minus_paper", "length_match"]
     return pd.DataFrame(rows, columns=cols)
 
 

@@ -47,3 +47,30 @@ def write_table(df: pd.DataFrame, csv_path, md: bool = True, title: str | None =
     if md:
         back = pd.read_csv(csv_path, keep_default_na=False, na_values=[""])
         atomic_write_text(os.path.splitext(os.fspath(csv_path))[0] + ".md", to_markdown(back, title, note))
+
+
+def add_paper_differences(df: pd.DataFrame, pairs: dict[str, str], suffix: str = "_minus_paper") -> pd.DataFrame:
+    """Put ``ours - paper`` beside each published column.
+
+    Parameters
+    ----------
+    df : DataFrame with our columns and the paper's
+    pairs : {our column: the paper's column}; pairs whose columns are absent are skipped
+    suffix : the difference column is ``<our column><suffix>``
+
+    Returns
+    -------
+    A copy with each difference inserted right after the paper's column
+    (empty where either value is missing or not numeric).
+    """
+    out = df.copy()
+    for ours, paper in pairs.items():
+        if ours not in out or paper not in out:
+            continue
+        a = pd.to_numeric(out[ours], errors="coerce").astype(float)
+        b = pd.to_numeric(out[paper], errors="coerce").astype(float)
+        name = ours + suffix
+        if name in out:
+            out = out.drop(columns=name)
+        out.insert(out.columns.get_loc(paper) + 1, name, a - b)
+    return out

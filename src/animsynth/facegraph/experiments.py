@@ -19,6 +19,7 @@ from scipy.sparse.csgraph import connected_components, dijkstra
 from threadpoolctl import threadpool_limits
 
 from ..io.ckplus import EMOTIONS, emotion_code
+from ..tables import add_paper_differences
 from .baseline import FaceGraphBaseline
 from .evaluate import compare, evaluate_resynthesis, summarise
 from .model import FaceGraphModel
@@ -165,7 +166,7 @@ TABLE1_COLUMNS = (
      "threshold_mode", "creation_achieved", "merge_achieved", "creation_in_band_pct", "merge_in_band_pct",
      "thresholds_converged", "poses", "nodes", "edges", "strong_components_max", "reachable_peaks_mean",
      "shared_peak_pct"]
-    + [c for k in _PAPER_BESIDE for c in (k, "paper_" + k)]
+    + [c for k in _PAPER_BESIDE for c in (k, "paper_" + k, k + "_minus_paper")]
     + ["duration_signed"]
     + [p + k for p in ("random_", "linear_") for k in ACCURACY_KEYS]
 )
@@ -185,7 +186,8 @@ def assemble_table1(rows: list[dict], order: list[str], paper: dict | None = Non
         for k in _PAPER_BESIDE:
             r["paper_" + k] = pv.get(k, np.nan)
         out.append(r)
-    return pd.DataFrame(out)[TABLE1_COLUMNS]
+    df = add_paper_differences(pd.DataFrame(out), {k: "paper_" + k for k in _PAPER_BESIDE})
+    return df[TABLE1_COLUMNS]
 
 
 def assemble_timing(rows: list[dict], order: list[str], paper: dict | None = None) -> pd.DataFrame:

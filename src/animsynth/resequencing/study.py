@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from ..motion import Motion
+from ..tables import add_paper_differences
 from .distances import PAPER_WEIGHTS, l2_distances, lee_distances
 from .embedding import (DisconnectedGraphError, PrecomputedIsomap, graph_components, knn_graph,
                         min_connected_k, neighbor_ranks, residual_variance, spatio_temporal_distances,
@@ -546,8 +547,8 @@ def min_k_table(grid: pd.DataFrame, published: pd.DataFrame | None, frame_step: 
     df = df.sort_values(["_o", "dataset", "global_dof", "_s", "method", "metric"], kind="stable")
     cols = ["dataset", "trial", "frames", "fps", "global_dof", "sign_mode", "method", "metric", "min_k",
             "min_k_paper", "paper_frames", "components_at_min_k_minus_1", "components_at_min_k"]
-    out = df[cols].reset_index(drop=True)
-    for c in ("min_k_paper", "paper_frames"):
+    out = add_paper_differences(df[cols].reset_index(drop=True), {"min_k": "min_k_paper", "frames": "paper_frames"})
+    for c in ("min_k_paper", "paper_frames", "min_k_minus_paper", "frames_minus_paper"):
         out[c] = out[c].astype("Int64")
     return out
 

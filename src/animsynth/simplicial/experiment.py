@@ -453,7 +453,8 @@ def table2(folds: pd.DataFrame, datasets, methods=("delaunay", "knn"), paper: pd
     One row per metric (``error_a``, ``error_f``) x method; columns the
     subsets and ``all`` with our medians (``col``: bounding-box-normalised by
     default), then ``paper_<subset>`` with the published value (empty when
-    ``paper`` is None or lacks the cell).
+    ``paper`` is None or lacks the cell), then ``<subset>_minus_paper``
+    (ours - paper, empty without the published value).
 
     Parameters
     ----------
@@ -478,8 +479,11 @@ def table2(folds: pd.DataFrame, datasets, methods=("delaunay", "knn"), paper: pd
                 if pap is not None and (met, m) in pap.index and d in pap.columns:
                     val = float(pap.loc[(met, m), d])
                 r[f"paper_{d}"] = val
+            for d in cols:
+                r[f"{d}_minus_paper"] = r[d] - r[f"paper_{d}"]
             rows.append(r)
-    return pd.DataFrame(rows, columns=["metric", "method"] + cols + [f"paper_{d}" for d in cols])
+    return pd.DataFrame(rows, columns=["metric", "method"] + cols + [f"paper_{d}" for d in cols]
+                        + [f"{d}_minus_paper" for d in cols])
 
 
 def table2_units(folds: pd.DataFrame, datasets, methods=("delaunay", "knn")) -> pd.DataFrame:
