@@ -565,3 +565,89 @@ def undo_merge(s, st, first, red, Dsum, Dmean, Dred, cnt, node_map,
     st[0] = n0
     st[1] = ne0
     st[2] = 0
+
+
+# ---------------------------------------------------------------------------
+# node-to-node similarities
+@njit(cache=True)
+def edge_weights(edges, Dred, vin_mean, order, lo, hi, lam, eps):
+    """Node-to-node eq. 3 of every edge: minimum over the incoming-velocity pairs.
+
+    Parameters
+    ----------
+    edges : int ndarray (E, 2)
+    Dred : ndarray (N, Lr, 2), mean reduced displacements
+    vin_mean : ndarray (V, Lr, 2), incoming-edge velocities
+    order, lo, hi : int ndarrays
+        ``order[lo[f]:hi[f]]`` are the incoming edges of node ``f``.
+
+    Returns
+    -------
+    ndarray (E,)
+    """
+    E = edges.shape[0]
+    Lr = Dred.shape[1]
+    dist = np.empty(Lr)
+    prod = np.empty(Lr)
+    w = np.full(E, np.inf)
+    for k in range(E):
+        a, b = edges[k, 0], edges[k, 1]
+        for l in range(Lr):
+            d0 = Dred[a, l, 0] - Dred[b, l, 0]
+            d1 = Dred[a, l, 1] - Dred[b, l, 1]
+            dist[l] = math.sqrt(d0 * d0 + d1 * d1)
+        for i in range(lo[a], hi[a]):
+            ia = order[i]
+            for j in range(lo[b], hi[b]):
+                ib = order[j]
+                for l in range(Lr):
+                    va0, va1 = vin_mean[ia, l, 0], vin_mean[ia, l, 1]
+                    vb0, vb1 = vin_mean[ib, l, 0], vin_mean[ib, l, 1]
+                    na = math.sqrt(va0 * va0 + va1 * va1)
+                    nb = math.sqrt(vb0 * vb0 + vb1 * vb1)
+                    if na > eps and nb > eps:
+                        c = (va0 * vb0 + va1 * vb1) / (na * nb)
+                    else:
+                        c = 1.0
+                    prod[l] = dist[l] * (1.0 + lam * (1.0 - min(abs(c), 1.0)))
+                v = pw_sum(prod, Lr)
+                if v < w[k]:
+                    w[k] = v
+    return w
+
+
+@njit(cache=True)
+def nearest_other_sample(D, sample, q):
+    """For each query node, the smallest landmark-distance sum to a node of another sample.
+
+    Parameters
+    ----------
+    D : ndarray (G, L, 2), reduced node displacements
+    sample : int ndarray (G,)
+    q : int ndarray (k,), query nodes
+
+    Returns
+    -------
+    ndarray (k,), ``inf`` where no other sample has nodes. The sum runs over
+    landmarks in order (as the pruned numpy search it replaces did).
+    """
+    G, L = D.shape[0], D.shape[1]
+    out = np.full(q.shape[0], np.inf)
+    for i in range(q.shape[0]):
+        a = q[i]
+        best = np.inf
+        for j in range(G):
+            if sample[j] == sample[a]:
+                continue
+            tot = 0.0
+            for l in range(L):
+                d0 = D[j, l, 0] - D[a, l, 0]
+                d1 = D[j, l, 1] - D[a, l, 1]
+                dl = math.sqrt(d0 * d0 + d1 * d1)
+                tot = dl if l == 0 else tot + dl
+                if tot > best:
+                    break
+            if tot < best:
+                best = tot
+        out[i] = best
+    return out

@@ -25,7 +25,6 @@ import numpy as np
 from . import _jit
 from .regiongraph import EDGE_EPS, RegionGraph
 from .samplegraphs import RegionData, SampleNodes
-from .similarity import vinfl
 
 # ---------------------------------------------------------------------------
 def _rigid2d(a: np.ndarray, b: np.ndarray):
@@ -206,22 +205,15 @@ def _finish_graph(rd, nodes, node_map, visit_map, n, Dmean, cnt, vin_mean, vin_o
 
 
 def _edge_weights(edges, Dred, vin_mean, vin_owner, n, lam, eps) -> np.ndarray:
-    """Node-to-node eq. 3 for every edge (min over incoming-velocity pairs) + EDGE_EPS."""
+    """Node-to-node eq. 3 for every edge (min over incoming-velocity pairs) + EDGE_EPS
+    (compiled, :func:`._jit.edge_weights`)."""
     if len(edges) == 0:
         return np.zeros(0)
     order = np.argsort(vin_owner, kind="stable")
     own_sorted = vin_owner[order]
     lo = np.searchsorted(own_sorted, np.arange(n))
     hi = np.searchsorted(own_sorted, np.arange(n), side="right")
-    ka, kb = hi[edges[:, 0]] - lo[edges[:, 0]], hi[edges[:, 1]] - lo[edges[:, 1]]
-    npair = ka * kb
-    eid = np.repeat(np.arange(len(edges)), npair)
-    # index of each pair within its edge -> (i, j) entries
-    within = np.arange(npair.sum()) - np.repeat(np.cumsum(npair) - npair, npair)
-    ia = order[lo[edges[eid, 0]] + within // kb[eid]]
-    ib = order[lo[edges[eid, 1]] + within % kb[eid]]
-    dist = np.sqrt(((Dred[edges[:, 0]] - Dred[edges[:, 1]]) ** 2).sum(-1))  # (E, Lr)
-    sc = (dist[eid] * (1.0 + lam * vinfl(vin_mean[ia], vin_mean[ib], eps))).sum(-1)
-    w = np.full(len(edges), np.inf)
-    np.minimum.at(w, eid, sc)
+    w = _jit.edge_weights(np.ascontiguousarray(edges, np.int64), np.ascontiguousarray(Dred, float),
+                          np.ascontiguousarray(vin_mean, float), order.astype(np.int64), lo.astype(np.int64),
+                          hi.astype(np.int64), float(lam), float(eps))
     return w + EDGE_EPS
