@@ -22,13 +22,9 @@ import math
 
 import numpy as np
 
+from . import _jit
 from .regiongraph import EDGE_EPS, RegionGraph
 from .samplegraphs import RegionData, SampleNodes
-from .similarity import vinfl
-
-#: ``np.add.reduce`` is what ``ndarray.sum`` calls, without its Python wrapper (same result).
-_sum = np.add.reduce
-
 
 # ---------------------------------------------------------------------------
 def _rigid2d(a: np.ndarray, b: np.ndarray):
@@ -53,200 +49,88 @@ class Merger:
     pruned with the Frobenius lower bound of eq. 3 (exact result). A merge made
     with ``trial=True`` keeps an undo log and is reverted by :meth:`undo`, so
     a per-sample threshold search can try thresholds on the real state.
+
+    The visit loop is compiled (:func:`._jit.merge_sample`, numpy's arithmetic
+    reproduced); the state lives in preallocated arrays: node sums and means
+    (G, Lf, 2), reduced means (G, 2 Lr), and per incoming edge (at most one
+    per visit) the velocity sum, mean (V, Lr, 2) and speeds (V, Lr), chained
+    per node in creation order.
     """
 
     def __init__(self, rd: RegionData, nodes: SampleNodes, lam: float = 1.0, eps: float = 1e-2,
                  procrustes: bool = True):
         G, Lf = nodes.n, len(rd.landmarks)
         self.rd, self.nodes, self.lam, self.eps, self.procrustes = rd, nodes, float(lam), float(eps), procrustes
-        self.red = rd.red
-        self.Lr = len(rd.red)
-        self.M = rd.neutral_ref
-        self.Dsum = np.empty((G, Lf, 2))
-        self.Dmean = np.empty((G, Lf, 2))
-        self.Dred = np.empty((G, self.Lr * 2))
-        self.Dsq = np.empty(G)
-        self.cnt = np.zeros(G)
-        self.node_map = np.full(G, -1, int)
+        self.red = np.ascontiguousarray(rd.red, np.int64)
+        self.Lr = Lr = len(rd.red)
+        self.M = np.ascontiguousarray(rd.neutral_ref, float)
         nv = len(nodes.visit_node)
-        self.vin_sum = np.empty((nv, self.Lr, 2))
-        self.vin_mean = np.empty_like(self.vin_sum)
-        self.vin_nrm = np.empty((nv, self.Lr))   # landmark speeds of vin_mean (for vinfl)
+        self._nodes = (np.ascontiguousarray(nodes.visit_node, np.int64), np.ascontiguousarray(nodes.visit_vel, float),
+                       np.ascontiguousarray(nodes.visit_first, np.int64), np.ascontiguousarray(nodes.disp, float),
+                       np.ascontiguousarray(nodes.count, float), np.ascontiguousarray(nodes.first, np.int64))
+        self.Dsum = np.zeros((G, Lf, 2))
+        self.Dmean = np.zeros((G, Lf, 2))
+        self.Dred = np.zeros((G, Lr * 2))
+        self.cnt = np.zeros(G)
+        self.node_map = np.full(G, -1, np.int64)
+        self.visit_map = np.zeros(nv, np.int64)
+        self.vin_sum = np.zeros((nv, Lr, 2))
+        self.vin_mean = np.zeros((nv, Lr, 2))
+        self.vin_nrm = np.zeros((nv, Lr))   # landmark speeds of vin_mean (for vinfl)
         self.vin_cnt = np.zeros(nv)
-        self.vin_owner = np.empty(nv, int)
-        self.vin_of: list[list[int]] = []
-        self.vin_key: dict[tuple[int, int], int] = {}
-        self.visit_map = np.empty(nv, int)
-        self.n = 0
-        self.ne = 0
-        self._undo = None
+        self.vin_owner = np.zeros(nv, np.int64)
+        self._vin_prev = np.zeros(nv, np.int64)
+        self._vin_next = np.full(nv, -1, np.int64)
+        self._vin_oldtail = np.full(nv, -1, np.int64)
+        self._head = np.full(G, -1, np.int64)
+        self._tail = np.full(G, -1, np.int64)
+        cap = int(np.diff(nodes.visit_first).max()) if nv else 0   # touched per trial <= visits of a sample
+        self._u_node = np.zeros(cap, np.int64)
+        self._u_Dsum = np.zeros((cap, Lf, 2))
+        self._u_cnt = np.zeros(cap)
+        self._node_stamp = np.zeros(G, np.int64)
+        self._u_vin = np.zeros(cap, np.int64)
+        self._u_vsum = np.zeros((cap, Lr, 2))
+        self._u_vcnt = np.zeros(cap)
+        self._u_vmean = np.zeros((cap, Lr, 2))
+        self._u_vnrm = np.zeros((cap, Lr))
+        self._vin_stamp = np.zeros(nv, np.int64)
+        self._st = np.zeros(8, np.int64)   # n, ne, trial open, n0, ne0, undo counts (nodes, vins), stamp
+        self._s = -1
 
-    def _touch_node(self, f):
-        u = self._undo
-        if u is not None and f < u["n"] and f not in u["nodes"]:
-            u["nodes"][f] = (self.Dsum[f].copy(), self.cnt[f])
+    @property
+    def n(self) -> int:
+        return int(self._st[0])
 
-    def _touch_vin(self, e):
-        u = self._undo
-        if u is not None and e < u["ne"] and e not in u["vins"]:
-            u["vins"][e] = (self.vin_sum[e].copy(), self.vin_cnt[e], self.vin_mean[e].copy(), self.vin_nrm[e].copy())
+    @property
+    def ne(self) -> int:
+        return int(self._st[1])
 
     def merge(self, s: int, threshold: float, trial: bool = False) -> float:
         """Merge sample ``s`` with ``threshold``; return its merge compression
         (%): ``100 * (1 - new final nodes / nodes of the sample)``."""
-        nodes, red, Lr, M, lam, eps = self.nodes, self.red, self.Lr, self.M, self.lam, self.eps
-        T = float(threshold)
-        T2 = T * T
-        n0 = self.n
-        self._undo = None
-        if trial:
-            self._undo = {"n": self.n, "ne": self.ne, "nodes": {}, "vins": {}, "vin_of_len": {}, "keys": [], "s": s}
-        Dsum, Dmean, Dred, Dsq, cnt, node_map = self.Dsum, self.Dmean, self.Dred, self.Dsq, self.cnt, self.node_map
-        vin_sum, vin_mean, vin_cnt, vin_owner, vin_of, vin_key = (self.vin_sum, self.vin_mean, self.vin_cnt,
-                                                                  self.vin_owner, self.vin_of, self.vin_key)
-        visit_node, visit_vel, visit_first = nodes.visit_node, nodes.visit_vel, nodes.visit_first
-        n, ne = self.n, self.ne
-        R = None
-        tr = None
-        prev = -1
-        vin_nrm = self.vin_nrm
-        procrustes = self.procrustes
-        Lf = M.shape[0]
-        for vi_ in range(visit_first[s], visit_first[s + 1]):
-            g = visit_node[vi_]
-            qv = visit_vel[vi_]
-            if R is not None:
-                qv = qv @ R.T
-            f = node_map[g]
-            if f < 0:
-                qd = nodes.disp[g]
-                if R is not None:
-                    qd = (M + qd) @ R.T + tr - M
-                qdr = qd[red]
-                qr = qdr.ravel()
-                best = -1
-                if n:
-                    frob2 = Dsq[:n] + qr @ qr - 2.0 * (Dred[:n] @ qr)
-                    cand = np.flatnonzero(frob2 <= T2 + 1e-12)  # eq. 3 >= distance sum >= Frobenius
-                    if cand.size:
-                        diff = Dred[cand].reshape(-1, Lr, 2) - qdr
-                        dist = np.sqrt(_sum(diff * diff, -1))  # (c, Lr)
-                        ok = _sum(dist, -1) <= T
-                        if ok.any():
-                            cand, dist = cand[ok], dist[ok]
-                            if cand.size == 1:
-                                ent = vin_of[cand[0]]
-                                rows = np.zeros(len(ent), int)
-                            else:
-                                lists = [vin_of[c] for c in cand]
-                                ent = np.concatenate(lists)
-                                rows = np.repeat(np.arange(cand.size), [len(x) for x in lists])
-                            # vinfl(qv, vin_mean[ent]) with the stored speeds (same arithmetic)
-                            vb = vin_mean[ent]
-                            qn = np.sqrt(_sum(qv * qv, -1))
-                            okv = (qn > eps) & (vin_nrm[ent] > eps)
-                            den = np.where(okv, qn * vin_nrm[ent], 1.0)
-                            cos = np.where(okv, _sum(qv * vb, -1) / den, 1.0)
-                            vi = 1.0 - np.minimum(np.abs(cos), 1.0)
-                            sc = _sum(dist[rows] * (1.0 + lam * vi), -1)
-                            j = int(np.argmin(sc))
-                            if sc[j] <= T:
-                                best = int(cand[rows[j]])
-                c = nodes.count[g]
-                if best >= 0:
-                    if procrustes:
-                        # _rigid2d(M + qd, M + Dmean[best]), inlined
-                        a = M + qd
-                        b = M + Dmean[best]
-                        ma = _sum(a, 0) / Lf
-                        mb = _sum(b, 0) / Lf
-                        a0 = a - ma
-                        b0 = b - mb
-                        dot = float(_sum(a0 * b0, None))
-                        cross = float(_sum(a0[:, 0] * b0[:, 1] - a0[:, 1] * b0[:, 0], None))
-                        h = math.hypot(dot, cross)
-                        cs, sn = (dot / h, cross / h) if h > 0 else (1.0, 0.0)
-                        Ra = np.array([[cs, -sn], [sn, cs]])
-                        ta = mb - Ra @ ma
-                        qd = a @ Ra.T + ta - M
-                        qv = qv @ Ra.T
-                        if R is None:
-                            R, tr = Ra, ta
-                        else:
-                            R, tr = Ra @ R, Ra @ tr + ta
-                    f = best
-                    if self._undo is not None:
-                        self._touch_node(f)
-                    Dsum[f] += c * qd
-                    cnt[f] += c
-                else:
-                    f = n
-                    n += 1
-                    Dsum[f] = c * qd
-                    cnt[f] = c
-                    vin_of.append([])
-                dm = Dsum[f] / cnt[f]
-                Dmean[f] = dm
-                dr = dm[red].ravel()
-                Dred[f] = dr
-                Dsq[f] = dr @ dr
-                node_map[g] = f
-            key = (f, prev)
-            e = vin_key.get(key)
-            if e is None:
-                e = vin_key[key] = ne
-                vin_owner[e] = f
-                vin_sum[e] = qv
-                vin_cnt[e] = 1.0
-                vin_mean[e] = qv
-                vin_nrm[e] = np.sqrt(_sum(qv * qv, -1))
-                if self._undo is not None:
-                    self._undo["keys"].append(key)
-                    if f < n0 and f not in self._undo["vin_of_len"]:
-                        self._undo["vin_of_len"][f] = len(vin_of[f])
-                vin_of[f].append(e)
-                ne += 1
-            else:
-                if self._undo is not None:
-                    self._touch_vin(e)
-                vin_sum[e] += qv
-                vin_cnt[e] += 1.0
-                vm = vin_sum[e] / vin_cnt[e]
-                vin_mean[e] = vm
-                vin_nrm[e] = np.sqrt(_sum(vm * vm, -1))
-            self.visit_map[vi_] = f
-            prev = f
-        self.n, self.ne = n, ne
-        k = nodes.first[s + 1] - nodes.first[s]
-        return 100.0 * (1.0 - (n - n0) / max(k, 1))
+        self._s = int(s)
+        return float(_jit.merge_sample(
+            int(s), float(threshold), bool(trial), self.lam, self.eps, bool(self.procrustes), self._st,
+            *self._nodes[:5], self._nodes[5], self.red, self.M,
+            self.Dsum, self.Dmean, self.Dred, self.cnt, self.node_map, self.visit_map,
+            self.vin_sum, self.vin_mean, self.vin_nrm, self.vin_cnt, self.vin_owner, self._vin_prev, self._vin_next,
+            self._vin_oldtail, self._head, self._tail,
+            self._u_node, self._u_Dsum, self._u_cnt, self._node_stamp, self._u_vin, self._u_vsum, self._u_vcnt,
+            self._u_vmean, self._u_vnrm, self._vin_stamp))
 
     def undo(self) -> None:
         """Revert the last ``trial`` merge."""
-        u = self._undo
-        if u is None:
+        if not self._st[2]:
             raise RuntimeError("no trial merge to undo")
-        red = self.red
-        for f, (dsum, c) in u["nodes"].items():
-            self.Dsum[f] = dsum
-            self.cnt[f] = c
-            self.Dmean[f] = dsum / c
-            self.Dred[f] = self.Dmean[f][red].ravel()
-            self.Dsq[f] = self.Dred[f] @ self.Dred[f]
-        for e, (vs, vc, vm, vn) in u["vins"].items():
-            self.vin_sum[e], self.vin_cnt[e], self.vin_mean[e], self.vin_nrm[e] = vs, vc, vm, vn
-        for key in u["keys"]:
-            del self.vin_key[key]
-        for f, ln in u["vin_of_len"].items():
-            del self.vin_of[f][ln:]
-        del self.vin_of[u["n"]:]
-        s = u["s"]
-        self.node_map[self.nodes.first[s]:self.nodes.first[s + 1]] = -1
-        self.n, self.ne = u["n"], u["ne"]
-        self._undo = None
+        _jit.undo_merge(self._s, self._st, self._nodes[5], self.red, self.Dsum, self.Dmean, self.Dred, self.cnt,
+                        self.node_map, self.vin_sum, self.vin_mean, self.vin_nrm, self.vin_cnt, self.vin_owner,
+                        self._vin_next, self._vin_oldtail, self._tail, self._u_node, self._u_Dsum, self._u_cnt,
+                        self._u_vin, self._u_vsum, self._u_vcnt, self._u_vmean, self._u_vnrm)
 
     def commit(self) -> None:
         """Keep the last ``trial`` merge."""
-        self._undo = None
+        self._st[2] = 0
 
     def finish(self, threshold_info) -> RegionGraph:
         """The final :class:`RegionGraph` after every sample was merged."""
@@ -321,22 +205,15 @@ def _finish_graph(rd, nodes, node_map, visit_map, n, Dmean, cnt, vin_mean, vin_o
 
 
 def _edge_weights(edges, Dred, vin_mean, vin_owner, n, lam, eps) -> np.ndarray:
-    """Node-to-node eq. 3 for every edge (min over incoming-velocity pairs) + EDGE_EPS."""
+    """Node-to-node eq. 3 for every edge (min over incoming-velocity pairs) + EDGE_EPS
+    (compiled, :func:`._jit.edge_weights`)."""
     if len(edges) == 0:
         return np.zeros(0)
     order = np.argsort(vin_owner, kind="stable")
     own_sorted = vin_owner[order]
     lo = np.searchsorted(own_sorted, np.arange(n))
     hi = np.searchsorted(own_sorted, np.arange(n), side="right")
-    ka, kb = hi[edges[:, 0]] - lo[edges[:, 0]], hi[edges[:, 1]] - lo[edges[:, 1]]
-    npair = ka * kb
-    eid = np.repeat(np.arange(len(edges)), npair)
-    # index of each pair within its edge -> (i, j) entries
-    within = np.arange(npair.sum()) - np.repeat(np.cumsum(npair) - npair, npair)
-    ia = order[lo[edges[eid, 0]] + within // kb[eid]]
-    ib = order[lo[edges[eid, 1]] + within % kb[eid]]
-    dist = np.sqrt(((Dred[edges[:, 0]] - Dred[edges[:, 1]]) ** 2).sum(-1))  # (E, Lr)
-    sc = (dist[eid] * (1.0 + lam * vinfl(vin_mean[ia], vin_mean[ib], eps))).sum(-1)
-    w = np.full(len(edges), np.inf)
-    np.minimum.at(w, eid, sc)
+    w = _jit.edge_weights(np.ascontiguousarray(edges, np.int64), np.ascontiguousarray(Dred, float),
+                          np.ascontiguousarray(vin_mean, float), order.astype(np.int64), lo.astype(np.int64),
+                          hi.astype(np.int64), float(lam), float(eps))
     return w + EDGE_EPS

@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from . import _jit
 from .merging import Merger, merge_sample_graphs
 from .preprocess import FaceDatabase
 from .samplegraphs import (PoseStack, RegionData, SampleNodes, create_sample_graphs, creation_compression,
@@ -39,48 +40,24 @@ def _consecutive_similarity(rd: RegionData, lam, eps) -> np.ndarray:
     return pose_similarity(rd.disp[i][:, r], rd.vel[i][:, r], rd.disp[i - 1][:, r], rd.vel[i - 1][:, r], lam, eps)
 
 
-def _landmark_distance_sum(D, a, b):
-    """Sum over landmarks of ``||D[a] - D[b]||`` (pairs), summed landmark by
-    landmark (the order of a reduction over the strided landmark axis of
-    ``D[None] - D[:, None]``, kept so that results do not change)."""
-    dist = np.sqrt(((D[a] - D[b]) ** 2).sum(-1))   # (pairs, L)
-    tot = dist[:, 0].copy()
-    for j in range(1, dist.shape[1]):
-        tot += dist[:, j]
-    return tot
-
-
 def _nn_similarity(nodes: SampleNodes, red, rng, k: int = 256) -> np.ndarray:
     """Plain distance sum from up to k random sample nodes to their nearest node of another sample.
 
-    Exact but pruned (written by hand: the distance is a sum of per-landmark
-    Euclidean norms, which no scipy/scikit-learn neighbour search offers). With
-    ``f`` the Frobenius distance of two reduced poses and ``L`` the reduced
-    landmarks, ``f <= sum of landmark distances``; the Frobenius distances of
-    all pairs come from one matrix product, the exact sum to the
-    Frobenius-nearest node bounds the minimum from above, and the exact sum is
-    evaluated only for nodes whose ``f`` is within that bound (plus a rounding
-    margin), with the arithmetic of a full evaluation, so the result is
-    identical.
+    Exact, compiled (:func:`._jit.nearest_other_sample`; written by hand: the
+    distance is a sum of per-landmark Euclidean norms, which no
+    scipy/scikit-learn neighbour search offers). The sum runs landmark by
+    landmark (the order of a reduction over the strided landmark axis of
+    ``D[None] - D[:, None]``, kept so that results do not change).
+
+    Returns
+    -------
+    ndarray (<= k,), one value per query node that has nodes of another sample
     """
     q = rng.choice(nodes.n, size=min(k, nodes.n), replace=False)
-    D = nodes.disp[:, red]
-    G, L = D.shape[0], D.shape[1]
     if len(q) == 0:
         return np.zeros(0)
-    flat = D.reshape(G, -1)
-    sq = (flat * flat).sum(-1)
-    frob2 = sq[q][:, None] + sq[None, :] - 2.0 * (flat[q] @ flat.T)       # (k, G)
-    other = nodes.sample[None, :] != nodes.sample[q][:, None]            # other samples only
-    frob2 = np.where(other, np.maximum(frob2, 0.0), np.inf)
-    has = np.isfinite(frob2).any(1)
-    q, frob2, sqq = q[has], frob2[has], sq[q[has]]
-    # exact sum to the Frobenius-nearest node: an upper bound of the minimum
-    ub = _landmark_distance_sum(D, frob2.argmin(1), q)
-    slack = 1e-9 * (sqq[:, None] + sq[None, :]) + 1e-12
-    rows, cols = np.nonzero(frob2 <= (ub * ub)[:, None] * (1.0 + 1e-9) + slack)
-    out = np.full(len(q), np.inf)
-    np.minimum.at(out, rows, _landmark_distance_sum(D, cols, q[rows]))
+    D = np.ascontiguousarray(nodes.disp[:, red], float)
+    out = _jit.nearest_other_sample(D, np.ascontiguousarray(nodes.sample, np.int64), np.asarray(q, np.int64))
     return out[np.isfinite(out)]
 
 

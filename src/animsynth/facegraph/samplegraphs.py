@@ -8,9 +8,9 @@ was entered (its incoming edges). The next pose is compared with the nodes of
 its sample graph by eq. 3 (reduced landmarks, :mod:`.similarity`); if the
 similarity is at most the creation threshold the pose is merged into the most
 similar node, otherwise it opens a new node linked from the current one. The
-walk runs in lock-step over all samples and regions (numpy), which is what
-makes the threshold searches cheap; the threshold may differ per region and
-per sample (per-sample thresholds, :mod:`.model`).
+walks are compiled (numba, :mod:`._jit`), which is what makes the threshold
+searches cheap; the threshold may differ per region and per sample
+(per-sample thresholds, :mod:`.model`).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _jit
 from .preprocess import FaceDatabase
 from .regions import REGION_NAMES
 from .similarity import pose_similarity
@@ -108,8 +109,7 @@ def _unit(v, eps):
     return np.where(ok[..., None], v / np.where(ok, n, 1.0)[..., None], 0.0), ok.astype(float)
 
 
-def create_sample_graphs(stack: PoseStack, thresholds, lam: float = 1.0, max_entries: int = 3,
-                         n_candidates: int = 4) -> np.ndarray:
+def create_sample_graphs(stack: PoseStack, thresholds, lam: float = 1.0, max_entries: int = 3) -> np.ndarray:
     """Algorithm 1 for every sample and region at once.
 
     Each pose of a neutral-peak-neutral sample is compared (eq. 3, reduced
@@ -121,11 +121,8 @@ def create_sample_graphs(stack: PoseStack, thresholds, lam: float = 1.0, max_ent
     most the threshold, otherwise it opens a new node; a change of node is an
     edge. The time-reversed half thus folds back onto the forward nodes.
 
-    Exact but pruned: since eq. 3 >= sum of landmark distances >= Frobenius
-    distance, eq. 3 is evaluated only for the current node and the
-    ``n_candidates`` nodes nearest in Frobenius distance; when the best of them
-    is not below the next node's Frobenius distance (so a farther node could
-    still win) the full set of nodes of that sample is evaluated.
+    The walks run compiled, one sample at a time (:func:`._jit.alg1_all`), with
+    the arithmetic of eq. 3 over the zero-padded landmark axis of the stack.
 
     Parameters
     ----------
@@ -143,111 +140,12 @@ def create_sample_graphs(stack: PoseStack, thresholds, lam: float = 1.0, max_ent
     thr = np.asarray(thresholds, float)
     if thr.ndim < 3:
         thr = np.atleast_2d(thr)[..., None]
-    thr = np.broadcast_to(thr, (thr.shape[0], R, S0))
-    B = thr.shape[0]
-    Q = int(max_entries)
-    order = np.argsort(-stack.lengths, kind="stable")  # longest first: active samples are a prefix
-    thr = thr[:, :, order]
-    lengths = stack.lengths[order]
-    X = stack.X[:, order]
-    U = stack.U[:, order]
-    OK = stack.ok[:, order]
-    F = L * 2
-    shape = (B, R, S0)
-    node_mean = np.zeros(shape + (T, L, 2))
-    node_sq = np.zeros(shape + (T,))
-    node_cnt = np.zeros(shape + (T,))
-    ent_u = np.zeros(shape + (T, Q, L, 2))
-    ent_ok = np.zeros(shape + (T, Q, L))
-    ent_n = np.zeros(shape + (T,), int)
-    node_mean[..., 0, :, :] = X[:, :, 0]
-    node_sq[..., 0] = (X[:, :, 0] ** 2).sum((-1, -2))
-    node_cnt[..., 0] = 1
-    ent_u[..., 0, 0, :, :] = U[:, :, 0]
-    ent_ok[..., 0, 0, :] = OK[:, :, 0]
-    ent_n[..., 0] = 1
-    n_nodes = np.ones(shape, int)
-    cur = np.zeros(shape, int)
-    assign = np.full(shape + (T,), -1, int)
-    assign[..., 0] = 0
-    kmax = 1
-    for t in range(1, T):
-        na = int(np.searchsorted(-lengths, -t, side="left"))  # samples with length > t
-        if na == 0:
-            break
-        kc = kmax
-        x, u, ok = X[:, :na, t], U[:, :na, t], OK[:, :na, t]  # (R, na, L, 2), (R, na, L)
-        mean = node_mean[:, :, :na, :kc]
-        nn = n_nodes[:, :, :na]
-        cu = cur[:, :, :na]
-        xf = x.reshape(R, na, F)
-        xm = np.matmul(mean.reshape(B, R, na, kc, F), np.broadcast_to(xf[None, ..., None], (B, R, na, F, 1)))
-        frob2 = (xf ** 2).sum(-1)[None, :, :, None] + node_sq[:, :, :na, :kc] - 2.0 * xm[..., 0]
-        frob2 = np.where(np.arange(kc) < nn[..., None], frob2, np.inf)
-        m = min(n_candidates, kc)
-        if kc > m:
-            part = np.argpartition(frob2, m, axis=-1)
-            cand = part[..., :m]
-            bound = np.sqrt(np.maximum(np.take_along_axis(frob2, part[..., m:m + 1], -1)[..., 0], 0.0))
-        else:
-            cand = np.broadcast_to(np.arange(kc), (B, R, na, kc))
-            bound = np.full((B, R, na), np.inf)
-        cand = np.concatenate([cu[..., None], cand], -1)  # current node first (wins ties)
-        sc = _alg1_scores(x, u, ok, mean, ent_u[:, :, :na], ent_ok[:, :, :na], ent_n[:, :, :na], cand, lam, nn)
-        j = sc.argmin(-1)
-        best = np.take_along_axis(cand, j[..., None], -1)[..., 0]
-        bs = np.take_along_axis(sc, j[..., None], -1)[..., 0]
-        unsure = (bs > bound) & (bound <= thr[:, :, :na])
-        if unsure.any():  # a farther node might be more similar: evaluate all nodes there
-            full = np.broadcast_to(np.arange(kc), (B, R, na, kc))
-            scf = _alg1_scores(x, u, ok, mean, ent_u[:, :, :na], ent_ok[:, :, :na], ent_n[:, :, :na], full, lam, nn)
-            scf = np.concatenate([np.take_along_axis(scf, cu[..., None], -1), scf], -1)
-            jf = scf.argmin(-1)
-            bf = np.where(jf == 0, cu, jf - 1)
-            best = np.where(unsure, bf, best)
-            bs = np.where(unsure, np.take_along_axis(scf, jf[..., None], -1)[..., 0], bs)
-        merge = bs <= thr[:, :, :na]
-        target = np.where(merge, best, nn)
-        bi, ri, si = np.meshgrid(np.arange(B), np.arange(R), np.arange(na), indexing="ij")
-        bi, ri, si, ti = bi.ravel(), ri.ravel(), si.ravel(), target.ravel()
-        c = node_cnt[bi, ri, si, ti] + 1.0
-        newmean = node_mean[bi, ri, si, ti] + (x[ri, si] - node_mean[bi, ri, si, ti]) / c[:, None, None]
-        node_mean[bi, ri, si, ti] = newmean
-        node_sq[bi, ri, si, ti] = (newmean ** 2).sum((-1, -2))
-        node_cnt[bi, ri, si, ti] = c
-        enter = (ti != cu.ravel()) & (ent_n[bi, ri, si, ti] < Q)
-        b_, r_, s_, k_ = bi[enter], ri[enter], si[enter], ti[enter]
-        q_ = ent_n[b_, r_, s_, k_]
-        ent_u[b_, r_, s_, k_, q_] = u[r_, s_]
-        ent_ok[b_, r_, s_, k_, q_] = ok[r_, s_]
-        ent_n[b_, r_, s_, k_] += 1
-        n_nodes[:, :, :na] = nn + ~merge
-        cur[:, :, :na] = target
-        assign[:, :, :na, t] = target
-        kmax = int(n_nodes.max())
-    out = np.empty_like(assign)
-    out[:, :, order] = assign
+    thr = np.ascontiguousarray(np.broadcast_to(thr, (thr.shape[0], R, S0)))
+    out = np.empty(thr.shape + (T,), np.int64)
+    _jit.alg1_all(np.ascontiguousarray(stack.X, float), np.ascontiguousarray(stack.U, float),
+                  np.ascontiguousarray(stack.ok, float), np.ascontiguousarray(stack.lengths, np.int64), thr,
+                  float(lam), int(max_entries), out)
     return out
-
-
-def _alg1_scores(x, u, ok, mean, ent_u, ent_ok, ent_n, cand, lam, nn):
-    """Eq. 3 of the current poses against candidate nodes -> (B, R, na, m)."""
-    B, R, na, m = cand.shape
-    bi = np.arange(B)[:, None, None, None]
-    ri = np.arange(R)[None, :, None, None]
-    si = np.arange(na)[None, None, :, None]
-    mc = mean[bi, ri, si, cand]                                  # (B, R, na, m, L, 2)
-    d = x[None, :, :, None] - mc
-    dist = np.sqrt((d * d).sum(-1))                              # (B, R, na, m, L)
-    eu = ent_u[bi, ri, si, cand]                                 # (B, R, na, m, Q, L, 2)
-    eo = ent_ok[bi, ri, si, cand]                                # (B, R, na, m, Q, L)
-    en = ent_n[bi, ri, si, cand]                                 # (B, R, na, m)
-    cos = np.abs((u[None, :, :, None, None] * eu).sum(-1))       # (B, R, na, m, Q, L)
-    vi = (1.0 - np.minimum(cos, 1.0)) * eo * ok[None, :, :, None, None, :]
-    sc = dist.sum(-1)[..., None] + lam * (dist[..., None, :] * vi).sum(-1)
-    Q = eu.shape[4]
-    sc = np.where(np.arange(Q) < en[..., None], sc, np.inf).min(-1)
-    return np.where(cand < nn[..., None], sc, np.inf)
 
 
 def create_sample_graph_reference(X: np.ndarray, V: np.ndarray, threshold: float, lam: float = 1.0,
