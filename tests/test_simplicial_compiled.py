@@ -126,7 +126,7 @@ def test_certified_knn_equals_exact_knn():
     for x in xs:
         d, i = tree.query(x, k=k)
         for a in (int(i[0]), int(rng.integers(0, len(f.points_)))):  # nearest anchor, and a random one
-            ok = kernels._knn_list(x, a, k, tab["nl"], tab["dl"], tab["Rend"], tab["eps"], tab["pu"], bd, bi)
+            ok = kernels._knn_list(x, a, k, tab["nl"], tab["nc"], tab["dl"], tab["Rend"], tab["eps"], tab["pu"], bd, bi)
             if ok:
                 n_cert += 1
                 assert set(bi.tolist()) == set(i.tolist())
@@ -145,7 +145,8 @@ def test_a_false_certificate_is_caught():
     f = VectorField("knn", 6).fit(X, training_vectors(clips, "forward"))
     stack = FieldStack([f])
     tab = pm._kernel_tables(stack)
-    tab["nl"], tab["dl"] = np.ascontiguousarray(tab["nl"][:, :6]), np.ascontiguousarray(tab["dl"][:, :6])
+    for key in ("nl", "nc", "dl"):
+        tab[key] = np.ascontiguousarray(tab[key][:, :6])
     tab["Rend"] = np.full(len(tab["Rend"]), np.inf)
     starts = _starts(X, 10, 12, outside=0)
     bad = pm.BatchPaths(*pm._follow_compiled(stack, starts, 100, np.zeros(10, int)))

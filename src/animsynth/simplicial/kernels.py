@@ -24,29 +24,33 @@ Delaunay (1/D^2 weights, full-rank triangulation)
     tolerance band of the hull, degenerate simplices, long walks) is
     returned to Python for the reference evaluation.
 k-NN (and the outside-hull fallback)
-    Certified candidate caching: every path keeps the ``M`` nearest training
-    points of an anchor point ``a`` and ``r_M``, the distance of the M-th.
-    At ``x`` with ``delta = |x - a|`` every other training point is at least
-    ``r_M - delta`` away (triangle inequality), so the k nearest candidates
-    are the exact k nearest whenever their k-th distance is below
-    ``r_M - delta`` (with a relative margin of 1e-12 for rounding). Otherwise
-    the cache is refilled at ``x``: here by brute force over all training
-    points when ``brute`` is set (a few microseconds for a fold of ~1,300
-    points, less than one return to Python), else by Python with one batched
-    ``cKDTree.query(k=M, workers=-1)``. If even a fresh cache cannot certify
-    (k-th and M-th neighbour at the same distance), the step is returned to
-    Python. Exact distance ties at the k-th neighbour are broken by candidate
-    order here and by the tree's order in ``cKDTree.query``; they have measure
-    zero for real data and change only which of two equidistant points is used.
+    Certified candidate lists: every training point ``a`` carries its L
+    nearest training points by increasing distance (one ``cKDTree.query`` for
+    all of them when the tables are built; L = 16 k by default). A path keeps
+    an anchor ``a`` (the training point nearest to it one step earlier). At
+    ``x`` with ``e = |x - a|``, a point at distance ``D_a`` from ``a`` is at
+    least ``D_a - e`` from ``x`` (triangle inequality), so the scan of a's
+    list stops, certified, at the first listed point with ``D_a - e`` above
+    the k-th distance found so far (with a relative margin of 1e-12 and an
+    absolute one of 1e-12 times the bounding-box diagonal for rounding); no
+    later point, listed or not, can be among the k nearest. Near the data
+    this reads about twice k points. An uncertified scan moves the anchor to
+    the nearest point it found and tries again; if that does not help, the
+    exact k nearest are found by brute force over all training points when
+    ``brute`` is set (a few microseconds for a fold of ~1,300 points, less
+    than one return to Python), else the step goes to Python. Exact distance
+    ties at the k-th neighbour are broken by scan order here and by the
+    tree's order in ``cKDTree.query``; they have measure zero for real data
+    and change only which of two equidistant points is used.
 
-Weights are ``m / D^2`` (``m`` = merged duplicates) with the same hit rule
-and the same arithmetic order as :meth:`VectorField.__call__` (neighbours
-sorted by distance, weights normalised before the weighted sum), so results
-agree with the reference to float rounding.
+Weights are ``m / D^2`` (``m`` = merged duplicates) with the hit rule of
+:meth:`VectorField.__call__`; summation order and the single normalising
+division differ from it, so a step agrees with the reference to float
+rounding (about 1e-16 relative; along a path such differences can grow like
+any perturbation of the field's flow).
 
-Status codes written to ``status`` per path: 0 finished, 1 the step at
-``t[p]`` needs the reference evaluation, 2 the k-NN cache needs a refill at
-the current point.
+``status[p]`` is 0 when path p is finished and 1 when the step at ``t[p]``
+needs the reference evaluation.
 """
 
 from __future__ import annotations
@@ -56,7 +60,7 @@ from numba import njit, prange
 
 from .geometry import HINT_EPS
 
-#: certification margin (relative) of the candidate cache
+#: certification margin (relative) of the candidate lists
 CERT_MARGIN = 1e-12
 
 
@@ -130,11 +134,12 @@ def _idw(out, dist, idx, n, V, f, cnt, hit_tol):
 
 
 @njit(cache=True)
-def _knn_list(x, a, k, nl, dl, Rend, eps, pu, bd, bi):
+def _knn_list(x, a, k, nl, nc, dl, Rend, eps, pu, bd, bi):
     """k nearest of x among the listed neighbours of training point ``a`` (into bd, bi; nearest first).
 
-    The list holds the nearest training points of ``a`` by increasing
-    distance ``dl``. Once a listed distance minus ``e = |x - a|`` exceeds the
+    The list holds the nearest training points of ``a`` (indices ``nl``,
+    coordinates ``nc``, stored with the list so that the scan reads
+    contiguous memory) by increasing distance ``dl``. Once a listed distance minus ``e = |x - a|`` exceeds the
     current k-th distance, no later point (listed or not) can enter the k
     nearest, so the scan stops there, certified. At the end of the list the
     same test with ``Rend`` (distance of the last listed point; ``inf`` when
@@ -153,7 +158,7 @@ def _knn_list(x, a, k, nl, dl, Rend, eps, pu, bd, bi):
         q = nl[a, m]
         d2 = 0.0
         for i in range(d):
-            c = pu[q, i] - x[i]
+            c = nc[a, m, i] - x[i]
             d2 += c * c
         bd[m] = d2
         bi[m] = q
@@ -171,7 +176,7 @@ def _knn_list(x, a, k, nl, dl, Rend, eps, pu, bd, bi):
         q = nl[a, m]
         d2 = 0.0
         for i in range(d):
-            c = pu[q, i] - x[i]
+            c = nc[a, m, i] - x[i]
             d2 += c * c
         if d2 < bd[jm]:
             bd[jm] = d2
@@ -222,7 +227,7 @@ def _knn_brute(x, k, pu, bd, bi):
 
 @njit(cache=True)
 def _advance_path(p, X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
-                  TT, simp, nbr, hullA, hullc, hull_lim, nl, dl, Rend, eps, brute, max_walk):
+                  TT, simp, nbr, hullA, hullc, hull_lim, nl, nc, dl, Rend, eps, brute, max_walk):
     """Advance path p from step ``t[p]`` until it is finished or needs Python (``status[p] = 1``)."""
     d = X.shape[1]
     f = which[p]
@@ -267,7 +272,7 @@ def _advance_path(p, X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V
             for _ in range(8):  # move the anchor to the nearest point found while that helps
                 if a < 0:
                     break
-                ok = _knn_list(x, a, k, nl, dl, Rend, eps, pu, bd, bi)
+                ok = _knn_list(x, a, k, nl, nc, dl, Rend, eps, pu, bd, bi)
                 if ok or bi[0] == a:
                     break
                 a = bi[0]
@@ -288,23 +293,45 @@ def _advance_path(p, X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V
 
 @njit(cache=True)
 def advance_serial(X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
-                   TT, simp, nbr, hullA, hullc, hull_lim, nl, dl, Rend, eps, brute, max_walk):
-    """:func:`_advance_path` for every path, one after the other (few paths)."""
+                   TT, simp, nbr, hullA, hullc, hull_lim, nl, nc, dl, Rend, eps, brute, max_walk):
+    """Advance every path until it is finished or needs Python, one path after the other (few paths).
+
+    Parameters (P paths, d dimensions, F fields, u training points, S simplices, L listed neighbours)
+    ----------
+    X : float (P, d), current points (updated)
+    pts : float (steps+1, P, d), path points (row 0 = starts; filled)
+    fb : bool (steps, P), fallback flags (filled)
+    t : int (P,), next step of every path (updated)
+    s : int (P,), last simplex of every path, -1 none (updated)
+    anchor : int (P,), k-NN anchor (training point) of every path, -1 none (updated)
+    status : int (P,), 0 finished / 1 the step ``t[p]`` needs the reference (written)
+    steps : int
+    which : int (P,), field of every path
+    meth : int (F,), 0 k-NN / 1 Delaunay (1/D^2)
+    kf : int (F,), k of every field (also its outside-hull fallback)
+    V : float (F, u, d), vectors; pu : float (u, d), points; cnt : float (u,), multiplicities
+    hit_tol : float
+    TT : float (S, d+1, d), barycentric transforms; simp, nbr : int (S, d+1), vertices, neighbours
+    hullA : float (h, d), hullc : float (h,), hull facets ``A x + c <= 0``; hull_lim : float
+    nl : int (u, L), nc : float (u, L, d), dl : float (u, L), Rend : float (u,), eps : float
+        Neighbour lists of the training points (see the module docstring).
+    brute : bool, max_walk : int
+    """
     for p in range(X.shape[0]):
         if t[p] < steps:
             _advance_path(p, X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
-                          TT, simp, nbr, hullA, hullc, hull_lim, nl, dl, Rend, eps, brute, max_walk)
+                          TT, simp, nbr, hullA, hullc, hull_lim, nl, nc, dl, Rend, eps, brute, max_walk)
         else:
             status[p] = 0
 
 
 @njit(cache=True, parallel=True)
 def advance_parallel(X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
-                     TT, simp, nbr, hullA, hullc, hull_lim, nl, dl, Rend, eps, brute, max_walk):
-    """:func:`_advance_path` for every path, paths spread over numba's threads (many paths)."""
+                     TT, simp, nbr, hullA, hullc, hull_lim, nl, nc, dl, Rend, eps, brute, max_walk):
+    """:func:`advance_serial` with the paths spread over numba's threads (many paths)."""
     for p in prange(X.shape[0]):
         if t[p] < steps:
             _advance_path(p, X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
-                          TT, simp, nbr, hullA, hullc, hull_lim, nl, dl, Rend, eps, brute, max_walk)
+                          TT, simp, nbr, hullA, hullc, hull_lim, nl, nc, dl, Rend, eps, brute, max_walk)
         else:
             status[p] = 0

@@ -200,7 +200,8 @@ def _kernel_tables(stack: FieldStack) -> dict:
     """Contiguous arrays for :mod:`kernels`, built once per stack (triangulation parts once per triangulation).
 
     ``nl`` (u, L) lists the L nearest training points of every training
-    point (itself first) by increasing distance ``dl`` (u, L); ``Rend`` (u,)
+    point (itself first) by increasing distance ``dl`` (u, L), with their
+    coordinates ``nc`` (u, L, d); ``Rend`` (u,)
     is the distance of the L-th (``inf`` when that is every point): the
     certified candidate lists of the k-NN.
     """
@@ -235,7 +236,7 @@ def _kernel_tables(stack: FieldStack) -> dict:
     tab = stack._kernel = {
         "geo": geo, "meth": np.array([0 if f.method == "knn" else 1 for f in stack.fields], np.int64),
         "kf": kf, "V": np.ascontiguousarray(stack.vectors_, float), "pu": pu,
-        "cnt": np.ascontiguousarray(stack.counts_, float), "hit_tol": float(stack.hit_tol_), "nl": nl, "dl": dl,
+        "cnt": np.ascontiguousarray(stack.counts_, float), "hit_tol": float(stack.hit_tol_), "nl": nl, "nc": pu[nl], "dl": dl,
         "Rend": Rend, "eps": 1e-12 * float(tri.scale_)}
     return tab
 
@@ -254,7 +255,7 @@ def _follow_compiled(stack: FieldStack, x, steps: int, which, brute: bool | None
     tab = _kernel_tables(stack)
     TT, simp, nbr, A, c, lim = tab["geo"]
     meth, kf, V, pu, cnt, hit_tol = (tab[n] for n in ("meth", "kf", "V", "pu", "cnt", "hit_tol"))
-    nl, dl, Rend, eps = tab["nl"], tab["dl"], tab["Rend"], tab["eps"]
+    nl, nc, dl, Rend, eps = tab["nl"], tab["nc"], tab["dl"], tab["Rend"], tab["eps"]
     if brute is None:
         brute = pu.shape[0] <= BRUTE_MAX_POINTS
     X = np.array(x, float, order="C")
@@ -270,7 +271,7 @@ def _follow_compiled(stack: FieldStack, x, steps: int, which, brute: bool | None
     kern = kernels.advance_parallel if P >= PARALLEL_MIN_PATHS else kernels.advance_serial
     while P:
         kern(X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
-             TT, simp, nbr, A, c, lim, nl, dl, Rend, eps, bool(brute), MAX_WALK)
+             TT, simp, nbr, A, c, lim, nl, nc, dl, Rend, eps, bool(brute), MAX_WALK)
         ref = np.flatnonzero(status == 1)
         if not ref.size:
             break
