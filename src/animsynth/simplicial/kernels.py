@@ -64,7 +64,7 @@ from .geometry import HINT_EPS
 CERT_MARGIN = 1e-12
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _locate(x, s, TT, nbr, max_walk):
     """Walk from simplex ``s`` toward ``x``: (simplex, code 0 inside / 1 crossed a hull facet / 2 give up)."""
     d = x.shape[0]
@@ -98,7 +98,7 @@ def _locate(x, s, TT, nbr, max_walk):
     return s, 2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _clearly_outside(x, A, c, lim):
     """True when ``x`` is beyond some hull facet by more than ``lim``."""
     for f in range(A.shape[0]):
@@ -110,7 +110,7 @@ def _clearly_outside(x, A, c, lim):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _idw(out, dist, idx, n, V, f, cnt, hit_tol):
     """``out = sum_j w_j V[f, idx_j] / sum_j w_j`` with ``w = m / D^2``, or hits only (weighted by m)."""
     anyhit = False
@@ -133,7 +133,7 @@ def _idw(out, dist, idx, n, V, f, cnt, hit_tol):
         out[i] /= wsum
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _knn_list(x, a, k, nl, nc, dl, Rend, eps, pu, bd, bi):
     """k nearest of x among the listed neighbours of training point ``a`` (into bd, bi; nearest first).
 

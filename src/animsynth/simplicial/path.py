@@ -178,8 +178,9 @@ def follow_batch(fields, starts, steps: int, which=None, compiled: bool = True) 
 BRUTE_MAX_POINTS = 20000
 #: neighbours listed per training point for the certified k-NN: CACHE_FACTOR * k (at most all points)
 CACHE_FACTOR = 16
-#: the compiled loop runs on numba's threads from this many paths on
+#: the compiled loop runs on numba's threads from this many paths on, in chunks of PARALLEL_CHUNK paths
 PARALLEL_MIN_PATHS = 64
+PARALLEL_CHUNK = 16
 #: faces a simplex walk may cross in one step before the step goes to the reference
 MAX_WALK = 32
 
@@ -250,6 +251,8 @@ def _follow_compiled(stack: FieldStack, x, steps: int, which, brute: bool | None
     (default: at most ``BRUTE_MAX_POINTS`` training points) lets the compiled
     loop settle uncertified k-NN steps itself.
     """
+    import numba
+
     from . import kernels
 
     tab = _kernel_tables(stack)
@@ -270,8 +273,13 @@ def _follow_compiled(stack: FieldStack, x, steps: int, which, brute: bool | None
     status = np.zeros(P, np.int64)
     kern = kernels.advance_parallel if P >= PARALLEL_MIN_PATHS else kernels.advance_serial
     while P:
-        kern(X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
-             TT, simp, nbr, A, c, lim, nl, nc, dl, Rend, eps, bool(brute), MAX_WALK)
+        # small chunks handed out dynamically: on a shared machine one descheduled thread does not hold up the rest
+        old = numba.set_parallel_chunksize(PARALLEL_CHUNK)
+        try:
+            kern(X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
+                 TT, simp, nbr, A, c, lim, nl, nc, dl, Rend, eps, bool(brute), MAX_WALK)
+        finally:
+            numba.set_parallel_chunksize(old)
         ref = np.flatnonzero(status == 1)
         if not ref.size:
             break
