@@ -50,7 +50,7 @@ def test_batched_equals_one_at_a_time(method, weights):
     b = follow_batch(f, starts, 40)
     assert b.points.shape == (41, 7, 2) and b.fallback.shape == (40, 7)
     for j in range(7):
-        one = follow_field(f, starts[j], 40)
+        one = follow_field(f, starts[j], 40, compiled=False)
         np.testing.assert_allclose(b.points[:, j], one.points, rtol=0, atol=1e-9)
         assert (b.fallback[:, j] == one.fallback).all()
     if method != "knn":
@@ -67,7 +67,7 @@ def test_batched_mixed_fields_share_one_triangulation():
     which = np.tile(np.arange(len(fields)), 3)
     b = follow_batch(fields, starts, 25, which)
     for j in range(len(starts)):
-        one = follow_field(fields[which[j]], starts[j], 25)
+        one = follow_field(fields[which[j]], starts[j], 25, compiled=False)
         np.testing.assert_allclose(b.points[:, j], one.points, rtol=0, atol=1e-9)
     with pytest.raises(ValueError, match="same triangulation"):
         FieldStack([fields[0], VectorField("knn").fit(X, training_vectors(clips))])
@@ -187,7 +187,7 @@ def test_single_path_fast_route_equals_follow_field(method):
     V = training_vectors(clips, "half")
     f = VectorField(method, 6).fit(X, V)
     for start in (X[5], X[5] + 0.013, np.array([2.5, -2.5])):  # on a training point, inside, outside the hull
-        one = follow_field(f, start, 60)
+        one = follow_field(f, start, 60, compiled=False)
         b = follow_batch(f, start[None], 60)
         np.testing.assert_allclose(b.points[:, 0], one.points, rtol=0, atol=1e-9)
         assert (b.fallback[:, 0] == one.fallback).all()

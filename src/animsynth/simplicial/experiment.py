@@ -305,7 +305,7 @@ def run_fold_ensemble(train: list, test, variants, *, n_starts: int = 16, jitter
 
     Variants that share a latent dimension share the PCA and the
     triangulation; all their field-following paths (members x variants) are
-    advanced together, one vectorised field evaluation per step. The jitter
+    advanced together (:func:`~animsynth.simplicial.path.follow_batch`). The jitter
     directions are seeded by ``seed`` and the latent dimension only, so every
     variant (and every job) of a fold uses the same starts: member j of
     Delaunay pairs with member j of k-NN.

@@ -41,10 +41,12 @@ neighbours out of the neighbourhood.
 
 Many query points, and many fields that share one set of training points
 (e.g. the same fold with different derivatives or methods), are evaluated
-together by :func:`evaluate_stack`: one point location and one k-NN query for
-all points, vectorised weights, per-point fallback. :meth:`VectorField.evaluate`
-is that function with a single field, so batched and one-at-a-time results
-agree to float rounding.
+together by :meth:`FieldStack.evaluate`: one point location and one k-NN query
+for all points, vectorised weights, per-point fallback. :meth:`VectorField.evaluate`
+is that method with a single field, so batched and one-at-a-time results
+agree to float rounding. :meth:`VectorField.__call__` (one point) is the
+reference that field following is tested against; following itself runs in
+compiled loops (:mod:`animsynth.simplicial.kernels`).
 """
 
 from __future__ import annotations

@@ -3,10 +3,11 @@
 :func:`follow_field` starts at a latent point and repeatedly samples the vector
 field and steps by it (explicit Euler with unit step, as in the paper).
 :func:`follow_batch` advances many paths at once (an ensemble of starts, and
-several fields on the same training points): every step is one vectorised
-field evaluation for all current points (:class:`FieldStack`), so following
-P paths costs far less than P single paths; each path gets exactly the steps
-:func:`follow_field` would give it (to float rounding).
+several fields on the same training points): k-NN and Delaunay (1/D^2) paths
+run all their steps in one compiled loop (:mod:`animsynth.simplicial.kernels`),
+the other field kinds take one vectorised field evaluation for all current
+points per step (:class:`FieldStack`); each path gets exactly the steps
+:func:`follow_field` would give it alone (to float rounding).
 
 :class:`TargetPlanner` is the "beyond the paper" alternative: shortest paths
 in G' (edge weights = latent edge lengths, all pairs computed once with
@@ -25,7 +26,7 @@ import numpy as np
 from scipy.sparse.csgraph import shortest_path
 from scipy.spatial import cKDTree
 
-from .field import FieldStack
+from .field import FieldStack, VectorField
 from .graph import MotionGraph
 
 
@@ -52,14 +53,27 @@ class GeneratedPath:
         return int(np.count_nonzero(self.fallback))
 
 
-def follow_field(field, start, steps: int) -> GeneratedPath:
-    """Follow ``field`` for ``steps`` unit Euler steps from ``start``."""
+def follow_field(field, start, steps: int, compiled: bool = True) -> GeneratedPath:
+    """Follow ``field`` for ``steps`` unit Euler steps from ``start``.
+
+    Parameters
+    ----------
+    field : VectorField, or any callable ``x (d,) -> (vector (d,), fallback bool)``
+    start : array (d,)
+    steps : int
+    compiled : bool
+        For a :class:`VectorField`, take the compiled route of
+        :func:`follow_batch` (same steps to float rounding). ``False`` (or any
+        other callable) calls ``field(x)`` step by step: the reference.
+    """
     steps = int(steps)
     if steps < 0:
         raise ValueError(f"steps must be >= 0, got {steps}")
     x = np.asarray(start, float).copy()
     if not np.all(np.isfinite(x)):
         raise ValueError("follow_field: start point is not finite")
+    if compiled and isinstance(field, VectorField):
+        return follow_batch(field, x[None, :], steps).path(0)
     pts = np.empty((steps + 1, x.size))
     fb = np.zeros(steps, bool)
     pts[0] = x
@@ -90,8 +104,19 @@ class BatchPaths:
         return GeneratedPath(self.points[:, j, :].copy(), self.fallback[:, j].copy())
 
 
-def follow_batch(fields, starts, steps: int, which=None) -> BatchPaths:
-    """Follow several paths together, one vectorised field evaluation per step.
+def follow_batch(fields, starts, steps: int, which=None, compiled: bool = True) -> BatchPaths:
+    """Follow several paths together.
+
+    Paths whose field is k-NN, or Delaunay with 1/D^2 weights on a full-rank
+    triangulation, run in the compiled loop (:mod:`animsynth.simplicial.kernels`:
+    warm-started simplex walks, certified k-NN candidate caches, all steps of
+    all paths in one call, on numba's threads from ``PARALLEL_MIN_PATHS``
+    paths); the few steps it cannot settle exactly go to
+    :meth:`FieldStack.evaluate`, batched over paths. The other paths
+    (k-Delaunay, barycentric weights, reduced-rank triangulations), and all
+    paths with ``compiled=False``, take one vectorised
+    :meth:`FieldStack.evaluate` per step (the reference). Every path gets the
+    steps :func:`follow_field` would give it alone (to float rounding).
 
     Parameters
     ----------
@@ -101,6 +126,8 @@ def follow_batch(fields, starts, steps: int, which=None) -> BatchPaths:
     steps : int
     which : array (P,) of int, optional
         Field of every path (index into ``fields``); default all 0.
+    compiled : bool
+        ``False``: the per-step numpy reference for every path.
 
     Returns
     -------
@@ -109,8 +136,14 @@ def follow_batch(fields, starts, steps: int, which=None) -> BatchPaths:
     steps = int(steps)
     if steps < 0:
         raise ValueError(f"steps must be >= 0, got {steps}")
-    stack = fields if isinstance(fields, FieldStack) else FieldStack(
-        fields if isinstance(fields, (list, tuple)) else [fields])
+    if isinstance(fields, FieldStack):
+        stack = fields
+    elif isinstance(fields, VectorField):
+        if fields._stack is None:  # kept on the field, with its compiled-loop tables
+            fields._stack = FieldStack([fields])
+        stack = fields._stack
+    else:
+        stack = FieldStack(list(fields))
     x = np.array(np.atleast_2d(starts), float)
     P = x.shape[0]
     if not np.all(np.isfinite(x)):
@@ -118,260 +151,148 @@ def follow_batch(fields, starts, steps: int, which=None) -> BatchPaths:
     which = np.zeros(P, int) if which is None else np.asarray(which, int)
     if which.shape != (P,) or (P and (which.min() < 0 or which.max() >= len(stack.fields))):
         raise ValueError(f"follow_batch: 'which' must be {P} indices into {len(stack.fields)} fields")
-    if P == 1 and _SinglePath.supports(stack):
-        if getattr(stack, "_single", None) is None:  # scalar tables, built once per stack
-            stack._single = _SinglePath(stack)
-        return stack._single.follow(x[0], steps)
-    if P > 1 and _SinglePath.supports(stack) and stack.fields[0].method == "delaunay":
-        return _follow_delaunay_many(stack, x, steps)
     pts = np.empty((steps + 1, P, x.shape[1]))
     fb = np.zeros((steps, P), bool)
     pts[0] = x
-    hint = np.full(P, -1)
-    for t in range(steps):
-        v, fb[t] = stack.evaluate(x, which, hint)
-        x = x + v
-        pts[t + 1] = x
+    fast = _compiled_fields(stack)[which] if compiled else np.zeros(P, bool)
+    if fast.all():
+        pts, fb = _follow_compiled(stack, x, steps, which)
+    elif fast.any():
+        sel = np.flatnonzero(fast)
+        pts[:, sel], fb[:, sel] = _follow_compiled(stack, x[sel], steps, which[sel])
+    rest = np.flatnonzero(~fast)
+    if rest.size:
+        xr, wr = x[rest], which[rest]
+        hint = np.full(rest.size, -1)
+        for t in range(steps):
+            v, fb[t, rest] = stack.evaluate(xr, wr, hint)
+            xr = xr + v
+            pts[t + 1, rest] = xr
     if not np.all(np.isfinite(pts)):
         raise FloatingPointError("follow_batch produced a non-finite point")
     return BatchPaths(pts, fb)
 
 
-def _follow_delaunay_many(stack: FieldStack, x, steps: int) -> BatchPaths:
-    """Many paths through one Delaunay field (1/D^2 weights, full-rank triangulation), lean vectorised steps.
+#: the compiled loop finds exact k nearest neighbours by brute force when the certified lists fail,
+#: up to this many training points (above it such steps go to the reference, one batched cKDTree query)
+BRUTE_MAX_POINTS = 20000
+#: neighbours listed per training point for the certified k-NN: CACHE_FACTOR * k (at most all points)
+CACHE_FACTOR = 16
+#: the compiled loop runs on numba's threads from this many paths on, in chunks of PARALLEL_CHUNK paths
+PARALLEL_MIN_PATHS = 64
+PARALLEL_CHUNK = 16
+#: faces a simplex walk may cross in one step before the step goes to the reference
+MAX_WALK = 32
 
-    Each point is walked from the simplex it was in one step earlier (as in
-    :meth:`SafeDelaunay.find` with a hint) and weighted with ``m / D^2`` over
-    that simplex's vertices, with a handful of array operations per step.
-    Points not found strictly inside a simplex within a few face crossings,
-    and exact hits on a training point, take the general route
-    (:meth:`FieldStack.evaluate`), so every path gets the steps
-    :func:`follow_field` would give it (to float rounding).
+
+def _compiled_fields(stack: FieldStack) -> np.ndarray:
+    """Which fields of ``stack`` the compiled loop handles exactly (bool per field)."""
+    ok = getattr(stack, "_compiled_ok", None)
+    if ok is None:
+        tri = stack.tri_
+        full = tri._tri is not None and tri.basis_ is None and tri.simplices_.shape[0] > 0
+        ok = np.array([f.method == "knn" or (f.method == "delaunay" and f.weights == "idw" and full)
+                       for f in stack.fields])
+        stack._compiled_ok = ok
+    return ok
+
+
+def _kernel_tables(stack: FieldStack) -> dict:
+    """Contiguous arrays for :mod:`kernels`, built once per stack (triangulation parts once per triangulation).
+
+    ``nl`` (u, L) lists the L nearest training points of every training
+    point (itself first) by increasing distance ``dl`` (u, L), with their
+    coordinates ``nc`` (u, L, d); ``Rend`` (u,)
+    is the distance of the L-th (``inf`` when that is every point): the
+    certified candidate lists of the k-NN.
     """
-    from .geometry import HINT_EPS, HINT_WALK
+    tab = getattr(stack, "_kernel", None)
+    if tab is not None:
+        return tab
+    tri = stack.tri_
+    d = stack.dim_
+    geo = getattr(tri, "_kernel_geometry", None)
+    if geo is None:
+        if tri._tri is not None and tri.basis_ is None and tri.simplices_.shape[0] > 0:
+            TT = np.ascontiguousarray(tri._barycentric_transform(), float)
+            simp = np.ascontiguousarray(tri.simplices_, np.int64)
+            nbr = np.ascontiguousarray(tri._tri.neighbors, np.int64)
+        else:  # never used: such stacks have no compiled Delaunay field
+            TT, simp, nbr = np.zeros((1, d + 1, d)), np.zeros((1, d + 1), np.int64), np.full((1, d + 1), -1, np.int64)
+        if tri._hull_eq is not None:
+            A, c = (np.ascontiguousarray(a, float) for a in tri._hull_eq)
+        else:  # no facets: nothing is "clearly outside", such steps go to the reference
+            A, c = np.zeros((0, d)), np.zeros(0)
+        # outside by clearly more than the tolerance of SafeDelaunay.find (rounding of the dot products)
+        lim = float(tri.tol_) * (1.0 + 1e-6) + 1e-12 * float(tri.scale_)
+        geo = tri._kernel_geometry = (TT, simp, nbr, A, c, lim)
+    pu = np.ascontiguousarray(stack.points_, float)
+    u = pu.shape[0]
+    kf = np.asarray(stack.k_, np.int64)
+    L = int(min(u, CACHE_FACTOR * kf.max()))
+    dl, nl = stack.tree_.query(pu, k=L)
+    nl = np.ascontiguousarray(np.reshape(nl, (u, L)), np.int64)
+    dl = np.ascontiguousarray(np.reshape(dl, (u, L)), float)
+    Rend = np.full(u, np.inf) if L >= u else dl[:, -1].copy()
+    tab = stack._kernel = {
+        "geo": geo, "meth": np.array([0 if f.method == "knn" else 1 for f in stack.fields], np.int64),
+        "kf": kf, "V": np.ascontiguousarray(stack.vectors_, float), "pu": pu,
+        "cnt": np.ascontiguousarray(stack.counts_, float), "hit_tol": float(stack.hit_tol_), "nl": nl, "nc": pu[nl], "dl": dl,
+        "Rend": Rend, "eps": 1e-12 * float(tri.scale_)}
+    return tab
 
-    f = stack.fields[0]
-    tri = f.triangulation_
-    TT = tri._barycentric_transform()
-    nbr = tri._tri.neighbors
-    simp = tri.simplices_
-    pts_u, vec, cnt = f.points_, f.vectors_, f.counts_
-    r = pts_u.shape[1]
-    P = x.shape[0]
-    pts = np.empty((steps + 1, P, r))
+
+def _follow_compiled(stack: FieldStack, x, steps: int, which, brute: bool | None = None):
+    """Paths through compiled-capable fields: ``(points (steps+1, P, d), fallback (steps, P))``.
+
+    Runs :func:`kernels.advance_serial` / :func:`kernels.advance_parallel`
+    until every path is finished; in between, the steps they hand back are
+    evaluated with :meth:`FieldStack.evaluate`, batched over paths. ``brute``
+    (default: at most ``BRUTE_MAX_POINTS`` training points) lets the compiled
+    loop settle uncertified k-NN steps itself.
+    """
+    import numba
+
+    from . import kernels
+
+    tab = _kernel_tables(stack)
+    TT, simp, nbr, A, c, lim = tab["geo"]
+    meth, kf, V, pu, cnt, hit_tol = (tab[n] for n in ("meth", "kf", "V", "pu", "cnt", "hit_tol"))
+    nl, nc, dl, Rend, eps = tab["nl"], tab["nc"], tab["dl"], tab["Rend"], tab["eps"]
+    if brute is None:
+        brute = pu.shape[0] <= BRUTE_MAX_POINTS
+    X = np.array(x, float, order="C")
+    P, d = X.shape
+    which = np.ascontiguousarray(which, np.int64)
+    pts = np.empty((steps + 1, P, d))
+    pts[0] = X
     fb = np.zeros((steps, P), bool)
-    pts[0] = x
-    s = np.full(P, -1)
-    zero = np.zeros(P, int)
-    v = np.empty_like(x)
-    for t in range(steps):
-        ok = np.zeros(P, bool)
-        idx = np.flatnonzero(s >= 0)
-        for _ in range(HINT_WALK):
-            if not idx.size:
-                break
-            T = TT[s[idx]]
-            b = np.einsum("mij,mj->mi", T[:, :r, :], x[idx] - T[:, r, :])
-            full = np.concatenate([b, 1.0 - b.sum(axis=1, keepdims=True)], axis=1)
-            bmin = full.min(axis=1)
-            good = bmin > HINT_EPS
-            ok[idx[good]] = True
-            rest = ~good & np.isfinite(bmin)
-            idx = idx[rest]
-            s[idx] = nbr[s[idx], np.argmin(full[rest], axis=1)]
-            idx = idx[s[idx] >= 0]
-        oi = np.flatnonzero(ok)
-        if oi.size:
-            verts = simp[s[oi]]
-            diff = pts_u[verts] - x[oi, None, :]
-            d2 = np.einsum("mkd,mkd->mk", diff, diff)
-            hit = (d2 <= f.hit_tol_ ** 2).any(axis=1)
-            if hit.any():
-                ok[oi[hit]] = False
-                oi, verts, d2 = oi[~hit], verts[~hit], d2[~hit]
-            w = cnt[verts] / d2
-            v[oi] = np.einsum("mk,mkd->md", w, vec[verts]) / w.sum(axis=1, keepdims=True)
-        bad = np.flatnonzero(~ok)
-        if bad.size:
-            hb = np.full(bad.size, -1)
-            v[bad], fb[t, bad] = stack.evaluate(x[bad], zero[:bad.size], hb)
-            s[bad] = hb
-        x = x + v
-        pts[t + 1] = x
-    if not np.all(np.isfinite(pts)):
-        raise FloatingPointError("follow_batch produced a non-finite point")
-    return BatchPaths(pts, fb)
-
-
-class _SinglePath:
-    """One path through one field, with per-step costs of a few microseconds.
-
-    With a single path, numpy's per-call overhead dominates a vectorised
-    step, so this follows it with scalar arithmetic instead, giving the same
-    answer as :func:`follow_field` (to float rounding):
-
-    * Delaunay (1/D^2 weights, full-rank triangulation): the point is first
-      tried in the simplex it was in one step earlier, then walked across the
-      face opposite its most negative barycentric coordinate (a few steps at
-      most). Only a point found *strictly* inside a simplex is accepted that
-      way (then that simplex is the only one containing it); anything else
-      (faces, vertices, outside the hull) goes to :meth:`VectorField.__call__`,
-      the reference. scipy has no warm-started point location, hence the walk
-      by hand.
-    * k-NN: one ``cKDTree.query`` per step through :meth:`VectorField.__call__`
-      (a cached candidate set bounded by the triangle inequality was tried
-      and was no faster than the query itself at k = 16).
-    """
-
-    MAX_WALK = 32
-
-    @staticmethod
-    def supports(stack: FieldStack) -> bool:
-        if len(stack.fields) != 1:
-            return False
-        f = stack.fields[0]
-        if f.method == "knn":
-            return True
-        tri = f.triangulation_
-        return (f.method == "delaunay" and f.weights == "idw" and tri._tri is not None and tri.basis_ is None)
-
-    def __init__(self, stack: FieldStack):
-        f = stack.fields[0]
-        self.f = f
-        self.d = f.points_.shape[1]
-        self.hit2 = f.hit_tol_ ** 2
-        if f.method == "delaunay":
-            tri = f.triangulation_
-            self.T = tri._barycentric_transform().tolist()
-            self.simp = tri.simplices_.tolist()
-            self.nbr = tri._tri.neighbors.tolist()
-            self.P = f.points_.tolist()
-            self.V = f.vectors_.tolist()
-            self.m = f.counts_.tolist()
-
-    def follow(self, x0, steps: int) -> BatchPaths:
-        pts = np.empty((steps + 1, 1, self.d))
-        fb = np.zeros((steps, 1), bool)
-        pts[0, 0] = x0
-        if self.f.method == "delaunay" and self.d == 2:
-            return self._follow_delaunay_2d(x0, steps, pts, fb)
-        step = self._delaunay_step if self.f.method == "delaunay" else self._knn_step
-        x = np.array(x0, float)
-        self.s = -1
-        for t in range(steps):
-            v, fb[t, 0] = step(x)
-            x = x + v
-            pts[t + 1, 0] = x
-        if not np.all(np.isfinite(pts)):
-            raise FloatingPointError("follow_batch produced a non-finite point")
-        return BatchPaths(pts, fb)
-
-    def _follow_delaunay_2d(self, x0, steps, pts, fb):
-        """The Delaunay step unrolled for the paper's 2-D latent space (same arithmetic as the general step)."""
-        from .geometry import HINT_EPS
-
-        if getattr(self, "_packed", None) is None:
-            # per simplex: transform, centre, neighbours and vertices; per vertex: position, multiplier, vector
-            self._packed = (
-                [(a00, a01, a10, a11, c0, c1, n[0], n[1], n[2], v[0], v[1], v[2])
-                 for ((a00, a01), (a10, a11), (c0, c1)), n, v in zip(self.T, self.nbr, self.simp)],
-                [(p[0], p[1], m, w[0], w[1]) for p, m, w in zip(self.P, self.m, self.V)])
-        TS, PV = self._packed
-        hit2, max_walk = self.hit2, self.MAX_WALK
-        x0_, x1_ = float(x0[0]), float(x0[1])
-        s = -1
-        xs = [(x0_, x1_)]
-        for t in range(steps):
-            found = False
-            if s >= 0:
-                for _ in range(max_walk):
-                    a00, a01, a10, a11, c0, c1, n0, n1, n2, i0, i1, i2 = TS[s]
-                    y0, y1 = x0_ - c0, x1_ - c1
-                    b0 = a00 * y0 + a01 * y1
-                    b1 = a10 * y0 + a11 * y1
-                    b2 = 1.0 - (b0 + b1)
-                    bm = min(b0, b1, b2)
-                    if bm > HINT_EPS:
-                        found = True
-                        break
-                    if bm != bm:
-                        break
-                    s = n0 if bm == b0 else (n1 if bm == b1 else n2)
-                    if s < 0:
-                        break
-            if found:
-                p0, p1, m0, u0, w0 = PV[i0]
-                q0, q1, m1, u1, w1 = PV[i1]
-                r0, r1, m2, u2, w2 = PV[i2]
-                e0, e1 = p0 - x0_, p1 - x1_
-                da = e0 * e0 + e1 * e1
-                e0, e1 = q0 - x0_, q1 - x1_
-                db = e0 * e0 + e1 * e1
-                e0, e1 = r0 - x0_, r1 - x1_
-                dc = e0 * e0 + e1 * e1
-                found = da > hit2 and db > hit2 and dc > hit2
-            if found:
-                wa, wb, wc = m0 / da, m1 / db, m2 / dc
-                wsum = wa + wb + wc
-                v0 = (wa * u0 + wb * u1 + wc * u2) / wsum
-                v1 = (wa * w0 + wb * w1 + wc * w2) / wsum
-            else:
-                x = np.array((x0_, x1_))
-                s = self.f.triangulation_.find_one(x)
-                v, fb[t, 0] = self.f(x)
-                v0, v1 = float(v[0]), float(v[1])
-            x0_, x1_ = x0_ + v0, x1_ + v1
-            xs.append((x0_, x1_))
-        pts[:, 0, :] = xs
-        if not np.all(np.isfinite(pts)):
-            raise FloatingPointError("follow_batch produced a non-finite point")
-        return BatchPaths(pts, fb)
-
-    def _bary(self, s, x):
-        Ts = self.T[s]
-        c = Ts[self.d]
-        y = [x[j] - c[j] for j in range(self.d)]
-        b = [sum(row[j] * y[j] for j in range(self.d)) for row in Ts[:self.d]]
-        b.append(1.0 - sum(b))
-        return b
-
-    def _delaunay_step(self, x):
-        from .geometry import HINT_EPS
-
-        xl = x.tolist()
-        s = self.s
-        found = False
-        for _ in range(self.MAX_WALK if s >= 0 else 0):
-            b = self._bary(s, xl)
-            if b != b or min(b) > HINT_EPS:  # NaN (degenerate simplex) fails the next test too
-                found = min(b) > HINT_EPS
-                break
-            j = b.index(min(b))
-            s = self.nbr[s][j]
-            if s < 0:
-                break
-        if not found:
-            self.s = self.f.triangulation_.find_one(x)
-            v, fb = self.f(x)
-            return v, fb
-        self.s = s
-        verts = self.simp[s]
-        acc = [0.0] * self.d
-        wsum = 0.0
-        for vi in verts:
-            p = self.P[vi]
-            d2 = sum((p[j] - xl[j]) ** 2 for j in range(self.d))
-            if d2 <= self.hit2:
-                return self.f(x)
-            w = self.m[vi] / d2
-            wsum += w
-            vv = self.V[vi]
-            for j in range(self.d):
-                acc[j] += w * vv[j]
-        return np.array(acc) / wsum, False
-
-    def _knn_step(self, x):
-        return self.f(x)
+    t = np.zeros(P, np.int64)
+    s = np.full(P, -1, np.int64)
+    anchor = np.full(P, -1, np.int64)
+    status = np.zeros(P, np.int64)
+    kern = kernels.advance_parallel if P >= PARALLEL_MIN_PATHS else kernels.advance_serial
+    while P:
+        # small chunks handed out dynamically: on a shared machine one descheduled thread does not hold up the rest
+        old = numba.set_parallel_chunksize(PARALLEL_CHUNK)
+        try:
+            kern(X, pts, fb, t, s, anchor, status, steps, which, meth, kf, V, pu, cnt, hit_tol,
+                 TT, simp, nbr, A, c, lim, nl, nc, dl, Rend, eps, bool(brute), MAX_WALK)
+        finally:
+            numba.set_parallel_chunksize(old)
+        ref = np.flatnonzero(status == 1)
+        if not ref.size:
+            break
+        h = s[ref].copy()
+        v, fbv = stack.evaluate(X[ref], which[ref], h)
+        s[ref] = h
+        anchor[ref] = np.reshape(stack.tree_.query(X[ref], k=1, workers=-1)[1], -1)  # a start for the lists
+        X[ref] += v
+        tr = t[ref]
+        pts[tr + 1, ref] = X[ref]
+        fb[tr, ref] = fbv
+        t[ref] += 1
+    return pts, fb
 
 
 class TargetPlanner:
