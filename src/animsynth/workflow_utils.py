@@ -7,6 +7,16 @@ import os
 import sys
 
 
+def limit_compiled_threads(n: int) -> None:
+    """Let numba's parallel loops use at most ``n`` threads (the rule's ``threads:``),
+    so two single-thread jobs on a 2-core machine do not each start two threads."""
+    n = max(1, int(n))
+    os.environ["NUMBA_NUM_THREADS"] = str(n)  # for a numba imported later
+    numba = sys.modules.get("numba")
+    if numba is not None:
+        numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
+
+
 def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None = None) -> logging.Logger:
     """Send ``animsynth`` log records (INFO and up) to the rule's ``log:`` file.
 
@@ -32,6 +42,7 @@ def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None 
         from .io.atomic import clean_stale_temporaries
 
         clean_stale_temporaries(str(o) for o in snakemake.output)
+        limit_compiled_threads(int(getattr(snakemake, "threads", 1) or 1))
 
     def _hook(exc_type, exc, tb):
         root.error("job failed", exc_info=(exc_type, exc, tb))
