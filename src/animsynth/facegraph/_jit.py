@@ -280,6 +280,18 @@ def alg1_all(X, U, OK, lengths, thr, lam, Q, out):
 # ---------------------------------------------------------------------------
 # merging (state arrays of merging.Merger; ``st`` = [n, ne, trial, n0, ne0, n_undo_nodes, n_undo_vins, stamp])
 @njit(cache=True)
+def _rotate_rows(qv, R, qvt, n):
+    """``qv[:n] = qv[:n] @ R.T`` in place (rows are 2-D vectors), rounded as numpy's
+    ``(n, 2) @ (2, 2)`` product does (module docstring); ``qvt`` is scratch."""
+    for l in range(n):
+        x0 = qv[l, 0]
+        x1 = qv[l, 1]
+        qvt[l, 0] = fma(x1, R[0, 1], x0 * R[0, 0])
+        qvt[l, 1] = fma(x1, R[1, 1], x0 * R[1, 0])
+    qv[:n, :] = qvt[:n, :]
+
+
+@njit(cache=True)
 def merge_sample(s, T, trial, lam, eps, procrustes, st,
                  visit_node, visit_vel, visit_first, ndisp, ncount, first, red, M,
                  Dsum, Dmean, Dred, cnt, node_map, visit_map,
@@ -334,12 +346,7 @@ def merge_sample(s, T, trial, lam, eps, procrustes, st,
             qv[l, 0] = visit_vel[vi_, l, 0]
             qv[l, 1] = visit_vel[vi_, l, 1]
         if has_R:
-            for l in range(Lr):
-                x0 = qv[l, 0]
-                x1 = qv[l, 1]
-                qvt[l, 0] = fma(x1, R[0, 1], x0 * R[0, 0])
-                qvt[l, 1] = fma(x1, R[1, 1], x0 * R[1, 0])
-            qv[:, :] = qvt
+            _rotate_rows(qv, R, qvt, Lr)
         f = node_map[g]
         if f < 0:
             if has_R:
@@ -433,12 +440,7 @@ def merge_sample(s, T, trial, lam, eps, procrustes, st,
                         a1 = a[l, 1]
                         qd[l, 0] = ((fma(a1, Ra[0, 1], a0 * Ra[0, 0])) + ta[0]) - M[l, 0]
                         qd[l, 1] = ((fma(a1, Ra[1, 1], a0 * Ra[1, 0])) + ta[1]) - M[l, 1]
-                    for l in range(Lr):
-                        x0 = qv[l, 0]
-                        x1 = qv[l, 1]
-                        qvt[l, 0] = fma(x1, Ra[0, 1], x0 * Ra[0, 0])
-                        qvt[l, 1] = fma(x1, Ra[1, 1], x0 * Ra[1, 0])
-                    qv[:, :] = qvt
+                    _rotate_rows(qv, Ra, qvt, Lr)
                     if not has_R:
                         R[:, :] = Ra
                         tr[0] = ta[0]

@@ -134,6 +134,26 @@ def _idw(out, dist, idx, n, V, f, cnt, hit_tol):
 
 
 @njit(cache=True, inline="always")
+def _listed_dist2(x, nc, a, m, d):
+    """Squared distance from ``x`` (d,) to the ``m``-th listed point of anchor ``a`` (``nc`` (P, L, d))."""
+    d2 = 0.0
+    for i in range(d):
+        c = nc[a, m, i] - x[i]
+        d2 += c * c
+    return d2
+
+
+@njit(cache=True, inline="always")
+def _farthest(bd, k):
+    """Index of the largest of ``bd[:k]`` (the first one on ties)."""
+    jm = 0
+    for j in range(1, k):
+        if bd[j] > bd[jm]:
+            jm = j
+    return jm
+
+
+@njit(cache=True, inline="always")
 def _knn_list(x, a, k, nl, nc, dl, Rend, eps, pu, bd, bi):
     """k nearest of x among the listed neighbours of training point ``a`` (into bd, bi; nearest first).
 
@@ -156,16 +176,10 @@ def _knn_list(x, a, k, nl, nc, dl, Rend, eps, pu, bd, bi):
     L = nl.shape[1]
     for m in range(k):  # k <= L: the first k listed points
         q = nl[a, m]
-        d2 = 0.0
-        for i in range(d):
-            c = nc[a, m, i] - x[i]
-            d2 += c * c
+        d2 = _listed_dist2(x, nc, a, m, d)
         bd[m] = d2
         bi[m] = q
-    jm = 0
-    for j in range(1, k):
-        if bd[j] > bd[jm]:
-            jm = j
+    jm = _farthest(bd, k)
     lim = np.sqrt(bd[jm]) * (1.0 + CERT_MARGIN) + eps
     ok = False
     m = k
@@ -174,17 +188,11 @@ def _knn_list(x, a, k, nl, nc, dl, Rend, eps, pu, bd, bi):
             ok = True
             break
         q = nl[a, m]
-        d2 = 0.0
-        for i in range(d):
-            c = nc[a, m, i] - x[i]
-            d2 += c * c
+        d2 = _listed_dist2(x, nc, a, m, d)
         if d2 < bd[jm]:
             bd[jm] = d2
             bi[jm] = q
-            jm = 0
-            for j in range(1, k):
-                if bd[j] > bd[jm]:
-                    jm = j
+            jm = _farthest(bd, k)
             lim = np.sqrt(bd[jm]) * (1.0 + CERT_MARGIN) + eps
         m += 1
     if not ok:
