@@ -44,6 +44,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numpy as np  # noqa: E402
 from scipy.spatial import Delaunay, cKDTree  # noqa: E402
+import numba  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
 from animsynth.config import derive_seed  # noqa: E402
@@ -105,7 +106,8 @@ def _row(name, value, base, cpu, base_cpu, same, target_txt, target):
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     return {"family": "simplicial", "benchmark": name, "value": round(value, 1), "unit": "steps/s",
             "baseline": f"{BASELINE}; CPU-time rates ours {cpu:.0f} vs baseline {base_cpu:.0f} steps/s "
-                        f"(wall {value:.0f} vs {base:.0f}; load average {load:.1f}); "
+                        f"(wall {value:.0f} vs {base:.0f}; load average {load:.1f}; "
+                        f"{numba.get_num_threads()} numba thread(s)); "
                         + ("same paths" if same else "PATHS DIFFER"),
             "baseline_value": round(base, 1), "ratio": round(value / base, 2), "target": target_txt,
             "meets_target": bool(target(value, base) and same)}

@@ -3,6 +3,7 @@
 import hashlib
 import socket
 
+import pandas as pd
 import pytest
 
 from animsynth.data import DownloadError, PAPER_TABLE_I, datasets_table, fetch_file, load_trial, sha256_normalised
@@ -68,3 +69,8 @@ def test_datasets_table_layout():
     assert list(df.columns) == ["dataset", "source", "trials", "dims", "n_sequences", "lengths", "total_nodes"]
     assert df.loc[0, "trials"] == "t0 t1" and df.loc[0, "lengths"] == "50 51" and df.loc[0, "total_nodes"] == 101
     assert (df["dims"] == 56).all()
+    # with published lengths: the paper's beside ours and the difference; empty for a subset the paper lacks
+    dp = datasets_table({"w1": ["t0", "t1"], "w2": ["t2", "t3"]}, motions, "synthetic", paper={"w1": [50, 60]})
+    assert dp.loc[0, "paper_total_nodes"] == 110 and dp.loc[0, "total_nodes_minus_paper"] == 101 - 110
+    assert pd.isna(dp.loc[1, "total_nodes_minus_paper"])
+    assert "t1 (51) for 60" in dp.loc[0, "length_match"]

@@ -398,6 +398,16 @@ def test_database_with_huge_coordinate_is_refused(db):
         FacePreprocessor().fit_transform(seqs)
 
 
+def test_region_beyond_the_compiled_sum_limit_is_refused_with_its_size(db):
+    regions = dict(db.regions)
+    name = next(iter(regions))
+    regions[name] = np.tile(np.asarray(regions[name]), 300 // len(regions[name]) + 1)[:300]
+    big = FaceDatabase(list(db.names), db.emotions, db.lengths, db.disp, db.neutral, db.mean_neutral,
+                       regions, db.reduced)
+    with pytest.raises(ValueError, match=f"more than 240 landmarks.*'{name}': 300"):
+        FaceGraphModel(20, 70, creation_tolerance=10, merge_tolerance=20).fit(big)
+
+
 # -- pre-processing -------------------------------------------------------------
 def test_sigmoid_fit_recovers_known_sigmoid():
     t = np.arange(25.0)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import ast
 import io
+import os
 import re
 import subprocess
 import tokenize
@@ -212,3 +213,17 @@ def test_no_tracker_references():
             if TRACKER.search(line):
                 hits.append(f"{rel}:{k}: {line.strip()[:100]}")
     assert not hits, "tracker references (name things by what they are):\n" + "\n".join(hits)
+
+
+def test_jobs_cap_numba_threads_at_the_rule_threads(monkeypatch):
+    numba = pytest.importorskip("numba")
+    from animsynth.workflow_utils import limit_compiled_threads
+
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "2")  # restored after the test (the call sets it for later imports)
+    before = numba.get_num_threads()
+    try:
+        limit_compiled_threads(1)
+        assert numba.get_num_threads() == 1
+        assert os.environ["NUMBA_NUM_THREADS"] == "1"
+    finally:
+        numba.set_num_threads(before)

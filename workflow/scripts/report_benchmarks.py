@@ -3,11 +3,17 @@
 Rows measured by other rules (the scale study's 100,000-frame re-sequencing
 benchmark, when it is on) are appended as they are.
 """
-import pandas as pd
+import os
 
-from animsynth.report import run_benchmarks
-from animsynth.tables import write_table
-from animsynth.workflow_utils import setup_logging
+# numba's OpenMP threads would otherwise spin after each parallel run and take CPU from the next
+# timing; set before any benchmark module starts them
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+import pandas as pd  # noqa: E402
+
+from animsynth.report import run_benchmarks  # noqa: E402
+from animsynth.tables import write_table  # noqa: E402
+from animsynth.workflow_utils import setup_logging  # noqa: E402
 
 log = setup_logging(snakemake)  # noqa: F821
 df = run_benchmarks(snakemake.input.scripts)  # noqa: F821

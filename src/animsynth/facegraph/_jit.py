@@ -54,6 +54,12 @@ def fma(a, b, c):
     return _fma_intrinsic(a, b, c)
 
 
+#: Most elements :func:`pw_sum` adds (three levels of numpy's block halving above 128).
+MAX_SUM = 480
+#: Most landmarks of one region (a 2-D dot product sums 2 values per landmark).
+MAX_REGION_LANDMARKS = MAX_SUM // 2
+
+
 @njit(cache=True)
 def pw_sum(a, n):
     """``np.add.reduce(a[:n])`` of a contiguous float64 array, in numpy's order.
@@ -108,7 +114,7 @@ def _pw_split2(a, lo, n):
 
 @njit(cache=True)
 def _pw_split1(a, lo, n):
-    if n > 480:
+    if n > MAX_SUM:
         raise ValueError("pw_sum: more than 480 elements")
     n2 = n // 2
     n2 -= n2 % 8

@@ -248,6 +248,10 @@ class FaceGraphModel:
         if bad or not np.all(np.isfinite(db.mean_neutral)):
             raise ValueError(f"pre-processed database holds non-finite coordinates (samples {bad[:10]}); "
                              "refusing to build graphs")
+        too_big = {r: len(ix) for r, ix in db.regions.items() if len(ix) > _jit.MAX_REGION_LANDMARKS}
+        if too_big:
+            raise ValueError(f"regions with more than {_jit.MAX_REGION_LANDMARKS} landmarks ({too_big}): the compiled "
+                             "graph code sums at most that many per region in numpy's order; split the region")
         cpu0, wall0 = time.process_time(), time.perf_counter()
         lam, eps = float(self.lam), float(self.velocity_eps)
         tol_c = float(self.tolerance if self.creation_tolerance is None else self.creation_tolerance)

@@ -524,6 +524,7 @@ def check_lee_weights(path, weights: dict) -> pd.DataFrame | None:
         raise ValueError(f"{path}: expected columns joint_pair, weight; got {list(df.columns)}")
     df = df.rename(columns={"joint_pair": "group", "weight": "weight_paper"})
     df["weight_ours"] = df["group"].map(lambda g: float(weights.get(g, 0.0)))
+    df["weight_minus_paper"] = df["weight_ours"] - df["weight_paper"]
     df["match"] = np.isclose(df["weight_ours"], df["weight_paper"], rtol=0, atol=5e-5)
     return df
 

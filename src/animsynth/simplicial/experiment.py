@@ -554,6 +554,8 @@ def table2_ensemble(members: pd.DataFrame, datasets, methods=("delaunay", "knn")
             if pap is not None and (met, a) in pap.index and (met, b) in pap.index and d in pap.columns:
                 pa, pb = float(pap.loc[(met, a), d]), float(pap.loc[(met, b), d])
             r[f"paper_{a}"], r[f"paper_{b}"] = pa, pb
+            r[f"{a}_median_minus_paper"] = r[f"{a}_median"] - pa
+            r[f"{b}_median_minus_paper"] = r[f"{b}_median"] - pb
             if np.isfinite(pa) and np.isfinite(pb) and n:
                 r["paper_ordering"] = f"{a}<{b}" if pa < pb else f"{b}<{a}" if pb < pa else "tie"
                 r["agree_share"] = share if pa < pb else (1.0 - share if pb < pa else np.nan)

@@ -150,6 +150,9 @@ class SafeDelaunay:
         if not np.all(np.isfinite(p)):
             raise ValueError("SafeDelaunay: points contain NaN or inf")
         n, d = p.shape
+        # caches of an earlier fit (barycentric transforms, the compiled route's tables) describe other points
+        self._transform = None
+        self._kernel_geometry = None
         self.points_ = p
         self.notes_: list[str] = []
         scale = bbox_diagonal(p)
