@@ -19,6 +19,7 @@ import subprocess
 import tokenize
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import REPO, SNAKEMAKE
@@ -224,6 +225,16 @@ def test_jobs_cap_numba_threads_at_the_rule_threads(monkeypatch):
     try:
         limit_compiled_threads(1)
         assert numba.get_num_threads() == 1
-        assert os.environ["NUMBA_NUM_THREADS"] == "1"
+        assert os.environ["NUMBA_NUM_THREADS"] == "2"  # numba already imported: the pool is masked, env untouched
+
+        # and a function compiled afterwards still runs (a changed env variable made numba refuse to compile)
+        @numba.njit(parallel=True)
+        def total(a):
+            s = 0.0
+            for i in numba.prange(a.size):
+                s += a[i]
+            return s
+
+        assert total(np.arange(10.0)) == 45.0
     finally:
         numba.set_num_threads(before)

@@ -11,9 +11,12 @@ def limit_compiled_threads(n: int) -> None:
     """Let numba's parallel loops use at most ``n`` threads (the rule's ``threads:``),
     so two single-thread jobs on a 2-core machine do not each start two threads."""
     n = max(1, int(n))
-    os.environ["NUMBA_NUM_THREADS"] = str(n)  # for a numba imported later
     numba = sys.modules.get("numba")
-    if numba is not None:
+    if numba is None:
+        os.environ["NUMBA_NUM_THREADS"] = str(n)  # read when numba is imported later
+    else:
+        # not the environment variable: numba rereads it at every compile and refuses a change
+        # once its thread pool runs; set_num_threads only masks threads of the running pool
         numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
 
 
