@@ -41,10 +41,12 @@ def test_tiny_workflow_facegraph_outputs(tiny_workflow, tmp_path):
     assert (t1.nodes.diff().dropna() < 0).all()  # more compression, fewer nodes
     assert (t1.node_compression_pct == (100 * (1 - t1.nodes / t1.poses)).round(4)).all()
     assert t1.duration_diff.max() < t1.random_duration_diff.min()  # stored durations beat a random peak's
-    # ours - paper beside every published column (the tiny configs are among the paper's 15)
+    # ours - paper beside every published column (the tiny configs are among the paper's 15); without
+    # ../shared/papers (a bare copy of the project) the paper's columns and the differences are empty
+    published = (wd / "../shared/papers/s4_table1.csv").exists()
     for k in ("node_compression_pct", "landmark_diff_px", "velocity_angle_diff_pct"):
-        assert t1["paper_" + k].notna().all()
-        assert np.allclose(t1[k + "_minus_paper"], t1[k] - t1["paper_" + k], atol=1e-4)
+        assert t1["paper_" + k].notna().all() == published and t1["paper_" + k].isna().all() != published
+        np.testing.assert_allclose(t1[k + "_minus_paper"], t1[k] - t1["paper_" + k], atol=1e-4)
     tm = pd.read_csv(wd / "results/facegraph/table1_timing.csv")
     assert tm.config.tolist() == t1.config.tolist() and (tm.creation_cpu_s > 0).all()
     md = (wd / "results/facegraph/table1.md").read_text()
