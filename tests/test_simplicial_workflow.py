@@ -37,7 +37,11 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
     t2 = pd.read_csv(wd / "results/simplicial/table2.csv")
     assert t2[["metric", "method"]].values.tolist() == [["error_a", "delaunay"], ["error_a", "knn"],
                                                         ["error_f", "delaunay"], ["error_f", "knn"]]
-    assert list(t2.columns)[-1] == "paper_all"
+    subsets = [c for c in t2.columns[2:] if not c.startswith("paper_") and not c.endswith("_minus_paper")]
+    assert subsets[-1] == "all"
+    assert list(t2.columns[2:]) == subsets + [f"paper_{d}" for d in subsets] + [f"{d}_minus_paper" for d in subsets]
+    for d in subsets:  # empty without ../shared/papers beside the run, ours - paper with it
+        np.testing.assert_allclose(t2[f"{d}_minus_paper"], t2[d] - t2[f"paper_{d}"], rtol=0, atol=1e-5)
     v = pd.read_csv(wd / "results/simplicial/verdicts.csv")
     assert list(v.columns) == VERDICT_COLUMNS and len(v) >= 8
     assert set(v["verdict"]) <= {"reproduced", "partly", "not reproduced", "contradicted", "within noise"}
