@@ -288,7 +288,7 @@ def run_main(d: Prepared, cfg: dict, refit_rig=None):
         else:
             rig_b, w_b, rt_b, ang_b = refit_rig(tr)
             db = replace(d, rig=rig_b, weights=w_b, root_t=rt_b, angles=ang_b, train=tr, test=te)
-            cb = context(db, (cfg["level"],), cfg)
+            cb = ctx.with_skin(rig_b, w_b)  # the mesh-only pieces (control mesh, upsampler) are shared
         for k, over in _variants(cfg).items():
             m = _fit(_model(cfg, **over), cb, db, tr)
             p = _predict(m, cb, db, te)

@@ -26,6 +26,8 @@ control vertex's dominant-joint frame.
 
 from __future__ import annotations
 
+import copy
+
 import logging
 import time
 
@@ -154,6 +156,20 @@ class MeshContext:
         if cache is not None:
             self._pos[key] = out
         return out
+
+    def with_skin(self, rig: Rig, weights) -> "MeshContext":
+        """The same mesh with another skeleton and skin (e.g. one cross-validation fold's).
+
+        Shares what depends only on the mesh (control meshes, RBF upsamplers,
+        Laplacian coders, the cached control positions of the captured frames);
+        drops the cached positions of skinned frames, which depend on the skin.
+        """
+        new = copy.copy(self)
+        new.rig = rig
+        new.weights = sparse.csr_matrix(weights)
+        new.dom = np.asarray(new.weights.argmax(axis=1)).ravel()
+        new._pos = {k: v for k, v in self._pos.items() if k[2] == "frames"}
+        return new
 
     def skin(self, root_t, angles):
         """Skinned vertices (F, V, 3), world rotations (F, J, 3, 3) and joint starts (F, J, 3)."""
