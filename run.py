@@ -4,7 +4,8 @@
     python3 run.py            # full default reproduction + report (results/)
     python3 run.py paper [--config cmu_mirror=... mesh_dir=...]
                               # all four papers on real data -> results/paper/
-    python3 run.py test       # the test suite (what CI runs)
+    python3 run.py test       # the test suite (what CI runs); add -m "not workflow" for the fast unit subset
+    python3 run.py bench      # the performance benchmarks at full size -> results/bench/benchmarks.csv
     python3 run.py snakemake ARGS...   # any snakemake call inside the project's venv
 
 It creates ./.venv on first use (or when pyproject.toml changes) and installs
@@ -30,6 +31,8 @@ PY = BIN / ("python.exe" if os.name == "nt" else "python")
 # The real-data reproduction: CMU trials, the samba meshes, then the paper run's
 # own settings (results/paper/, skip a family whose data are unavailable).
 PAPER_CONFIG = ("--configfile", "config/cmu.yaml", "config/samba.yaml", "config/paper.yaml")
+# The performance benchmarks at the sizes their targets are stated for, in a results folder of their own.
+BENCH_DIR = "results/bench"
 
 
 def ensure_venv() -> None:
@@ -67,6 +70,10 @@ def main(argv: list[str]) -> int:
         if rc == 0:
             rc = sh(snakemake, *PAPER_CONFIG, *argv[1:], "--report", "results/paper/report.html")
         return rc
+    if argv[0] == "bench":
+        # Extra arguments go to snakemake (e.g. --config cmu_mirror=DIR is not needed: the benchmarks make their data).
+        return sh(snakemake, "--cores", str(os.cpu_count() or 2), f"{BENCH_DIR}/benchmarks.csv", *argv[1:],
+                  "--config", f"results_dir={BENCH_DIR}", "benchmark_size=full")
     if argv[0] == "test":
         return sh(str(PY), "-m", "pytest", *argv[1:])
     if argv[0] == "snakemake":

@@ -74,16 +74,22 @@ def _gpy_pipeline(model: HybridModel, ctx, V, rt, A, iterations=100):
     return secs, float(mean_vertex_error(P, V).mean() * 1000)
 
 
-def run() -> list[dict]:
-    rig, ch, rt, A, V = _data()
+# frames of the synthetic clip and iterations: full size (the targets) and demo size (seconds)
+SIZES = {"full": dict(frames=120, iterations=100, repeat=3), "demo": dict(frames=40, iterations=20, repeat=1)}
+
+
+def run(size: str = "full") -> list[dict]:
+    """Benchmark rows; ``size`` "full" (120 frames, 100 iterations) or "demo" (40 frames, 20 iterations)."""
+    frames, iterations, repeat = SIZES[size]["frames"], SIZES[size]["iterations"], SIZES[size]["repeat"]
+    rig, ch, rt, A, V = _data(frames)
     ctx = MeshContext(ch.rest, ch.faces, rig, ch.weights)
     tr = np.arange(len(V))
     rows = []
-    own = HybridModel(level=5, regressor="gp", iterations=100).fit(ctx, V[tr], rt[tr], A[tr])
+    own = HybridModel(level=5, regressor="gp", iterations=iterations).fit(ctx, V[tr], rt[tr], A[tr])
     own_err = float(mean_vertex_error(own.predict(ctx, rt, A), V).mean() * 1000)
     per100 = own.train_seconds_ * 100 / len(tr)
     try:
-        gpy_secs, gpy_err = _gpy_pipeline(own, ctx, V, rt, A)
+        gpy_secs, gpy_err = _gpy_pipeline(own, ctx, V, rt, A, iterations)
         have_gpy = True
     except ImportError:  # GPy is optional (not a runtime dependency)
         have_gpy = False
@@ -98,10 +104,10 @@ def run() -> list[dict]:
                      "baseline_value": round(gpy_per100, 3), "ratio": round(gpy_per100 / per100, 2),
                      "target": "not slower than GPy", "meets_target": bool(per100 <= gpy_per100)})
     lbs = HybridModel(level=5, regressor="none").fit(ctx, V[tr], rt[tr], A[tr])
-    spf, _ = reconstruction_seconds_per_frame(own, ctx, rt[:40], A[:40], repeat=3)
-    spf_lbs, _ = reconstruction_seconds_per_frame(lbs, ctx, rt[:40], A[:40], repeat=3)
-    full = HybridModel(level=100, regressor="gp", iterations=100).fit(ctx, V[tr], rt[tr], A[tr])
-    spf_full, _ = reconstruction_seconds_per_frame(full, ctx, rt[:40], A[:40], repeat=3)
+    spf, _ = reconstruction_seconds_per_frame(own, ctx, rt[:40], A[:40], repeat=repeat)
+    spf_lbs, _ = reconstruction_seconds_per_frame(lbs, ctx, rt[:40], A[:40], repeat=repeat)
+    full = HybridModel(level=100, regressor="gp", iterations=iterations).fit(ctx, V[tr], rt[tr], A[tr])
+    spf_full, _ = reconstruction_seconds_per_frame(full, ctx, rt[:40], A[:40], repeat=repeat)
     rows.append({"family": "meshdetail", "benchmark": "recon_ms_per_frame_level5_vs_full",
                  "value": round(1000 * spf, 3), "unit": "ms", "baseline": "same model at full resolution (100 %)",
                  "baseline_value": round(1000 * spf_full, 3), "ratio": round(spf_full / spf, 3),

@@ -48,6 +48,10 @@ REPO = Path(__file__).resolve().parents[1]
 CMU = Path(os.environ.get("ANIMSYNTH_SHARED_DATA", REPO.parent / "shared" / "data")) / "cmu_mocap" / "subjects"
 
 
+# full size (the targets) and demo size (seconds): frames of the synthetic dance, repeats, CMU data used if present
+SIZES = {"full": dict(frames=800, repeat=3, cmu=True), "demo": dict(frames=200, repeat=1, cmu=False)}
+
+
 def _best(fn, repeat=3):
     best, out = np.inf, None
     for _ in range(repeat):
@@ -57,15 +61,15 @@ def _best(fn, repeat=3):
     return best, out
 
 
-def _dance_lee():
-    m = generate_motion("dance", 800, 3, cmu_like_skeleton("syn05", 7))
+def _dance_lee(frames=800):
+    m = generate_motion("dance", frames, 3, cmu_like_skeleton("syn05", 7))
     return lee_distances(motion_features(m), nu=0.01)
 
 
-def _walk_features():
-    """CMU 35_01 (or, without the data, a synthetic walk with one joint turning round and round)."""
+def _walk_features(cmu=True):
+    """CMU 35_01 (or, without the data or with ``cmu=False``, a synthetic walk with one joint turning round and round)."""
     amc = CMU / "35" / "35_01.amc"
-    if amc.is_file():
+    if cmu and amc.is_file():
         from animsynth.io import read_amc, read_asf
 
         return motion_features(read_amc(amc, read_asf(CMU / "35" / "35.asf"))), "cmu_35_01"
@@ -85,16 +89,18 @@ def _scan_min_k(D):
     return None
 
 
-def run() -> list[dict]:
+def run(size: str = "full") -> list[dict]:
+    """Benchmark rows; ``size`` "full" (800 frames, CMU 35_01 when present) or "demo" (200 frames, synthetic)."""
+    frames, repeat, cmu = SIZES[size]["frames"], SIZES[size]["repeat"], SIZES[size]["cmu"]
     rows = []
-    D = _dance_lee()
+    D = _dance_lee(frames)
     n = D.shape[0]
     for name, make in (("isomap", lambda: PrecomputedIsomap(None, 10)), ("stisomap", lambda: STIsomap(None, 10))):
         with threadpool_limits(limits=1, user_api="blas"):
-            t, est = _best(lambda: make().fit(D))
+            t, est = _best(lambda: make().fit(D), repeat)
             Dm = est.dist_st_ if name == "stisomap" else D
             k = est.n_neighbors_ if name == "isomap" else max(est.n_neighbors_, min_connected_k(Dm))
-            tb, base = _best(lambda: Isomap(n_neighbors=k, n_components=10, metric="precomputed").fit(Dm))
+            tb, base = _best(lambda: Isomap(n_neighbors=k, n_components=10, metric="precomputed").fit(Dm), repeat)
         same = bool(np.allclose(est.dist_matrix_, base.dist_matrix_, rtol=1e-9, atol=1e-12))
         note = ("identical geodesics" if same else
                 "GEODESICS DIFFER" if name == "isomap" else
@@ -106,11 +112,11 @@ def run() -> list[dict]:
                      "baseline_value": round(tb, 3), "ratio": round(tb / t, 2),
                      "target": "<= 1.5 s and, for Isomap, identical geodesics",
                      "meets_target": bool(t <= 1.5 and (same or name == "stisomap"))})
-    feats, label = _walk_features()
+    feats, label = _walk_features(cmu)
     for mode in ("continuous", "matrix_naive"):
         Dk = l2_distances(feats.linearised(False, mode))
-        t, k = _best(lambda: min_connected_k(Dk))
-        tb, kb = _best(lambda: _scan_min_k(Dk))
+        t, k = _best(lambda: min_connected_k(Dk), repeat)
+        tb, kb = _best(lambda: _scan_min_k(Dk), repeat)
         same = k == kb
         rows.append({"family": "resequencing", "benchmark": f"min_k_exact_{label}_l2_{mode}", "value": round(t * 1e3, 1),
                      "unit": "ms", "baseline": f"NearestNeighbors + connected_components scan over k = 1..{kb}"

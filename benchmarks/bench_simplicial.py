@@ -53,18 +53,19 @@ from animsynth.simplicial.field import FieldStack, VectorField, training_vectors
 from animsynth.simplicial.path import follow_batch  # noqa: E402
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion  # noqa: E402
 
-STEPS_1 = 500
-STEPS_MANY = 100
-N_PATHS = 1000
-N_BASELINE_PATHS = 20
 K = 16
+# full size (the performance targets) and demo size (seconds, for the default and tiny runs)
+SIZES = {
+    "full": dict(frames=(443, 360, 455, 454), steps_1=500, steps_many=100, n_paths=1000, n_baseline=20, repeat=3),
+    "demo": dict(frames=(150, 120, 140, 130), steps_1=200, steps_many=40, n_paths=200, n_baseline=5, repeat=1),
+}
 BASELINE = "plain scipy loop (Delaunay.find_simplex / cKDTree.query per step, one path at a time)"
 
 
-def _fold(latent_dim=2):
+def _fold(latent_dim=2, frames=SIZES["full"]["frames"]):
     sk = cmu_like_skeleton("bench35", 7)
     trials = [generate_motion("walk_straight", n, derive_seed(5, "bench", i), sk).without_root()
-              for i, n in enumerate((443, 360, 455, 454))]
+              for i, n in enumerate(frames)]
     pca = fit_pca(trials[1:], latent_dim)
     clips = [pca.transform(t) for t in trials[1:]]
     X = np.vstack(clips)
@@ -113,14 +114,16 @@ def _row(name, value, base, cpu, base_cpu, same, target_txt, target):
             "meets_target": bool(target(value, base) and same)}
 
 
-def run() -> list[dict]:
+def run(size: str = "full") -> list[dict]:
+    """Benchmark rows; ``size`` "full" (the targets) or "demo" (fewer paths and steps, seconds)."""
     # one BLAS thread: idle BLAS threads spinning after the PCA would take CPU from (and show up in) the timings
     with threadpool_limits(limits=1, user_api="blas"):
-        return _run()
+        return _run(**SIZES[size])
 
 
-def _run() -> list[dict]:
-    X, V, start = _fold(2)
+def _run(frames, steps_1, steps_many, n_paths, n_baseline, repeat) -> list[dict]:
+    STEPS_1, STEPS_MANY, N_PATHS, N_BASELINE_PATHS = steps_1, steps_many, n_paths, n_baseline
+    X, V, start = _fold(2, frames)
     # the baseline uses scipy on the same (duplicate-free) points our field uses
     rows = []
     rng = np.random.default_rng(derive_seed(5, "bench", "starts"))
@@ -134,20 +137,20 @@ def _run() -> list[dict]:
         starts = P[rng.integers(0, len(P), N_PATHS)] + 1e-3 * np.ptp(P, axis=0) * rng.normal(size=(N_PATHS, P.shape[1]))
         # warm-up, untimed: numba compilation (or its cache), barycentric transforms, neighbour lists
         follow_batch(stack, start[None], 5)
-        t, c, ours = _best(lambda: follow_batch(stack, start[None], STEPS_1))
-        tb, cb, base = _best(lambda: plain_scipy_path(tri, tree, P, Vu, start, STEPS_1, method))
+        t, c, ours = _best(lambda: follow_batch(stack, start[None], STEPS_1), repeat)
+        tb, cb, base = _best(lambda: plain_scipy_path(tri, tree, P, Vu, start, STEPS_1, method), repeat)
         same = bool(np.allclose(ours.points[:21, 0], base[:21], rtol=0, atol=1e-9 * np.ptp(P)))
         rows.append(_row(f"steps_per_s_1_path_{method}", STEPS_1 / t, STEPS_1 / tb, STEPS_1 / c, STEPS_1 / cb, same,
                          ">= 2x baseline", lambda v, b: v >= 2 * b))
 
         follow_batch(stack, starts, 2)  # warm-up of the parallel code, after the one-path baseline
-        t, c, ours = _best(lambda: follow_batch(stack, starts, STEPS_MANY))
+        t, c, ours = _best(lambda: follow_batch(stack, starts, STEPS_MANY), repeat)
         sub = starts[:N_BASELINE_PATHS]
         tb, cb, base = _best(lambda: [plain_scipy_path(tri, tree, P, Vu, s, STEPS_MANY, method) for s in sub], repeat=1)
         same = all(np.allclose(ours.points[:21, j], base[j][:21], rtol=0, atol=1e-9 * np.ptp(P))
                    for j in range(N_BASELINE_PATHS))
         n_ours, n_base = N_PATHS * STEPS_MANY, N_BASELINE_PATHS * STEPS_MANY
-        rows.append(_row(f"steps_per_s_1000_paths_{method}", n_ours / t, n_base / tb, n_ours / c, n_base / cb, same,
+        rows.append(_row(f"steps_per_s_{N_PATHS}_paths_{method}", n_ours / t, n_base / tb, n_ours / c, n_base / cb, same,
                          ">= 1,000,000 steps/s", lambda v, b: v >= 1e6))
     return rows
 

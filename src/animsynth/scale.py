@@ -330,9 +330,6 @@ def exponents(curves: pd.DataFrame) -> pd.DataFrame:
 
 def plot_curves(curves: pd.DataFrame, path) -> None:
     """Log-log CPU seconds vs size, one panel per family, one line per step, exponent in the legend."""
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fams = [f for f in FAMILIES if f in set(curves["family"])]

@@ -85,8 +85,10 @@ rule benchmarks:
             caption="../report/benchmarks.rst",
             category="0. Summary",
         ),
-    # measured on the tiny config: 254 MB peak, 10 min wall on a loaded 2-core machine;
-    # 2 threads: the simplicial 1,000-path rows spread paths over numba's threads (fewer with --cores 1)
+    params:
+        size=config["benchmark_size"],
+    # full size: ~160 s CPU, 254 MB peak; demo size: seconds
+    # 2 threads: the simplicial many-path rows spread paths over numba's threads (fewer with --cores 1)
     threads: 2
     resources:
         mem_mb=1000,

@@ -16,7 +16,7 @@ from animsynth.tables import write_table  # noqa: E402
 from animsynth.workflow_utils import setup_logging  # noqa: E402
 
 log = setup_logging(snakemake)  # noqa: F821
-df = run_benchmarks(snakemake.input.scripts)  # noqa: F821
+df = run_benchmarks(snakemake.input.scripts, size=snakemake.params.size)  # noqa: F821
 extra = [pd.read_csv(p) for p in snakemake.input.extra]  # noqa: F821
 if extra:
     df = pd.concat([df, *extra], ignore_index=True)[list(df.columns)]

@@ -1,17 +1,14 @@
-"""Figures of the facegraph experiments (matplotlib, Agg)."""
+"""Figures of the facegraph experiments (matplotlib)."""
 
 from __future__ import annotations
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.collections import LineCollection
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
-
-from ..io.atomic import atomic_path  # noqa: E402
-from ..io.ckplus import EMOTIONS  # noqa: E402
+from ..io.atomic import atomic_path
+from ..io.ckplus import EMOTIONS
 
 #: Polylines of the 68-point face (closed ones repeat their first point).
 FACE_LINES = [

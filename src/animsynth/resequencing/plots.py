@@ -1,16 +1,13 @@
-"""Figures of the re-sequencing study (matplotlib, Agg)."""
+"""Figures of the re-sequencing study (matplotlib)."""
 
 from __future__ import annotations
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+from matplotlib.collections import LineCollection
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
-
-from ..io.atomic import atomic_path  # noqa: E402
+from ..io.atomic import atomic_path
 
 __all__ = ["embedding_figure", "residual_variance_figure"]
 

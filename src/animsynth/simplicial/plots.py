@@ -1,4 +1,4 @@
-"""Figures of the simplicial family (matplotlib, Agg, written atomically).
+"""Figures of the simplicial family (matplotlib, written atomically).
 
 * :func:`plot_graphs` - G' edges for several folds (paper Figs 1-2)
 * :func:`plot_field` - the vector field as a quiver plot over the training data (Figs 3-4)
@@ -9,15 +9,12 @@
 
 from __future__ import annotations
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.collections import LineCollection
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
-
-from ..motion import Motion  # noqa: E402
-from ..io.atomic import atomic_path  # noqa: E402
+from ..motion import Motion
+from ..io.atomic import atomic_path
 
 _CLIP_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink")
 
