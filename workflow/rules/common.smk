@@ -27,13 +27,13 @@ MOCAP_MIRROR = config["cmu_mirror"] if SOURCE == "cmu" else config.get("data_dir
 BVH_TRIALS = {t for t, rec in TRIALS.items() if "bvh" in rec and "amc" not in rec}
 
 
-def raw_trial_files(wildcards):
+def raw_trial_files(trial):
     """Raw files of one trial: ASF + AMC, or BVH."""
-    if wildcards.trial in BVH_TRIALS:
-        return {"bvh": f"resources/mocap/{wildcards.trial}.bvh"}
+    if trial in BVH_TRIALS:
+        return {"bvh": f"resources/mocap/{trial}.bvh"}
     return {
-        "amc": f"resources/mocap/{wildcards.trial}.amc",
-        "asf": f"resources/mocap/{wildcards.trial}.asf",
+        "amc": f"resources/mocap/{trial}.amc",
+        "asf": f"resources/mocap/{trial}.asf",
     }
 
 
@@ -48,6 +48,13 @@ def trial_npz(trial):
 
 def subset_npz(wildcards):
     return [trial_npz(t) for t in SUBSETS[wildcards.dataset]]
+
+
+def job_benchmarks(rule, **wildcards):
+    """Benchmark files of one rule's jobs in this run (wildcard value lists zipped), declared as inputs of
+    rule_benchmarks, so the aggregate holds exactly this run's jobs, never a stale file left by another run."""
+    pattern = str(getattr(rules, rule).rule.benchmark)
+    return expand(pattern, zip, **wildcards) if wildcards else [pattern]
 
 
 def family_targets():

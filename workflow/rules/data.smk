@@ -11,14 +11,16 @@
 # downloads get 20 min for a slow network (3 attempts with a 60 s timeout each).
 
 if SOURCE == "synthetic":
+    # Every synthetic trial in one job: each takes a fraction of a second, less
+    # than a job's start-up. Each trial keeps its own seed.
 
-    rule synth_trial:
+    rule synth_trials:
         output:
-            amc="resources/mocap/{trial}.amc",
-            asf="resources/mocap/{trial}.asf",
+            amc=[f"resources/mocap/{t}.amc" for t in USED_TRIALS],
+            asf=[f"resources/mocap/{t}.asf" for t in USED_TRIALS],
         params:
-            spec=lambda wc: TRIALS[wc.trial],
-            seed=lambda wc: seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], wc.trial),
+            specs=[TRIALS[t] for t in USED_TRIALS],
+            seeds=[seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], t) for t in USED_TRIALS],
             subject_seed=config["synthetic_mocap"]["seed"],
             fps=config["fps"],
         threads: 1
@@ -26,13 +28,13 @@ if SOURCE == "synthetic":
             mem_mb=500,
             runtime=10,
         log:
-            L("data/synth_trial/{trial}.log"),
+            L("data/synth_trials.log"),
         benchmark:
-            B("data/synth_trial/{trial}.tsv")
+            B("data/synth_trials.tsv")
         conda:
             "../envs/animsynth.yaml"
         script:
-            "../scripts/data_synth_trial.py"
+            "../scripts/data_synth_trials.py"
 
 else:
 
@@ -80,25 +82,34 @@ else:
             "../scripts/data_download_trial.py"
 
 
-rule parse_trial:
+def raw_files_of_used_trials(wildcards=None):
+    """Raw files of every used trial, flat (ASF + AMC, or BVH), in USED_TRIALS order."""
+    return [f for t in USED_TRIALS for f in raw_trial_files(t).values()]
+
+
+# Every used trial parsed in one job (a fraction of a second each, less than a
+# job's start-up); a malformed file still fails the job with its file and line.
+rule parse_trials:
     input:
-        unpack(raw_trial_files),
+        raw_files_of_used_trials,
     output:
-        R("data/trials/{trial}.npz"),
+        [trial_npz(t) for t in USED_TRIALS],
     params:
+        trials=USED_TRIALS,
+        raw={t: raw_trial_files(t) for t in USED_TRIALS},
         fps=config["fps"],
     threads: 1
     resources:
         mem_mb=500,
         runtime=10,
     log:
-        L("data/parse_trial/{trial}.log"),
+        L("data/parse_trials.log"),
     benchmark:
-        B("data/parse_trial/{trial}.tsv")
+        B("data/parse_trials.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
-        "../scripts/data_parse_trial.py"
+        "../scripts/data_parse_trials.py"
 
 
 rule datasets_table:
@@ -184,3 +195,22 @@ if MESH_CHECK:
             "../envs/animsynth.yaml"
         script:
             "../scripts/data_mesh_checksums.py"
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def data_benchmarks():
+    if SOURCE == "synthetic":
+        raw = job_benchmarks("synth_trials")
+    else:
+        amc = [t for t in USED_TRIALS if t not in BVH_TRIALS]
+        bvh = [t for t in USED_TRIALS if t in BVH_TRIALS]
+        raw = (job_benchmarks("download_trial", trial=amc) if amc else []) + (
+            job_benchmarks("download_bvh_trial", trial=bvh) if bvh else []
+        )
+    return raw + job_benchmarks("parse_trials") + job_benchmarks("datasets_table")
+
+
+def mesh_data_benchmarks():
+    """The mesh sequence's fetch and checksum jobs (in the run when the hybrid mesh family runs)."""
+    fetch = job_benchmarks("mesh_fetch") if MESH_FRAMES != MESH_SRC else []
+    return fetch + (job_benchmarks("mesh_checksums") if MESH_CHECK else [])

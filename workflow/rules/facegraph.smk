@@ -1,13 +1,12 @@
 # Facial animation with region motion graphs (Serra et al. 2018).
 # Data: a synthetic CK+-layout database is generated (or facegraph.ckplus_dir
 # points at a real CK+ copy) and parsed by the strict CK+ loader, then
-# pre-processed once. Table 1: one job per compression configuration (the
+# pre-processed once. Table 1: one job fits every compression configuration (the
 # paper's 15 targets with tolerances by default; per-sample threshold search,
 # graph build, re-synthesis of every sequence), aggregated by facegraph_table1
 # with the published values beside ours. The baseline, uniqueness study and
 # figures use the graphs of the showcase configuration. Every job gets only
 # the config keys it uses.
-import re
 
 from animsynth.facegraph.settings import (check_facegraph_config, configurations, showcase,
                                           sweep_configurations)
@@ -30,10 +29,6 @@ FG_SHOWCASE_GRAPH = R(f"facegraph/graphs/{FG_SHOWCASE}.npz")
 # baseline 446 / 685 MB (face graphs capped at baseline.max_nodes poses), table1/verdicts/uniqueness ~160 MB. Runtimes (minutes)
 # allow for a machine shared by several jobs (wall up to 20x CPU seen) and scale with the database size.
 FG_SCALE = max(1.0, FG["synthetic"]["n_sequences"] / 70.0) if FG_SYNTHETIC else 5.0
-
-
-wildcard_constraints:
-    fgcfg="|".join(re.escape(n) for n in sorted(FG_CONFIG_MAP)),
 
 
 if FG_SYNTHETIC:
@@ -87,30 +82,69 @@ rule facegraph_prepare:
         "../scripts/facegraph_prepare.py"
 
 
-rule facegraph_graph:
+def fg_graph_outputs(names):
+    """Per-configuration outputs of one graphs job, in the order of ``names``."""
+    return dict(
+        graphs=[R(f"facegraph/graphs/{n}.npz") for n in names],
+        run=[R(f"facegraph/runs/{n}.json") for n in names],
+        samples=[R(f"facegraph/runs/{n}_samples.csv") for n in names],
+        sample_thresholds=[R(f"facegraph/runs/{n}_thresholds.csv") for n in names],
+    )
+
+
+# Table 1's configurations and the showcase in one job (each fit takes about a
+# second, less than a job's start-up); the optional sweep has a job of its own,
+# so switching it on does not rerun Table 1.
+FG_MAIN_NAMES = list(dict.fromkeys([c["name"] for c in FG_TABLE_CONFIGS] + [FG_SHOWCASE]))
+FG_SWEEP_NAMES = [n for n in dict.fromkeys(c["name"] for c in FG_SWEEP_CONFIGS) if n not in FG_MAIN_NAMES]
+
+
+rule facegraph_graphs:
     input:
         R("facegraph/preprocessed.npz"),
     output:
-        graphs=R("facegraph/graphs/{fgcfg}.npz"),
-        run=R("facegraph/runs/{fgcfg}.json"),
-        samples=R("facegraph/runs/{fgcfg}_samples.csv"),
-        sample_thresholds=R("facegraph/runs/{fgcfg}_thresholds.csv"),
+        **fg_graph_outputs(FG_MAIN_NAMES),
     params:
-        conf=lambda wc: FG_CONFIG_MAP[wc.fgcfg],
+        confs=[FG_CONFIG_MAP[n] for n in FG_MAIN_NAMES],
         cfg={k: FG[k] for k in ("graph", "synthesis", "evaluation")},
         seed=FG_SEED_GRAPH,
     threads: 1
     resources:
         mem_mb=lambda wc, attempt: 1000 * attempt,
-        runtime=lambda wc, attempt: int(20 * FG_SCALE * attempt),
+        runtime=lambda wc, attempt: int(len(FG_MAIN_NAMES) * 5 * FG_SCALE * attempt),
     log:
-        L("facegraph/graph/{fgcfg}.log"),
+        L("facegraph/graphs.log"),
     benchmark:
-        B("facegraph/graph/{fgcfg}.tsv")
+        B("facegraph/graphs.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
-        "../scripts/facegraph_graph.py"
+        "../scripts/facegraph_graphs.py"
+
+
+if FG_SWEEP_NAMES:
+
+    rule facegraph_sweep_graphs:
+        input:
+            R("facegraph/preprocessed.npz"),
+        output:
+            **fg_graph_outputs(FG_SWEEP_NAMES),
+        params:
+            confs=[FG_CONFIG_MAP[n] for n in FG_SWEEP_NAMES],
+            cfg={k: FG[k] for k in ("graph", "synthesis", "evaluation")},
+            seed=FG_SEED_GRAPH,
+        threads: 1
+        resources:
+            mem_mb=lambda wc, attempt: 1000 * attempt,
+            runtime=lambda wc, attempt: int(len(FG_SWEEP_NAMES) * 5 * FG_SCALE * attempt),
+        log:
+            L("facegraph/sweep_graphs.log"),
+        benchmark:
+            B("facegraph/sweep_graphs.tsv")
+        conda:
+            "../envs/animsynth.yaml"
+        script:
+            "../scripts/facegraph_graphs.py"
 
 
 rule facegraph_table1:
@@ -353,3 +387,12 @@ FACEGRAPH_SUMMARY = [
     },
 ]
 FACEGRAPH_VERDICTS = [R("facegraph/verdicts.csv")]
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def facegraph_benchmarks():
+    rules_run = (["facegraph_synth_db"] if FG_SYNTHETIC else []) + ["facegraph_prepare", "facegraph_graphs"]
+    rules_run += (["facegraph_sweep_graphs"] if FG_SWEEP_NAMES else []) + ["facegraph_table1"]
+    rules_run += (["facegraph_sweep"] if FG_SWEEP_CONFIGS else []) + [
+        "facegraph_baseline", "facegraph_uniqueness", "facegraph_figures", "facegraph_verdicts"]
+    return [f for r in rules_run for f in job_benchmarks(r)]

@@ -3,9 +3,9 @@
 # Isomap / ST-Isomap fits at each configuration's min k, the fixed-k sweep,
 # residual variance, 2-D embeddings); one explanation job per dataset (min k
 # over sign mode x frame rate x global DOF, quaternion sign flips); one path job
-# per dataset x method x metric x global flag (Dijkstra paths, BVH, GIF,
-# per-path and per-transition smoothness); one Fig 2 per dataset x method, one
-# Fig 3 per dataset; one aggregation (Table 2 beside the paper, explanations,
+# per dataset for every method x metric x global flag (Dijkstra paths, BVH, GIF,
+# per-path and per-transition smoothness); one figures job per dataset (Fig 2
+# per method, Fig 3); one aggregation (Table 2 beside the paper, explanations,
 # smoothness, verdicts).
 # Resources: measured on CMU (05_02 at 800 frames, 2 cores at load ~20): peak RSS 200 MB (analyse,
 # explain, figures), 275 MB (path), 170 MB (tables); wall time at most 70 s (analyse, explain), 285 s
@@ -100,23 +100,35 @@ rule resequencing_explain:
         "../scripts/resequencing_explain.py"
 
 
+def reseq_path_outputs(pattern):
+    """One output per method x metric x global flag of a dataset (the order of RESEQ_PATH_CONFIGS)."""
+    return [pattern.format(rsmethod=m, rsmetric=x, rsgdof=g) for m, x, g in RESEQ_PATH_CONFIGS]
+
+
+RESEQ_PATH_CONFIGS = [(m, x, g) for m in RESEQ_METHODS for x in RESEQ_METRICS for g in RESEQ_GDOF]
+
+
+# One job per dataset runs every method x metric x global flag: each path takes
+# about a second, less than a job's own start-up.
 rule resequencing_path:
     input:
         npz=lambda wc: trial_npz(RESEQ_TRIALS[wc.rsdata]),
-        min_k=f"{RESEQ_WORK}/{{rsdata}}_{{rsgdof}}_min_k.csv",
+        min_k=expand(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{g}}_min_k.csv", g=RESEQ_GDOF),
     output:
-        csv=R("resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.csv"),
-        bvh=R("resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.bvh"),
-        gif=R("resequencing/paths/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.gif"),
-        smooth=f"{RESEQ_WORK}/{{rsdata}}_{{rsmethod}}_{{rsmetric}}_{{rsgdof}}_smoothness.csv",
-        transitions=f"{RESEQ_WORK}/{{rsdata}}_{{rsmethod}}_{{rsmetric}}_{{rsgdof}}_transitions.csv",
+        csv=reseq_path_outputs(R("resequencing/paths/{{rsdata}}_{rsmethod}_{rsmetric}_{rsgdof}.csv")),
+        bvh=reseq_path_outputs(R("resequencing/paths/{{rsdata}}_{rsmethod}_{rsmetric}_{rsgdof}.bvh")),
+        gif=reseq_path_outputs(R("resequencing/paths/{{rsdata}}_{rsmethod}_{rsmetric}_{rsgdof}.gif")),
+        smooth=reseq_path_outputs(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{rsmethod}}_{{rsmetric}}_{{rsgdof}}_smoothness.csv"),
+        transitions=reseq_path_outputs(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{rsmethod}}_{{rsmetric}}_{{rsgdof}}_transitions.csv"),
     params:
         cfg=RESEQ_PATH_CFG,
+        configs=RESEQ_PATH_CONFIGS,
+        gdof=RESEQ_GDOF,
         seed=lambda wc: seed_for("resequencing", "pairs", wc.rsdata),
     log:
-        L("resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.log"),
+        L("resequencing/path/{rsdata}.log"),
     benchmark:
-        B("resequencing/path/{rsdata}_{rsmethod}_{rsmetric}_{rsgdof}.tsv")
+        B("resequencing/path/{rsdata}.tsv")
     threads: 1
     resources:
         mem_mb=1000,
@@ -127,47 +139,35 @@ rule resequencing_path:
         "../scripts/resequencing_path.py"
 
 
-rule resequencing_fig2:
+# Figures 2 and 3 of one dataset in one job (each takes less than a job's start-up).
+rule resequencing_figures:
     input:
         emb=expand(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{g}}_embedding.npz", g=RESEQ_GDOF),
         min_k=expand(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{g}}_min_k.csv", g=RESEQ_GDOF),
+        rv=expand(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{g}}_residual_variance.csv", g=RESEQ_GDOF),
     output:
-        report(
-            R("resequencing/figures/fig2_{rsdata}_{rsmethod}.png"),
-            caption="../report/resequencing_fig2.rst",
-            category="Re-sequencing",
-            subcategory="Fig 2 embeddings",
-        ),
-    params:
-        metrics=RESEQ_METRICS,
-    log:
-        L("resequencing/fig2/{rsdata}_{rsmethod}.log"),
-    benchmark:
-        B("resequencing/fig2/{rsdata}_{rsmethod}.tsv")
-    threads: 1
-    resources:
-        mem_mb=600,
-        runtime=10,
-    conda:
-        "../envs/animsynth.yaml"
-    script:
-        "../scripts/resequencing_fig2.py"
-
-
-rule resequencing_fig3:
-    input:
-        expand(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{g}}_residual_variance.csv", g=RESEQ_GDOF),
-    output:
-        report(
+        fig2=[
+            report(
+                R(f"resequencing/figures/fig2_{{rsdata}}_{m}.png"),
+                caption="../report/resequencing_fig2.rst",
+                category="Re-sequencing",
+                subcategory="Fig 2 embeddings",
+            )
+            for m in RESEQ_METHODS
+        ],
+        fig3=report(
             R("resequencing/figures/fig3_residual_variance_{rsdata}.png"),
             caption="../report/resequencing_fig3.rst",
             category="Re-sequencing",
             subcategory="Fig 3 residual variance",
         ),
+    params:
+        methods=RESEQ_METHODS,
+        metrics=RESEQ_METRICS,
     log:
-        L("resequencing/fig3/{rsdata}.log"),
+        L("resequencing/figures/{rsdata}.log"),
     benchmark:
-        B("resequencing/fig3/{rsdata}.tsv")
+        B("resequencing/figures/{rsdata}.tsv")
     threads: 1
     resources:
         mem_mb=600,
@@ -175,7 +175,7 @@ rule resequencing_fig3:
     conda:
         "../envs/animsynth.yaml"
     script:
-        "../scripts/resequencing_fig3.py"
+        "../scripts/resequencing_figures.py"
 
 
 rule resequencing_tables:
@@ -286,3 +286,15 @@ RESEQUENCING_SUMMARY = [
     },
 ]
 RESEQUENCING_VERDICTS = [R("resequencing/verdicts.csv")]
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def resequencing_benchmarks():
+    pairs = [(d, g) for d in RESEQ_DATASETS for g in RESEQ_GDOF]
+    return (
+        job_benchmarks("resequencing_analyse", rsdata=[d for d, _ in pairs], rsgdof=[g for _, g in pairs])
+        + job_benchmarks("resequencing_explain", rsdata=RESEQ_DATASETS)
+        + job_benchmarks("resequencing_path", rsdata=RESEQ_DATASETS)
+        + job_benchmarks("resequencing_figures", rsdata=RESEQ_DATASETS)
+        + job_benchmarks("resequencing_tables")
+    )

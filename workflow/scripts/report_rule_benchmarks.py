@@ -1,7 +1,4 @@
-"""Aggregate Snakemake's per-rule benchmark files (runtime, peak memory), per rule and per family."""
-import glob
-import os
-
+"""Aggregate the benchmark files of this run's jobs (declared inputs: runtime, peak memory), per rule and per family."""
 from animsynth.report import aggregate_rule_benchmarks, family_benchmark_summary, rule_benchmark_summary
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
@@ -9,7 +6,7 @@ from animsynth.workflow_utils import setup_logging
 log = setup_logging(snakemake)  # noqa: F821
 out = snakemake.output  # noqa: F821
 root = snakemake.params.root  # noqa: F821
-jobs = aggregate_rule_benchmarks(glob.glob(os.path.join(root, "**", "*.tsv"), recursive=True), root=root)
+jobs = aggregate_rule_benchmarks(list(snakemake.input), root=root)  # noqa: F821
 write_table(jobs, out.jobs, md=False)
 write_table(rule_benchmark_summary(jobs), out.per_rule, md=True,
             title="Runtime and peak memory per rule (this machine)")

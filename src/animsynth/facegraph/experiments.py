@@ -87,6 +87,17 @@ def original_nbytes(db: FaceDatabase) -> int:
     return int(db.lengths.sum()) * 68 * 2 * 4
 
 
+def warm_up(db: FaceDatabase, conf: dict, cfg: dict, seed: int, max_poses: int = 200) -> None:
+    """Fit ``conf`` once on a small subset of ``db`` (at most ``max_poses`` poses), untimed.
+
+    numba compiles the creation loops (empty cache) or loads them from its cache
+    on the first fit of a process; a warm-up makes the creation times of the
+    configurations that follow in the same process comparable with one another.
+    """
+    with threadpool_limits(1):
+        model_for(conf, cfg, seed).fit(_subset_database(db, max_poses, seed))
+
+
 def run_configuration(db: FaceDatabase, conf: dict, cfg: dict, seed: int):
     """Build the region graphs for one compression configuration and evaluate them.
 

@@ -76,9 +76,12 @@ def run_main_fold(paths, ids, dataset: str, fold: str, cfg: dict, seed: int):
     return rows, members
 
 
-def write_fold_json(path, rows: list, members: pd.DataFrame) -> None:
+def write_fold_json(path, rows: list, members) -> None:
+    """Fold rows and ensemble members (one DataFrame, or a list of them, one per fold) -> one JSON file."""
+    if isinstance(members, pd.DataFrame):
+        members = [members]
     payload = {"rows": [ex.to_jsonable(r) for r in rows],
-               "members": [ex.to_jsonable(r) for r in members.to_dict("records")]}
+               "members": [ex.to_jsonable(r) for m in members for r in m.to_dict("records")]}
     atomic_write_text(path, json.dumps(payload, indent=0) + "\n")
 
 
