@@ -31,6 +31,10 @@ FAMILY_PAPERS = {
 def aggregate_rule_benchmarks(paths, root: str = "benchmarks/rules") -> pd.DataFrame:
     """Collect Snakemake ``benchmark:`` TSVs into one table (one row per job).
 
+    ``paths`` are the benchmark files of exactly the jobs of one run (the
+    workflow declares them as inputs); a missing or empty file is an error,
+    never a silently shorter table.
+
     Columns: rule, job (the file's path below the rule folder), seconds,
     max_rss_mb (peak resident memory), and the other columns Snakemake writes.
     """
@@ -38,8 +42,8 @@ def aggregate_rule_benchmarks(paths, root: str = "benchmarks/rules") -> pd.DataF
     for p in sorted(map(str, paths)):
         try:
             df = pd.read_csv(p, sep="\t")
-        except (pd.errors.EmptyDataError, FileNotFoundError):
-            continue
+        except pd.errors.EmptyDataError:
+            raise ValueError(f"{p}: empty benchmark file (the job that writes it was interrupted?)") from None
         rel = os.path.relpath(p, root)
         parts = rel.split(os.sep)
         # layout: <family>/<step>.tsv (one job) or <family>/<step>/<job>.tsv
@@ -146,7 +150,23 @@ def is_synthetic(data: str) -> bool:
     return "synthetic" in str(data).lower()
 
 
-def claims_table(paths, family_data: dict[str, str] | None = None) -> pd.DataFrame:
+PAPER_RUN_COMMAND = ("python3 run.py paper --config cmu_mirror=../shared/data/cmu_mocap "
+                     "mesh_dir=../shared/data/vlasic_mesh_animation/samba")
+
+
+def demo_banner(family_real: dict[str, bool] | None) -> str:
+    """The line that opens a summary of a run in which some family ran on synthetic data ('' otherwise)."""
+    synthetic = sorted(f for f, real in (family_real or {}).items() if not real)
+    if not synthetic:
+        return ""
+    return ("**This is a demo on synthetic data** (" + ", ".join(synthetic) + "): every study runs, on data the "
+            "workflow generates, at demo size (see config/config.yaml). Verdicts on synthetic data say whether "
+            "the code reproduces a claim's mechanism, not whether the claim holds on real data. The real-data "
+            f"reproduction of the four papers at full size: `{PAPER_RUN_COMMAND}`.")
+
+
+def claims_table(paths, family_data: dict[str, str] | None = None,
+                 family_real: dict[str, bool] | None = None) -> pd.DataFrame:
     """Every claim of the four papers, one row each, from the families' ``verdicts.csv``.
 
     Parameters
@@ -155,6 +175,10 @@ def claims_table(paths, family_data: dict[str, str] | None = None) -> pd.DataFra
         ``<family>/verdicts.csv`` files (the family is the parent folder's name).
     family_data : dict, optional
         {family: what it ran on}; fills ``data`` where a verdict row leaves it empty.
+    family_real : dict, optional
+        {family: True if it ran on real data}, as the data layer recorded it. A
+        row's ``real`` comes from its family's entry; only a family missing here
+        falls back to the word "synthetic" in the row's ``data`` text.
 
     Returns
     -------
@@ -184,7 +208,9 @@ def claims_table(paths, family_data: dict[str, str] | None = None) -> pd.DataFra
     if not frames:
         return pd.DataFrame(columns=cols)
     out = pd.concat(frames, ignore_index=True)
-    out["real"] = ~out["data"].map(is_synthetic)
+    by_text = ~out["data"].map(is_synthetic)
+    recorded = out["family"].map(lambda f: (family_real or {}).get(f))
+    out["real"] = [bool(r) if r is not None else bool(t) for r, t in zip(recorded, by_text)]
     out = out.sort_values(["real", "order"], ascending=[False, True], kind="stable")
     return out[cols].reset_index(drop=True)
 
@@ -266,14 +292,19 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
 
 
 def build_summary(sections: list[dict], verdict_paths, source_note: str,
-                  provenance: pd.DataFrame | None = None, family_data: dict[str, str] | None = None) -> str:
+                  provenance: pd.DataFrame | None = None, family_data: dict[str, str] | None = None,
+                  family_real: dict[str, bool] | None = None) -> str:
     """Markdown summary: the papers' claims first (real data, then synthetic), then every table.
 
     ``sections``: dicts with ``title``, ``csv`` and optional ``note`` (what it
     reproduces and on which data), in order.
     """
-    out = ["# animsynth: reproduction summary", "", source_note, ""]
-    claims = claims_table(verdict_paths, family_data)
+    out = ["# animsynth: reproduction summary", ""]
+    banner = demo_banner(family_real)
+    if banner:
+        out += [banner, ""]
+    out += [source_note, ""]
+    claims = claims_table(verdict_paths, family_data, family_real)
     if claims.empty:
         out += ["## Claims of the four papers", "", "(no verdicts were produced)", ""]
     else:

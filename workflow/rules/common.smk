@@ -1,7 +1,7 @@
 # Shared helpers: config checks beyond the schema, trial lookups, target lists.
 import json
 
-from snakemake.io import is_flagged
+from snakemake.io import is_flagged, strip_wildcard_constraints
 
 from animsynth.config import check_config, derive_seed
 from animsynth.sources import is_archive, is_url, mesh_source_name, probe_source
@@ -53,8 +53,11 @@ def subset_npz(wildcards):
 def job_benchmarks(rule, **wildcards):
     """Benchmark files of one rule's jobs in this run (wildcard value lists zipped), declared as inputs of
     rule_benchmarks, so the aggregate holds exactly this run's jobs, never a stale file left by another run."""
-    pattern = str(getattr(rules, rule).rule.benchmark)
-    return expand(pattern, zip, **wildcards) if wildcards else [pattern]
+    pattern = strip_wildcard_constraints(str(getattr(rules, rule).rule.benchmark))
+    files = expand(pattern, zip, **wildcards) if wildcards else [pattern]
+    if not files or any("{" in f for f in files):
+        raise ValueError(f"benchmark files of rule {rule}: {pattern} with {wildcards} gave {files}")
+    return files
 
 
 def family_targets():
@@ -137,6 +140,14 @@ def _family_status():
 
 
 FAMILY_STATUS, FAMILY_RAN = _family_status()
+# Real or synthetic data per family, from the data sources themselves (never from words in a table).
+FAMILY_REAL = {
+    "data": SOURCE != "synthetic",
+    "simplicial": SOURCE != "synthetic",
+    "resequencing": SOURCE != "synthetic",
+    "meshdetail": bool(config.get("mesh_dir")),
+    "facegraph": bool(config["facegraph"].get("ckplus_dir")),
+}
 
 
 def provenance_rows():

@@ -60,6 +60,7 @@ rule summary:
         faces=config["facegraph"].get("ckplus_dir"),
         provenance=provenance_rows(),
         family_data={fam: label for fam, (label, _ok, _why) in FAMILY_STATUS.items()},
+        family_real=FAMILY_REAL,
         report_outputs=report_outputs,
     threads: 1
     resources:

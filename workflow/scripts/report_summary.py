@@ -17,8 +17,8 @@ note = ("What each part ran on: " + "; ".join(f"**{r.family}**: {r.data} ({r.sta
 if p.timing:
     note += (" Machine-dependent timing tables are not shown here (they differ between runs): "
              + ", ".join(f"`{t}`" for t in p.timing) + ".")
-claims = claims_table(verdicts, p.family_data)
+claims = claims_table(verdicts, p.family_data, p.family_real)
 write_table(claims, out.claims, md=False)
 atomic_write_text(out.home, claims_rst(claims, provenance, p.report_outputs))
-atomic_write_text(out.summary, build_summary(p.sections, verdicts, note, provenance, p.family_data))
+atomic_write_text(out.summary, build_summary(p.sections, verdicts, note, provenance, p.family_data, p.family_real))
 log.info("summary with %d tables, %d claims (%d on real data)", len(p.sections), len(claims), int(claims["real"].sum()))
