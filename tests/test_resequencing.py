@@ -586,13 +586,20 @@ def test_global_dof_verdict_per_dataset():
     assert v["verdict"] == "reproduced" and "walk: re-sequencing paths 10/10 without vs 0/10 with" in v["ours"]
 
 
-def test_library_defaults_match_the_embedded_config():
+def test_library_defaults_match_the_full_size_config():
+    """The library's defaults are the study at full size: the embedded (demo-sized) config with the real-data
+    config's full sizes merged over it, as the workflow merges them."""
     import yaml
     from pathlib import Path
 
+    from snakemake.utils import update_config
+
     from animsynth.resequencing.study import DEFAULTS
 
-    cfg = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text())
+    root = Path(__file__).resolve().parents[1] / "config"
+    cfg = yaml.safe_load((root / "config.yaml").read_text())
+    assert cfg["resequencing"] != DEFAULTS  # the embedded default is the demo
+    update_config(cfg, {"resequencing": yaml.safe_load((root / "cmu.yaml").read_text())["resequencing"]})
     assert cfg["resequencing"] == DEFAULTS
 
 

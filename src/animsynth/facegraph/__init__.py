@@ -9,16 +9,27 @@ recovery, coherent noise). :mod:`.experiments` holds Table 1, the baseline
 comparison and the uniqueness study.
 """
 
-from .baseline import FaceGraphBaseline
-from .model import FaceGraphModel
-from .regiongraph import RegionGraph, load_graphs, save_graphs
-from .preprocess import FaceDatabase, FacePreprocessor
-from .regions import DEFAULT_REDUCED, DEFAULT_REGIONS, DEFAULT_RIGID, REGION_NAMES
-from .similarity import node_similarity, pose_similarity, vinfl
-from .synthesis import Animation, FaceSynthesizer, SynthesisError
+from .._lazy import lazy_exports
 
-__all__ = [
-    "Animation", "DEFAULT_REDUCED", "DEFAULT_REGIONS", "DEFAULT_RIGID", "FaceDatabase", "FaceGraphBaseline",
-    "FaceGraphModel", "FacePreprocessor", "FaceSynthesizer", "REGION_NAMES", "RegionGraph", "SynthesisError",
-    "load_graphs", "node_similarity", "pose_similarity", "save_graphs", "vinfl",
-]
+# name -> module; imported on first use (the family's heavy libraries load only when needed)
+_EXPORTS = {
+    "Animation": ".synthesis",
+    "DEFAULT_REDUCED": ".regions",
+    "DEFAULT_REGIONS": ".regions",
+    "DEFAULT_RIGID": ".regions",
+    "FaceDatabase": ".preprocess",
+    "FaceGraphBaseline": ".baseline",
+    "FaceGraphModel": ".model",
+    "FacePreprocessor": ".preprocess",
+    "FaceSynthesizer": ".synthesis",
+    "REGION_NAMES": ".regions",
+    "RegionGraph": ".regiongraph",
+    "SynthesisError": ".synthesis",
+    "load_graphs": ".regiongraph",
+    "node_similarity": ".similarity",
+    "pose_similarity": ".similarity",
+    "save_graphs": ".regiongraph",
+    "vinfl": ".similarity",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

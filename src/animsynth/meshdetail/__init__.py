@@ -15,8 +15,18 @@ The skeleton, forward kinematics, linear blend skinning and skinning weights
 (bone heat, refit, distance) live in :mod:`animsynth.skinning`.
 """
 
-from .gp import GPRegression, SharedGPDM
-from .models import HybridModel, MeshContext
-from ..skinning import JOINTS, PARENTS, Rig, default_rig
+from .._lazy import lazy_exports
 
-__all__ = ["GPRegression", "HybridModel", "JOINTS", "MeshContext", "PARENTS", "Rig", "SharedGPDM", "default_rig"]
+# name -> module; imported on first use (the family's heavy libraries load only when needed)
+_EXPORTS = {
+    "GPRegression": ".gp",
+    "HybridModel": ".models",
+    "JOINTS": "..skinning",
+    "MeshContext": ".models",
+    "PARENTS": "..skinning",
+    "Rig": "..skinning",
+    "SharedGPDM": ".gp",
+    "default_rig": "..skinning",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -14,19 +14,34 @@ verdicts    the paper's claims in the common verdict format
 plots       Fig. 2 (embeddings with edges) and Fig. 3 (residual variance)
 """
 
-from .distances import PAPER_WEIGHTS, l2_distances, lee_distances, lee_metric
-from .embedding import (DisconnectedGraphError, PrecomputedIsomap, STIsomap, knn_graph, min_connected_k,
-                        residual_variance, spatio_temporal_distances, temporal_adjacency)
-from .features import (SIGN_MODES, linearize_quaternions, matrix_naive_quaternions, motion_features, quat_log,
-                       sign_flips)
-from .metrics import classify_path, pass_jumps, transitions
-from .paths import pad_path, play_path, shortest_path_frames
+from .._lazy import lazy_exports
 
-__all__ = [
-    "PAPER_WEIGHTS", "l2_distances", "lee_distances", "lee_metric",
-    "DisconnectedGraphError", "PrecomputedIsomap", "STIsomap", "knn_graph", "min_connected_k",
-    "residual_variance", "spatio_temporal_distances", "temporal_adjacency",
-    "SIGN_MODES", "linearize_quaternions", "matrix_naive_quaternions", "motion_features", "quat_log", "sign_flips",
-    "classify_path", "pass_jumps", "transitions",
-    "pad_path", "play_path", "shortest_path_frames",
-]
+# name -> module; imported on first use (the family's heavy libraries load only when needed)
+_EXPORTS = {
+    "DisconnectedGraphError": ".embedding",
+    "PAPER_WEIGHTS": ".distances",
+    "PrecomputedIsomap": ".embedding",
+    "SIGN_MODES": ".features",
+    "STIsomap": ".embedding",
+    "classify_path": ".metrics",
+    "knn_graph": ".embedding",
+    "l2_distances": ".distances",
+    "lee_distances": ".distances",
+    "lee_metric": ".distances",
+    "linearize_quaternions": ".features",
+    "matrix_naive_quaternions": ".features",
+    "min_connected_k": ".embedding",
+    "motion_features": ".features",
+    "pad_path": ".paths",
+    "pass_jumps": ".metrics",
+    "play_path": ".paths",
+    "quat_log": ".features",
+    "residual_variance": ".embedding",
+    "shortest_path_frames": ".paths",
+    "sign_flips": ".features",
+    "spatio_temporal_distances": ".embedding",
+    "temporal_adjacency": ".embedding",
+    "transitions": ".metrics",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

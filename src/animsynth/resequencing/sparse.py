@@ -73,7 +73,6 @@ import math
 import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import connected_components, minimum_spanning_tree
-from sklearn.neighbors import NearestNeighbors
 
 from .distances import PAPER_WEIGHTS, joint_weights
 from .embedding import DisconnectedGraphError, check_st_params
@@ -151,6 +150,8 @@ def _check_m(m, n: int, what: str = "n_candidates") -> int:
 
 
 def _index(X, algorithm: str, leaf_size: int, n_jobs):
+    from sklearn.neighbors import NearestNeighbors  # only the large-database route needs it
+
     return NearestNeighbors(algorithm=algorithm, leaf_size=leaf_size, n_jobs=n_jobs).fit(X)
 
 

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from scipy.stats import binomtest
 
 __all__ = ["VERDICT_COLUMNS", "explanation_verdicts", "lee_vs_l2_verdict", "paired_share", "st_smoother_verdict",
            "global_dof_verdict", "all_verdicts"]
@@ -161,6 +160,8 @@ def paired_share(a: pd.Series, b: pd.Series) -> tuple[int, int, int, float]:
     a, b = a[ok].astype(float), b[ok].astype(float)
     lo, hi = int((b < a).sum()), int((b > a).sum())
     ties = int(len(a) - lo - hi)
+    from scipy.stats import binomtest  # here, not at import (scipy.stats is slow to import)
+
     p = float(binomtest(lo, lo + hi, 0.5).pvalue) if lo + hi else 1.0
     return lo, hi, ties, p
 
@@ -252,6 +253,8 @@ def global_dof_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: float
         lo, hi, _, p = paired_share(out.loc[both, PRIMARY], inn.loc[both, PRIMARY]) if both else (0, 0, 0, 1.0)
         eff_s = {"yes": "help", "opposite": "hurt"}.get(_decide(lo, hi, p, share, alpha), "no clear effect")
         only_in, only_out = int((rs_in & ~rs_out).sum()), int((rs_out & ~rs_in).sum())
+        from scipy.stats import binomtest
+
         p_a = float(binomtest(only_in, only_in + only_out, 0.5).pvalue) if only_in + only_out else 1.0
         eff_a = {"yes": "help", "opposite": "hurt"}.get(_decide(only_in, only_out, p_a, share, alpha),
                                                         "no clear effect")

@@ -14,16 +14,28 @@ plots       the paper's figures and the beyond-the-paper figure
 jobs        one function per workflow job (the Snakemake scripts stay thin)
 """
 
-from .experiment import FOLD_COLUMNS, MEMBER_COLUMNS, Variant, run_fold, run_fold_ensemble, run_subset
-from .generate import generate_from_trials
-from .field import FieldStack, VectorField, training_vectors
-from .geometry import SafeDelaunay
-from .graph import MotionGraph
-from .metrics import error_a, error_f, point_polyline_distance
-from .path import TargetPlanner, follow_batch, follow_field
+from .._lazy import lazy_exports
 
-__all__ = [
-    "FOLD_COLUMNS", "FieldStack", "MEMBER_COLUMNS", "MotionGraph", "SafeDelaunay", "TargetPlanner", "Variant",
-    "VectorField", "error_a", "error_f", "follow_batch", "follow_field", "generate_from_trials",
-    "point_polyline_distance", "run_fold", "run_fold_ensemble", "run_subset", "training_vectors",
-]
+# name -> module; imported on first use (the family's heavy libraries load only when needed)
+_EXPORTS = {
+    "FOLD_COLUMNS": ".experiment",
+    "FieldStack": ".field",
+    "MEMBER_COLUMNS": ".experiment",
+    "MotionGraph": ".graph",
+    "SafeDelaunay": ".geometry",
+    "TargetPlanner": ".path",
+    "Variant": ".experiment",
+    "VectorField": ".field",
+    "error_a": ".metrics",
+    "error_f": ".metrics",
+    "follow_batch": ".path",
+    "follow_field": ".path",
+    "generate_from_trials": ".generate",
+    "point_polyline_distance": ".metrics",
+    "run_fold": ".experiment",
+    "run_fold_ensemble": ".experiment",
+    "run_subset": ".experiment",
+    "training_vectors": ".field",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -43,7 +43,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 from sklearn.decomposition import PCA
 
 from .field import DERIVATIVES, VectorField, training_vectors
@@ -621,6 +620,8 @@ def paired_comparison(folds: pd.DataFrame, a: str = "delaunay", b: str = "knn",
              "median_diff": float(np.median(d)) if n else np.nan, "a_better_folds": int(np.sum(d < 0)),
              "b_better_folds": int(np.sum(d > 0))}
         if n >= 2 and np.any(d != 0):
+            from scipy import stats  # here, not at import: scipy.stats costs a fold job a third of a second
+
             w = stats.wilcoxon(x, y, zero_method="wilcox", alternative="two-sided")
             r["wilcoxon_stat"], r["p_value"] = float(w.statistic), float(w.pvalue)
         else:

@@ -1,0 +1,47 @@
+"""Render the README's cost table from runs' own ``rule_benchmarks_per_family.csv``.
+
+Usage::
+
+    python benchmarks/cost_table.py "default run" results "paper run" results/paper
+
+prints one Markdown table per run: per family the number of jobs, the summed
+wall time and CPU time of its jobs (Snakemake's ``benchmark:`` files) and the
+largest job's peak memory, then the total. Whole-run wall and CPU time (with
+the scheduler's own work and job start-up) are measured around the command
+itself (``/usr/bin/time -v``) and quoted beside these tables in the README.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+
+def cost_table(per_family_csv) -> str:
+    df = pd.read_csv(per_family_csv)
+    total = {"family": "**total**", "jobs": int(df["jobs"].sum()), "wall_s": df["wall_s"].sum(),
+             "cpu_s": df["cpu_s"].sum(), "peak_rss_mb": df["peak_rss_mb"].max()}
+    df = pd.concat([df, pd.DataFrame([total])], ignore_index=True)
+    lines = ["| family | jobs | wall s (sum over jobs) | CPU s | largest job's peak MB |", "|---|---:|---:|---:|---:|"]
+    for r in df.itertuples():
+        lines.append(f"| {r.family} | {int(r.jobs)} | {r.wall_s:.0f} | {r.cpu_s:.0f} | {r.peak_rss_mb:.0f} |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) < 2 or len(argv) % 2:
+        print(__doc__)
+        return 2
+    for label, folder in zip(argv[::2], argv[1::2]):
+        path = Path(folder) / "rule_benchmarks_per_family.csv"
+        if not path.is_file():
+            print(f"cost_table: {path} does not exist (run the workflow first)", file=sys.stderr)
+            return 2
+        print(f"{label} (`{path}`):\n\n{cost_table(path)}\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
