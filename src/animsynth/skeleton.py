@@ -84,6 +84,9 @@ class Skeleton:
         ``"deg"`` or ``"rad"``: the angle unit the source file declared (ASF
         ``:units angle``). An AMC file without a ``:DEGREES`` / ``:RADIANS``
         header is read in this unit.
+    roles : dict of str -> str
+        Joint-role overrides ``{role: joint name}`` (config ``joint_roles``);
+        see :mod:`animsynth.joints`.
     """
 
     joints: list[Joint]
@@ -91,6 +94,7 @@ class Skeleton:
     angle_unit: str = "deg"
     name: str = "skeleton"
     file_angle_unit: str = "deg"
+    roles: dict = field(default_factory=dict)
 
     def __post_init__(self):
         for i, j in enumerate(self.joints):
@@ -141,6 +145,7 @@ class Skeleton:
             "length_to_m": self.length_to_m,
             "angle_unit": self.angle_unit,
             "file_angle_unit": self.file_angle_unit,
+            "roles": dict(self.roles),
             "joints": [
                 {
                     "name": j.name,
@@ -176,7 +181,7 @@ class Skeleton:
             for j in d["joints"]
         ]
         return cls(joints, float(d["length_to_m"]), d.get("angle_unit", "deg"), d.get("name", "skeleton"),
-                   d.get("file_angle_unit", "deg"))
+                   d.get("file_angle_unit", "deg"), dict(d.get("roles") or {}))
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict())

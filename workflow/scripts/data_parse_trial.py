@@ -5,6 +5,7 @@ from animsynth.workflow_utils import setup_logging
 log = setup_logging(snakemake)  # noqa: F821
 inp = snakemake.input  # noqa: F821
 m = load_trial(amc=inp.get("amc"), asf=inp.get("asf"), bvh=inp.get("bvh"), fps=snakemake.params.fps,  # noqa: F821
-               name=snakemake.wildcards.trial)  # noqa: F821
+               name=snakemake.wildcards.trial, joint_roles=snakemake.params.get("joint_roles"),  # noqa: F821
+               bvh_length_to_m=snakemake.params.get("bvh_length_to_m", 1.0))  # noqa: F821
 m.save_npz(snakemake.output[0])  # noqa: F821
 log.info("%s: %d frames x %d DOF", m.name, m.n_frames, m.values.shape[1])
