@@ -130,8 +130,11 @@ def test_read_write_read_reproduces_every_channel(path, tmp_path):
 
 # --- the defects ------------------------------------------------------------
 
-def _hips_text():
-    return (DATA / "hips_xyz.bvh").read_text()
+@pytest.fixture(params=["Hips", "root"])
+def base_text(request):
+    """hips_xyz.bvh, with its root renamed ``root`` too (so the defects show
+    on a reader that only knew roots called ``root``)."""
+    return (DATA / "hips_xyz.bvh").read_text().replace("ROOT Hips", f"ROOT {request.param}")
 
 
 def _write(tmp_path, text, name="x.bvh"):
@@ -151,16 +154,16 @@ def test_root_not_called_root_is_read(tmp_path):
     assert m.skeleton.joints[0].dofs == ["tx", "ty", "tz", "rz", "ry", "rx"]
 
 
-def test_repeated_rotation_axis_is_refused(tmp_path):
-    text = _hips_text().replace("CHANNELS 3 Xrotation Yrotation Zrotation", "CHANNELS 3 Xrotation Xrotation Xrotation", 1)
+def test_repeated_rotation_axis_is_refused(tmp_path, base_text):
+    text = base_text.replace("CHANNELS 3 Xrotation Yrotation Zrotation", "CHANNELS 3 Xrotation Xrotation Xrotation", 1)
     p = _write(tmp_path, text)
     with pytest.raises(MotionFormatError, match="repeat an axis") as ei:
         read_bvh(p)
     assert ei.value.line == _line_of(text, "Xrotation Xrotation Xrotation")
 
 
-def test_duplicate_joint_names_are_refused(tmp_path):
-    text = _hips_text().replace("JOINT RightUpLeg", "JOINT LeftUpLeg")
+def test_duplicate_joint_names_are_refused(tmp_path, base_text):
+    text = base_text.replace("JOINT RightUpLeg", "JOINT LeftUpLeg")
     p = _write(tmp_path, text)
     with pytest.raises(MotionFormatError, match="duplicate joint name 'LeftUpLeg'") as ei:
         read_bvh(p)
@@ -169,8 +172,8 @@ def test_duplicate_joint_names_are_refused(tmp_path):
 
 @pytest.mark.parametrize("extra,msg", [("ROOT Other\n{\n  OFFSET 0 0 0\n  CHANNELS 0\n}\n", "second ROOT"),
                                        ("}\n", "'}' after the root")])
-def test_content_after_the_root_is_refused(tmp_path, extra, msg):
-    text = _hips_text().replace("MOTION\n", extra + "MOTION\n")
+def test_content_after_the_root_is_refused(tmp_path, extra, msg, base_text):
+    text = base_text.replace("MOTION\n", extra + "MOTION\n")
     p = _write(tmp_path, text)
     with pytest.raises(MotionFormatError, match=msg) as ei:
         read_bvh(p)
@@ -178,24 +181,24 @@ def test_content_after_the_root_is_refused(tmp_path, extra, msg):
 
 
 @pytest.mark.parametrize("ft", ["1e-320", "1e300", "1e-7", "3600"])
-def test_frame_time_out_of_bounds_is_refused(tmp_path, ft):
-    text = re.sub(r"Frame Time: .*", f"Frame Time: {ft}", _hips_text())
+def test_frame_time_out_of_bounds_is_refused(tmp_path, ft, base_text):
+    text = re.sub(r"Frame Time: .*", f"Frame Time: {ft}", base_text)
     p = _write(tmp_path, text)
     with pytest.raises(MotionFormatError, match="frame time .* is outside") as ei:
         read_bvh(p)
     assert ei.value.line == _line_of(text, "Frame Time:")
 
 
-def test_position_channels_on_a_child_are_refused(tmp_path):
-    text = _hips_text().replace("CHANNELS 3 Xrotation Yrotation Zrotation",
+def test_position_channels_on_a_child_are_refused(tmp_path, base_text):
+    text = base_text.replace("CHANNELS 3 Xrotation Yrotation Zrotation",
                                 "CHANNELS 6 Xposition Yposition Zposition Xrotation Yrotation Zrotation", 1)
     with pytest.raises(MotionFormatError, match="position channels on a non-root joint"):
         read_bvh(_write(tmp_path, text))
 
 
 @pytest.mark.parametrize("fps", [120.0, 30.0, 24.0, 60.0, 29.97, 100.0])
-def test_frame_rate_survives_a_write(tmp_path, fps):
-    m = read_bvh(DATA / "hips_xyz.bvh")
+def test_frame_rate_survives_a_write(tmp_path, fps, base_text):
+    m = read_bvh(_write(tmp_path, base_text, "in.bvh"))
     m.fps = fps
     write_bvh(tmp_path / "o.bvh", m)
     assert read_bvh(tmp_path / "o.bvh").fps == fps
