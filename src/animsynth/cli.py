@@ -8,8 +8,12 @@
 
 ``animsynth COMMAND --help`` explains each. Every argument is checked before
 any work (types and ranges in argparse; frame indices and ``--k`` against the
-loaded motion). A bad argument or input file prints one line naming the
-argument or the file and line, exits with status 2 and writes nothing.
+loaded motion; ``--steps``, ``--length`` and the trial's frames against the
+memory budget ``--memory-budget-gib``, see :mod:`animsynth.limits`). A bad
+argument or input file prints one line naming the argument or the file and
+line, exits with status 2 and writes nothing. ``--fps`` is the frame rate of
+the input motion (1/60 to 100,000 fps): it is written to BVH output, and GIFs
+play in real time at it.
 """
 
 from __future__ import annotations
@@ -21,6 +25,8 @@ import os
 import sys
 
 import numpy as np
+
+from .limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
 
 MOTION_OUTPUTS = (".bvh", ".amc", ".gif")
 
@@ -55,6 +61,17 @@ def positive_float(text: str) -> float:
     value = _finite(text)
     if value <= 0:
         raise argparse.ArgumentTypeError(f"must be > 0, got {text!r}")
+    return value
+
+
+def fps_float(text: str) -> float:
+    """argparse type: a frame rate whose frame time a BVH file can hold (1/60 to 100,000 fps)."""
+    from .io.bvh import MAX_FRAME_TIME, MIN_FRAME_TIME
+
+    value = positive_float(text)
+    if not 1.0 / MAX_FRAME_TIME <= value <= 1.0 / MIN_FRAME_TIME:
+        raise argparse.ArgumentTypeError(f"must be between {1.0 / MAX_FRAME_TIME:g} and {1.0 / MIN_FRAME_TIME:g} "
+                                         f"frames per second, got {text!r}")
     return value
 
 
@@ -143,7 +160,8 @@ def cmd_preview(a) -> None:
     from .viz import motion_previews
 
     m = _load(a.asf, a.amc, a.fps)
-    motion_previews(m, gif_path=a.out)
+    _check_frames(a, m.n_frames, len(m.skeleton.joints), "frames of " + a.amc)
+    motion_previews(m, gif_path=a.out)  # plays in real time at the motion's --fps
     print(f"wrote {a.out}")
 
 
@@ -155,6 +173,9 @@ def cmd_generate(a) -> None:
     if a.start_trial >= len(a.train):
         raise UsageError("--start-trial", f"{a.start_trial} but only {len(a.train)} training file(s) given (0-based)")
     sk = read_asf(a.asf)
+    # output values, joint angles, latent path and the GIF's joint positions, float64
+    check_budget(f"argument --steps: {a.steps} steps",
+                 8.0 * (a.steps + 1) * (2 * sk.n_dof + a.latent_dim + 3 * len(sk.joints)), a.memory_budget_gib)
     train = [read_amc(p, sk, fps=a.fps) for p in a.train]
     n_start = train[a.start_trial].n_frames
     if a.start_frame >= n_start:
@@ -180,6 +201,12 @@ def cmd_resequence(a) -> None:
     from .resequencing.study import resequence_motion
 
     m = _load(a.asf, a.amc, a.fps)
+    if a.length is not None:
+        # played values, local rotations (quaternions) and joint positions of every frame, float64
+        check_budget(f"argument --length: {a.length} frames",
+                     8.0 * a.length * (2 * m.skeleton.n_dof + 7 * len(m.skeleton.joints)), a.memory_budget_gib)
+    # frame distance, neighbourhood and geodesic matrices of the trial
+    check_budget(f"{a.amc}: {m.n_frames} frames", 8.0 * 4 * m.n_frames ** 2, a.memory_budget_gib)
     for option, value in (("--start", a.start), ("--end", a.end)):
         if value >= m.n_frames:
             raise UsageError(option, f"{value} is outside {a.amc} ({m.n_frames} frames, 0-based)")
@@ -189,6 +216,10 @@ def cmd_resequence(a) -> None:
                                        global_dof=a.global_dof, length=a.length)
     _write_motion(a.out, played)
     print(f"wrote {a.out}: {len(frames)} frames; path " + " ".join(map(str, frames[:20])) + (" ..." if len(frames) > 20 else ""))
+
+
+def _check_frames(a, n_frames: int, n_joints: int, what: str) -> None:
+    check_budget(f"{what}: {n_frames}", 8.0 * n_frames * n_joints * 6, a.memory_budget_gib)
 
 
 def cmd_face(a) -> None:
@@ -222,14 +253,14 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("amc2bvh", help="convert an ASF/AMC trial to BVH (opens in Blender)")
     s.add_argument("asf", type=_existing_file), s.add_argument("amc", type=_existing_file)
     s.add_argument("out", type=_out_with((".bvh",)), help="output .bvh")
-    s.add_argument("--fps", type=positive_float, default=120.0)
+    s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
     s.add_argument("--metres", action="store_true", help="write lengths in metres instead of ASF units")
     s.set_defaults(func=cmd_amc2bvh)
 
     s = sub.add_parser("preview", help="animated GIF of an ASF/AMC trial's skeleton")
     s.add_argument("asf", type=_existing_file), s.add_argument("amc", type=_existing_file)
     s.add_argument("out", type=_out_with((".gif",)), help="output .gif")
-    s.add_argument("--fps", type=positive_float, default=120.0)
+    s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
     s.set_defaults(func=cmd_preview)
 
     s = sub.add_parser("generate", help="generate a motion with the Delaunay or k-NN vector field (Gauch & Peters)")
@@ -243,7 +274,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--start-frame", type=index_int, default=0)
     s.add_argument("--start-pose", default=None, help=argparse.SUPPRESS)
     s.add_argument("--seed", type=seed_int, default=0)
-    s.add_argument("--fps", type=positive_float, default=120.0)
+    s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
     s.add_argument("--out", required=True, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_generate)
 
@@ -256,7 +287,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--k", type=positive_int, default=None, help="neighbours (default: smallest k giving one component)")
     s.add_argument("--global-dof", action="store_true", help="include root translation and orientation")
     s.add_argument("--length", type=positive_int, default=None, help="pad the path to this many frames")
-    s.add_argument("--fps", type=positive_float, default=120.0)
+    s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
     s.add_argument("--out", required=True, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_resequence)
 
@@ -267,6 +298,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=seed_int, default=0)
     s.add_argument("out", type=_out_with((".gif", ".csv")), help="output .gif (or .csv of landmarks)")
     s.set_defaults(func=cmd_face)
+    for s in sub.choices.values():
+        s.add_argument("--memory-budget-gib", type=positive_float, default=DEFAULT_MEMORY_BUDGET_GIB,
+                       help=f"refuse requests whose arrays exceed this many GiB (default {DEFAULT_MEMORY_BUDGET_GIB:g})")
     return p
 
 
@@ -279,9 +313,10 @@ def main(argv=None) -> int:
     logging.basicConfig(level=logging.WARNING, format="animsynth: %(levelname)s: %(message)s")
     try:
         args.func(args)
-    except (ValueError, KeyError, IndexError, OSError, ImportError) as exc:
+    except (ValueError, KeyError, IndexError, OSError, ImportError, RuntimeError) as exc:
         # UsageError names the argument; MotionFormatError names file and line
-        print(f"animsynth {args.command}: error: {exc}", file=sys.stderr)
+        msg = " ".join(str(exc).split()) or type(exc).__name__  # one line
+        print(f"animsynth {args.command}: error: {msg}", file=sys.stderr)
         return 2
     return 0
 

@@ -74,8 +74,52 @@ def resolve_inside(root: str, rel: str, key: str) -> str:
     return path
 
 
+#: Largest number of values a config may expand to (YAML aliases counted at
+#: every use); the shipped configs have a few thousand.
+MAX_CONFIG_VALUES = 200_000
+
+
+def check_config_size(config, limit: int = MAX_CONFIG_VALUES) -> None:
+    """Refuse a config whose YAML aliases expand past ``limit`` values (a
+    "billion laughs" file) or refer to themselves, before anything walks it."""
+    from .limits import count_nodes
+
+    try:
+        n = count_nodes(config, limit)
+    except ValueError as exc:
+        raise ConfigError(f"config: {exc}") from None
+    if n > limit:
+        raise ConfigError(f"config: more than {limit} values once YAML aliases (&name / *name) are expanded; "
+                          "refusing it (a config this large is a mistake or an attack)")
+
+
+def check_results_dir(config: dict, project: str | None = None) -> None:
+    """``results_dir`` is a relative path inside the project, or (with
+    ``results_outside_project: true``) an absolute folder that is neither a
+    filesystem root, the home folder, nor the project or a folder holding it."""
+    rd = str(config.get("results_dir") or "results")
+    project = os.path.realpath(project or os.getcwd())
+    norm = posixpath.normpath(rd)
+    if not posixpath.isabs(rd):
+        if norm == "." or norm == ".." or norm.startswith("../"):
+            raise ConfigError(f"config key 'results_dir': {rd!r} is not a folder inside the project {project!r}; "
+                              "give a relative path such as results/myrun")
+        return
+    if not config.get("results_outside_project"):
+        raise ConfigError(f"config key 'results_dir': {rd!r} is absolute; give a relative path inside the project, "
+                          "or set results_outside_project: true to write to a folder you name explicitly")
+    real = os.path.realpath(rd)
+    home = os.path.realpath(os.path.expanduser("~"))
+    if real == os.path.dirname(real) or real == home or os.path.commonpath([real, project]) == real:
+        raise ConfigError(f"config key 'results_dir': {rd!r} is a filesystem root, the home folder, or holds the "
+                          "project; name a dedicated folder")
+
+
 def check_config(config: dict) -> None:
     """Cross-key checks on a schema-validated config; raise :class:`ConfigError`."""
+    from .limits import DEFAULT_MEMORY_BUDGET_GIB, BudgetError, check_budget, synthetic_trial_bytes
+
+    check_results_dir(config)
     ids = [t["id"] for t in config["trials"]]
     dup = sorted({i for i in ids if ids.count(i) > 1})
     if dup:
@@ -89,6 +133,12 @@ def check_config(config: dict) -> None:
         if src == "synthetic":
             if "frames" not in t:
                 raise ConfigError(f"{where}: synthetic trials need 'frames'")
+            try:
+                check_budget(f"config keys 'trials[{k}].frames' ({t['frames']}) x 'fps' ({config.get('fps', 120)})",
+                             synthetic_trial_bytes(t["frames"], float(config.get("fps", 120))),
+                             float(config.get("memory_budget_gib", DEFAULT_MEMORY_BUDGET_GIB)))
+            except BudgetError as exc:
+                raise ConfigError(str(exc)) from None
             if t["kind"] not in ("walk_straight", "walk_turn", "run_straight", "run_turn", "dance"):
                 raise ConfigError(f"{where}: the synthetic generator cannot make kind {t['kind']!r}")
         else:
@@ -156,6 +206,10 @@ def explain_schema_error(config: dict, schema: dict) -> str | None:
 def validate_config(config: dict, schema_path: str) -> None:
     """Validate ``config`` against the YAML JSON Schema and fill in defaults.
 
+    A config whose YAML aliases expand past :data:`MAX_CONFIG_VALUES` values
+    is refused first (:func:`check_config_size`), so validation never walks a
+    "billion laughs" file.
+
     Wraps :func:`snakemake.utils.validate` (which also sets defaults) so that
     a violation raises a :class:`ConfigError` of a few lines (see
     :func:`explain_schema_error`) instead of the validator's dump.
@@ -163,6 +217,7 @@ def validate_config(config: dict, schema_path: str) -> None:
     import yaml
     from snakemake.utils import validate
 
+    check_config_size(config)
     try:
         validate(config, schema_path)
     except Exception as exc:  # snakemake's WorkflowError embeds the whole schema and config

@@ -105,14 +105,36 @@ def copy_local(src, dest) -> None:
         shutil.copyfile(src, tmp)
 
 
-def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "") -> Motion:
-    """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion`."""
+def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
+               bvh_length_to_m: float = 1.0) -> Motion:
+    """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion`.
+
+    ``joint_roles`` (config ``joint_roles``) are checked against the skeleton
+    and stored on it (:attr:`Skeleton.roles`, see :mod:`animsynth.joints`).
+    A BVH file's lengths are ``bvh_length_to_m`` metres per unit; a skeleton
+    whose rest height is then below 0.3 m or above 3 m is logged as a warning
+    (the unit is probably wrong).
+    """
+    from .joints import check_role_overrides
+
     if bvh is not None:
         from .io.bvh import read_bvh
+        from .kinematics import forward_kinematics
 
         m = read_bvh(bvh)
+        m.skeleton.length_to_m = float(bvh_length_to_m)
+        rest = forward_kinematics(m.skeleton, m.values[:1] * 0.0)[0] * m.skeleton.length_to_m
+        height = float(rest[:, 1].max() - rest[:, 1].min())
+        if not 0.3 <= height <= 3.0:
+            log.warning("%s: the skeleton is %.3g m tall at rest with bvh_length_to_m=%g; set bvh_length_to_m to "
+                        "the file's unit (0.01 for centimetres, 0.0254 for inches)", bvh, height, bvh_length_to_m)
     else:
         m = read_amc(amc, read_asf(asf), fps=fps)
+    try:
+        check_role_overrides(m.skeleton.names, joint_roles)
+    except ValueError as exc:
+        raise ConfigError(f"config key {exc} (in {bvh or asf})") from None
+    m.skeleton.roles = dict(joint_roles or {})
     m.name = name or m.name
     return m
 

@@ -50,7 +50,7 @@ def root_translation(skeleton: Skeleton, values) -> np.ndarray:
     values = _check_values(skeleton, values)
     root = skeleton.joints[0]
     t = np.tile(np.asarray(root.offset, float), (values.shape[0], 1))
-    sl = skeleton.dof_slices()["root"]
+    sl = skeleton.dof_slices()[root.name]
     for k, d in enumerate(root.dofs):
         if d in TRANS_DOFS:
             t[:, TRANS_DOFS.index(d)] = values[:, sl][:, k] + root.offset[TRANS_DOFS.index(d)]

@@ -77,14 +77,24 @@ class Skeleton:
     length_to_m : float
         Factor converting lengths (offsets, root translation) to metres.
     angle_unit : str
-        ``"deg"`` (only degrees are supported in files we write).
+        ``"deg"``: angles held by the skeleton (axis frames) and by motions on
+        it are always degrees.
     name : str
+    file_angle_unit : str
+        ``"deg"`` or ``"rad"``: the angle unit the source file declared (ASF
+        ``:units angle``). An AMC file without a ``:DEGREES`` / ``:RADIANS``
+        header is read in this unit.
+    roles : dict of str -> str
+        Joint-role overrides ``{role: joint name}`` (config ``joint_roles``);
+        see :mod:`animsynth.joints`.
     """
 
     joints: list[Joint]
     length_to_m: float = 1.0
     angle_unit: str = "deg"
     name: str = "skeleton"
+    file_angle_unit: str = "deg"
+    roles: dict = field(default_factory=dict)
 
     def __post_init__(self):
         for i, j in enumerate(self.joints):
@@ -134,6 +144,8 @@ class Skeleton:
             "name": self.name,
             "length_to_m": self.length_to_m,
             "angle_unit": self.angle_unit,
+            "file_angle_unit": self.file_angle_unit,
+            "roles": dict(self.roles),
             "joints": [
                 {
                     "name": j.name,
@@ -168,7 +180,8 @@ class Skeleton:
             )
             for j in d["joints"]
         ]
-        return cls(joints, float(d["length_to_m"]), d.get("angle_unit", "deg"), d.get("name", "skeleton"))
+        return cls(joints, float(d["length_to_m"]), d.get("angle_unit", "deg"), d.get("name", "skeleton"),
+                   d.get("file_angle_unit", "deg"), dict(d.get("roles") or {}))
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict())

@@ -35,8 +35,11 @@ import pandas as pd
 
 log = logging.getLogger("animsynth.sources")
 
+from .io.obj import is_frame_name
+
 ARCHIVE_SUFFIXES = (".zip", ".tar.gz", ".tgz", ".tar")
-_FRAME_RX = re.compile(r"\.obj(\.gz)?$", re.IGNORECASE)
+#: Default cap (MB, 10**6 bytes) on the total unpacked size of a mesh archive.
+DEFAULT_MAX_UNPACKED_MB = 8000.0
 
 
 class MeshSourceError(RuntimeError):
@@ -106,29 +109,42 @@ def probe_source(source: str | os.PathLike | None, probe: str | None = None, tim
 
 
 def list_frames(folder: str | os.PathLike) -> list[Path]:
-    """OBJ / OBJ.gz files directly in ``folder``, sorted by name."""
-    return sorted(p for p in Path(folder).iterdir() if p.is_file() and _FRAME_RX.search(p.name))
+    """Frame files directly in ``folder`` (:func:`animsynth.io.obj.is_frame_name`), sorted by name."""
+    return sorted(p for p in Path(folder).iterdir() if p.is_file() and is_frame_name(p.name))
 
 
-def _frames_folder(root: Path) -> Path:
-    """The folder below ``root`` holding the most OBJ frames (archives often nest one level)."""
-    best, n_best = None, 0
-    for d in [root, *sorted(p for p in root.rglob("*") if p.is_dir())]:
-        n = len(list_frames(d))
-        if n > n_best:
-            best, n_best = d, n
-    if best is None:
-        raise MeshSourceError(f"no .obj or .obj.gz frames found in {root}")
-    return best
+def _frames_folder(root: Path, source) -> Path:
+    """The one folder below ``root`` holding frames (archives often nest one level).
+
+    Hidden and ``__MACOSX`` folders never hold frames; frames in two folders
+    are refused, naming both, since which one is meant cannot be guessed.
+    """
+    found = [d for d in [root, *sorted(p for p in root.rglob("*") if p.is_dir())]
+             if is_frame_name(d.relative_to(root) / "x.obj") and list_frames(d)]
+    if not found:
+        raise MeshSourceError(f"{source}: no .obj or .obj.gz frames found")
+    if len(found) > 1:
+        a, b = (str(d.relative_to(root)) or "." for d in found[:2])
+        raise MeshSourceError(f"{source}: frames in more than one folder ({a!r} with {len(list_frames(found[0]))}, "
+                              f"{b!r} with {len(list_frames(found[1]))}); keep one sequence per archive")
+    return found[0]
 
 
-def _extract(archive: Path, dest: Path) -> None:
-    """Unpack ``archive`` into ``dest``, refusing members that would land outside it."""
+def _extract(archive: Path, dest: Path, max_unpacked_mb: float = DEFAULT_MAX_UNPACKED_MB) -> None:
+    """Unpack ``archive`` into ``dest``, refusing members that would land outside it
+    and archives whose members add up to more than ``max_unpacked_mb`` MB."""
     dest = dest.resolve()
     name = archive.name.lower()
+    cap = float(max_unpacked_mb) * 1e6
+
+    def check_size(total: float) -> None:
+        if total > cap:
+            raise MeshSourceError(f"{archive}: unpacks to {total / 1e6:.6g} MB, over the {max_unpacked_mb:g} MB cap "
+                                  "(config key meshdetail.max_unpacked_mb)")
     try:
         if name.endswith(".zip"):
             with zipfile.ZipFile(archive) as z:
+                check_size(sum(i.file_size for i in z.infolist()))
                 for m in z.namelist():
                     target = (dest / m).resolve()
                     if not str(target).startswith(str(dest) + os.sep) and target != dest:
@@ -136,6 +152,7 @@ def _extract(archive: Path, dest: Path) -> None:
                 z.extractall(dest)
         else:
             with tarfile.open(archive, "r:*") as t:
+                check_size(sum(m.size for m in t.getmembers() if m.isfile()))
                 t.extractall(dest, filter="data")  # refuses absolute paths, '..' and links out of dest
     except (zipfile.BadZipFile, tarfile.TarError, EOFError, OSError) as e:
         if isinstance(e, MeshSourceError):
@@ -143,12 +160,19 @@ def _extract(archive: Path, dest: Path) -> None:
         raise MeshSourceError(f"{archive}: cannot unpack ({e})") from e
 
 
-def fetch_mesh_frames(source: str, dest: str | os.PathLike, timeout: float = 120.0) -> list[Path]:
+def fetch_mesh_frames(source: str, dest: str | os.PathLike, timeout: float = 120.0, sums: dict | None = None,
+                      max_unpacked_mb: float = DEFAULT_MAX_UNPACKED_MB) -> list[Path]:
     """Put the OBJ frames of ``source`` (an archive file, or a URL of one) into ``dest``.
 
     The frames are copied flat into ``dest`` (created; must not hold frames
     already). Everything is first unpacked in a temporary folder next to
-    ``dest``, so an interrupted fetch leaves no partial ``dest``.
+    ``dest`` and, when ``sums`` (``{frame: sha256}``) is given, checked there
+    (:func:`verify_mesh_frames`), so a failed or interrupted fetch leaves
+    neither ``dest`` nor the temporary folder behind. What counts as a frame
+    is :func:`animsynth.io.obj.is_frame_name` (macOS ``__MACOSX`` / ``._``
+    companions are ignored); frames in two folders of the archive are refused.
+    An archive unpacking to more than ``max_unpacked_mb`` MB is refused before
+    anything is written.
 
     Returns
     -------
@@ -176,12 +200,14 @@ def fetch_mesh_frames(source: str, dest: str | os.PathLike, timeout: float = 120
             raise MeshSourceError(f"{source}: not an archive ({', '.join(ARCHIVE_SUFFIXES)}) nor a folder")
         unpacked = tmp / "unpacked"
         unpacked.mkdir()
-        _extract(archive, unpacked)
-        folder = _frames_folder(unpacked)
+        _extract(archive, unpacked, max_unpacked_mb)
+        folder = _frames_folder(unpacked, source)
         staged = tmp / "frames"
         staged.mkdir()
         for f in list_frames(folder):
             shutil.move(str(f), staged / f.name)
+        if sums is not None:
+            verify_mesh_frames(staged, sums)
         if dest.exists():
             shutil.rmtree(dest)
         os.replace(staged, dest)
@@ -232,6 +258,8 @@ def verify_mesh_frames(folder: str | os.PathLike, sums: dict[str, str]) -> pd.Da
         Naming the first frame that is missing, unlisted or whose hash differs.
     """
     found = {re.sub(r"\.gz$", "", f.name, flags=re.IGNORECASE): f for f in list_frames(folder)}
+    if len(found) != len(list_frames(folder)):
+        raise MeshSourceError(f"{folder}: a frame exists both as .obj and .obj.gz")
     extra = sorted(set(found) - set(sums))
     if extra:
         raise MeshSourceError(f"{folder}: frame {extra[0]} is not in the checksum list ({len(extra)} unlisted frames)")

@@ -31,7 +31,8 @@ def _camera(elev_deg: float = 10.0, azim_deg: float = -60.0) -> np.ndarray:
 
 
 def skeleton_gif(path, positions_list, parents, titles=None, fps: float = 30.0, step: int = 4,
-                 follow_root: bool = True, max_frames: int = 150, panel_px: int = 230) -> None:
+                 follow_root: bool = True, max_frames: int = 150, source_fps: float | None = None,
+                 panel_px: int = 230) -> None:
     """Animated GIF of one or more stick figures side by side.
 
     Drawn with Pillow (orthographic projection, one line per bone), not with
@@ -49,6 +50,10 @@ def skeleton_gif(path, positions_list, parents, titles=None, fps: float = 30.0, 
     step : take every ``step``-th frame
     follow_root : centre each figure on its root horizontally (long walks stay in view)
     max_frames : cap on GIF frames (the step is increased to respect it)
+    source_fps : frame rate of the motions; when given, the GIF plays in real
+        time: ``step`` is chosen so that the GIF runs at about ``fps`` frames
+        per second (or slower, within ``max_frames``) and its playback rate is
+        ``source_fps / step``
     panel_px : width and height of one figure's panel in pixels
     """
     from PIL import Image, ImageDraw
@@ -57,7 +62,11 @@ def skeleton_gif(path, positions_list, parents, titles=None, fps: float = 30.0, 
         raise ValueError(f"GIF frame rate must be a positive number, got {fps!r}")
     positions_list = [np.asarray(p, float) for p in positions_list]
     n = max(p.shape[0] for p in positions_list)
+    if source_fps is not None:
+        step = max(1, int(round(source_fps / fps)))
     step = max(step, int(np.ceil(n / max_frames)))
+    if source_fps is not None:
+        fps = source_fps / step
     frames = list(range(0, n, step))
     k = len(positions_list)
     titles = titles or [""] * k
@@ -134,7 +143,10 @@ def filmstrip(path, positions, parents, n_panels: int = 8, title: str = "") -> N
 
 def motion_previews(motion, gif_path=None, bvh_path=None, png_path=None, original=None, titles=None,
                     fps: float = 30.0) -> None:
-    """Write the standard previews of a generated motion: BVH, GIF (beside ``original`` if given), filmstrip."""
+    """Write the standard previews of a generated motion: BVH, GIF (beside ``original`` if given), filmstrip.
+
+    The GIF plays in real time at ``motion.fps``, showing about ``fps`` frames per second.
+    """
     from .io.bvh import write_bvh
     from .kinematics import forward_kinematics
 
@@ -146,6 +158,7 @@ def motion_previews(motion, gif_path=None, bvh_path=None, png_path=None, origina
         plist = [pos]
         if original is not None:
             plist = [forward_kinematics(original.skeleton, original.values) * original.skeleton.length_to_m, pos]
-        skeleton_gif(gif_path, plist, sk.parents(), titles or (["original", "generated"] if original is not None else ["generated"]), fps=fps)
+        skeleton_gif(gif_path, plist, sk.parents(), titles or (["original", "generated"] if original is not None else ["generated"]), fps=fps,
+                     source_fps=motion.fps)
     if png_path:
         filmstrip(png_path, pos, sk.parents(), title=motion.name)

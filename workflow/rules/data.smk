@@ -98,6 +98,8 @@ rule parse_trials:
         trials=USED_TRIALS,
         raw={t: raw_trial_files(t) for t in USED_TRIALS},
         fps=config["fps"],
+        joint_roles=config.get("joint_roles") or {},
+        bvh_length_to_m=config.get("bvh_length_to_m", 1.0),
     threads: 1
     resources:
         mem_mb=500,
@@ -156,10 +158,13 @@ if MESH_SRC and (is_url(MESH_SRC) or is_archive(MESH_SRC)):
     MESH_FRAMES = f"resources/mesh/{mesh_source_name(MESH_SRC)}"
 
     rule mesh_fetch:
+        input:
+            sums=MESH_SUMS or [],
         output:
             directory(MESH_FRAMES),
         params:
             source=MESH_SRC,
+            max_unpacked_mb=config.get("meshdetail", {}).get("max_unpacked_mb", 8000),
         log:
             L("data/mesh_fetch.log"),
         benchmark:

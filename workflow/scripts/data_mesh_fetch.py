@@ -1,7 +1,10 @@
 """Unpack mesh_dir (an archive, or a URL of one) into resources/mesh/<name>/."""
-from animsynth.sources import fetch_mesh_frames
+from animsynth.sources import fetch_mesh_frames, read_sha256_list
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
-frames = fetch_mesh_frames(snakemake.params.source, snakemake.output[0])  # noqa: F821
+sums = snakemake.input.get("sums")  # noqa: F821
+frames = fetch_mesh_frames(snakemake.params.source, snakemake.output[0],  # noqa: F821
+                           sums=read_sha256_list(sums) if sums else None,
+                           max_unpacked_mb=snakemake.params.max_unpacked_mb)  # noqa: F821
 log.info("%d frames from %s", len(frames), snakemake.params.source)  # noqa: F821

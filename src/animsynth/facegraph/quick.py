@@ -9,7 +9,7 @@ import tempfile
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from ..io.ckplus import emotion_code, read_ckplus
+from ..io.ckplus import EMOTIONS, emotion_code, read_ckplus
 from .experiments import graph_kwargs, synth_kwargs
 from .model import FaceGraphModel
 from .preprocess import FacePreprocessor
@@ -39,6 +39,11 @@ def synthesise_from_labels(labels, out: str, ckplus_dir: str | None = None, seed
             root = os.path.join(tmp, "ckplus")
             generate_database(root, seed=seed)
         seqs = read_ckplus(root)
+        have = {sq.label for sq in seqs if sq.label is not None}
+        missing = [lb for lb in labels if EMOTIONS[emotion_code(lb)] not in have]
+        if missing:
+            raise ValueError(f"{root}: no labelled sequence for {', '.join(repr(m) for m in missing)} "
+                             f"(this copy has {', '.join(sorted(have)) or 'no labels'})")
         db = FacePreprocessor().fit_transform(seqs, source=str(ckplus_dir or "synthetic CK+-layout data"))
     with threadpool_limits(1):
         model = FaceGraphModel(creation, merge, seed=seed, creation_tolerance=creation_tolerance,

@@ -8,6 +8,7 @@ joint angles in CMU AMC bone order).
 
 from __future__ import annotations
 
+import logging
 import os
 
 import numpy as np
@@ -17,12 +18,18 @@ from ..skeleton import Skeleton
 from .atomic import atomic_write_text
 from .errors import MotionFormatError, parse_float, read_text_lines
 
+log = logging.getLogger("animsynth.io")
+
 
 def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
     """Parse an AMC file against ``skeleton``.
 
     Every frame must list every bone that has DOF, each with exactly its DOF
     count of finite numbers. Frame numbers must be consecutive from the first.
+    Angles are in the unit the header declares (``:DEGREES`` or ``:RADIANS``);
+    a file with neither uses the ASF's ``:units angle``
+    (``skeleton.file_angle_unit``, logged when that is radians). The returned
+    values are always degrees.
 
     Raises
     ------
@@ -42,7 +49,7 @@ def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
     cur_line = 0
     frame_no = None
     in_header = True
-    degrees_flag = True  # AMC header :DEGREES (default) or :RADIANS
+    degrees_flag = None  # AMC header :DEGREES or :RADIANS; without one, the ASF's angle unit
 
     def finish(ln: int):
         if cur is None:
@@ -61,6 +68,8 @@ def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
         if line.startswith(":"):
             if line.upper().startswith(":RADIANS"):
                 degrees_flag = False
+            elif line.upper().startswith(":DEGREES"):
+                degrees_flag = True
             continue
         tok = line.split()
         if len(tok) == 1 and tok[0].isascii() and tok[0].isdigit():
@@ -90,6 +99,11 @@ def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
     if not frames:
         raise MotionFormatError(path, None, "no frames")
     values = np.vstack(frames)
+    if degrees_flag is None:
+        degrees_flag = skeleton.file_angle_unit != "rad"
+        if not degrees_flag:
+            log.info("%s: no :DEGREES or :RADIANS header; angles read in radians, as the ASF's ':units angle rad' "
+                     "declares", os.fspath(path))
     if not degrees_flag:
         rot_cols = [i for i, c in enumerate(skeleton.columns()) if c.split(".")[1].startswith("r")]
         values[:, rot_cols] *= np.rad2deg(1.0)

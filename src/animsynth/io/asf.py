@@ -24,6 +24,11 @@ from .errors import MotionFormatError, parse_float, read_text_lines
 _AXES = {"X", "Y", "Z"}
 
 
+#: Bounds of ``:units length`` (file units per inch): beyond them lengths in
+#: metres overflow or vanish.
+MIN_LENGTH_UNIT, MAX_LENGTH_UNIT = 1e-6, 1e6
+
+
 def read_asf(path) -> Skeleton:
     """Parse an ASF file into a :class:`~animsynth.skeleton.Skeleton`.
 
@@ -31,7 +36,8 @@ def read_asf(path) -> Skeleton:
     ------
     MotionFormatError
         On any malformed line (message names file and line), a file that is
-        not UTF-8 text, a non-positive ``:units length`` or a missing
+        not UTF-8 text, a ``:units length`` that is not positive or lies outside
+        [:data:`MIN_LENGTH_UNIT`, :data:`MAX_LENGTH_UNIT`], or a missing
         ``:root`` section. A leading UTF-8 byte-order mark is ignored.
     """
     lines = read_text_lines(path)
@@ -72,6 +78,9 @@ def read_asf(path) -> Skeleton:
                 units[key] = parse_float(tok[1], path, ln, f"{key} unit")
                 if key == "length" and units[key] <= 0:
                     raise MotionFormatError(path, ln, f"length unit must be positive, got {tok[1]!r}")
+                if key == "length" and not MIN_LENGTH_UNIT <= units[key] <= MAX_LENGTH_UNIT:
+                    raise MotionFormatError(path, ln, f"length unit {tok[1]!r} is outside [{MIN_LENGTH_UNIT:g}, "
+                                                      f"{MAX_LENGTH_UNIT:g}] (CMU files use 0.45)")
         elif section == "root":
             key = tok[0].lower()
             if key == "order":
@@ -260,7 +269,7 @@ def _build_skeleton(path, name, units, root, bones, children) -> Skeleton:
             )
         )
     length_to_m = (1.0 / units["length"]) * 2.54 / 100.0
-    return Skeleton(joints, length_to_m=length_to_m, angle_unit="deg", name=name)
+    return Skeleton(joints, length_to_m=length_to_m, angle_unit="deg", name=name, file_angle_unit=units["angle"])
 
 
 def write_asf(path, skeleton: Skeleton, length_unit: float | None = None) -> None:

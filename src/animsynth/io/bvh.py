@@ -1,24 +1,52 @@
 """BVH (Biovision hierarchy) writer and reader.
 
-:func:`write_bvh` writes any :class:`~animsynth.motion.Motion` so that it opens
-in Blender: one BVH joint per skeleton joint (ASF bone), ``OFFSET`` = where
-the joint starts relative to its parent (the parent bone's direction x
-length), an ``End Site`` at the tip of every leaf, root channels
-``Xposition Yposition Zposition Zrotation Yrotation Xrotation`` and
-``Zrotation Yrotation Xrotation`` for every other joint with rotational DOF.
-Joints without DOF (e.g. CMU ``lhipjoint``) get no channels. BVH rotations
-are the local rotations ``L = C M C^-1`` of :mod:`animsynth.kinematics`,
-written as intrinsic Z-Y-X Euler angles in degrees. Lengths stay in skeleton
-units unless ``scale`` is given (e.g. ``skeleton.length_to_m`` for metres).
+Reading (:func:`read_bvh`) accepts BVH as it exists in the wild: any root name
+(``ROOT Hips``, ``ROOT root``, ``ROOT mixamorig:Hips``), any rotation-channel
+order per joint, lengths in whatever unit the file uses. It is strict where a
+silent misreading would follow; each of these is a
+:class:`~animsynth.io.errors.MotionFormatError` naming file and line:
 
-:func:`read_bvh` reads a BVH file into a generic :class:`Skeleton` (axis =
-identity, DOF = the file's rotation channels turned into the equivalent
-extrinsic order) and :class:`Motion`. :func:`motion_from_bvh_on` maps a BVH
-written by us back onto the original ASF skeleton's DOF (the round trip).
+* a joint's rotation (or position) channels must name distinct axes
+  (``Xrotation Xrotation Xrotation`` is refused); position channels are only
+  supported on the root joint;
+* joint names must be unique;
+* nothing may follow the root joint's closing brace before ``MOTION`` (a
+  second ``ROOT``, a stray ``}``);
+* the frame time must lie in [:data:`MIN_FRAME_TIME`, :data:`MAX_FRAME_TIME`]
+  seconds (100 kHz down to one frame a minute); the frame count must match
+  the rows.
+
+The file becomes a generic :class:`Skeleton` (axis = identity; each joint's DOF
+are its position channels, then its rotation channels in reverse order, since
+a BVH rotation ``CHANNELS ... Zrotation Xrotation Yrotation`` is the intrinsic
+Z-X-Y rotation, i.e. the *extrinsic* ``ry rx rz`` of
+:mod:`animsynth.skeleton`) and a :class:`Motion` whose values are the file's
+channel values (root positions minus the root ``OFFSET``). The frame rate is
+``1 / Frame Time``, except that when an integer rate is consistent with the
+printed frame time (``0.008333`` -> 120, ``0.0333333`` -> 30), or a rate with
+a few decimals is (29.97), that rate is used: a frame time is a rounded print
+of ``1 / fps``.
+
+Writing (:func:`write_bvh`): one BVH joint per skeleton joint, ``OFFSET`` =
+where the joint starts relative to its parent, an ``End Site`` at the tip of
+every leaf. A joint that came from a BVH file (no ASF axis frame) is written
+with its own channels in its own order, so reading a BVH and writing it back
+reproduces every channel value to the printed precision (6 decimals). An ASF
+joint with rotational DOF gets ``Zrotation Yrotation Xrotation`` (the local
+rotation ``L = C M C^-1`` of :mod:`animsynth.kinematics` as intrinsic Z-Y-X
+Euler angles, degrees); an ASF joint without DOF (e.g. CMU ``lhipjoint``) gets
+no channels. The root's positions are absolute (its translation plus its
+``OFFSET``). The frame time is written with 17 significant digits, so
+``1 / Frame Time`` gives back the frame rate. Lengths stay in skeleton units
+unless ``scale`` is given (e.g. ``skeleton.length_to_m`` for metres).
+
+:func:`motion_from_bvh_on` maps a BVH written by us back onto the original ASF
+skeleton's DOF (the round trip).
 """
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -26,68 +54,151 @@ from scipy.spatial.transform import Rotation
 
 from ..kinematics import dof_values_from_local, local_rotations, root_translation
 from ..motion import Motion
-from ..skeleton import Joint, Skeleton
+from ..skeleton import ROT_DOFS, TRANS_DOFS, Joint, Skeleton
 from .atomic import atomic_write_text
 from .errors import MotionFormatError, parse_float, read_text_lines
 
 _CH = {"Xposition": "tx", "Yposition": "ty", "Zposition": "tz",
        "Xrotation": "rx", "Yrotation": "ry", "Zrotation": "rz"}
+_CH_NAME = {v: k for k, v in _CH.items()}
+
+#: Shortest frame time accepted (seconds): 100,000 frames per second.
+MIN_FRAME_TIME = 1e-5
+#: Longest frame time accepted (seconds): one frame a minute.
+MAX_FRAME_TIME = 60.0
+#: Values of the channels and offsets are written with this many decimals.
+DECIMALS = 6
+
+
+def _native(j: Joint) -> bool:
+    """Is ``j`` written with its own channels (a BVH joint: no ASF axis frame)?"""
+    return j.direction is None and not np.any(np.asarray(j.axis, float))
+
+
+def _check_frame_time(ftime: float, where: str) -> None:
+    if not MIN_FRAME_TIME <= ftime <= MAX_FRAME_TIME:
+        raise ValueError(f"{where}: frame time {ftime:g} s is outside [{MIN_FRAME_TIME:g}, {MAX_FRAME_TIME:g}] s "
+                         f"(frame rate {1 / MAX_FRAME_TIME:g} to {1 / MIN_FRAME_TIME:g} fps)")
 
 
 def write_bvh(path, motion: Motion, scale: float = 1.0) -> None:
-    """Write ``motion`` as BVH (see module docstring)."""
+    """Write ``motion`` as BVH (see module docstring).
+
+    Raises
+    ------
+    ValueError
+        Non-finite values, a non-finite or non-positive ``scale``, offsets or
+        positions that are not finite after scaling, or a frame rate whose
+        frame time is outside [:data:`MIN_FRAME_TIME`, :data:`MAX_FRAME_TIME`]
+        (such a file could not be read back). Nothing is written then.
+    """
     sk = motion.skeleton
     values = np.asarray(motion.values, float)
     if not np.all(np.isfinite(values)):
         raise ValueError(f"refusing to write {path}: motion has non-finite values")
+    scale = float(scale)
+    if not math.isfinite(scale) or scale <= 0:
+        raise ValueError(f"refusing to write {path}: length scale {scale!r} must be finite and > 0")
+    fps = float(motion.fps)
+    if not math.isfinite(fps) or fps <= 0:
+        raise ValueError(f"refusing to write {path}: frame rate {fps!r} must be finite and > 0")
+    _check_frame_time(1.0 / fps, f"refusing to write {path}")
     L = local_rotations(sk, values)
     root_t = root_translation(sk, values) * scale
-    has_rot = [bool(j.rot_dofs) or i == 0 for i, j in enumerate(sk.joints)]
+    sl = sk.dof_slices()
+    n = values.shape[0]
     lines = ["HIERARCHY"]
+    blocks = []
+
+    def num(v) -> str:
+        return f"{v:.{DECIMALS}f}"
 
     def emit(i: int, depth: int):
         j = sk.joints[i]
         ind = "  " * depth
-        head = "ROOT" if i == 0 else "JOINT"
-        lines.append(f"{ind}{head} {j.name}")
+        lines.append(f"{ind}{'ROOT' if i == 0 else 'JOINT'} {j.name}")
         lines.append(f"{ind}{{")
-        off = np.zeros(3) if i == 0 else np.asarray(j.offset) * scale
-        lines.append(f"{ind}  OFFSET {off[0]:.6f} {off[1]:.6f} {off[2]:.6f}")
-        if i == 0:
-            lines.append(f"{ind}  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation")
-        elif has_rot[i]:
-            lines.append(f"{ind}  CHANNELS 3 Zrotation Yrotation Xrotation")
+        off = np.asarray(j.offset, float) * scale
+        if not np.all(np.isfinite(off)):
+            raise ValueError(f"refusing to write {path}: joint {j.name!r} has a non-finite offset after scaling")
+        lines.append(f"{ind}  OFFSET {num(off[0])} {num(off[1])} {num(off[2])}")
+        chans: list[str] = []
+        if _native(j):
+            trans = [d for d in j.dofs if d in TRANS_DOFS]
+            rots = [d for d in j.dofs if d in ROT_DOFS][::-1]  # extrinsic DOF order -> intrinsic channel order
+            if i != 0 and trans:
+                raise ValueError(f"refusing to write {path}: joint {j.name!r} has position DOF (only the root may)")
+            cols = values[:, sl[j.name]]
+            for d in trans:
+                blocks.append(root_t[:, TRANS_DOFS.index(d)][:, None])
+            for d in rots:
+                blocks.append(cols[:, [j.dofs.index(d)]])
+            chans = [_CH_NAME[d] for d in trans + rots]
         else:
-            lines.append(f"{ind}  CHANNELS 0")
+            if i == 0:
+                chans = ["Xposition", "Yposition", "Zposition"]
+                blocks.append(root_t)
+            if j.rot_dofs or i == 0:
+                chans += ["Zrotation", "Yrotation", "Xrotation"]
+                blocks.append(L[i].as_euler("ZYX", degrees=True))
+        lines.append(f"{ind}  CHANNELS {len(chans)}" + "".join(" " + c for c in chans))
         kids = sk.children(i)
         for k in kids:
             emit(k, depth + 1)
         if not kids:
-            tail = np.asarray(j.tail) * scale
+            tail = np.asarray(j.tail, float) * scale
+            if not np.all(np.isfinite(tail)):
+                raise ValueError(f"refusing to write {path}: joint {j.name!r} has a non-finite tail after scaling")
             lines.append(f"{ind}  End Site")
             lines.append(f"{ind}  {{")
-            lines.append(f"{ind}    OFFSET {tail[0]:.6f} {tail[1]:.6f} {tail[2]:.6f}")
+            lines.append(f"{ind}    OFFSET {num(tail[0])} {num(tail[1])} {num(tail[2])}")
             lines.append(f"{ind}  }}")
         lines.append(f"{ind}}}")
 
     emit(0, 0)
-    n = values.shape[0]
-    lines += ["MOTION", f"Frames: {n}", f"Frame Time: {1.0 / motion.fps:.9f}"]
-    blocks = [root_t]
-    for i, r in enumerate(L):
-        if has_rot[i]:
-            blocks.append(r.as_euler("ZYX", degrees=True))
-    data = np.hstack(blocks)
-    lines += [" ".join(f"{v:.6f}" for v in row) for row in data]
+    data = np.hstack(blocks) if blocks else np.zeros((n, 0))
+    if not np.all(np.isfinite(data)):
+        raise ValueError(f"refusing to write {path}: a channel value is not finite after scaling")
+    lines += ["MOTION", f"Frames: {n}", f"Frame Time: {1.0 / fps:.17g}"]
+    lines += [" ".join(num(v) for v in row) for row in data]
     atomic_write_text(path, "\n".join(lines) + "\n")
 
 
-def read_bvh(path, fps: float | None = None) -> Motion:
-    """Read a BVH file into a generic skeleton and motion.
+def _frame_rate(ft_s: str, ftime: float) -> float:
+    """``1 / ftime``, or the shortest decimal rate that the printed frame time is a rounding of."""
+    fps = 1.0 / ftime
+    low = ft_s.strip().lower()
+    mant, _, exp = low.partition("e")
+    decimals = len(mant.split(".", 1)[1]) if "." in mant else 0
+    half_ulp = 0.5 * 10.0 ** ((int(exp) if exp else 0) - decimals)
+    for d in range(7):
+        cand = round(fps, d)
+        if cand > 0 and abs(1.0 / cand - ftime) <= half_ulp * (1 + 1e-9):
+            return float(cand)
+    return fps
 
-    Raises :class:`MotionFormatError` (file and line) on malformed input,
-    including bytes that are not UTF-8, a frame count below 1 and a frame time
-    that is not positive. A leading UTF-8 byte-order mark is ignored.
+
+def read_bvh(path, fps: float | None = None) -> Motion:
+    """Read a BVH file into a generic skeleton and motion (see module docstring).
+
+    Parameters
+    ----------
+    path : path
+    fps : float, optional
+        Override the frame rate given by the file's frame time.
+
+    Returns
+    -------
+    Motion
+        ``values`` (frames, n_dof) in file order of joints; angles in degrees,
+        lengths in file units (``skeleton.length_to_m`` is 1).
+
+    Raises
+    ------
+    MotionFormatError
+        Malformed input (file and line): see the module docstring, plus bytes
+        that are not UTF-8, a frame count below 1, rows that do not match the
+        channels. A leading UTF-8 byte-order mark is ignored.
     """
     raw = read_text_lines(path)
     toks: list[tuple[str, int]] = []
@@ -104,7 +215,7 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     def nxt():
         nonlocal pos
         if pos >= len(toks):
-            raise MotionFormatError(path, motion_line, "hierarchy ends early")
+            raise MotionFormatError(path, motion_line, "hierarchy ends early (a joint is not closed)")
         pos += 1
         return toks[pos - 1]
 
@@ -112,38 +223,58 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     if t != "HIERARCHY":
         raise MotionFormatError(path, ln, f"expected HIERARCHY, got {t!r}")
     joints: list[dict] = []
-    channels: list[tuple[int, list[str]]] = []
+    seen: dict[str, int] = {}
 
-    def parse_joint(parent: int):
-        kw, ln0 = nxt()
-        name, _ = nxt()
+    def axes_of(chans, suffix, lnc, name):
+        ax = [c[0] for c in chans if c.endswith(suffix)]
+        if len(set(ax)) != len(ax):
+            raise MotionFormatError(path, lnc, f"joint {name!r}: {suffix} channels repeat an axis "
+                                               f"({' '.join(c for c in chans if c.endswith(suffix))}); "
+                                               "each axis may appear once")
+        return ax
+
+    def parse_joint(parent: int, kw: str, ln0: int):
+        name, lnn = nxt()
+        if name in ("{", "}"):
+            raise MotionFormatError(path, lnn, f"{kw} without a name")
+        if name in seen:
+            raise MotionFormatError(path, lnn, f"duplicate joint name {name!r} (first on line {seen[name]})")
+        seen[name] = lnn
         b, lnb = nxt()
         if b != "{":
             raise MotionFormatError(path, lnb, f"expected '{{' after {kw} {name}")
-        rec = {"name": name, "parent": parent, "offset": None, "channels": [], "end": None, "kids": []}
+        rec = {"name": name, "parent": parent, "offset": None, "channels": None, "end": None, "line": ln0}
         idx = len(joints)
         joints.append(rec)
         while True:
             t, ln = nxt()
             if t == "OFFSET":
+                if rec["offset"] is not None:
+                    raise MotionFormatError(path, ln, f"joint {name!r} has a second OFFSET")
                 rec["offset"] = np.array([parse_float(nxt()[0], path, ln, "offset") for _ in range(3)])
             elif t == "CHANNELS":
+                if rec["channels"] is not None:
+                    raise MotionFormatError(path, ln, f"joint {name!r} has a second CHANNELS line")
                 c, lnc = nxt()
                 try:
                     k = int(c)
                 except ValueError:
                     raise MotionFormatError(path, lnc, f"bad channel count {c!r}") from None
-                if k < 0:
-                    raise MotionFormatError(path, lnc, f"negative channel count {c!r}")
-                chans = [nxt()[0] for _ in range(k)]
-                bad = [c for c in chans if c not in _CH]
+                if not 0 <= k <= 6:
+                    raise MotionFormatError(path, lnc, f"channel count must be 0 to 6, got {c!r}")
+                chans = [nxt() for _ in range(k)]
+                bad = [c for c, _ in chans if c not in _CH]
                 if bad:
-                    raise MotionFormatError(path, lnc, f"unknown channel(s) {bad}")
+                    raise MotionFormatError(path, chans[[c for c, _ in chans].index(bad[0])][1],
+                                            f"unknown channel {bad[0]!r} (expected {', '.join(_CH)})")
+                chans = [c for c, _ in chans]
+                axes_of(chans, "rotation", lnc, name)
+                if axes_of(chans, "position", lnc, name) and parent >= 0:
+                    raise MotionFormatError(path, lnc, f"joint {name!r}: position channels on a non-root joint "
+                                                       "are not supported")
                 rec["channels"] = chans
-                channels.append((idx, chans))
-            elif t in ("JOINT",):
-                pos_back()
-                rec["kids"].append(parse_joint(idx))
+            elif t == "JOINT":
+                parse_joint(idx, t, ln)
             elif t == "End":
                 s, lns = nxt()
                 b2, _ = nxt()
@@ -157,18 +288,24 @@ def read_bvh(path, fps: float | None = None) -> Motion:
             elif t == "}":
                 break
             else:
-                raise MotionFormatError(path, ln, f"unexpected token {t!r}")
+                raise MotionFormatError(path, ln, f"unexpected token {t!r} in joint {name!r}")
         if rec["offset"] is None:
             raise MotionFormatError(path, ln0, f"joint {name!r} has no OFFSET")
+        if rec["channels"] is None:
+            rec["channels"] = []
         return idx
 
-    def pos_back():
-        nonlocal pos
-        pos -= 1
-
-    parse_joint(-1)
+    kw, ln = nxt()
+    if kw != "ROOT":
+        raise MotionFormatError(path, ln, f"expected ROOT, got {kw!r}")
+    parse_joint(-1, kw, ln)
+    if pos < len(toks):
+        t, ln = toks[pos]
+        what = "a second ROOT (one skeleton per file is supported)" if t == "ROOT" else repr(t)
+        raise MotionFormatError(path, ln, f"{what} after the root joint's closing brace")
     # motion header
     i = motion_line
+
     def header(prefix):
         nonlocal i
         while i < len(raw) and not raw[i].strip():
@@ -178,6 +315,7 @@ def read_bvh(path, fps: float | None = None) -> Motion:
         val = raw[i].split(":", 1)[1].strip()
         i += 1
         return val, i
+
     nf_s, lnf = header("Frames:")
     ft_s, lnt = header("Frame Time:")
     try:
@@ -189,7 +327,11 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     ftime = parse_float(ft_s, path, lnt, "frame time")
     if ftime <= 0:
         raise MotionFormatError(path, lnt, f"frame time must be positive (seconds per frame), got {ft_s!r}")
-    ncols = sum(len(c) for _, c in channels)
+    try:
+        _check_frame_time(ftime, "frame time")
+    except ValueError as exc:
+        raise MotionFormatError(path, lnt, str(exc).replace("frame time: ", "")) from None
+    ncols = sum(len(r["channels"]) for r in joints)
     rows = []
     for k in range(i, len(raw)):
         if not raw[k].strip():
@@ -203,35 +345,28 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     if len(rows) != nframes:
         raise MotionFormatError(path, len(raw), f"header says {nframes} frames, file has {len(rows)} (truncated?)")
     data = np.array(rows, float).reshape(nframes, ncols)
-    # build the generic skeleton: DOF are the channels, rotations in
-    # extrinsic order = reversed intrinsic channel order
-    sk_joints = []
-    cols = []
-    col = 0
-    chan_of = dict(channels)
+    # the generic skeleton: DOF = position channels, then rotation channels
+    # reversed (intrinsic channel order -> extrinsic DOF order)
+    sk_joints, cols, col = [], [], 0
     for idx, rec in enumerate(joints):
-        chans = chan_of.get(idx, [])
-        trans = [_CH[c] for c in chans if c.endswith("position")]
-        rots = [_CH[c] for c in chans if c.endswith("rotation")]
-        dofs = trans + rots[::-1]
-        kids = [k for k, r in enumerate(joints) if r["parent"] == idx]
-        tail = rec["end"] if rec["end"] is not None else (joints[kids[0]]["offset"] if kids else np.zeros(3))
-        sk_joints.append(Joint(rec["name"], rec["parent"], rec["offset"] if idx else np.zeros(3), np.asarray(tail, float), dofs))
-        # columns of this joint in file order
+        chans = rec["channels"]
         order = {c: col + k for k, c in enumerate(chans)}
         col += len(chans)
-        file_cols = [order[c] for c in chans if c.endswith("position")] + [order[c] for c in chans if c.endswith("rotation")][::-1]
-        cols += file_cols
+        trans = [c for c in chans if c.endswith("position")]
+        rots = [c for c in chans if c.endswith("rotation")][::-1]
+        kids = [k for k, r in enumerate(joints) if r["parent"] == idx]
+        tail = rec["end"] if rec["end"] is not None else (joints[kids[0]]["offset"] if kids else np.zeros(3))
+        sk_joints.append(Joint(rec["name"], rec["parent"], np.asarray(rec["offset"], float),
+                               np.asarray(tail, float), [_CH[c] for c in trans + rots]))
+        cols += [order[c] for c in trans + rots]
     values = data[:, cols] if cols else np.zeros((nframes, 0))
-    root_off = joints[0]["offset"]
     sk = Skeleton(sk_joints, name=os.path.splitext(os.path.basename(os.fspath(path)))[0])
-    sk.joints[0].offset = np.asarray(root_off, float)
     # root positions in BVH are absolute; our root translation adds the offset
-    sl = sk.dof_slices()["root"]
-    for k, d in enumerate(sk.joints[0].dofs):
-        if d.startswith("t"):
-            values[:, sl.start + k] -= root_off["xyz".index(d[1])]
-    return Motion(values, sk, fps if fps is not None else round(1.0 / ftime, 6), sk.name)
+    root = sk.joints[0]
+    for k, d in enumerate(root.dofs):
+        if d in TRANS_DOFS:
+            values[:, k] -= root.offset[TRANS_DOFS.index(d)]
+    return Motion(values, sk, float(fps) if fps is not None else _frame_rate(ft_s, ftime), sk.name)
 
 
 def motion_from_bvh_on(bvh_motion: Motion, skeleton: Skeleton) -> Motion:

@@ -13,7 +13,6 @@ accepted.
 
 from __future__ import annotations
 
-import glob
 import gzip
 import os
 import re
@@ -25,13 +24,14 @@ import numpy as np
 from .atomic import atomic_path, atomic_write_bytes
 from .errors import MotionFormatError, parse_float
 
-__all__ = ["MeshSequence", "read_obj", "write_obj", "read_obj_sequence", "write_obj_sequence", "list_obj_frames"]
+__all__ = ["MeshSequence", "read_obj", "write_obj", "read_obj_sequence", "write_obj_sequence", "list_obj_frames",
+           "is_frame_name", "frame_stem"]
 
 
 def _read_text(path) -> str:
     p = os.fspath(path)
     try:
-        if p.endswith(".gz"):
+        if p.lower().endswith(".gz"):
             with gzip.open(p, "rb") as fh:
                 data = fh.read()
         else:
@@ -168,17 +168,42 @@ def _natural_key(s: str):
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", s)]
 
 
+_FRAME_RX = re.compile(r"\.obj(\.gz)?$", re.IGNORECASE)
+#: Folders whose content is never frames: macOS Finder's resource forks.
+JUNK_FOLDERS = ("__MACOSX",)
+
+
+def is_frame_name(path) -> bool:
+    """Does ``path`` (a file path, relative or not) name a mesh frame?
+
+    The one rule shared by the reader, the fetch and the checksum check: the
+    file name ends in ``.obj`` or ``.obj.gz`` in any letter case; hidden files
+    (``.``-prefixed, e.g. macOS ``._mesh_0001.obj`` companions) and anything
+    inside a hidden folder or a ``__MACOSX`` folder are not frames.
+    """
+    parts = [p for p in re.split(r"[\\/]+", os.fspath(path)) if p not in ("", ".")]
+    if not parts or not _FRAME_RX.search(parts[-1]):
+        return False
+    return not any(p.startswith(".") or p in JUNK_FOLDERS for p in parts)
+
+
+def frame_stem(name: str) -> str:
+    """The frame name without ``.obj`` / ``.obj.gz`` (any case)."""
+    return _FRAME_RX.sub("", os.path.basename(name))
+
+
 def list_obj_frames(folder) -> list[str]:
-    """Frame files of a mesh sequence folder (``*.obj`` and ``*.obj.gz``), in natural order."""
+    """Frame files directly in a mesh sequence folder (:func:`is_frame_name`), in natural order."""
     folder = os.fspath(folder)
     if not os.path.isdir(folder):
         raise FileNotFoundError(f"mesh sequence folder {folder!r} does not exist")
-    files = glob.glob(os.path.join(folder, "*.obj")) + glob.glob(os.path.join(folder, "*.obj.gz"))
+    files = [os.path.join(folder, f) for f in os.listdir(folder)
+             if is_frame_name(f) and os.path.isfile(os.path.join(folder, f))]
     stems = {}
     for f in files:
-        stem = os.path.basename(f)[: -len(".obj.gz")] if f.endswith(".obj.gz") else os.path.basename(f)[:-4]
+        stem = frame_stem(f)
         if stem in stems:
-            raise MotionFormatError(f, None, f"frame {stem!r} exists both as .obj and .obj.gz")
+            raise MotionFormatError(f, None, f"frame {stem!r} exists twice (as {os.path.basename(stems[stem])!r} too)")
         stems[stem] = f
     return [stems[s] for s in sorted(stems, key=_natural_key)]
 

@@ -32,27 +32,32 @@ __all__ = ["PAPER_WEIGHTS", "JOINT_GROUPS", "joint_weights", "l2_distances", "le
 #: Joint-group weights of the paper (Wang & Bodenheimer 2003 optimisation of Lee's metric).
 PAPER_WEIGHTS = {"hips": 1.0, "knees": 0.0901, "shoulders": 0.7884, "elbows": 0.0247}
 
-#: CMU joints of each group (the rotation *of* the bone: femur = hip joint, tibia = knee, ...).
+#: Joint roles of each group (:mod:`animsynth.joints`; the rotation *of* the
+#: bone: CMU lfemur / BVH LeftUpLeg = hip joint, ltibia / LeftLeg = knee, ...).
 JOINT_GROUPS = {
-    "hips": ("lfemur", "rfemur"),
-    "knees": ("ltibia", "rtibia"),
-    "shoulders": ("lhumerus", "rhumerus"),
-    "elbows": ("lradius", "rradius"),
+    "hips": ("left_hip", "right_hip"),
+    "knees": ("left_knee", "right_knee"),
+    "shoulders": ("left_shoulder", "right_shoulder"),
+    "elbows": ("left_elbow", "right_elbow"),
 }
 
 
-def joint_weights(joint_names, weights: dict) -> np.ndarray:
+def joint_weights(joint_names, weights: dict, roles: dict | None = None) -> np.ndarray:
     """Per-joint weight vector for ``joint_names`` from group (or joint) weights.
 
-    Keys of ``weights`` are group names of :data:`JOINT_GROUPS` or joint names.
-    Joints not mentioned get 0.
+    Keys of ``weights`` are group names of :data:`JOINT_GROUPS` (whose roles
+    are resolved by :func:`animsynth.joints.resolve_role`, with the overrides
+    ``roles``) or joint names. Joints not mentioned get 0.
 
     Raises
     ------
     ValueError
         A key that is neither a known group nor one of ``joint_names``, a group
-        whose joints are missing from the skeleton, or a negative weight.
+        whose roles have no joint in the skeleton (:class:`JointRoleError`,
+        naming the role and the joints), or a negative weight.
     """
+    from ..joints import resolve_roles
+
     names = list(joint_names)
     w = np.zeros(len(names))
     for key, val in weights.items():
@@ -60,10 +65,10 @@ def joint_weights(joint_names, weights: dict) -> np.ndarray:
         if not np.isfinite(val) or val < 0:
             raise ValueError(f"Lee weight {key!r} must be finite and >= 0, got {val}")
         if key in JOINT_GROUPS:
-            members = JOINT_GROUPS[key]
-            missing = [m for m in members if m not in names]
-            if missing:
-                raise ValueError(f"Lee weight group {key!r}: skeleton has no joint(s) {missing}")
+            try:
+                members = resolve_roles(names, JOINT_GROUPS[key], roles)
+            except ValueError as exc:
+                raise type(exc)(f"Lee weight group {key!r}: {exc}") from None
             for m in members:
                 w[names.index(m)] = val
         elif key in names:
@@ -161,6 +166,7 @@ def lee_distances(features: MotionFeatures, weights: dict | None = None, nu: flo
     weigh root travel alike). The Lee metric is sign-invariant
     (``arccos |<q_i, q_j>|``), so the linearisation's ``sign_mode`` does not
     apply to it."""
-    w = joint_weights(features.joint_names, PAPER_WEIGHTS if weights is None else weights)
+    w = joint_weights(features.joint_names, PAPER_WEIGHTS if weights is None else weights,
+                      getattr(features, "roles", None))
     root = float(translation_scale) * features.root_pos if include_global else None
     return lee_metric(features.quats, w, features.fps, nu, root_pos=root, sqrt=sqrt)

@@ -15,7 +15,7 @@ Conventions
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -194,6 +194,8 @@ class MotionFeatures:
     root_pos : ndarray (frames, 3)
         Root position in metres (Y up).
     fps : float
+    roles : dict
+        The skeleton's joint-role overrides (:mod:`animsynth.joints`).
     """
 
     joint_names: list
@@ -201,6 +203,7 @@ class MotionFeatures:
     root_quat: np.ndarray
     root_pos: np.ndarray
     fps: float
+    roles: dict = field(default_factory=dict)
 
     @property
     def n_frames(self) -> int:
@@ -234,4 +237,5 @@ def motion_features(motion) -> MotionFeatures:
         root_quat=q[:, 0, :],
         root_pos=root_translation(sk, values) * sk.length_to_m,
         fps=float(motion.fps),
+        roles=dict(getattr(sk, "roles", None) or {}),
     )

@@ -37,6 +37,10 @@ log = logging.getLogger("animsynth.resequencing")
 __all__ = ["joint_quats", "transitions", "pass_jumps", "classify_path", "TransitionReference", "transition_measures",
            "pose_steps", "jerk_magnitude", "root_reversals", "foot_ground", "foot_skate", "Reference", "smoothness"]
 
+#: Joint roles of the foot metrics (:mod:`animsynth.joints`): the end of the
+#: ankle's segment is the ball of the foot, the end of the toe's the toe tip.
+FOOT_ROLES = ("left_ankle", "left_toe", "right_ankle", "right_toe")
+#: The CMU joints of :data:`FOOT_ROLES`.
 FOOT_JOINTS = ("lfoot", "ltoes", "rfoot", "rtoes")
 
 
@@ -83,18 +87,31 @@ def root_reversals(motion, speed_threshold: float = 0.1) -> int:
     return int(np.count_nonzero(sig[1:] != sig[:-1]))
 
 
+def foot_joints(skeleton) -> tuple[str, ...]:
+    """The joints of :data:`FOOT_ROLES` in ``skeleton`` (raises JointRoleError naming a missing role)."""
+    from ..joints import resolve_roles
+
+    return tuple(resolve_roles(skeleton, FOOT_ROLES))
+
+
 def _foot_positions(motion, joints):
     sk = motion.skeleton
+    if joints is None:
+        joints = foot_joints(sk)
     pos = forward_kinematics(sk, motion.values) * sk.length_to_m
     return pos[:, [sk.index(j) for j in joints], :]
 
 
-def foot_ground(motion, joints=FOOT_JOINTS) -> np.ndarray:
+def foot_joints_of(motion) -> tuple[str, ...]:
+    return foot_joints(motion.skeleton)
+
+
+def foot_ground(motion, joints=None) -> np.ndarray:
     """Lowest height (metres) of each foot joint over a motion: its ground level."""
     return _foot_positions(motion, joints)[:, :, 1].min(axis=0)
 
 
-def foot_skate(motion, ground, contact_height: float = 0.02, joints=FOOT_JOINTS) -> tuple[float, float]:
+def foot_skate(motion, ground, contact_height: float = 0.02, joints=None) -> tuple[float, float]:
     """Mean horizontal foot speed during contact (m/s) and the fraction of contact steps.
 
     A foot joint is in contact on a step when its height is within
@@ -121,10 +138,10 @@ class Reference:
     """Measures of the original trial that re-sequenced motions are compared with."""
 
     def __init__(self, original, contact_height: float = 0.02, speed_threshold: float = 0.1,
-                 foot_joints=FOOT_JOINTS):
+                 foot_joints=None):
         self.contact_height = float(contact_height)
         self.speed_threshold = float(speed_threshold)
-        self.foot_joints = tuple(foot_joints)
+        self.foot_joints = foot_joints_of(original) if foot_joints is None else tuple(foot_joints)
         q = joint_quats(original)
         self.steps = pose_steps(q)
         self.jerk = jerk_magnitude(q, original.fps)
@@ -226,7 +243,7 @@ class TransitionReference:
     * ``skate``: the capture's mean contact foot speed (:func:`foot_skate`).
     """
 
-    def __init__(self, original, contact_height: float = 0.02, foot_joints=FOOT_JOINTS):
+    def __init__(self, original, contact_height: float = 0.02, foot_joints=None):
         q = joint_quats(original)
         if q.shape[0] < 6:
             raise ValueError("the original motion needs at least 6 frames")
@@ -237,7 +254,7 @@ class TransitionReference:
         a = np.diff(w, axis=0)  # a[s] = w[s+1] - w[s]
         self.acc = float(np.linalg.norm((a[3:] - a[:-3]).reshape(len(a) - 3, -1), axis=1).mean())
         self.contact_height = float(contact_height)
-        self.foot_joints = tuple(foot_joints)
+        self.foot_joints = foot_joints_of(original) if foot_joints is None else tuple(foot_joints)
         self.ground = foot_ground(original, self.foot_joints)
         self.skate, _ = foot_skate(original, self.ground, self.contact_height, self.foot_joints)
 

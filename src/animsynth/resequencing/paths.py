@@ -146,7 +146,7 @@ def play_path(motion: Motion, path, root: str = "integrate", name: str | None = 
         root = sk.joints[0]
         C = root.axis_rotation()
         M = C.inv() * Rnew * C
-        sl = sk.dof_slices()["root"]
+        sl = sk.dof_slices()[root.name]
         rd = [d for d in root.dofs if d in ROT_DOFS]
         if rd:
             ang = M.as_euler("".join(d[1] for d in rd), degrees=True)

@@ -198,7 +198,8 @@ def _lee_parts(features, weights, nu: float, include_global: bool):
     root-position vector ``(frames, 3)`` or None.
     """
     feats, _ = concat_features(features)
-    w = joint_weights(feats[0].joint_names, PAPER_WEIGHTS if weights is None else weights)
+    w = joint_weights(feats[0].joint_names, PAPER_WEIGHTS if weights is None else weights,
+                      getattr(feats[0], "roles", None))
     if not (np.isfinite(nu) and nu >= 0):
         raise ValueError(f"nu must be finite and >= 0, got {nu}")
     active = np.flatnonzero(w > 0)

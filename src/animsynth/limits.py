@@ -1,0 +1,65 @@
+"""Memory budget: refuse a request before allocating arrays that would not fit.
+
+A request (a CLI ``--steps`` / ``--length``, a config's trial frames) is turned
+into an estimate of the bytes its largest arrays need; above the budget it is
+refused with one line naming the argument (or config key) and the estimate,
+before any work starts. The budget is :data:`DEFAULT_MEMORY_BUDGET_GIB` unless
+configured (CLI ``--memory-budget-gib``, config key ``memory_budget_gib``).
+"""
+
+from __future__ import annotations
+
+GIB = float(2**30)
+
+#: Default budget (GiB) for the arrays of one request.
+DEFAULT_MEMORY_BUDGET_GIB = 4.0
+
+
+class BudgetError(ValueError):
+    """A request's arrays would exceed the memory budget (the message names the argument)."""
+
+
+def check_budget(what: str, nbytes: float, budget_gib: float = DEFAULT_MEMORY_BUDGET_GIB) -> None:
+    """Raise :class:`BudgetError` when ``nbytes`` exceeds ``budget_gib``.
+
+    Parameters
+    ----------
+    what : str
+        The argument or config key and its value, e.g. ``"--steps 1000000000"``.
+    nbytes : float
+        Estimated bytes of the arrays the request allocates.
+    budget_gib : float
+        The budget in GiB (2**30 bytes).
+    """
+    if nbytes > budget_gib * GIB:
+        raise BudgetError(f"{what} needs about {nbytes / GIB:.3g} GiB of arrays, over the memory budget of "
+                          f"{budget_gib:g} GiB (raise it with --memory-budget-gib / memory_budget_gib)")
+
+
+def synthetic_trial_bytes(frames: int, fps: float, n_dof: int = 62) -> float:
+    """Bytes the synthetic mocap generator allocates for one trial (values,
+    per-joint rotations, and smoothing noise padded by a few seconds)."""
+    return 8.0 * (4 * frames * n_dof + 4 * (frames + 6 * fps) * 3)
+
+
+def count_nodes(obj, limit: int) -> int:
+    """Number of values in ``obj`` with every shared reference (a YAML alias)
+    counted each time it is reached, stopping past ``limit``.
+
+    Returns the count (at most ``limit + 1``). Raises ``ValueError`` for a
+    structure that contains itself (a recursive alias).
+    """
+    count = 0
+    stack = [(obj, ())]
+    while stack:
+        o, ancestors = stack.pop()
+        count += 1
+        if count > limit:
+            return count
+        if isinstance(o, (dict, list, tuple)):
+            if id(o) in ancestors:
+                raise ValueError("the config contains itself (a recursive YAML alias)")
+            inner = ancestors + (id(o),)
+            items = list(o.keys()) + list(o.values()) if isinstance(o, dict) else o
+            stack.extend((x, inner) for x in items)
+    return count

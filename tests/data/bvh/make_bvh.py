@@ -1,0 +1,144 @@
+"""Write the small BVH files of this folder (run: python tests/data/bvh/make_bvh.py).
+
+Each file follows one convention seen in BVH files from elsewhere; all are
+made up here (smooth sinusoidal joint angles, a root walking forward) and do
+not come from any other project:
+
+* ``cmu_converted.bvh``: CMU-to-BVH conversion names (``Hips``, ``LHipJoint``,
+  ``LeftUpLeg``, ``LowerBack``, ``LeftToeBase`` ...), root ``Zrotation
+  Yrotation Xrotation``, joints ``Zrotation Yrotation Xrotation``, frame time
+  printed as ``.0083333`` (120 fps), space indentation.
+* ``hips_xyz.bvh``: ``ROOT Hips``, ``Xrotation Yrotation Zrotation``
+  everywhere, 120 fps printed as ``0.008333``.
+* ``hips_zxy.bvh``: Mixamo-style ``mixamorig:`` names, ``Zrotation
+  Xrotation Yrotation``, 30 fps, a root OFFSET that is not zero.
+* ``blender.bvh``: Blender-exporter style (tab indentation, rigify-style
+  lower-case ``thigh.L`` names, ``Yrotation Xrotation Zrotation``, 24 fps
+  printed as ``0.041667``, an ``End Site`` on every leaf).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+FRAMES = 24
+
+# (role name, parent role, offset) of a generic biped, Y up, lengths in cm
+BODY = [
+    ("hips", None, (0.0, 0.0, 0.0)),
+    ("spine", "hips", (0.0, 10.0, 0.5)),
+    ("chest", "spine", (0.0, 12.0, 0.0)),
+    ("neck", "chest", (0.0, 20.0, -1.0)),
+    ("head", "neck", (0.0, 8.0, 1.0)),
+    ("lshoulder", "chest", (3.0, 17.0, -1.0)),
+    ("larm", "lshoulder", (12.0, 0.0, 0.0)),
+    ("lforearm", "larm", (27.0, 0.0, 0.0)),
+    ("lhand", "lforearm", (25.0, 0.0, 0.0)),
+    ("rshoulder", "chest", (-3.0, 17.0, -1.0)),
+    ("rarm", "rshoulder", (-12.0, 0.0, 0.0)),
+    ("rforearm", "rarm", (-27.0, 0.0, 0.0)),
+    ("rhand", "rforearm", (-25.0, 0.0, 0.0)),
+    ("lupleg", "hips", (9.0, -6.0, 0.0)),
+    ("lleg", "lupleg", (0.0, -42.0, 0.5)),
+    ("lfoot", "lleg", (0.0, -41.0, -2.0)),
+    ("ltoe", "lfoot", (0.0, -6.0, 12.0)),
+    ("rupleg", "hips", (-9.0, -6.0, 0.0)),
+    ("rleg", "rupleg", (0.0, -42.0, 0.5)),
+    ("rfoot", "rleg", (0.0, -41.0, -2.0)),
+    ("rtoe", "rfoot", (0.0, -6.0, 12.0)),
+]
+END_SITES = {"head": (0.0, 10.0, 0.0), "lhand": (8.0, 0.0, 0.0), "rhand": (-8.0, 0.0, 0.0),
+             "ltoe": (0.0, 0.0, 5.0), "rtoe": (0.0, 0.0, 5.0)}
+
+
+def angles(k: int, t: int, fps: float) -> tuple[float, float, float]:
+    """Smooth made-up angles (degrees) of joint k at frame t, about X, Y, Z."""
+    s = 2.0 * math.pi * 1.1 * t / fps
+    a = 25.0 * math.sin(s + 0.7 * k) + 3.0 * k % 7
+    b = 12.0 * math.sin(0.5 * s + 1.3 * k)
+    c = 8.0 * math.cos(s + 0.4 * k) - 2.0
+    return a, b, c
+
+
+def write(name: str, names: dict, root_order: str, order: str, fps: float, frame_time: str, indent: str = "  ",
+          root_offset=(0.0, 0.0, 0.0), extra=(), skip=()) -> None:
+    body = [b for b in BODY if b[0] not in skip] + list(extra)
+    kids = {}
+    for role, parent, _ in body:
+        kids.setdefault(parent, []).append(role)
+    off = {role: o for role, _, o in body}
+    lines = ["HIERARCHY"]
+    chan_order = []
+
+    def emit(role, depth):
+        ind = indent * depth
+        lines.append(f"{ind}{'ROOT' if depth == 0 else 'JOINT'} {names[role]}")
+        lines.append(f"{ind}{{")
+        o = root_offset if depth == 0 else off[role]
+        lines.append(f"{ind}{indent}OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}")
+        ro = root_order if depth == 0 else order
+        rot = " ".join(f"{a}rotation" for a in ro)
+        if depth == 0:
+            lines.append(f"{ind}{indent}CHANNELS 6 Xposition Yposition Zposition {rot}")
+        else:
+            lines.append(f"{ind}{indent}CHANNELS 3 {rot}")
+        chan_order.append((role, depth == 0, ro))
+        for c in kids.get(role, []):
+            emit(c, depth + 1)
+        if role not in kids:
+            e = END_SITES.get(role, (0.0, 5.0, 0.0))
+            lines.append(f"{ind}{indent}End Site")
+            lines.append(f"{ind}{indent}{{")
+            lines.append(f"{ind}{indent}{indent}OFFSET {e[0]:.6f} {e[1]:.6f} {e[2]:.6f}")
+            lines.append(f"{ind}{indent}}}")
+        lines.append(f"{ind}}}")
+
+    emit("hips", 0)
+    lines += ["MOTION", f"Frames: {FRAMES}", f"Frame Time: {frame_time}"]
+    for t in range(FRAMES):
+        row = []
+        for k, (role, is_root, ro) in enumerate(chan_order):
+            if is_root:
+                row += [1.5 * t, 95.0 + 2.0 * math.sin(t / 3.0), 0.3 * t]
+            a = dict(zip("XYZ", angles(k, t, fps)))
+            row += [a[ax] for ax in ro]
+        lines.append(" ".join(f"{v:.6f}" for v in row))
+    (HERE / name).write_text("\n".join(lines) + "\n")
+
+
+def main():
+    cmu = {"hips": "Hips", "spine": "LowerBack", "chest": "Spine1", "neck": "Neck", "head": "Head",
+           "lshoulder": "LeftShoulder", "larm": "LeftArm", "lforearm": "LeftForeArm", "lhand": "LeftHand",
+           "rshoulder": "RightShoulder", "rarm": "RightArm", "rforearm": "RightForeArm", "rhand": "RightHand",
+           "lhip": "LHipJoint", "lupleg": "LeftUpLeg", "lleg": "LeftLeg", "lfoot": "LeftFoot", "ltoe": "LeftToeBase",
+           "rhip": "RHipJoint", "rupleg": "RightUpLeg", "rleg": "RightLeg", "rfoot": "RightFoot",
+           "rtoe": "RightToeBase"}
+    # the CMU conversions put a hip joint between the root and each thigh
+    global BODY
+    saved = BODY
+    BODY = [b if b[0] not in ("lupleg", "rupleg") else (b[0], "lhip" if b[0] == "lupleg" else "rhip", (3.0, -4.0, 0.0)
+                                                        if b[0] == "lupleg" else (-3.0, -4.0, 0.0)) for b in BODY]
+    BODY.insert(13, ("lhip", "hips", (6.0, -2.0, 0.0)))
+    BODY.insert(18, ("rhip", "hips", (-6.0, -2.0, 0.0)))
+    write("cmu_converted.bvh", cmu, "ZYX", "ZYX", 120.0, ".0083333")
+    BODY = saved
+    plain = {"hips": "Hips", "spine": "Spine", "chest": "Spine1", "neck": "Neck", "head": "Head",
+             "lshoulder": "LeftShoulder", "larm": "LeftArm", "lforearm": "LeftForeArm", "lhand": "LeftHand",
+             "rshoulder": "RightShoulder", "rarm": "RightArm", "rforearm": "RightForeArm", "rhand": "RightHand",
+             "lupleg": "LeftUpLeg", "lleg": "LeftLeg", "lfoot": "LeftFoot", "ltoe": "LeftToeBase",
+             "rupleg": "RightUpLeg", "rleg": "RightLeg", "rfoot": "RightFoot", "rtoe": "RightToeBase"}
+    write("hips_xyz.bvh", plain, "XYZ", "XYZ", 120.0, "0.008333")
+    mixamo = {k: "mixamorig:" + v for k, v in plain.items()}
+    write("hips_zxy.bvh", mixamo, "ZXY", "ZXY", 30.0, "0.0333333", root_offset=(0.0, 2.5, 0.0))
+    blender = {"hips": "hips", "spine": "spine", "chest": "chest", "neck": "neck", "head": "head",
+               "lshoulder": "shoulder.L", "larm": "upper_arm.L", "lforearm": "forearm.L", "lhand": "hand.L",
+               "rshoulder": "shoulder.R", "rarm": "upper_arm.R", "rforearm": "forearm.R", "rhand": "hand.R",
+               "lupleg": "thigh.L", "lleg": "shin.L", "lfoot": "foot.L", "ltoe": "toe.L",
+               "rupleg": "thigh.R", "rleg": "shin.R", "rfoot": "foot.R", "rtoe": "toe.R"}
+    write("blender.bvh", blender, "YXZ", "YXZ", 24.0, "0.041667", indent="\t")
+
+
+if __name__ == "__main__":
+    main()
