@@ -13,9 +13,6 @@ min_version("9.0")
 SRC = os.path.join(workflow.basedir, "src")
 sys.path.insert(0, SRC)
 os.environ.update(PYTHONPATH=os.pathsep.join(p for p in (SRC, os.environ.get("PYTHONPATH")) if p))
-# Workflow jobs draw figures into files: matplotlib's non-interactive backend, set
-# here for the jobs only (the library forces no backend, so interactive use works).
-os.environ["MPLBACKEND"] = "Agg"
 
 
 configfile: "config/config.yaml"

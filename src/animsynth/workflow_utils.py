@@ -24,9 +24,15 @@ def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None 
     """Send ``animsynth`` log records (INFO and up) to the rule's ``log:`` file.
 
     Uncaught exceptions are logged too, so the log explains a failed job.
+    Figures of the job are drawn with matplotlib's non-interactive Agg backend.
     Temporaries that an interrupted earlier run left for this job's outputs
     are removed (:func:`animsynth.io.atomic.clean_stale_temporaries`).
     """
+    # workflow jobs draw figures into files: matplotlib's non-interactive backend for them only (the library
+    # itself forces no backend, so interactive use keeps the user's)
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    if "matplotlib" in sys.modules:
+        sys.modules["matplotlib"].use("Agg")
     if log_path is None and snakemake is not None and len(snakemake.log):
         log_path = str(snakemake.log[0])
     root = logging.getLogger("animsynth")

@@ -50,13 +50,13 @@ def subset_npz(wildcards):
     return [trial_npz(t) for t in SUBSETS[wildcards.dataset]]
 
 
-def job_benchmarks(rule, **wildcards):
-    """Benchmark files of one rule's jobs in this run (wildcard value lists zipped), declared as inputs of
-    rule_benchmarks, so the aggregate holds exactly this run's jobs, never a stale file left by another run."""
-    pattern = strip_wildcard_constraints(str(getattr(rules, rule).rule.benchmark))
+def job_benchmarks(rule_name, **wildcards):
+    """Benchmark files of the jobs of one rule in this run (wildcard value lists zipped); the benchmark
+    aggregation declares them as inputs, so it holds exactly this run's jobs, never a stale file of another run."""
+    pattern = strip_wildcard_constraints(str(getattr(rules, rule_name).rule.benchmark))
     files = expand(pattern, zip, **wildcards) if wildcards else [pattern]
     if not files or any("{" in f for f in files):
-        raise ValueError(f"benchmark files of rule {rule}: {pattern} with {wildcards} gave {files}")
+        raise ValueError(f"benchmark files of {rule_name}: {pattern} with {wildcards} gave {files}")
     return files
 
 
@@ -162,3 +162,98 @@ def provenance_rows():
 def report_outputs(wildcards=None):
     """Every output path pattern wrapped in report(...), for links from the report's home page."""
     return sorted({str(f) for r in workflow.rules for f in r.output if is_flagged(f, "report")})
+
+
+# ---- per-family helpers (the functions live here; each family's file holds its rules) ----
+def raw_files_of_used_trials(wildcards=None):
+    """Raw files of every used trial, flat (ASF + AMC, or BVH), in USED_TRIALS order."""
+    return [f for t in USED_TRIALS for f in raw_trial_files(t).values()]
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def data_benchmarks():
+    if SOURCE == "synthetic":
+        raw = job_benchmarks("synth_trials")
+    else:
+        amc = [t for t in USED_TRIALS if t not in BVH_TRIALS]
+        bvh = [t for t in USED_TRIALS if t in BVH_TRIALS]
+        raw = (job_benchmarks("download_trial", trial=amc) if amc else []) + (
+            job_benchmarks("download_bvh_trial", trial=bvh) if bvh else []
+        )
+    return raw + job_benchmarks("parse_trials") + job_benchmarks("datasets_table")
+
+
+def mesh_data_benchmarks():
+    """The mesh sequence's fetch and checksum jobs (in the run when the hybrid mesh family runs)."""
+    fetch = job_benchmarks("mesh_fetch") if MESH_FRAMES != MESH_SRC else []
+    return fetch + (job_benchmarks("mesh_checksums") if MESH_CHECK else [])
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def simplicial_benchmarks():
+    grids = [(g, d) for g in ("derivative", "beyond") for d in SIMP_DATASETS]
+    return (
+        job_benchmarks("simplicial_fold", dataset=SIMP_DATASETS)
+        + job_benchmarks("simplicial_table")
+        + job_benchmarks("simplicial_grid", grid=[g for g, _ in grids], dataset=[d for _, d in grids])
+        + job_benchmarks("simplicial_summary")
+        + job_benchmarks("simplicial_figures")
+        + job_benchmarks("simplicial_walk")
+    )
+
+
+def reseq_path_outputs(pattern):
+    """One output per method x metric x global flag of a dataset (the order of RESEQ_PATH_CONFIGS)."""
+    return [pattern.format(rsmethod=m, rsmetric=x, rsgdof=g) for m, x, g in RESEQ_PATH_CONFIGS]
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def resequencing_benchmarks():
+    pairs = [(d, g) for d in RESEQ_DATASETS for g in RESEQ_GDOF]
+    return (
+        job_benchmarks("resequencing_analyse", rsdata=[d for d, _ in pairs], rsgdof=[g for _, g in pairs])
+        + job_benchmarks("resequencing_explain", rsdata=RESEQ_DATASETS)
+        + job_benchmarks("resequencing_path", rsdata=RESEQ_DATASETS)
+        + job_benchmarks("resequencing_figures", rsdata=RESEQ_DATASETS)
+        + job_benchmarks("resequencing_tables")
+    )
+
+
+def fg_graph_outputs(names):
+    """Per-configuration outputs of one graphs job, in the order of ``names``."""
+    return dict(
+        graphs=[R(f"facegraph/graphs/{n}.npz") for n in names],
+        run=[R(f"facegraph/runs/{n}.json") for n in names],
+        samples=[R(f"facegraph/runs/{n}_samples.csv") for n in names],
+        sample_thresholds=[R(f"facegraph/runs/{n}_thresholds.csv") for n in names],
+    )
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def facegraph_benchmarks():
+    rules_run = (["facegraph_synth_db"] if FG_SYNTHETIC else []) + ["facegraph_prepare", "facegraph_graphs"]
+    rules_run += (["facegraph_sweep_graphs"] if FG_SWEEP_NAMES else []) + ["facegraph_table1"]
+    rules_run += (["facegraph_sweep"] if FG_SWEEP_CONFIGS else []) + [
+        "facegraph_baseline", "facegraph_uniqueness", "facegraph_figures", "facegraph_verdicts"]
+    return [f for r in rules_run for f in job_benchmarks(r)]
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def meshdetail_benchmarks():
+    rules_run = ([] if MESH_DIR else ["meshdetail_character"]) + [
+        "meshdetail_load", "meshdetail_rig", "meshdetail_main", "meshdetail_resolution",
+        "meshdetail_representations", "meshdetail_figures", "meshdetail_verdicts"]
+    return [f for r in rules_run for f in job_benchmarks(r)] + mesh_data_benchmarks()
+
+
+def run_benchmark_files(wildcards=None):
+    """The benchmark file of every job of this run (the families that run, the summary and the benchmarks)."""
+    family_benchmarks = {
+        "data": data_benchmarks,
+        "simplicial": simplicial_benchmarks,
+        "resequencing": resequencing_benchmarks,
+        "facegraph": facegraph_benchmarks,
+        "meshdetail": meshdetail_benchmarks,
+    }
+    files = [f for fam, fn in family_benchmarks.items() if FAMILY_RAN[fam] for f in fn()]
+    return files + job_benchmarks("summary") + job_benchmarks("benchmarks")

@@ -82,11 +82,6 @@ else:
             "../scripts/data_download_trial.py"
 
 
-def raw_files_of_used_trials(wildcards=None):
-    """Raw files of every used trial, flat (ASF + AMC, or BVH), in USED_TRIALS order."""
-    return [f for t in USED_TRIALS for f in raw_trial_files(t).values()]
-
-
 # Every used trial parsed in one job (a fraction of a second each, less than a
 # job's start-up); a malformed file still fails the job with its file and line.
 rule parse_trials:
@@ -200,22 +195,3 @@ if MESH_CHECK:
             "../envs/animsynth.yaml"
         script:
             "../scripts/data_mesh_checksums.py"
-
-
-# Benchmark files of this family's jobs (inputs of rule_benchmarks).
-def data_benchmarks():
-    if SOURCE == "synthetic":
-        raw = job_benchmarks("synth_trials")
-    else:
-        amc = [t for t in USED_TRIALS if t not in BVH_TRIALS]
-        bvh = [t for t in USED_TRIALS if t in BVH_TRIALS]
-        raw = (job_benchmarks("download_trial", trial=amc) if amc else []) + (
-            job_benchmarks("download_bvh_trial", trial=bvh) if bvh else []
-        )
-    return raw + job_benchmarks("parse_trials") + job_benchmarks("datasets_table")
-
-
-def mesh_data_benchmarks():
-    """The mesh sequence's fetch and checksum jobs (in the run when the hybrid mesh family runs)."""
-    fetch = job_benchmarks("mesh_fetch") if MESH_FRAMES != MESH_SRC else []
-    return fetch + (job_benchmarks("mesh_checksums") if MESH_CHECK else [])

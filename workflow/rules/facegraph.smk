@@ -82,16 +82,6 @@ rule facegraph_prepare:
         "../scripts/facegraph_prepare.py"
 
 
-def fg_graph_outputs(names):
-    """Per-configuration outputs of one graphs job, in the order of ``names``."""
-    return dict(
-        graphs=[R(f"facegraph/graphs/{n}.npz") for n in names],
-        run=[R(f"facegraph/runs/{n}.json") for n in names],
-        samples=[R(f"facegraph/runs/{n}_samples.csv") for n in names],
-        sample_thresholds=[R(f"facegraph/runs/{n}_thresholds.csv") for n in names],
-    )
-
-
 # Table 1's configurations and the showcase in one job (each fit takes about a
 # second, less than a job's start-up); the optional sweep has a job of its own,
 # so switching it on does not rerun Table 1.
@@ -387,12 +377,3 @@ FACEGRAPH_SUMMARY = [
     },
 ]
 FACEGRAPH_VERDICTS = [R("facegraph/verdicts.csv")]
-
-
-# Benchmark files of this family's jobs (inputs of rule_benchmarks).
-def facegraph_benchmarks():
-    rules_run = (["facegraph_synth_db"] if FG_SYNTHETIC else []) + ["facegraph_prepare", "facegraph_graphs"]
-    rules_run += (["facegraph_sweep_graphs"] if FG_SWEEP_NAMES else []) + ["facegraph_table1"]
-    rules_run += (["facegraph_sweep"] if FG_SWEEP_CONFIGS else []) + [
-        "facegraph_baseline", "facegraph_uniqueness", "facegraph_figures", "facegraph_verdicts"]
-    return [f for r in rules_run for f in job_benchmarks(r)]

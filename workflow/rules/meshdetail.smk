@@ -351,11 +351,3 @@ MESHDETAIL_SUMMARY = [
     },
 ]
 MESHDETAIL_VERDICTS = [R("meshdetail/verdicts.csv")]
-
-
-# Benchmark files of this family's jobs (inputs of rule_benchmarks).
-def meshdetail_benchmarks():
-    rules_run = ([] if MESH_DIR else ["meshdetail_character"]) + [
-        "meshdetail_load", "meshdetail_rig", "meshdetail_main", "meshdetail_resolution",
-        "meshdetail_representations", "meshdetail_figures", "meshdetail_verdicts"]
-    return [f for r in rules_run for f in job_benchmarks(r)] + mesh_data_benchmarks()

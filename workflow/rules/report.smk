@@ -104,21 +104,6 @@ rule benchmarks:
         "../scripts/report_benchmarks.py"
 
 
-FAMILY_BENCHMARKS = {
-    "data": data_benchmarks,
-    "simplicial": simplicial_benchmarks,
-    "resequencing": resequencing_benchmarks,
-    "facegraph": facegraph_benchmarks,
-    "meshdetail": meshdetail_benchmarks,
-}
-
-
-def run_benchmark_files(wildcards=None):
-    """The benchmark file of every job of this run (the families that run, the summary and the benchmarks)."""
-    files = [f for fam, fn in FAMILY_BENCHMARKS.items() if FAMILY_RAN[fam] for f in fn()]
-    return files + job_benchmarks("summary") + job_benchmarks("benchmarks")
-
-
 rule rule_benchmarks:
     input:
         run_benchmark_files,

@@ -100,11 +100,6 @@ rule resequencing_explain:
         "../scripts/resequencing_explain.py"
 
 
-def reseq_path_outputs(pattern):
-    """One output per method x metric x global flag of a dataset (the order of RESEQ_PATH_CONFIGS)."""
-    return [pattern.format(rsmethod=m, rsmetric=x, rsgdof=g) for m, x, g in RESEQ_PATH_CONFIGS]
-
-
 RESEQ_PATH_CONFIGS = [(m, x, g) for m in RESEQ_METHODS for x in RESEQ_METRICS for g in RESEQ_GDOF]
 
 
@@ -286,15 +281,3 @@ RESEQUENCING_SUMMARY = [
     },
 ]
 RESEQUENCING_VERDICTS = [R("resequencing/verdicts.csv")]
-
-
-# Benchmark files of this family's jobs (inputs of rule_benchmarks).
-def resequencing_benchmarks():
-    pairs = [(d, g) for d in RESEQ_DATASETS for g in RESEQ_GDOF]
-    return (
-        job_benchmarks("resequencing_analyse", rsdata=[d for d, _ in pairs], rsgdof=[g for _, g in pairs])
-        + job_benchmarks("resequencing_explain", rsdata=RESEQ_DATASETS)
-        + job_benchmarks("resequencing_path", rsdata=RESEQ_DATASETS)
-        + job_benchmarks("resequencing_figures", rsdata=RESEQ_DATASETS)
-        + job_benchmarks("resequencing_tables")
-    )

@@ -343,16 +343,3 @@ SIMPLICIAL_SUMMARY = [
     },
 ]
 SIMPLICIAL_VERDICTS = [R("simplicial/verdicts.csv")]
-
-
-# Benchmark files of this family's jobs (inputs of rule_benchmarks).
-def simplicial_benchmarks():
-    grids = [(g, d) for g in ("derivative", "beyond") for d in SIMP_DATASETS]
-    return (
-        job_benchmarks("simplicial_fold", dataset=SIMP_DATASETS)
-        + job_benchmarks("simplicial_table")
-        + job_benchmarks("simplicial_grid", grid=[g for g, _ in grids], dataset=[d for _, d in grids])
-        + job_benchmarks("simplicial_summary")
-        + job_benchmarks("simplicial_figures")
-        + job_benchmarks("simplicial_walk")
-    )
