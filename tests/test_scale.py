@@ -296,7 +296,7 @@ def test_scale_workflow_builds_curves_landmark_table_and_benchmark_rows(tmp_path
 
     wd = copy_workflow(tmp_path)
     (wd / "config" / "scale_smoke.yaml").write_text(yaml.safe_dump(SMOKE, sort_keys=False))
-    res = run_snakemake(wd, "--configfile", "config/scale.yaml", "config/scale_smoke.yaml", timeout=1500)
+    res = run_snakemake(wd, "--configfile", "config/scale.yaml", "config/scale_smoke.yaml")
     assert res.returncode == 0, (res.stdout + res.stderr)[-5000:]
     out = wd / "results" / "scale"
     # only the scale outputs are built with the scale config
