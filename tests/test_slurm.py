@@ -29,7 +29,7 @@ import pytest
 
 from conftest import REPO, SAFETY_TIMEOUT, SNAKEMAKE, copy_workflow, place_papers, run_snakemake
 
-pytestmark = pytest.mark.slurm
+pytestmark = [pytest.mark.slurm, pytest.mark.workflow]
 
 SCRIPTS = REPO / "tests" / "slurm"
 CLUSTER_TOOLS = ("munged", "slurmctld", "slurmd", "sbatch", "squeue", "sinfo", "scontrol", "srun")
