@@ -20,6 +20,12 @@ import sys
 from pathlib import Path
 
 import pytest
+from threadpoolctl import threadpool_limits
+
+# One BLAS thread in the test process, as the workflow's jobs run their heavy loops: on a busy 2-core
+# machine OpenBLAS's threads turned scipy's first Delaunay.find_simplex (a thousand small LAPACK calls)
+# from 1 ms into 9 s. Subprocesses (snakemake runs) are not affected.
+_BLAS_LIMIT = threadpool_limits(1, user_api="blas")
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = Path(os.environ.get("ANIMSYNTH_SHARED_DATA", REPO.parent / "shared" / "data"))
