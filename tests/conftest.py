@@ -119,3 +119,11 @@ def tiny_without_papers(tiny_workflow, tmp_path_factory):
     if res.returncode != 0:
         pytest.fail("rebuilding the paper tables failed:\n" + res.stdout[-4000:] + "\n" + res.stderr[-8000:])
     return wd
+
+
+def pytest_collection_modifyitems(config, items):
+    """A test that reads the tiny run must be marked ``workflow``, so ``-m "not workflow"`` never starts it."""
+    bad = [i.nodeid for i in items if {"tiny_workflow", "tiny_without_papers"} & set(getattr(i, "fixturenames", ()))
+           and i.get_closest_marker("workflow") is None]
+    if bad:
+        raise pytest.UsageError("tests using the tiny workflow run must be marked workflow: " + ", ".join(bad))
