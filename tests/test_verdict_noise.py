@@ -22,10 +22,11 @@ from animsynth.simplicial.verdicts import build_verdicts
 from test_simplicial_ensemble import _trials
 
 REL = 1e-6
-#: Columns that are ratios of counts (shares of ensemble members, samples in a band, node compressions): the same
-#: on every machine as long as the counts are, so they get no noise of their own. Where a builder recomputes
-#: such a share from measured values (the simplicial tables below), it is recomputed from the noisy values.
-COUNT_RATIOS = re.compile(r"share|in_band|compression_pct")
+#: Columns that no machine changes: ratios of counts (shares of ensemble members, samples in a band, node
+#: compressions; the same as long as the counts are) and published values (read from a file; ours minus paper
+#: does move). Where a builder recomputes a share from measured values (the simplicial tables below), it is
+#: recomputed from the noisy values.
+NOT_MEASURED = re.compile(r"share|in_band|compression_pct|(?<!minus_)paper")
 
 
 def _unit_noise(x: np.ndarray, seed: int) -> np.ndarray:
@@ -41,12 +42,12 @@ def _unit_noise(x: np.ndarray, seed: int) -> np.ndarray:
 
 def perturbed(df: pd.DataFrame, seed: int, rel: float = REL) -> pd.DataFrame:
     """``df`` with every measured float ``x`` moved to ``x * (1 + rel * u)``, ``u`` in [-1, 1) (integer, text,
-    bool columns and ratios of counts kept). ``u`` is a seeded function of ``x`` itself, so values that are
+    bool columns, ratios of counts and published values kept). ``u`` is a seeded function of ``x`` itself, so values that are
     exactly equal (one computation feeding two columns or two methods, e.g. an error both methods share) stay
     equal, as they would on another machine; different values move independently."""
     out = df.copy()
     for c in out.columns:
-        if pd.api.types.is_float_dtype(out[c]) and not COUNT_RATIOS.search(str(c)):
+        if pd.api.types.is_float_dtype(out[c]) and not NOT_MEASURED.search(str(c)):
             x = out[c].to_numpy(np.float64)
             out[c] = x * (1.0 + rel * _unit_noise(x, seed))
     return out
@@ -62,6 +63,10 @@ def test_perturbation_moves_every_measured_float_and_keeps_ties():
     assert p["x"].iloc[0] != perturbed(df, 1)["x"].iloc[0]                         # the seed matters
     assert p["n"].equals(df["n"]) and p["s"].equals(df["s"]) and np.isnan(p["x"].iloc[2])
     assert p["a_lower_share"].equals(df["a_lower_share"])
+    paper = pd.DataFrame({"paper_w1": [0.5], "min_k_paper": [22.0], "w1_minus_paper": [0.1]})
+    q = perturbed(paper, 0)
+    assert q["paper_w1"].equals(paper["paper_w1"]) and q["min_k_paper"].equals(paper["min_k_paper"])
+    assert q["w1_minus_paper"].iloc[0] != 0.1
     u = _unit_noise(np.random.default_rng(0).random(10000), 3)
     assert -1 <= u.min() < -0.9 and 0.9 < u.max() < 1 and abs(u.mean()) < 0.05
 
@@ -144,5 +149,40 @@ def test_meshdetail_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workf
     assert want[["claim", "verdict"]].equals(written[["claim", "verdict"]])  # the rule's inputs, rebuilt
     got = verdicts(*(perturbed(t, seed) for t in tables), source, cfg["cv_rig"])
     assert len(want) >= 3
+    assert got["verdict"].tolist() == want["verdict"].tolist(), pd.concat(
+        [want[["claim", "verdict"]], got["verdict"].rename("noisy")], axis=1).to_string()
+
+
+def _tiny_config(wd) -> dict:
+    """config/config.yaml with config/test.yaml over it, as snakemake merges them, with the schema's defaults."""
+    import yaml
+    from snakemake.utils import update_config, validate
+
+    cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
+    update_config(cfg, yaml.safe_load((wd / "config" / "test.yaml").read_text()))
+    validate(cfg, str(wd / "config" / "schema.yaml"))
+    return cfg
+
+
+@pytest.mark.workflow
+@pytest.mark.parametrize("seed", [0, 1])
+def test_resequencing_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow, seed):
+    from animsynth.resequencing.study import read_published, with_defaults
+    from animsynth.resequencing.verdicts import all_verdicts
+
+    out = tiny_workflow / "results" / "resequencing"
+    rs = _tiny_config(tiny_workflow)["resequencing"]
+    cfg = with_defaults({k: rs[k] for k in ("frame_step", "explanations", "verdict_share", "verdict_alpha", "lee")})
+    published = read_published(str(tiny_workflow / rs["published"]["table2"]))
+    tables = [pd.read_csv(out / f"{k}.csv") for k in ("table2_min_k", "min_k_explanations", "smoothness_paths")]
+
+    def build(table2, grid, per_path):
+        return all_verdicts(table2, grid, published, per_path, int(cfg["frame_step"]), cfg)
+
+    want = build(*tables)
+    written = pd.read_csv(out / "verdicts.csv")
+    assert want[["claim", "verdict"]].equals(written[["claim", "verdict"]])  # the rule's inputs, rebuilt
+    got = build(*(perturbed(t, seed) for t in tables))
+    assert len(want) >= 4
     assert got["verdict"].tolist() == want["verdict"].tolist(), pd.concat(
         [want[["claim", "verdict"]], got["verdict"].rename("noisy")], axis=1).to_string()
