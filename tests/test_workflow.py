@@ -70,7 +70,7 @@ def _run_jobs(wd: Path) -> list[dict]:
 def test_every_job_of_the_tiny_run_kept_a_log_and_a_benchmark_file(tiny_workflow):
     jobs = [j for j in _run_jobs(tiny_workflow) if "output" in j]  # the target rule `all` makes nothing
     rules = {j["rule"] for j in jobs}
-    assert len(rules) > 20 and "parse_trial" in rules, sorted(rules)
+    assert len(rules) > 20, sorted(rules)
     problems = []
     for j in jobs:
         where = f"rule {j['rule']} ({j['output'][:60]})"
