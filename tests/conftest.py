@@ -1,5 +1,15 @@
 """Shared fixtures: paths to the real data in ../shared, and one run of the
-whole workflow on the tiny config (config/test.yaml) shared by the workflow tests."""
+whole workflow on the tiny config (config/test.yaml) shared by the workflow tests.
+
+The tiny run sees a copy of the published tables (tests/papers/, the same files
+as ../shared/papers/) at ``../shared/papers`` relative to its working directory,
+where the default configuration looks for them, so its "ours minus paper"
+columns hold numbers; :func:`tiny_without_papers` rebuilds only the tables that
+read them in a copy of the finished run where that folder is absent.
+
+No test depends on how long a run takes: every subprocess gets the same
+generous safety limit (:data:`SAFETY_TIMEOUT`), there only so that a hung
+process cannot block a CI job forever."""
 
 from __future__ import annotations
 
@@ -10,12 +20,22 @@ import sys
 from pathlib import Path
 
 import pytest
+from threadpoolctl import threadpool_limits
+
+# One BLAS thread in the test process, as the workflow's jobs run their heavy loops: on a busy 2-core
+# machine OpenBLAS's threads turned scipy's first Delaunay.find_simplex (a thousand small LAPACK calls)
+# from 1 ms into 9 s. Subprocesses (snakemake runs) are not affected.
+_BLAS_LIMIT = threadpool_limits(1, user_api="blas")
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = Path(os.environ.get("ANIMSYNTH_SHARED_DATA", REPO.parent / "shared" / "data"))
 CMU = SHARED / "cmu_mocap"
 VLASIC = SHARED / "vlasic_mesh_animation"
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
+PAPERS = REPO / "tests" / "papers"
+#: Seconds any one subprocess of a test may run before it is killed: a guard against a hang, far above
+#: what a run costs even on a busy machine (never a measure of speed).
+SAFETY_TIMEOUT = 3 * 3600
 
 
 def need(path: Path):
@@ -50,16 +70,60 @@ def copy_workflow(dest: Path) -> Path:
     return dest
 
 
-def run_snakemake(workdir: Path, *args, timeout: int = 1500) -> subprocess.CompletedProcess:
+def run_snakemake(workdir: Path, *args, timeout: int = SAFETY_TIMEOUT) -> subprocess.CompletedProcess:
     cmd = [SNAKEMAKE, "--cores", "2", *args]
     return subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout)
 
 
+def place_papers(workdir: Path) -> Path:
+    """Put the published tables where the default config looks for them: ``<workdir>/../shared/papers``."""
+    dest = workdir.parent / "shared" / "papers"
+    shutil.copytree(PAPERS, dest, dirs_exist_ok=True)
+    return dest
+
+
 @pytest.fixture(scope="session")
 def tiny_workflow(tmp_path_factory):
-    """Run the whole workflow once on config/test.yaml; return the working directory."""
-    wd = copy_workflow(tmp_path_factory.mktemp("tiny_workflow"))
+    """Run the whole workflow once on config/test.yaml (published tables beside it); return the working
+    directory. The session's only full run: every other workflow test reads it or copies it."""
+    root = tmp_path_factory.mktemp("tiny_workflow")  # holds run/ and shared/papers/, nothing else
+    wd = copy_workflow(root / "run")
+    place_papers(wd)
     res = run_snakemake(wd, "--configfile", "config/test.yaml")
     if res.returncode != 0:
         pytest.fail("tiny workflow failed:\n" + res.stdout[-4000:] + "\n" + res.stderr[-8000:])
     return wd
+
+
+def copy_finished_run(src: Path, dest: Path) -> Path:
+    """A copy of a finished run (workflow, resources, results, logs, snakemake metadata), times kept."""
+    shutil.copytree(src, dest, symlinks=True)
+    return dest
+
+
+#: The tables that read the published values (each with its rule's other outputs).
+PAPER_TABLES = ("results/data/datasets.csv", "results/simplicial/table2.csv", "results/facegraph/table1.csv",
+                "results/resequencing/table2_min_k.csv")
+
+
+@pytest.fixture(scope="session")
+def tiny_without_papers(tiny_workflow, tmp_path_factory):
+    """The finished tiny run copied where no ``../shared/papers`` exists, with the tables that read the
+    published values (:data:`PAPER_TABLES`) rebuilt there (those jobs only); return its directory."""
+    root = tmp_path_factory.mktemp("tiny_without_papers")
+    wd = copy_finished_run(tiny_workflow, root / "run")
+    assert not (wd / "../shared/papers").exists()
+    for rel in PAPER_TABLES:
+        (wd / rel).unlink()
+    res = run_snakemake(wd, *PAPER_TABLES, "--configfile", "config/test.yaml", "--rerun-triggers", "mtime")
+    if res.returncode != 0:
+        pytest.fail("rebuilding the paper tables failed:\n" + res.stdout[-4000:] + "\n" + res.stderr[-8000:])
+    return wd
+
+
+def pytest_collection_modifyitems(config, items):
+    """A test that reads the tiny run must be marked ``workflow``, so ``-m "not workflow"`` never starts it."""
+    bad = [i.nodeid for i in items if {"tiny_workflow", "tiny_without_papers"} & set(getattr(i, "fixturenames", ()))
+           and i.get_closest_marker("workflow") is None]
+    if bad:
+        raise pytest.UsageError("tests using the tiny workflow run must be marked workflow: " + ", ".join(bad))

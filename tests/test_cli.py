@@ -70,7 +70,15 @@ def test_errors_are_clear(trial_files, tmp_path, capsys):
     assert not (tmp_path / "x.bvh").exists() and not (tmp_path / "f.gif").exists()
 
 
-def test_face_from_labels(tmp_path):
+def test_face_from_labels(tmp_path, monkeypatch):
+    # the default route (a fresh synthetic CK+-layout database, written, read back, fitted), on a database
+    # of 14 sequences with every CK+ label instead of the paper-sized 70
+    from animsynth.synth import faces
+
+    full = faces.generate_database
+    monkeypatch.setattr(faces, "generate_database", lambda root, seed=0: full(
+        root, seed=seed, n_subjects=6, n_sequences=14, total_frames=280, n_unlabelled=1, min_frames=10,
+        max_frames=40))
     rc = main(["face", "--labels", "fear,surprise,happy", "--seed", "3", str(tmp_path / "f.csv")])
     assert rc == 0
     import pandas as pd

@@ -61,13 +61,17 @@ def test_real_data_needs_an_embedding(tmp_path):
 
 @pytest.mark.realdata
 def test_samba_skeleton_fits_the_whole_sequence(vlasic_dir):
-    """Default skinning on the full samba sequence: joints inside the first-frame mesh, held-out LBS <= 17 mm."""
+    """Default skinning on the whole samba sequence: joints inside the first-frame mesh, held-out LBS <= 17 mm.
+
+    Every second frame (88 of 175, still the whole dance, the last 20 % held out): about a third of the
+    full fit's cost (measured residuals: train 12.9 mm, held-out 14.0 mm, max 18.2 mm)."""
     seq = read_obj_sequence(vlasic_dir / "samba")
     assert seq.vertices.shape == (175, 9971, 3) and seq.faces.shape == (19938, 3)
     cfg = yaml.safe_load((REPO / "config" / "samba.yaml").read_text())["meshdetail"]
     rig = rig_from_joints(cfg["rig"]["joints"], cfg["rig"]["ends"])
-    train = np.arange(int(round(0.8 * seq.n_frames)))
-    rig, w, fit, joints, _ = fit_skeleton(seq.vertices, seq.faces, rig, train, skinning="heat+refit", refine=True)
+    frames = seq.vertices[::2]
+    train = np.arange(int(round(0.8 * len(frames))))
+    rig, w, fit, joints, _ = fit_skeleton(frames, seq.faces, rig, train, skinning="heat+refit", refine=True)
     assert bool(joints["inside"].all()), joints.to_string()
     assert fit.residual_[train].mean() < 0.016
     assert fit.residual_[len(train):].mean() < 0.017

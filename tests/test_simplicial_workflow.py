@@ -40,7 +40,12 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
     subsets = [c for c in t2.columns[2:] if not c.startswith("paper_") and not c.endswith("_minus_paper")]
     assert subsets[-1] == "all"
     assert list(t2.columns[2:]) == subsets + [f"paper_{d}" for d in subsets] + [f"{d}_minus_paper" for d in subsets]
-    for d in subsets:  # empty without ../shared/papers beside the run, ours - paper with it
+    # the run sees the published Table II at ../shared/papers (tests/papers/s1_table2.csv): ours - paper
+    paper = pd.read_csv(wd / "../shared/papers/s1_table2.csv").replace({"method": {"knn16": "knn"}})
+    want = t2[["metric", "method"]].merge(paper, on=["metric", "method"], how="left")
+    for d in subsets:
+        np.testing.assert_allclose(t2[f"paper_{d}"], want[d], rtol=0, atol=1e-12)
+        assert t2[f"{d}_minus_paper"].notna().all()
         np.testing.assert_allclose(t2[f"{d}_minus_paper"], t2[d] - t2[f"paper_{d}"], rtol=0, atol=1e-5)
     v = pd.read_csv(wd / "results/simplicial/verdicts.csv")
     assert list(v.columns) == VERDICT_COLUMNS and len(v) >= 8
@@ -49,6 +54,25 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
     row = json.loads(next((wd / "results/simplicial/folds").glob("*.json")).read_text())
     assert set(row["rows"][0]) == set(ex.FOLD_COLUMNS) and set(row["members"][0]) == set(ex.MEMBER_COLUMNS)
     assert (wd / "results/simplicial/figures/fig7_walk.bvh").read_text().startswith("HIERARCHY")
+
+
+@pytest.mark.workflow
+def test_without_published_table_the_paper_columns_are_empty(tiny_workflow, tiny_without_papers):
+    """A bare copy of the project (no ../shared/papers): Table II is rebuilt with empty paper_* and
+    difference columns, and ours unchanged."""
+    with_paper = pd.read_csv(tiny_workflow / "results/simplicial/table2.csv")
+    t2 = pd.read_csv(tiny_without_papers / "results/simplicial/table2.csv")
+    assert list(t2.columns) == list(with_paper.columns)
+    paper_cols = [c for c in t2.columns if c.startswith("paper_") or c.endswith("_minus_paper")]
+    assert len(paper_cols) >= 4 and t2[paper_cols].isna().all().all()
+    assert with_paper[paper_cols].notna().all().all()
+    ours = [c for c in t2.columns if c not in paper_cols]
+    pd.testing.assert_frame_equal(t2[ours], with_paper[ours])
+    # and Table I of the data layer: no published lengths beside ours
+    ds = pd.read_csv(tiny_without_papers / "results/data/datasets.csv")
+    ds_paper = pd.read_csv(tiny_workflow / "results/data/datasets.csv")
+    extra = [c for c in ds.columns if "paper" in c]
+    assert extra and ds[extra].isna().all().all() and ds_paper[extra].notna().any().all()
 
 
 @pytest.mark.realdata

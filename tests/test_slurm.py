@@ -27,9 +27,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from conftest import REPO, SNAKEMAKE, copy_workflow, run_snakemake
+from conftest import REPO, SAFETY_TIMEOUT, SNAKEMAKE, copy_workflow, place_papers, run_snakemake
 
-pytestmark = pytest.mark.slurm
+pytestmark = [pytest.mark.slurm, pytest.mark.workflow]
 
 SCRIPTS = REPO / "tests" / "slurm"
 CLUSTER_TOOLS = ("munged", "slurmctld", "slurmd", "sbatch", "squeue", "sinfo", "scontrol", "srun")
@@ -42,10 +42,13 @@ SLURM_TEST_ARGS = (
     "--seconds-between-status-checks", "2",
     "--slurm-keep-successful-logs",
 )
-# Seconds for the whole tiny workflow on SLURM (~130 jobs; each pays sbatch
-# scheduling plus two snakemake start-ups; 2 jobs at a time on a 2-core node).
-# Measured: see docs/scale.md; ANIMSYNTH_SLURM_TIMEOUT raises it on a loaded machine.
-RUN_TIMEOUT = int(os.environ.get("ANIMSYNTH_SLURM_TIMEOUT", "2400"))
+# Safety limits (seconds) of the `timeout -k` wrappers: there only so that a hung
+# status check or daemon cannot block CI forever, far above what the calls cost
+# on a busy machine (the whole tiny workflow on SLURM: see docs/scale.md).
+# ANIMSYNTH_SLURM_TIMEOUT overrides the limit of the whole run.
+RUN_TIMEOUT = int(os.environ.get("ANIMSYNTH_SLURM_TIMEOUT", str(SAFETY_TIMEOUT)))
+SETUP_TIMEOUT = 3600  # apt-get update + install of slurm-wlm/munge on a fresh machine, daemons started
+CALL_TIMEOUT = 600    # one squeue/scontrol call or the teardown
 # Tables that legitimately differ between runs (machine- and load-dependent).
 VOLATILE = re.compile(r"(timing|^benchmarks\.csv$|^rule_benchmarks)")  # e.g. meshdetail/timing.csv too
 # Columns of otherwise deterministic tables that hold timings (as tests/test_workflow.py).
@@ -106,13 +109,13 @@ def slurm_cluster(tmp_path_factory, request):
     env["SLURMCTLD_PORT"], env["SLURMD_PORT"] = map(str, _free_ports(2))
 
     def teardown():
-        subprocess.run(_timed(90, "bash", SCRIPTS / "teardown_cluster.sh", state), env=env,
-                       capture_output=True, text=True, timeout=120)
+        subprocess.run(_timed(CALL_TIMEOUT, "bash", SCRIPTS / "teardown_cluster.sh", state), env=env,
+                       capture_output=True, text=True, timeout=CALL_TIMEOUT + 60)
 
     request.addfinalizer(teardown)  # before the start: a partial start is stopped too
     # apt-get update + install can take minutes on a fresh machine.
-    res = subprocess.run(_timed(1500, "bash", SCRIPTS / "setup_cluster.sh", state), env=env,
-                         capture_output=True, text=True, timeout=1600)
+    res = subprocess.run(_timed(SETUP_TIMEOUT, "bash", SCRIPTS / "setup_cluster.sh", state), env=env,
+                         capture_output=True, text=True, timeout=SETUP_TIMEOUT + 60)
     if res.returncode == 3:  # host already has a SLURM configuration we must not shadow
         pytest.skip("single-node SLURM test not possible here: " + res.stderr.strip().splitlines()[-1])
     assert res.returncode == 0, f"setup_cluster.sh failed ({res.returncode}):\n{res.stdout[-3000:]}\n{res.stderr[-6000:]}"
@@ -123,8 +126,8 @@ def slurm_cluster(tmp_path_factory, request):
 
 def _squeue(env) -> dict[str, dict]:
     """Every job slurmctld still knows (MinJobAge=14400): id -> state, comment, limits."""
-    res = subprocess.run(_timed(30, "squeue", "-h", "-t", "all", "-o", "%i|%T|%k|%l|%m|%C"),
-                         env=env, capture_output=True, text=True, timeout=60)
+    res = subprocess.run(_timed(CALL_TIMEOUT, "squeue", "-h", "-t", "all", "-o", "%i|%T|%k|%l|%m|%C"),
+                         env=env, capture_output=True, text=True, timeout=CALL_TIMEOUT + 60)
     assert res.returncode == 0, res.stderr
     jobs = {}
     for line in res.stdout.splitlines():
@@ -135,7 +138,7 @@ def _squeue(env) -> dict[str, dict]:
 
 def _job_counts(wd: Path) -> dict[str, int]:
     """Jobs per rule that a fresh run of ``wd`` will execute (snakemake's dry-run job stats)."""
-    res = run_snakemake(wd, "-n", "--quiet", "rules", "--configfile", "config/test.yaml", timeout=300)
+    res = run_snakemake(wd, "-n", "--quiet", "rules", "--configfile", "config/test.yaml")
     assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
     counts = {}
     for line in (res.stdout + res.stderr).splitlines():
@@ -197,8 +200,9 @@ def _minutes(limit: str) -> int:
 def local_reference(request) -> Path:
     """The local run of config/test.yaml to compare with: the session's ``tiny_workflow``, or
     (ANIMSYNTH_SLURM_LOCAL_REFERENCE=DIR) a finished local run made beforehand in DIR, e.g. with
-    ``snakemake --cores 2 --configfile config/test.yaml`` in a copy of the workflow (on a
-    loaded machine, where the session fixture's time limit is too short)."""
+    ``snakemake --cores 2 --configfile config/test.yaml`` in a copy of the workflow, with
+    tests/papers copied to DIR/../shared/papers (to compare
+    with a run made elsewhere, or to skip the local run when only the SLURM side is of interest)."""
     given = os.environ.get("ANIMSYNTH_SLURM_LOCAL_REFERENCE")
     if given:
         return Path(given)  # checked when compared: it may still be running now
@@ -213,6 +217,7 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
     # finished before this starts. (Not concurrently with the SLURM run: on 2
     # cores that slows the SLURM jobs past the plugin's status polls.)
     remote = copy_workflow(tmp_path / "slurm")
+    place_papers(remote)  # the published tables beside it, as beside the local run
     expected = _job_counts(remote)
     n_jobs = sum(n for r, n in expected.items() if r != "all")  # `all` is local (localrule)
 
@@ -253,8 +258,8 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
     # ... --executor slurm-jobstep), and each job left its SLURM log.
     venv_bin = str(Path(sys.executable).parent) + os.sep
     for jid in sorted(slurm_ids, key=int)[:10]:  # a sample: scontrol per job is slow
-        res = subprocess.run(_timed(30, "scontrol", "write", "batch_script", jid, "-"),
-                             env=env, capture_output=True, text=True, timeout=60)
+        res = subprocess.run(_timed(CALL_TIMEOUT, "scontrol", "write", "batch_script", jid, "-"),
+                             env=env, capture_output=True, text=True, timeout=CALL_TIMEOUT + 60)
         assert res.returncode == 0, res.stderr
         command = [line for line in res.stdout.splitlines() if "-m snakemake" in line]
         assert command and command[0].startswith(venv_bin), (jid, res.stdout[:500])

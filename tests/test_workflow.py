@@ -1,12 +1,15 @@
 """The workflow itself: lint, a dry run of every config, the tiny run, determinism."""
 
+import json
 import re
+import shutil
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
-from conftest import REPO, copy_workflow, run_snakemake
+from conftest import REPO, copy_finished_run, copy_workflow, place_papers, run_snakemake
 
 CONFIGS = sorted(p.name for p in (REPO / "config").glob("*.yaml") if p.name != "schema.yaml")
 
@@ -43,9 +46,44 @@ def test_tiny_run_data_outputs(tiny_workflow):
     assert (df["dims"] == 56).all() and (df["n_sequences"] == 3).all()
     assert df.loc[0, "lengths"] == "90 80 96"
     assert (tiny_workflow / "results" / "data" / "datasets.md").read_text().startswith("### Table I")
-    # every rule kept a log and a benchmark file
-    assert any((tiny_workflow / "logs").rglob("*.log"))
-    assert any((tiny_workflow / "benchmarks" / "rules").rglob("*.tsv"))
+
+
+def _run_jobs(wd: Path) -> list[dict]:
+    """The jobs a snakemake run in ``wd`` printed (``rule NAME:`` blocks of .snakemake/log/), each as
+    {"rule": NAME, key: value} with the block's ``output``, ``log``, ``benchmark`` ... lines."""
+    jobs = []
+    for log in sorted((wd / ".snakemake" / "log").glob("*.snakemake.log")):
+        job = None
+        for line in log.read_text().splitlines():
+            m = re.fullmatch(r"(?:local)?rule (\w+):", line)
+            if m:
+                job = {"rule": m.group(1)}
+                jobs.append(job)
+            elif job is not None and line.startswith("    ") and ": " in line:
+                k, v = line.strip().split(": ", 1)
+                job.setdefault(k, v)
+            else:
+                job = None
+    return jobs
+
+
+def test_every_job_of_the_tiny_run_kept_a_log_and_a_benchmark_file(tiny_workflow):
+    jobs = [j for j in _run_jobs(tiny_workflow) if "output" in j]  # the target rule `all` makes nothing
+    rules = {j["rule"] for j in jobs}
+    assert len(rules) > 20, sorted(rules)
+    problems = []
+    for j in jobs:
+        where = f"rule {j['rule']} ({j['output'][:60]})"
+        logs = [s.strip() for s in j.get("log", "").split(",") if s.strip()]
+        if not logs:
+            problems.append(f"{where}: no log")
+        for lg in logs:
+            if not (tiny_workflow / lg).is_file() or (tiny_workflow / lg).stat().st_size == 0:
+                problems.append(f"{where}: log {lg} missing or empty")
+        bench = j.get("benchmark")
+        if not bench or not (tiny_workflow / bench).is_file() or (tiny_workflow / bench).stat().st_size == 0:
+            problems.append(f"{where}: no benchmark file ({bench})")
+    assert not problems, "\n".join(problems[:40])
 
 
 #: Machine- and load-dependent outputs, the only ones allowed to differ between runs.
@@ -72,11 +110,79 @@ def test_not_compared_is_only_timing_tables():
                        "rule_benchmarks.csv", "rule_benchmarks_per_rule.md"]
 
 
-def test_same_config_gives_identical_tables(tiny_workflow, tmp_path):
-    """Byte for byte, every table except the timing ones (no column filtering)."""
-    wd = copy_workflow(tmp_path)
-    res = run_snakemake(wd, "--configfile", "config/test.yaml")
+def _jobs_by_rule(wd: Path) -> dict[str, list[tuple[str, ...]]]:
+    """Every job of the finished run in ``wd``, as its output files, per rule (``--detailed-summary``:
+    outputs of one job share its log)."""
+    res = run_snakemake(wd, "--configfile", "config/test.yaml", "--detailed-summary")
     assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
+    lines = res.stdout.splitlines()
+    assert lines and lines[0].startswith("output_file\tdate\trule\tlog-file(s)"), res.stdout[:2000]
+    jobs: dict[tuple[str, str], list[str]] = {}
+    for line in lines[1:]:
+        out, date, rule, log = line.split("\t")[:4]
+        if date == "-":  # not made by this run (no such output)
+            continue
+        jobs.setdefault((rule, log if log != "-" else out), []).append(out)
+    by_rule: dict[str, list[tuple[str, ...]]] = {}
+    for (rule, _), outs in sorted(jobs.items()):
+        by_rule.setdefault(rule, []).append(tuple(sorted(outs)))
+    return by_rule
+
+
+#: Timing fields inside otherwise deterministic JSON outputs (e.g. a facegraph configuration's run record).
+JSON_TIMING = re.compile(r"_(cpu|wall)_s$|_ms(_sd)?$")
+
+
+def _comparable(path: Path, root: Path):
+    """What must be equal in an output of the run in ``root``: its bytes with ``root`` written as ``<wd>``
+    (a few outputs record where their inputs were); JSON without timing fields; ``.npz`` array by array
+    (the zip container stores write times); a folder, file by file."""
+    if path.is_dir():
+        return {str(p.relative_to(path)): _comparable(p, root) for p in sorted(path.rglob("*")) if p.is_file()}
+    if path.suffix == ".npz":
+        with np.load(path) as z:
+            return {k: ("U", z[k].shape, str(z[k].tolist()).replace(str(root), "<wd>")) if z[k].dtype.kind == "U"
+                    else (z[k].dtype.str, z[k].shape, z[k].tobytes()) for k in z.files}
+    data = path.read_bytes().replace(str(root).encode(), b"<wd>")
+    if path.suffix == ".json":
+        def drop(x):
+            if isinstance(x, dict):
+                return {k: drop(v) for k, v in x.items() if not JSON_TIMING.search(str(k))}
+            return [drop(v) for v in x] if isinstance(x, list) else x
+        return drop(json.loads(data))
+    return data
+
+
+def _same_content(a: Path, root_a: Path, b: Path, root_b: Path) -> bool:
+    return _comparable(a, root_a.resolve()) == _comparable(b, root_b.resolve())
+
+
+def test_same_config_gives_identical_outputs(tiny_workflow, tmp_path):
+    """Determinism without a second whole run: in a copy of the finished tiny run, one job of every rule
+    loses its outputs, and one snakemake call rebuilds exactly those (plus whatever lies between them);
+    every rule's computation thus runs a second time (except rules that write only timing tables). Each
+    rebuilt output must equal the first run's (:func:`_comparable`: bytes, up to the working directory's
+    path, timing fields of JSON records aside), and so must every table under results/ except the timing
+    ones, byte for byte."""
+    wd = copy_finished_run(tiny_workflow, tmp_path / "again" / "run")
+    place_papers(wd)
+    by_rule = _jobs_by_rule(wd)
+    assert len(by_rule) > 20, sorted(by_rule)
+    # one job per rule; a rule that writes only timing tables (compared nowhere) is not re-run
+    chosen = {rule: jobs[0] for rule, jobs in by_rule.items()
+              if not all(NOT_COMPARED.search(Path(o).name) for o in jobs[0])}
+    targets = sorted(o for outs in chosen.values() for o in outs)
+    for rel in targets:
+        p = wd / rel
+        shutil.rmtree(p) if p.is_dir() else p.unlink()
+    res = run_snakemake(wd, *targets, "--configfile", "config/test.yaml", "--rerun-triggers", "mtime")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-4000:]
+    ran = set(re.findall(r"^(?:local)?rule (\w+):$", out, re.M))
+    assert set(chosen) <= ran, f"rules not re-executed: {sorted(set(chosen) - ran)}"
+    timing = [t for t in targets if NOT_COMPARED.search(Path(t).name)]
+    differ = [t for t in targets if t not in timing and not _same_content(tiny_workflow / t, tiny_workflow, wd / t, wd)]
+    assert not differ, f"{len(differ)} of {len(targets)} rebuilt outputs differ from the first run: {differ}"
     a, b = _tables(tiny_workflow), _tables(wd)
     assert a.keys() == b.keys() and len(a) > 20
     differ = sorted(k for k in a if a[k] != b[k])

@@ -17,3 +17,4 @@ with np.load(i.preds) as z:
     preds = {k: z[k] for k in ("lbs", "hybrid", "ridge_cv")}
 truth = seq.vertices[frames]
 plots.render_frames(o.frames, truth, seq.faces, preds, list(range(len(frames))), titles=frames)
+log.info("wrote %s", ", ".join(map(str, snakemake.output)))  # noqa: F821

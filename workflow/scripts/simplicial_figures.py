@@ -5,3 +5,4 @@ from animsynth.workflow_utils import setup_logging
 log = setup_logging(snakemake)  # noqa: F821
 p = snakemake.params  # noqa: F821
 figures_job(list(snakemake.input), list(p.ids), p.dataset, dict(p.cfg), dict(snakemake.output.items()))  # noqa: F821
+log.info("wrote %s", ", ".join(map(str, snakemake.output)))  # noqa: F821
