@@ -1,8 +1,9 @@
 """Shared fixtures: paths to the real data in ../shared, and one run of the
 whole workflow on the tiny config (config/test.yaml) shared by the workflow tests.
 
-The tiny run sees a copy of the published tables (tests/papers/, the same files
-as ../shared/papers/) at ``../shared/papers`` relative to its working directory,
+The tiny run sees made-up tables in the layout of the published ones (tests/papers/,
+the file names and columns of ../shared/papers/, none of its values) at
+``../shared/papers`` relative to its working directory,
 where the default configuration looks for them, so its "ours minus paper"
 columns hold numbers; :func:`tiny_without_papers` rebuilds only the tables that
 read them in a copy of the finished run where that folder is absent.
