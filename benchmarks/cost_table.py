@@ -3,6 +3,7 @@
 Usage::
 
     python benchmarks/cost_table.py "default run" results "paper run" results/paper
+    python benchmarks/cost_table.py --benchmarks results/paper/benchmarks.csv
 
 prints one Markdown table per run: per family the number of jobs, the summed
 wall time and CPU time of its jobs (Snakemake's ``benchmark:`` files) and the
@@ -30,7 +31,22 @@ def cost_table(per_family_csv) -> str:
     return "\n".join(lines)
 
 
+def benchmark_table(benchmarks_csv) -> str:
+    """The performance targets of a run's ``benchmarks.csv``: ours, the in-run baseline, ratio, target, met."""
+    df = pd.read_csv(benchmarks_csv)
+    lines = ["| family | benchmark | ours | baseline (same run) | ratio | target | met |", "|---|---|---:|---:|---:|---|---|"]
+    for r in df.itertuples():
+        met = "" if pd.isna(r.meets_target) else ("yes" if str(r.meets_target).lower() == "true" else "**no**")
+        base = "" if pd.isna(r.baseline_value) else f"{r.baseline_value:.4g}"
+        ratio = "" if pd.isna(r.ratio) else f"{r.ratio:.3g}"
+        lines.append(f"| {r.family} | `{r.benchmark}` | {r.value:.4g} {r.unit} | {base} | {ratio} | {r.target} | {met} |")
+    return "\n".join(lines)
+
+
 def main(argv: list[str]) -> int:
+    if len(argv) == 2 and argv[0] == "--benchmarks":
+        print(benchmark_table(argv[1]))
+        return 0
     if len(argv) < 2 or len(argv) % 2:
         print(__doc__)
         return 2

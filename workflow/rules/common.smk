@@ -93,7 +93,8 @@ def L(path):
     return f"logs/{path}" if OUT == "results" else f"{OUT}/logs/{path}"
 
 
-BENCH_ROOT = "benchmarks/rules" if OUT == "results" else f"{OUT}/benchmarks/rules"
+# Job benchmark files are outputs of the run: below its results folder, never beside the benchmark sources.
+BENCH_ROOT = f"{OUT}/benchmarks/rules"
 
 
 def B(path):
