@@ -342,7 +342,7 @@ rule meshdetail_dembones:
         cfg=MD["dembones"],
         cv_folds=MD["cv_folds"],
         render_frames=lambda w: MD_SEQS[w.mdseq]["render_frames"],
-    # samba (9,971 vertices, 175 frames), bones [18, 40]: ~20 s CPU per fold, 0.6 GB
+    # samba (9,971 vertices, 175 frames), bones [18, 40]: SSDR fit 7 + 11 s, held-out solve 3.5 + 7.5 s CPU per fold
     threads: 1
     resources:
         mem_mb=1500,

@@ -12,7 +12,7 @@ write_table(table.drop(columns=[c for c in table.columns if c.endswith("_s")]), 
                  "blocks; on the held-out blocks the weights stay fixed and the rigid bone transforms are solved from "
                  "the held-out meshes (weighted Procrustes, ours: the package cannot fix weights) - the best such a "
                  "skin does when the transforms are known. heldout_affine_mm: bones may also scale/shear. train_mm: "
-                 "the same solve on the training frames; train_ssdr_mm: SSDR's own training transforms. Mean vertex "
+                 "SSDR's own fit of the training frames. Mean vertex "
                  "error (mm); times in dembones_timing.csv.")
 timing = [c for c in table.columns if c.endswith("_s")]
 write_table(table[["fold", "bones", "n_train", "n_heldout"] + timing], o.timing,
