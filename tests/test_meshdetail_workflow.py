@@ -5,8 +5,8 @@ import pytest
 
 @pytest.mark.workflow
 def test_meshdetail_outputs(tiny_workflow):
-    r = tiny_workflow / "results" / "meshdetail"
-    for name in ("fig5a.png", "fig5b.png", "fig5c.png", "frames.png", "rig_fit.md"):
+    r = tiny_workflow / "results" / "meshdetail" / "character"  # one folder per sequence
+    for name in ("fig5a.png", "fig5b.png", "fig5c.png", "frames.png", "error_map.png", "rig_fit.md"):
         assert (r / name).stat().st_size > 0
     a = pd.read_csv(r / "fig5a.csv")
     assert list(a.columns) == ["frame", "split", "full_deformation_mm", "detail_only_mm"]
@@ -31,3 +31,10 @@ def test_meshdetail_outputs(tiny_workflow):
     assert len(j) == 18
     rep = pd.read_csv(r / "representations.csv")
     assert len(rep) == 6
+    d = pd.read_csv(r / "dembones.csv")
+    assert set(d["fold"]) == set(range(5)) and (d["heldout_mm"] > 0).all()
+    side = pd.read_csv(r.parent / "sequences.csv").set_index("method")
+    assert {"character_mm", "character_fold_sd_mm"} <= set(side.columns)
+    assert side.index.str.startswith("Dem Bones LBS floor").any()
+    top = pd.read_csv(r.parent / "verdicts.csv")
+    assert top["claim"].str.startswith("[all sequences]").sum() == len(v)

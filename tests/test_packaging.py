@@ -27,10 +27,12 @@ def test_pyproject_and_environment_agree():
     assert len(pins) == len(py["project"]["dependencies"]) + len(py["project"]["optional-dependencies"]["test"]), \
         "every runtime and test dependency must be pinned with =="
     env = yaml.safe_load((REPO / "environment.yml").read_text())
-    conda = _pins([d for d in env["dependencies"] if isinstance(d, str) and "==" in d])
+    pip = [d for dep in env["dependencies"] if isinstance(dep, dict) for d in dep.get("pip", [])]
+    conda = _pins([d for d in env["dependencies"] + pip if isinstance(d, str) and "==" in d])
     assert conda == pins, f"environment.yml {conda} != pyproject.toml {pins}"
     rule_env = yaml.safe_load((REPO / "workflow" / "envs" / "animsynth.yaml").read_text())
-    rule_pins = _pins([d for d in rule_env["dependencies"] if isinstance(d, str) and "==" in d])
+    rule_pip = [d for dep in rule_env["dependencies"] if isinstance(dep, dict) for d in dep.get("pip", [])]
+    rule_pins = _pins([d for d in rule_env["dependencies"] + rule_pip if isinstance(d, str) and "==" in d])
     for name, version in rule_pins.items():
         assert pins.get(name) == version, f"workflow/envs/animsynth.yaml pins {name}=={version}, pyproject.toml {pins.get(name)}"
 

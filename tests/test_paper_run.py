@@ -31,7 +31,9 @@ def test_without_mirror_or_meshes_the_real_families_are_skipped(tmp_path):
 
 def test_paper_run_plans_every_family_into_results_paper(tmp_path, cmu_dir, vlasic_dir):
     wd = copy_workflow(tmp_path / "wd")
-    res = run_snakemake(wd, "-n", *PAPER, "--config", f"cmu_mirror={cmu_dir.parent}",
+    crane = tmp_path / "crane.yaml"  # the copied workflow is elsewhere: point crane at the data folder
+    crane.write_text(f"meshdetail:\n  sequences:\n    crane:\n      mesh_dir: {vlasic_dir / 'crane'}\n")
+    res = run_snakemake(wd, "-n", *PAPER, str(crane), "--config", f"cmu_mirror={cmu_dir.parent}",
                         f"mesh_dir={vlasic_dir / 'samba'}")
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-4000:]
@@ -40,6 +42,9 @@ def test_paper_run_plans_every_family_into_results_paper(tmp_path, cmu_dir, vlas
                  "facegraph_graph", "summary"):
         assert rule in out, rule
     assert "results/paper/simplicial/" in out and "results/paper/meshdetail/" in out
+    for seq in ("samba", "crane"):  # both sequences, each checked against its checksum list, with the LBS floor
+        assert f"results/paper/meshdetail/{seq}/dembones.csv" in out and f"data/mesh_checksums/{seq}.csv" in out
+    assert "results/paper/meshdetail/sequences.csv" in out
     assert "results/simplicial/" not in out  # nothing of the default run is touched
 
 
@@ -61,15 +66,15 @@ def _sequence_archive(tmp_path, corrupt=None):
 def test_mesh_archive_is_unpacked_and_checked(tmp_path, corrupt):
     wd = copy_workflow(tmp_path / "wd")
     arch, sums = _sequence_archive(tmp_path, corrupt)
-    res = run_snakemake(wd, "results/data/mesh_checksums.csv", "--config", f"mesh_dir={arch}", f"mesh_sha256={sums}")
+    res = run_snakemake(wd, "results/data/mesh_checksums/seq.csv", "--config", f"mesh_dir={arch}", f"mesh_sha256={sums}")
     out = res.stdout + res.stderr
     if corrupt is None:
         assert res.returncode == 0, out[-4000:]
         got = sorted(p.name for p in (wd / "resources" / "mesh" / "seq").glob("*.obj.gz"))
         assert got == [f"mesh_{i:04d}.obj.gz" for i in range(4)]
-        assert (wd / "results" / "data" / "mesh_checksums.csv").read_text().count("\n") == 5
+        assert (wd / "results" / "data" / "mesh_checksums" / "seq.csv").read_text().count("\n") == 5
     else:
         assert res.returncode != 0
-        log = (wd / "logs" / "data" / "mesh_checksums.log").read_text()
+        log = (wd / "logs" / "data" / "mesh_checksums" / "seq.log").read_text()
         assert "frame mesh_0002.obj has SHA-256" in log
-        assert not (wd / "results" / "data" / "mesh_checksums.csv").exists()
+        assert not (wd / "results" / "data" / "mesh_checksums" / "seq.csv").exists()

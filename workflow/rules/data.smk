@@ -141,56 +141,72 @@ rule datasets_table:
 DATA_TARGETS = [R("data/datasets.csv")] + [trial_npz(t) for t in USED_TRIALS]
 
 
-# ---- mesh sequence of the hybrid mesh experiments --------------------------
-# mesh_dir is a folder of OBJ / OBJ.gz frames, an archive of one (.zip,
-# .tar.gz) or a URL of such an archive; archives are unpacked into
-# resources/mesh/<name>/. With mesh_sha256 set, every frame is checked against
-# that list before any experiment reads it, and a mismatch names the frame.
-MESH_SRC = config.get("mesh_dir")
-MESH_SUMS = config.get("mesh_sha256")
-MESH_FRAMES = MESH_SRC
-if MESH_SRC and (is_url(MESH_SRC) or is_archive(MESH_SRC)):
-    MESH_FRAMES = f"resources/mesh/{mesh_source_name(MESH_SRC)}"
+# ---- mesh sequences of the hybrid mesh experiments -------------------------
+# Each sequence's mesh_dir (MD_SEQS, common.smk) is a folder of OBJ / OBJ.gz
+# frames, an archive of one (.zip, .tar.gz) or a URL of such an archive;
+# archives are unpacked into resources/mesh/<name>/. With mesh_sha256 set, every
+# frame is checked against that list before any experiment reads it, and a
+# mismatch names the frame.
+MD_FRAMES = {}  # sequence name -> folder of frames (or the synthetic character's)
+MESH_FETCH = {}  # resources/mesh/<name> -> archive or URL
+MESH_FETCH_SUMS = {}  # resources/mesh/<name> -> [its SHA-256 list] or []
+for _name, _s in MD_SEQS.items():
+    _src = _s["mesh_dir"]
+    if not _src:
+        MD_FRAMES[_name] = R("meshdetail/character/main")
+    elif is_url(_src) or is_archive(_src):
+        MD_FRAMES[_name] = f"resources/mesh/{mesh_source_name(_src)}"
+        MESH_FETCH[mesh_source_name(_src)] = _src
+        # the fetch checks the frames against the sequence's list before it places them
+        MESH_FETCH_SUMS[mesh_source_name(_src)] = [_s["mesh_sha256"]] if _s["mesh_sha256"] else []
+    else:
+        MD_FRAMES[_name] = _src
+MESH_CHECK = {n: [R(f"data/mesh_checksums/{n}.csv")] for n, s in MD_SEQS.items() if s["mesh_dir"] and s["mesh_sha256"]}
+
+if MESH_FETCH:
 
     rule mesh_fetch:
         input:
-            sums=MESH_SUMS or [],
+            sums=lambda w: MESH_FETCH_SUMS[w.meshsrc],
         output:
-            directory(MESH_FRAMES),
+            directory("resources/mesh/{meshsrc}"),
         params:
-            source=MESH_SRC,
+            source=lambda w: MESH_FETCH[w.meshsrc],
             max_unpacked_mb=config.get("meshdetail", {}).get("max_unpacked_mb", 8000),
         log:
-            L("data/mesh_fetch.log"),
+            L("data/mesh_fetch/{meshsrc}.log"),
         benchmark:
-            B("data/mesh_fetch.tsv")
+            B("data/mesh_fetch/{meshsrc}.tsv")
         threads: 1
         resources:
             mem_mb=1000,
             runtime=30,
+        wildcard_constraints:
+            meshsrc="|".join(map(re.escape, MESH_FETCH)),
         conda:
             "../envs/animsynth.yaml"
         script:
             "../scripts/data_mesh_fetch.py"
 
 
-MESH_CHECK = [R("data/mesh_checksums.csv")] if MESH_SRC and MESH_SUMS else []
 if MESH_CHECK:
 
     rule mesh_checksums:
         input:
-            frames=MESH_FRAMES,
-            sums=MESH_SUMS,
+            frames=lambda w: MD_FRAMES[w.mdseq],
+            sums=lambda w: MD_SEQS[w.mdseq]["mesh_sha256"],
         output:
-            R("data/mesh_checksums.csv"),
+            R("data/mesh_checksums/{mdseq}.csv"),
         log:
-            L("data/mesh_checksums.log"),
+            L("data/mesh_checksums/{mdseq}.log"),
         benchmark:
-            B("data/mesh_checksums.tsv")
+            B("data/mesh_checksums/{mdseq}.tsv")
         threads: 1
         resources:
             mem_mb=1000,
             runtime=10,
+        wildcard_constraints:
+            mdseq="|".join(map(re.escape, MESH_CHECK)),
         conda:
             "../envs/animsynth.yaml"
         script:

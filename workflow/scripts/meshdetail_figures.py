@@ -17,4 +17,12 @@ with np.load(i.preds) as z:
     preds = {k: z[k] for k in ("lbs", "hybrid", "ridge_cv")}
 truth = seq.vertices[frames]
 plots.render_frames(o.frames, truth, seq.faces, preds, list(range(len(frames))), titles=frames)
+# Error map: per-vertex held-out error of one frame (the first render frame): our skin, the Dem Bones floor, the hybrid
+with np.load(i.dembones) as z:
+    f, bones = int(z["frame"]), int(z["bones"][0])
+    floor = z[f"bones_{bones}"]
+j = frames.index(f)
+plots.error_map(o.error_map, truth[j], seq.faces,
+                {"our skin (LBS)": preds["lbs"][j], f"Dem Bones floor ({bones} bones)": floor, "hybrid": preds["hybrid"][j]},
+                title=f"{snakemake.params.name}, frame {f}: held-out per-vertex error (blocked CV)")  # noqa: F821
 log.info("wrote %s", ", ".join(map(str, snakemake.output)))  # noqa: F821

@@ -185,3 +185,23 @@ def load_prepared(seq_npz: str, pose_npz: str, edits_npz: str, train_fraction: f
             edits[name] = (z[f"vertices:{name}"], z[f"root_t:{name}"], z[f"angles:{name}"])
     tr, te = split_frames(seq.n_frames, train_fraction)
     return Prepared(seq.vertices, seq.faces, rig, weights, root_t, angles, tr, te, edits)
+
+
+def dembones_floor(seq_npz: str, cfg: dict, cv_folds: int, render_frames, out_npz: str):
+    """The Dem Bones LBS floor of one sequence under the meshdetail blocked CV (same folds as Fig. 5c).
+
+    Returns (per-fold table, per-bone-count summary); writes the held-out predictions of the
+    error-map frame (the first render frame) per bone count to ``out_npz``.
+    """
+    from .dembones import floor_cv, floor_summary
+    from .experiments import blocks
+
+    seq = MeshSequence.load_npz(seq_npz)
+    frame = min(max(int(list(render_frames)[0]), 0), seq.n_frames - 1)
+    table, preds = floor_cv(seq.vertices, seq.faces, blocks(seq.n_frames, int(cv_folds)), list(cfg["bones"]),
+                            max_influences=int(cfg["max_influences"]), iterations=int(cfg["iterations"]),
+                            sweeps=int(cfg["sweeps"]), keep_frames=[frame])
+    with atomic_path(out_npz, suffix=".npz") as tmp:
+        np.savez_compressed(tmp, frame=np.array(frame), bones=np.array(list(cfg["bones"])),
+                            **{f"bones_{b}": p[0] for b, p in preds.items()})
+    return table, floor_summary(table)

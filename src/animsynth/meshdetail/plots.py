@@ -128,3 +128,21 @@ def render_frames(path, truth, faces, preds: dict, frames: list, vmax_mm: float 
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=90)
     plt.close(fig)
+
+
+def error_map(path, truth, faces, preds: dict, title: str, vmax_mm: float | None = None) -> None:
+    """One frame, one panel per model: the model's held-out prediction coloured by per-vertex error (mm),
+    one shared colour scale (99th percentile of all panels unless ``vmax_mm``)."""
+    axes = _view_axes(truth)
+    errs = {k: np.linalg.norm(p - truth, axis=-1) * 1000 for k, p in preds.items()}
+    vmax = vmax_mm or float(np.percentile(np.concatenate(list(errs.values())), 99)) or 1.0
+    fig, ax = plt.subplots(1, len(preds), figsize=(3.0 * len(preds), 4.2), squeeze=False)
+    for j, (k, p) in enumerate(preds.items()):
+        draw_mesh(ax[0, j], p, faces, errs[k], vmax, axes=axes)
+        ax[0, j].set_title(f"{k}\nmean {errs[k].mean():.1f} mm, p95 {np.percentile(errs[k], 95):.1f} mm", fontsize=9)
+    fig.suptitle(title, fontsize=10)
+    sm = plt.cm.ScalarMappable(cmap="inferno_r", norm=plt.Normalize(0, vmax))
+    fig.colorbar(sm, ax=ax.ravel().tolist(), shrink=0.7, label="held-out vertex error (mm)")
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=90)
+    plt.close(fig)

@@ -111,3 +111,72 @@ def verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame, gen:
                                  f"{f(lo.size_pct_of_original)}% of the original",
                      "source": "meshdetail/fig5b.csv"})
     return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def holds_on(verdicts_by_seq: dict) -> tuple[str, str]:
+    """(words, verdict) for one claim across sequences: ``verdicts_by_seq`` maps sequence -> verdict.
+
+    The claim holds on a sequence when its verdict there is ``reproduced``. Holds on all:
+    ``reproduced``; on some: ``partly``; on none: ``contradicted`` / ``within noise`` when
+    every sequence says so, else ``not reproduced``.
+    """
+    names = list(verdicts_by_seq)
+    held = [n for n in names if verdicts_by_seq[n] == "reproduced"]
+    n = len(names)
+    if len(held) == n:
+        words = "holds on both" if n == 2 else ("holds on its one sequence" if n == 1 else f"holds on all {n}")
+        return words, "reproduced"
+    if held:
+        return (f"holds on one ({held[0]})" if n == 2 and len(held) == 1 else
+                f"holds on {len(held)} of {n} ({', '.join(held)})"), "partly"
+    kinds = set(verdicts_by_seq.values())
+    words = "holds on neither" if n == 2 else ("does not hold" if n == 1 else f"holds on none of {n}")
+    return words, (kinds.pop() if len(kinds) == 1 and kinds <= {"contradicted", "within noise"} else "not reproduced")
+
+
+def combine_verdicts(per_seq: dict) -> pd.DataFrame:
+    """Every sequence's verdict rows (claim prefixed with ``[sequence]``) and one row per claim saying on
+    which sequences it holds (``[all sequences]``). ``per_seq``: sequence -> verdict table."""
+    rows = []
+    for name, t in per_seq.items():
+        for r in t.to_dict("records"):
+            rows.append({**r, "claim": f"[{name}] {r['claim']}", "source": f"meshdetail/{name}/{r['source'].split('/')[-1]}"})
+    claims = list(dict.fromkeys(c for t in per_seq.values() for c in t["claim"]))
+    for claim in claims:
+        got = {n: t[t.claim == claim].iloc[0] for n, t in per_seq.items() if (t.claim == claim).any()}
+        words, verdict = holds_on({n: r.verdict for n, r in got.items()})
+        missing = [n for n in per_seq if n not in got]
+        rows.append({"claim": f"[all sequences] {claim}", "paper_value": next(iter(got.values())).paper_value,
+                     "ours": words + (f"; not tested on {', '.join(missing)}" if missing else ""),
+                     "data": "sequences: " + ", ".join(got), "verdict": verdict,
+                     "evidence": "; ".join(f"{n}: {r.verdict} ({r.ours})" for n, r in got.items()),
+                     "source": ", ".join(f"meshdetail/{n}/verdicts.csv" for n in got)})
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+SIDE_BY_SIDE = [("our skin (LBS, fitted 18-joint skeleton)", "lbs"), ("hybrid (SGPLVM+GPDM)", "hybrid"),
+                ("hybrid without dynamics", "hybrid_no_dynamics"), ("plain GP regression", "gp_regression"),
+                ("CV ridge", "ridge_cv")]
+
+
+def side_by_side(gens: dict, dembones: dict) -> pd.DataFrame:
+    """Held-out mean (fold SD) per method, one column pair per sequence.
+
+    ``gens``: sequence -> generalisation table; ``dembones``: sequence -> per-fold Dem Bones table.
+    """
+    rows = {}
+    for name, g in gens.items():
+        h = g.set_index("case").loc["held-out frames (blocked CV)"]
+        for label, key in SIDE_BY_SIDE:
+            rows.setdefault(label, {"method": label})
+            rows[label][f"{name}_mm"] = float(h[f"{key}_mm"])
+            rows[label][f"{name}_fold_sd_mm"] = float(h[f"{key}_fold_sd_mm"])
+        for bones, d in dembones[name].groupby("bones"):
+            label = f"Dem Bones LBS floor, {bones} bones (transforms solved on held-out meshes)"
+            rows.setdefault(label, {"method": label})
+            rows[label][f"{name}_mm"] = float(d.heldout_mm.mean())
+            rows[label][f"{name}_fold_sd_mm"] = float(d.heldout_mm.std(ddof=1)) if len(d) > 1 else np.nan
+    order = [SIDE_BY_SIDE[0][0]] + sorted(k for k in rows if k.startswith("Dem Bones")) + [l for l, _ in SIDE_BY_SIDE[1:]]
+    order = [k for k in order if k in rows]
+    out = pd.DataFrame([rows[k] for k in order])
+    return out.round(4)
