@@ -75,6 +75,8 @@ def test_mesh_archive_is_unpacked_and_checked(tmp_path, corrupt):
         assert (wd / "results" / "data" / "mesh_checksums" / "seq.csv").read_text().count("\n") == 5
     else:
         assert res.returncode != 0
-        log = (wd / "logs" / "data" / "mesh_checksums" / "seq.log").read_text()
-        assert "frame mesh_0002.obj has SHA-256" in log
+        # the fetch checks the frames in its temporary folder: the mismatch is its error, and nothing is left
+        log = (wd / "logs" / "data" / "mesh_fetch" / "seq.log").read_text()
+        assert "mesh_0002.obj" in log and "SHA-256" in log, log[-2000:]
+        assert not (wd / "resources" / "mesh" / "seq").exists()
         assert not (wd / "results" / "data" / "mesh_checksums" / "seq.csv").exists()

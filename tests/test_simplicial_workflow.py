@@ -29,7 +29,11 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
     assert not missing, missing
     folds = pd.read_csv(wd / "results/simplicial/folds.csv")
     assert list(folds.columns) == ex.FOLD_COLUMNS
-    n_folds = sum(1 for _ in (wd / "results/simplicial/folds").glob("*.json"))
+    # one JSON per dataset, holding every leave-one-out fold of its subset (3 trials each in the tiny config)
+    jsons = sorted((wd / "results/simplicial/folds").glob("*.json"))
+    assert [p.stem for p in jsons] == sorted(["w1", "w2", "r1", "r2"])
+    n_folds = sum(len({r["held_out"] for r in json.loads(p.read_text())["rows"]}) for p in jsons)
+    assert n_folds == 12
     assert len(folds) == 2 * n_folds and set(folds["method"]) == {"delaunay", "knn"}
     assert np.isfinite(folds[["error_a", "error_f", "error_a_norm", "error_f_norm"]].to_numpy(float)).all()
     members = pd.read_csv(wd / "results/simplicial/members.csv")
