@@ -181,22 +181,22 @@ def report_outputs(wildcards=None):
 
 
 # ---- per-family helpers (the functions live here; each family's file holds its rules) ----
-def raw_files_of_used_trials(wildcards=None):
-    """Raw files of every used trial, flat (ASF + AMC, or BVH), in USED_TRIALS order."""
-    return [f for t in USED_TRIALS for f in raw_trial_files(t).values()]
+def raw_trial_input(wildcards):
+    """Raw files of the trial of one parse job (input function)."""
+    return raw_trial_files(wildcards.trial)
 
 
 # Benchmark files of this family's jobs (inputs of rule_benchmarks).
 def data_benchmarks():
     if SOURCE == "synthetic":
-        raw = job_benchmarks("synth_trials")
+        raw = job_benchmarks("synth_trial", trial=USED_TRIALS)
     else:
         amc = [t for t in USED_TRIALS if t not in BVH_TRIALS]
         bvh = [t for t in USED_TRIALS if t in BVH_TRIALS]
         raw = (job_benchmarks("download_trial", trial=amc) if amc else []) + (
             job_benchmarks("download_bvh_trial", trial=bvh) if bvh else []
         )
-    return raw + job_benchmarks("parse_trials") + job_benchmarks("datasets_table")
+    return raw + job_benchmarks("parse_trial", trial=USED_TRIALS) + job_benchmarks("datasets_table")
 
 
 def mesh_data_benchmarks():

@@ -11,16 +11,16 @@
 # downloads get 20 min for a slow network (3 attempts with a 60 s timeout each).
 
 if SOURCE == "synthetic":
-    # Every synthetic trial in one job: each takes a fraction of a second, less
-    # than a job's start-up. Each trial keeps its own seed.
 
-    rule synth_trials:
+    # One job per trial (a fraction of a second each): a changed trial record
+    # reruns that trial's jobs and the studies that read it, nothing else.
+    rule synth_trial:
         output:
-            amc=[f"resources/mocap/{t}.amc" for t in USED_TRIALS],
-            asf=[f"resources/mocap/{t}.asf" for t in USED_TRIALS],
+            amc="resources/mocap/{trial}.amc",
+            asf="resources/mocap/{trial}.asf",
         params:
-            specs=[TRIALS[t] for t in USED_TRIALS],
-            seeds=[seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], t) for t in USED_TRIALS],
+            spec=lambda wc: TRIALS[wc.trial],
+            seed=lambda wc: seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], wc.trial),
             subject_seed=config["synthetic_mocap"]["seed"],
             fps=config["fps"],
         threads: 1
@@ -28,13 +28,13 @@ if SOURCE == "synthetic":
             mem_mb=500,
             runtime=10,
         log:
-            L("data/synth_trials.log"),
+            L("data/synth_trial/{trial}.log"),
         benchmark:
-            B("data/synth_trials.tsv")
+            B("data/synth_trial/{trial}.tsv")
         conda:
             "../envs/animsynth.yaml"
         script:
-            "../scripts/data_synth_trials.py"
+            "../scripts/data_synth_trial.py"
 
 else:
 
@@ -82,16 +82,14 @@ else:
             "../scripts/data_download_trial.py"
 
 
-# Every used trial parsed in one job (a fraction of a second each, less than a
-# job's start-up); a malformed file still fails the job with its file and line.
-rule parse_trials:
+# One job per trial, so that editing or adding one trial rewrites only its own
+# .npz and reruns only the studies that read it.
+rule parse_trial:
     input:
-        raw_files_of_used_trials,
+        unpack(raw_trial_input),
     output:
-        [trial_npz(t) for t in USED_TRIALS],
+        R("data/trials/{trial}.npz"),
     params:
-        trials=USED_TRIALS,
-        raw={t: raw_trial_files(t) for t in USED_TRIALS},
         fps=config["fps"],
         joint_roles=config.get("joint_roles") or {},
         bvh_length_to_m=config.get("bvh_length_to_m", 1.0),
@@ -100,13 +98,13 @@ rule parse_trials:
         mem_mb=500,
         runtime=10,
     log:
-        L("data/parse_trials.log"),
+        L("data/parse_trial/{trial}.log"),
     benchmark:
-        B("data/parse_trials.tsv")
+        B("data/parse_trial/{trial}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
-        "../scripts/data_parse_trials.py"
+        "../scripts/data_parse_trial.py"
 
 
 rule datasets_table:
