@@ -57,6 +57,21 @@ def ensure_venv() -> None:
     stamp.write_text(want + "\n")
 
 
+def bench_args(argv: list[str]) -> tuple[list[str], list[str]]:
+    """Split snakemake arguments into (the others, the KEY=VALUE pairs of a --config option)."""
+    args, pairs, i = [], [], 0
+    while i < len(argv):
+        if argv[i] == "--config":
+            i += 1
+            while i < len(argv) and not argv[i].startswith("-"):
+                pairs.append(argv[i])
+                i += 1
+            continue
+        args.append(argv[i])
+        i += 1
+    return args, pairs
+
+
 def sh(*args: str) -> int:
     print("[run.py] " + " ".join(args), flush=True)
     return subprocess.call(list(args), cwd=ROOT)
@@ -79,9 +94,11 @@ def main(argv: list[str]) -> int:
             rc = sh(snakemake, *PAPER_CONFIG, *argv[1:], "--report", "results/paper/report.html")
         return rc
     if argv[0] == "bench":
-        # Extra arguments go to snakemake (e.g. --config cmu_mirror=DIR is not needed: the benchmarks make their data).
-        return sh(snakemake, "--cores", str(os.cpu_count() or 2), f"{BENCH_DIR}/benchmarks.csv", *argv[1:],
-                  "--config", f"results_dir={BENCH_DIR}", "benchmark_size=full")
+        # Extra arguments go to snakemake; KEY=VALUE pairs after --config join the bench run's own (snakemake
+        # keeps only the last --config option).
+        args, extra = bench_args(argv[1:])
+        return sh(snakemake, "--cores", str(os.cpu_count() or 2), f"{BENCH_DIR}/benchmarks.csv", *args,
+                  "--config", *extra, f"results_dir={BENCH_DIR}", "benchmark_size=full")
     if argv[0] == "test":
         return sh(str(PY), "-m", "pytest", *argv[1:])
     if argv[0] == "snakemake":

@@ -43,9 +43,19 @@ def benchmark_table(benchmarks_csv) -> str:
     return "\n".join(lines)
 
 
+def provenance_line(path) -> str:
+    """When and where a table was made: the file's modification date and this machine (run it where the run ran)."""
+    import datetime
+
+    from animsynth.report import machine_label
+
+    when = datetime.datetime.fromtimestamp(Path(path).stat().st_mtime).strftime("%Y-%m-%d")
+    return f"Measured {when} on {machine_label()} (`{path}`)."
+
+
 def main(argv: list[str]) -> int:
     if len(argv) == 2 and argv[0] == "--benchmarks":
-        print(benchmark_table(argv[1]))
+        print(f"{provenance_line(argv[1])}\n\n{benchmark_table(argv[1])}")
         return 0
     if len(argv) < 2 or len(argv) % 2:
         print(__doc__)
@@ -55,7 +65,7 @@ def main(argv: list[str]) -> int:
         if not path.is_file():
             print(f"cost_table: {path} does not exist (run the workflow first)", file=sys.stderr)
             return 2
-        print(f"{label} (`{path}`):\n\n{cost_table(path)}\n")
+        print(f"{label}: {provenance_line(path)}\n\n{cost_table(path)}\n")
     return 0
 
 

@@ -70,3 +70,23 @@ def test_run_py_bench_targets_full_size_in_its_own_folder(tmp_path):
                           "benchmark_size=full"], cwd=REPO, capture_output=True, text=True)
     assert res.returncode == 0, res.stderr[-2000:]
     assert "benchmarks" in res.stdout and "results/bench/benchmarks.csv" in res.stdout
+
+
+def test_run_py_bench_joins_the_users_config_pairs_to_its_own():
+    sys.path.insert(0, str(REPO))
+    import run
+
+    assert run.bench_args(["--config", "cmu_mirror=/m", "seed=3", "-n"]) == (["-n"], ["cmu_mirror=/m", "seed=3"])
+    assert run.bench_args(["-n", "--dry-run"]) == (["-n", "--dry-run"], [])
+
+
+def test_cost_table_sums_families_and_names_date_and_machine(tmp_path):
+    sys.path.insert(0, str(REPO / "benchmarks"))
+    import cost_table
+
+    csv = tmp_path / "rule_benchmarks_per_family.csv"
+    csv.write_text("family,jobs,wall_s,cpu_s,peak_rss_mb\ndata,3,8.4,2.6,107\nmeshdetail,8,161.2,40.9,419.6\n")
+    md = cost_table.cost_table(csv)
+    assert "| **total** | 11 | 170 | 44 | 420 |" in md and "| data | 3 | 8 | 3 | 107 |" in md
+    line = cost_table.provenance_line(csv)
+    assert "cores" in line and str(csv) in line and line.startswith("Measured 20")

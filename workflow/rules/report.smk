@@ -61,6 +61,7 @@ rule summary:
         provenance=provenance_rows(),
         family_data={fam: label for fam, (label, _ok, _why) in FAMILY_STATUS.items()},
         family_real=FAMILY_REAL,
+        demo=config["demo"],
         report_outputs=report_outputs,
     threads: 1
     resources:

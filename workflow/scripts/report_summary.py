@@ -20,5 +20,6 @@ if p.timing:
 claims = claims_table(verdicts, p.family_data, p.family_real)
 write_table(claims, out.claims, md=False)
 atomic_write_text(out.home, claims_rst(claims, provenance, p.report_outputs))
-atomic_write_text(out.summary, build_summary(p.sections, verdicts, note, provenance, p.family_data, p.family_real))
+atomic_write_text(out.summary, build_summary(p.sections, verdicts, note, provenance, p.family_data, p.family_real,
+                                                 p.demo))
 log.info("summary with %d tables, %d claims (%d on real data)", len(p.sections), len(claims), int(claims["real"].sum()))

@@ -1,0 +1,29 @@
+"""A workflow job imports the library before it does any work: importing a family package must not import the
+heavy libraries (numba, scikit-learn, scipy.stats, matplotlib) until a name that needs them is used."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from conftest import SAFETY_TIMEOUT
+
+HEAVY = ("numba", "sklearn", "scipy.stats", "matplotlib")
+
+
+def _loaded_after(code: str) -> set[str]:
+    probe = code + "\nimport sys\nprint(' '.join(m for m in " + repr(HEAVY) + " if m in sys.modules))"
+    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=SAFETY_TIMEOUT)
+    assert res.returncode == 0, res.stderr[-2000:]
+    return set(res.stdout.split())
+
+
+def test_family_packages_import_no_heavy_library():
+    assert _loaded_after("import animsynth.simplicial, animsynth.resequencing, animsynth.facegraph, "
+                         "animsynth.meshdetail, animsynth.io, animsynth.motion") == set()
+
+
+def test_a_name_loads_its_module_on_first_use():
+    # the lazy export really imports the module behind the name (and with it what that module needs)
+    assert "sklearn" in _loaded_after("from animsynth.simplicial import run_fold")
+    assert "sklearn" in _loaded_after("from animsynth.resequencing import STIsomap")
