@@ -2,6 +2,7 @@
 tens of GiB: refused before anything runs, naming the key."""
 
 import importlib.util
+import re
 import os
 
 import pytest
@@ -162,3 +163,53 @@ def test_joint_roles_key_is_validated():
     cfg["joint_roles"] = {"left_kne": "Knee_L"}
     with pytest.raises(ConfigError, match="left_kne"):
         validate_config(cfg, SCHEMA)
+
+
+@pytest.mark.parametrize("path", [
+    ("meshdetail", "character", "frames"),
+    ("facegraph", "synthetic", "total_frames"),
+    ("facegraph", "synthetic", "n_sequences"),
+    ("facegraph", "synthetic", "n_subjects"),
+    ("resequencing", "path", "pad_to"),
+    ("simplicial", "ensemble", "n_starts"),
+    ("simplicial", "bootstrap"),
+    ("facegraph", "uniqueness", "runs"),
+    ("facegraph", "baseline", "max_queries"),
+], ids=".".join)
+def test_sizes_are_bounded(path):
+    cfg = default_config()
+    validate_config(cfg, SCHEMA)  # fills the defaults, so every block exists
+    node = cfg
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = 10**9
+    with pytest.raises(ConfigError, match=re.escape(f"config key '{'.'.join(path)}'") + ".*maximum"):
+        validate_config(cfg, SCHEMA)
+
+
+@pytest.fixture(scope="module")
+def walk():
+    from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+    return generate_motion("walk_straight", 120, 0, cmu_like_skeleton("c", 1))
+
+
+def test_resequencing_over_the_memory_budget_is_refused_before_the_distances(walk, monkeypatch):
+    from animsynth.limits import BudgetError
+    from animsynth.resequencing import study
+
+    def no_distances(*a, **k):
+        raise AssertionError("distance matrices built before the budget check")
+
+    monkeypatch.setattr(study, "base_distances", no_distances)
+    monkeypatch.setattr(study, "config_graph", no_distances)
+    n = walk.n_frames
+    msg = rf"re-sequencing trial 'syn_walk': {n} frames .*{n} x {n}.*needs about .* GiB.*memory budget of 1e-05 GiB"
+    with pytest.raises(BudgetError, match=msg):
+        study.analyse(walk, "walk", "syn_walk", False, {}, budget_gib=1e-5)
+    with pytest.raises(BudgetError, match=msg):
+        study.explain(walk, "walk", "syn_walk", {"explanations": {"frame_steps": [4, 1]}}, budget_gib=1e-5)
+    walk = walk.__class__(walk.values, walk.skeleton, walk.fps, "syn_walk")
+    with pytest.raises(BudgetError, match=msg):
+        study.resequence(walk, False, "isomap", "l2", 5, {}, budget_gib=1e-5)
+    study.check_distance_budget(n, "syn_walk", 8.0 * 4 * n * n / 2**30 * 1.01)  # fits: no error
