@@ -8,6 +8,11 @@
     python3 run.py bench      # the performance benchmarks at full size -> results/bench/benchmarks.csv
     python3 run.py snakemake ARGS...   # any snakemake call inside the project's venv
 
+Every --configfile given (and the config/*.yaml files run.py passes itself) is
+checked first for YAML aliases that expand past a size limit ("billion
+laughs"), before Snakemake loads and merges it: a plain `snakemake
+--configfile` merges the file before any project code runs.
+
 It creates ./.venv on first use (or when pyproject.toml changes) and installs
 the pinned stack from pyproject.toml into it. Set ANIMSYNTH_VENV to use
 another location.
@@ -72,12 +77,57 @@ def bench_args(argv: list[str]) -> tuple[list[str], list[str]]:
     return args, pairs
 
 
+def configfiles(args: list[str]) -> list[str]:
+    """The files given to snakemake's ``--configfile`` / ``--configfiles`` in ``args``."""
+    files, taking = [], False
+    for a in args:
+        opt, eq, val = a.partition("=")
+        if opt in ("--configfile", "--configfiles"):
+            taking = not eq
+            if eq:
+                files.append(val)
+        elif a.startswith("-"):
+            taking = False
+        elif taking:
+            files.append(a)
+    return files
+
+
+def check_configfiles(files: list[str]) -> str | None:
+    """The first refusal of ``animsynth.config.check_config_file`` among
+    ``files`` (relative to the project, where snakemake runs), as one line
+    naming the file, or None. Needs the project's packages (runs in the venv)."""
+    from animsynth.config import ConfigError, check_config_file
+
+    for f in files:
+        path = Path(f) if Path(f).is_absolute() else ROOT / f
+        try:
+            check_config_file(path)
+        except ConfigError as exc:
+            return str(exc)
+    return None
+
+
+def prescan(args: list[str]) -> int:
+    """Check the config files among snakemake ``args`` in the venv; 0 if fine, 2 (and one line) if not."""
+    files = configfiles(args)
+    if not files:
+        return 0
+    return subprocess.call([str(PY), str(Path(__file__).resolve()), "_check-configfiles", *files], cwd=ROOT)
+
+
 def sh(*args: str) -> int:
     print("[run.py] " + " ".join(args), flush=True)
     return subprocess.call(list(args), cwd=ROOT)
 
 
 def main(argv: list[str]) -> int:
+    if argv[:1] == ["_check-configfiles"]:  # run by prescan() inside the venv
+        msg = check_configfiles(argv[1:])
+        if msg:
+            print(f"[run.py] {msg}", file=sys.stderr, flush=True)
+            return 2
+        return 0
     ensure_venv()
     snakemake = str(BIN / "snakemake")
     if not argv:
@@ -87,6 +137,9 @@ def main(argv: list[str]) -> int:
         if rc == 0:
             print(DEMO_NOTE, flush=True)
         return rc
+    if argv[0] in ("paper", "bench", "snakemake") and prescan([*PAPER_CONFIG, *argv[1:]] if argv[0] == "paper"
+                                                             else argv[1:]):
+        return 2
     if argv[0] == "paper":
         # Extra arguments (e.g. --config cmu_mirror=DIR mesh_dir=DIR) go to both calls.
         rc = sh(snakemake, "--cores", str(os.cpu_count() or 2), *PAPER_CONFIG, *argv[1:])

@@ -110,12 +110,39 @@ def test_joint_positions_match_an_independent_forward_kinematics(path):
         np.testing.assert_allclose(tips[:, k], p, atol=1e-9)
 
 
+def _as_written_back(joints, ends, data):
+    """What a write-back of the read holds: constant position channels of a
+    non-root joint become its OFFSET (their first value), the joint keeps its
+    rotation channels; every other channel is unchanged."""
+    joints = [list(j) for j in joints]
+    keep, col = [], 0
+    for k, j in enumerate(joints):
+        off = j[2].copy()
+        for c in j[3]:
+            if k > 0 and c.endswith("position"):
+                off["XYZ".index(c[0])] = data[0, col]
+            else:
+                keep.append(col)
+            col += 1
+        j[2] = off
+        if k > 0:
+            j[3] = [c for c in j[3] if not c.endswith("position")]
+    return joints, ends, data[:, keep]
+
+
+def test_blender_file_has_position_channels_on_unconnected_bones():
+    joints, _, _ = _parse(DATA / "blender.bvh")
+    six = {j[0] for j in joints[1:] if len(j[3]) == 6}
+    assert six == {"thigh.L", "thigh.R", "shoulder.L", "shoulder.R", "upper_arm.L", "upper_arm.R"}
+    assert "\tOFFSET" in (DATA / "blender.bvh").read_text()
+
+
 @pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
 def test_read_write_read_reproduces_every_channel(path, tmp_path):
     m = read_bvh(path)
     out = tmp_path / path.name
     write_bvh(out, m)
-    j0, e0, d0 = _parse(path)
+    j0, e0, d0 = _as_written_back(*_parse(path))
     j1, e1, d1 = _parse(out)
     assert [(a[0], a[1], a[3]) for a in j0] == [(a[0], a[1], a[3]) for a in j1]  # names, tree, channel orders
     for a, b in zip(j0, j1):
@@ -189,11 +216,88 @@ def test_frame_time_out_of_bounds_is_refused(tmp_path, ft, base_text):
     assert ei.value.line == _line_of(text, "Frame Time:")
 
 
-def test_position_channels_on_a_child_are_refused(tmp_path, base_text):
-    text = base_text.replace("CHANNELS 3 Xrotation Yrotation Zrotation",
-                                "CHANNELS 6 Xposition Yposition Zposition Xrotation Yrotation Zrotation", 1)
-    with pytest.raises(MotionFormatError, match="position channels on a non-root joint"):
-        read_bvh(_write(tmp_path, text))
+def _perturb_column(text, col, fn):
+    """``text`` with frame-row column ``col`` replaced by ``fn(frame, value)``."""
+    head, body = text.split("Frame Time:")
+    first, *rows = body.split("\n")
+    out = []
+    for f, row in enumerate(rows):
+        parts = row.split()
+        if parts:
+            parts[col] = f"{fn(f, float(parts[col])):.6f}"
+        out.append(" ".join(parts))
+    return head + "Frame Time:" + "\n".join([first] + out)
+
+
+def _column_of(path, joint, channel):
+    joints, _, _ = _parse(path)
+    col = 0
+    for j in joints:
+        if j[0] == joint:
+            return col + j[3].index(channel)
+        col += len(j[3])
+    raise AssertionError(joint)
+
+
+def test_constant_child_positions_are_read_as_offsets(caplog):
+    with caplog.at_level("INFO", logger="animsynth.io"):
+        m = read_bvh(DATA / "blender.bvh")
+    thigh = m.skeleton.joints[m.skeleton.index("thigh.L")]
+    assert thigh.dofs == ["rz", "rx", "ry"]  # rotations only; the positions became the offset
+    np.testing.assert_array_equal(thigh.offset, [9.0, -6.0, 0.0])
+    msgs = [r.getMessage() for r in caplog.records if "non-root" in r.getMessage()]
+    assert len(msgs) == 1 and "thigh.L" in msgs[0] and "upper_arm.R" in msgs[0]
+
+
+def test_child_positions_within_the_tolerance_are_read(tmp_path):
+    text = (DATA / "blender.bvh").read_text()
+    col = _column_of(DATA / "blender.bvh", "thigh.L", "Yposition")
+    p = _write(tmp_path, _perturb_column(text, col, lambda f, v: v + 1e-6 * (f % 3 - 1)))  # float32-like noise
+    names, pos, _ = _independent_fk(p)
+    m = read_bvh(p)
+    np.testing.assert_allclose(forward_kinematics(m.skeleton, m.values, ends=False), pos, atol=1e-5)
+
+
+def test_varying_child_positions_are_refused(tmp_path):
+    text = (DATA / "blender.bvh").read_text()
+    col = _column_of(DATA / "blender.bvh", "upper_arm.R", "Xposition")
+    p = _write(tmp_path, _perturb_column(text, col, lambda f, v: v + 0.5 * f))  # a stretching arm
+    with pytest.raises(MotionFormatError, match=r"joint 'upper_arm.R': Xposition varies .* by up to 5\.75 .*"
+                                                r"translation of a non-root joint is not supported") as ei:
+        read_bvh(p)
+    assert "x.bvh" in str(ei.value)
+    assert ei.value.line == _line_of(text, "JOINT upper_arm.R") + 3  # its CHANNELS line
+
+
+def _under_dummy_root(text, offset="1.5 -2.0 3.0"):
+    """``text``'s skeleton as the single child of a ``ROOT __0`` without channels."""
+    head, motion = text.split("MOTION\n")
+    body = head.split("HIERARCHY\n", 1)[1].replace("ROOT ", "JOINT ", 1)
+    body = "".join("\t" + ln + "\n" for ln in body.splitlines())
+    return f"HIERARCHY\nROOT __0\n{{\n\tOFFSET {offset}\n\tCHANNELS 0\n{body}}}\nMOTION\n{motion}"
+
+
+def test_a_dummy_root_with_one_child_is_collapsed(tmp_path, caplog):
+    p = _write(tmp_path, _under_dummy_root((DATA / "blender.bvh").read_text()))
+    with caplog.at_level("INFO", logger="animsynth.io"):
+        m = read_bvh(p)
+    names, pos, endpos = _independent_fk(p)
+    assert names[0] == "__0" and m.skeleton.names == names[1:]
+    np.testing.assert_allclose(m.skeleton.joints[0].offset, [1.5, -2.0, 3.0])
+    np.testing.assert_allclose(forward_kinematics(m.skeleton, m.values, ends=False), pos[:, 1:], atol=1e-9)
+    assert any("'__0'" in r.getMessage() and "'hips' is the root" in r.getMessage() for r in caplog.records)
+    write_bvh(tmp_path / "o.bvh", m)
+    back = read_bvh(tmp_path / "o.bvh")
+    assert back.skeleton.names == names[1:]
+    np.testing.assert_allclose(forward_kinematics(back.skeleton, back.values, ends=False), pos[:, 1:], atol=1e-5)
+
+
+def test_a_dummy_root_with_several_children_is_refused():
+    p = DATA / "multiroot" / "blender_two_roots.bvh"
+    with pytest.raises(MotionFormatError, match=r"root joint '__0' has no channels and 2 children \('hips', 'prop'\)"
+                       ) as ei:
+        read_bvh(p)
+    assert "blender_two_roots.bvh" in str(ei.value) and ei.value.line == 2
 
 
 @pytest.mark.parametrize("fps", [120.0, 30.0, 24.0, 60.0, 29.97, 100.0])

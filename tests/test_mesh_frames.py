@@ -121,3 +121,58 @@ def test_a_checksum_failure_in_the_fetch_leaves_nothing(tmp_path):
     with pytest.raises(MeshSourceError, match=r"mesh_0001\.obj has SHA-256"):
         fetch_mesh_frames(str(arch), dest, sums=sums)
     assert not dest.exists() and list((tmp_path / "out").iterdir()) == []
+
+
+def test_checksum_list_names_the_frame_the_reader_sees_in_any_case(tmp_path):
+    frames = _frames(3)
+    sums = _sums(frames, tmp_path)  # lists mesh_0001.obj
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    for n, b in frames.items():
+        (folder / (n.replace(".obj", ".OBJ") if n == "mesh_0001.obj" else n)).write_bytes(b)
+    table = verify_mesh_frames(folder, sums)
+    assert list(table["frame"]) == sorted(frames)
+    assert table.set_index("frame").loc["mesh_0001.obj", "file"] == "mesh_0001.OBJ"
+    (folder / "mesh_0001.OBJ").write_bytes(OBJ.format(z=9).encode())  # the check still reads it
+    with pytest.raises(MeshSourceError, match=r"mesh_0001\.OBJ: frame mesh_0001\.obj has SHA-256"):
+        verify_mesh_frames(folder, sums)
+    (folder / "mesh_0001.obj").write_bytes(frames["mesh_0001.obj"])
+    if len(list(folder.iterdir())) == 4:  # a case-sensitive file system: two files, one frame
+        with pytest.raises(MeshSourceError, match="the same frame 'mesh_0001'"):
+            verify_mesh_frames(folder, sums)
+
+
+def _big_zip(path):
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_STORED) as z:
+        z.writestr("seq/mesh_0000.obj", OBJ.format(z=0) + "#" * 3_000_000)
+    return path
+
+
+def test_a_download_over_the_cap_is_refused_and_leaves_nothing(tmp_path):
+    arch = _big_zip(tmp_path / "big.zip")
+    dest = tmp_path / "out" / "big"
+    with pytest.raises(MeshSourceError, match=r"big\.zip: download is 3\.\d+ MB, over the 1 MB cap.*max_unpacked_mb"):
+        fetch_mesh_frames(arch.as_uri(), dest, max_unpacked_mb=1)
+    assert not dest.exists() and list((tmp_path / "out").iterdir()) == []
+    assert fetch_mesh_frames(arch.as_uri(), dest, max_unpacked_mb=10)[0].name == "mesh_0000.obj"
+
+
+def test_a_download_without_a_declared_size_stops_at_the_cap(tmp_path, monkeypatch):
+    import urllib.request
+
+    class Response(io.BytesIO):  # a server that sends no Content-Length
+        headers = {}
+        served = 0
+
+        def read(self, n=-1):
+            out = super().read(n)
+            Response.served += len(out)
+            return out
+
+    body = _big_zip(tmp_path / "big.zip").read_bytes()
+    monkeypatch.setattr(urllib.request, "urlopen", lambda url, timeout: Response(body))
+    dest = tmp_path / "out" / "big"
+    with pytest.raises(MeshSourceError, match=r"download is more than 1 MB, over the 1 MB cap"):
+        fetch_mesh_frames("http://mirror.invalid/big.zip", dest, max_unpacked_mb=1)
+    assert 1_000_000 < Response.served <= 2 * 2**20 < len(body)  # the copy stopped past the cap
+    assert not dest.exists() and list((tmp_path / "out").iterdir()) == []

@@ -93,6 +93,53 @@ def check_config_size(config, limit: int = MAX_CONFIG_VALUES) -> None:
                           "refusing it (a config this large is a mistake or an attack)")
 
 
+def _yaml_children(node):
+    import yaml
+
+    if isinstance(node, yaml.MappingNode):
+        return [x for pair in node.value for x in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return node.value
+    return None
+
+
+def check_config_file(path, limit: int = MAX_CONFIG_VALUES) -> None:
+    """Refuse a YAML config file whose aliases expand past ``limit`` values.
+
+    The file is only composed (parsed into YAML nodes, an alias being a
+    shared node), never constructed or merged, so neither list, dictionary
+    nor merge-key (``<<: *name``) aliases can make this check slow. This is
+    the check to run on a ``--configfile`` before Snakemake loads and merges
+    it (``run.py`` does); :func:`check_config_size` is too late for
+    dictionary aliases, which Snakemake's merge walks first.
+
+    Raises
+    ------
+    ConfigError
+        One line naming the file: too many values, a recursive alias, not
+        readable, or not YAML.
+    """
+    import yaml
+
+    from .limits import count_nodes
+
+    try:
+        with open(path, encoding="utf-8") as fh:
+            root = yaml.compose(fh, Loader=yaml.SafeLoader)
+    except OSError as exc:
+        raise ConfigError(f"config file {os.fspath(path)}: cannot read it ({exc.strerror})") from None
+    except (yaml.YAMLError, UnicodeDecodeError) as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ConfigError(f"config file {os.fspath(path)}: not valid YAML ({first})") from None
+    try:
+        n = count_nodes(root, limit, children=_yaml_children)
+    except ValueError as exc:
+        raise ConfigError(f"config file {os.fspath(path)}: {exc}") from None
+    if n > limit:
+        raise ConfigError(f"config file {os.fspath(path)}: more than {limit} values once YAML aliases "
+                          "(&name / *name) are expanded; refusing it (a config this large is a mistake or an attack)")
+
+
 def check_results_dir(config: dict, project: str | None = None) -> None:
     """``results_dir`` is a relative path inside the project, or (with
     ``results_outside_project: true``) an absolute folder that is neither a

@@ -42,9 +42,26 @@ def synthetic_trial_bytes(frames: int, fps: float, n_dof: int = 62) -> float:
     return 8.0 * (4 * frames * n_dof + 4 * (frames + 6 * fps) * 3)
 
 
-def count_nodes(obj, limit: int) -> int:
+def _python_children(o):
+    if isinstance(o, dict):
+        return list(o.keys()) + list(o.values())
+    if isinstance(o, (list, tuple)):
+        return o
+    return None
+
+
+def count_nodes(obj, limit: int, children=_python_children) -> int:
     """Number of values in ``obj`` with every shared reference (a YAML alias)
     counted each time it is reached, stopping past ``limit``.
+
+    Parameters
+    ----------
+    obj : object
+        Loaded YAML (dicts, lists, scalars), or any graph ``children`` knows.
+    limit : int
+    children : callable, optional
+        ``children(o)``: the values inside ``o``, or None for a leaf (default:
+        dict keys and values, list and tuple items).
 
     Returns the count (at most ``limit + 1``). Raises ``ValueError`` for a
     structure that contains itself (a recursive alias).
@@ -56,10 +73,10 @@ def count_nodes(obj, limit: int) -> int:
         count += 1
         if count > limit:
             return count
-        if isinstance(o, (dict, list, tuple)):
+        items = children(o)
+        if items is not None:
             if id(o) in ancestors:
                 raise ValueError("the config contains itself (a recursive YAML alias)")
             inner = ancestors + (id(o),)
-            items = list(o.keys()) + list(o.values()) if isinstance(o, dict) else o
             stack.extend((x, inner) for x in items)
     return count

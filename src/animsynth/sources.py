@@ -35,7 +35,7 @@ import pandas as pd
 
 log = logging.getLogger("animsynth.sources")
 
-from .io.obj import is_frame_name
+from .io.obj import frame_stem, is_frame_name
 
 ARCHIVE_SUFFIXES = (".zip", ".tar.gz", ".tgz", ".tar")
 #: Default cap (MB, 10**6 bytes) on the total unpacked size of a mesh archive.
@@ -160,6 +160,37 @@ def _extract(archive: Path, dest: Path, max_unpacked_mb: float = DEFAULT_MAX_UNP
         raise MeshSourceError(f"{archive}: cannot unpack ({e})") from e
 
 
+def _download(url: str, dest: Path, timeout: float, max_mb: float) -> None:
+    """Copy ``url`` to ``dest``, stopping with :class:`MeshSourceError` once it passes ``max_mb`` MB.
+
+    A declared ``Content-Length`` over the cap is refused before the copy;
+    either way the partial file is removed.
+    """
+    cap = float(max_mb) * 1e6
+
+    def over(size: str) -> MeshSourceError:
+        return MeshSourceError(f"{url}: download is {size} MB, over the {max_mb:g} MB cap "
+                               "(config key meshdetail.max_unpacked_mb); stopped, nothing kept")
+    total = 0
+    try:
+        with urllib.request.urlopen(url, timeout=timeout) as r:
+            declared = r.headers.get("Content-Length")
+            if declared and declared.strip().isdigit() and int(declared) > cap:
+                raise over(f"{int(declared) / 1e6:.6g}")
+            with open(dest, "wb") as f:
+                for chunk in iter(lambda: r.read(1 << 20), b""):
+                    total += len(chunk)
+                    if total > cap:
+                        raise over(f"more than {cap / 1e6:.6g}")
+                    f.write(chunk)
+    except (urllib.error.URLError, OSError, ValueError) as e:
+        dest.unlink(missing_ok=True)
+        raise MeshSourceError(f"{url}: download failed ({getattr(e, 'reason', e)})") from e
+    except MeshSourceError:
+        dest.unlink(missing_ok=True)
+        raise
+
+
 def fetch_mesh_frames(source: str, dest: str | os.PathLike, timeout: float = 120.0, sums: dict | None = None,
                       max_unpacked_mb: float = DEFAULT_MAX_UNPACKED_MB) -> list[Path]:
     """Put the OBJ frames of ``source`` (an archive file, or a URL of one) into ``dest``.
@@ -172,7 +203,9 @@ def fetch_mesh_frames(source: str, dest: str | os.PathLike, timeout: float = 120
     is :func:`animsynth.io.obj.is_frame_name` (macOS ``__MACOSX`` / ``._``
     companions are ignored); frames in two folders of the archive are refused.
     An archive unpacking to more than ``max_unpacked_mb`` MB is refused before
-    anything is written.
+    anything is written; so is a download that passes ``max_unpacked_mb`` MB
+    (the copy stops there: an archive is at most about as large as what it
+    unpacks to).
 
     Returns
     -------
@@ -187,11 +220,7 @@ def fetch_mesh_frames(source: str, dest: str | os.PathLike, timeout: float = 120
             fname = source.rstrip("/").rsplit("/", 1)[-1] or "mesh_archive"
             archive = tmp / fname
             log.info("downloading %s", source)
-            try:
-                with urllib.request.urlopen(source, timeout=timeout) as r, open(archive, "wb") as f:
-                    shutil.copyfileobj(r, f)
-            except (urllib.error.URLError, OSError, ValueError) as e:
-                raise MeshSourceError(f"{source}: download failed ({getattr(e, 'reason', e)})") from e
+            _download(source, archive, timeout, max_unpacked_mb)
         else:
             archive = Path(source)
             if not archive.is_file():
@@ -249,26 +278,41 @@ def verify_mesh_frames(folder: str | os.PathLike, sums: dict[str, str]) -> pd.Da
     Returns
     -------
     table : DataFrame
-        One row per listed frame: ``frame`` (name of the uncompressed OBJ),
-        ``file`` (as found), ``sha256``.
+        One row per listed frame: ``frame`` (name of the uncompressed OBJ,
+        as listed), ``file`` (as found), ``sha256``. A listed name and a file
+        are the same frame when their :func:`~animsynth.io.obj.frame_stem`
+        agree (the reader's rule: ``a.obj``, ``a.OBJ`` and ``a.obj.gz`` are
+        frame ``a``).
 
     Raises
     ------
     MeshSourceError
         Naming the first frame that is missing, unlisted or whose hash differs.
     """
-    found = {re.sub(r"\.gz$", "", f.name, flags=re.IGNORECASE): f for f in list_frames(folder)}
-    if len(found) != len(list_frames(folder)):
-        raise MeshSourceError(f"{folder}: a frame exists both as .obj and .obj.gz")
-    extra = sorted(set(found) - set(sums))
+    found: dict[str, Path] = {}
+    for f in list_frames(folder):
+        stem = frame_stem(f.name)
+        if stem in found:
+            raise MeshSourceError(f"{folder}: {found[stem].name} and {f.name} are the same frame {stem!r} "
+                                  "(.obj / .obj.gz in any letter case)")
+        found[stem] = f
+    listed: dict[str, str] = {}
+    for name in sums:
+        stem = frame_stem(name) if is_frame_name(name) else name
+        if stem in listed:
+            raise MeshSourceError(f"checksum list: {listed[stem]} and {name} are the same frame {stem!r}")
+        listed[stem] = name
+    extra = sorted(set(found) - set(listed))
     if extra:
-        raise MeshSourceError(f"{folder}: frame {extra[0]} is not in the checksum list ({len(extra)} unlisted frames)")
+        raise MeshSourceError(f"{folder}: frame {found[extra[0]].name} is not in the checksum list "
+                              f"({len(extra)} unlisted frames)")
     rows = []
-    for name in sorted(sums):
-        if name not in found:
+    for stem in sorted(listed, key=lambda k: listed[k]):
+        name = listed[stem]
+        if stem not in found:
             raise MeshSourceError(f"{folder}: frame {name} is missing (listed in the checksum list)")
-        got = _frame_hash(found[name])
+        got = _frame_hash(found[stem])
         if got != sums[name]:
-            raise MeshSourceError(f"{found[name]}: frame {name} has SHA-256 {got}, expected {sums[name]}")
-        rows.append({"frame": name, "file": found[name].name, "sha256": got})
+            raise MeshSourceError(f"{found[stem]}: frame {name} has SHA-256 {got}, expected {sums[name]}")
+        rows.append({"frame": name, "file": found[stem].name, "sha256": got})
     return pd.DataFrame(rows, columns=["frame", "file", "sha256"])

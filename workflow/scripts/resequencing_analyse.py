@@ -11,7 +11,8 @@ cfg = snakemake.params.cfg  # noqa: F821
 wc = snakemake.wildcards  # noqa: F821
 motion = prepare_motion(Motion.load_npz(snakemake.input[0]), cfg["max_frames"], cfg["frame_step"])  # noqa: F821
 log.info("%s (%s): %d frames at %.4g fps", wc.rsdata, snakemake.params.trial, motion.n_frames, motion.fps)  # noqa: F821
-min_k, rv, emb, timing = analyse(motion, wc.rsdata, snakemake.params.trial, gdof_flag(wc.rsgdof), cfg)  # noqa: F821
+min_k, rv, emb, timing = analyse(motion, wc.rsdata, snakemake.params.trial, gdof_flag(wc.rsgdof), cfg,  # noqa: F821
+                                  budget_gib=snakemake.config.get("memory_budget_gib"))  # noqa: F821
 out = snakemake.output  # noqa: F821
 with atomic_path(out.min_k) as tmp:
     min_k.to_csv(tmp, index=False, lineterminator="\n")

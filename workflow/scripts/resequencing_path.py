@@ -20,7 +20,8 @@ for gdof, path in zip(snakemake.params.gdof, snakemake.input.min_k):  # noqa: F8
 for i, (method, metric, gdof) in enumerate(snakemake.params.configs):  # noqa: F821
     k = min_k[(method, metric, gdof)]
     paths, (main_path, main), per_path, per_tr = resequence(motion, gdof_flag(gdof), method, metric, k, cfg,
-                                                            seed=snakemake.params.seed)  # noqa: F821
+                                                            seed=snakemake.params.seed,  # noqa: F821
+                                                            budget_gib=snakemake.config.get("memory_budget_gib"))  # noqa: F821
     rows = [{"pair": "main", "start": int(main_path[0]), "end": int(main_path[-1]), "step": j, "frame": int(f)}
             for j, f in enumerate(main_path)]
     rows += [{"pair": p, "start": int(path[0]), "end": int(path[-1]), "step": j, "frame": int(f)}

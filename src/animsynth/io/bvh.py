@@ -7,8 +7,20 @@ silent misreading would follow; each of these is a
 :class:`~animsynth.io.errors.MotionFormatError` naming file and line:
 
 * a joint's rotation (or position) channels must name distinct axes
-  (``Xrotation Xrotation Xrotation`` is refused); position channels are only
-  supported on the root joint;
+  (``Xrotation Xrotation Xrotation`` is refused);
+* position channels on a non-root joint (in BVH they replace the joint's
+  ``OFFSET`` in every frame; Blender's exporter writes them on every bone not
+  connected to its parent) must be constant over the frames, to within
+  :data:`CHILD_POSITION_REL_TOL` of the skeleton's size (the sum of its bone
+  lengths) plus the printed precision: they are then read as the joint's
+  ``OFFSET`` (their mean; one log line names the joints). Translation
+  animation of a non-root joint is not supported (the skeleton has fixed bone
+  offsets) and is refused, naming the joint and its largest deviation;
+* a root with no channels (``CHANNELS 0``, Blender's dummy ``ROOT __0``) and
+  exactly one child is dropped: the child becomes the root, the dummy's
+  ``OFFSET`` added to the child's offset and positions (logged). With several
+  children (an armature with several root bones) it is refused: one skeleton
+  with one root translation per file is supported;
 * joint names must be unique;
 * nothing may follow the root joint's closing brace before ``MOTION`` (a
   second ``ROOT``, a stray ``}``);
@@ -31,7 +43,10 @@ Writing (:func:`write_bvh`): one BVH joint per skeleton joint, ``OFFSET`` =
 where the joint starts relative to its parent, an ``End Site`` at the tip of
 every leaf. A joint that came from a BVH file (no ASF axis frame) is written
 with its own channels in its own order, so reading a BVH and writing it back
-reproduces every channel value to the printed precision (6 decimals). An ASF
+reproduces every channel value to the printed precision (6 decimals), except
+that constant position channels of a non-root joint are written back as that
+joint's ``OFFSET`` (the skeleton holds fixed offsets, not channels): the joint
+positions are the same, the joint has its rotation channels only. An ASF
 joint with rotational DOF gets ``Zrotation Yrotation Xrotation`` (the local
 rotation ``L = C M C^-1`` of :mod:`animsynth.kinematics` as intrinsic Z-Y-X
 Euler angles, degrees); an ASF joint without DOF (e.g. CMU ``lhipjoint``) gets
@@ -46,6 +61,7 @@ skeleton's DOF (the round trip).
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 
@@ -61,6 +77,13 @@ from .errors import MotionFormatError, parse_float, read_text_lines
 _CH = {"Xposition": "tx", "Yposition": "ty", "Zposition": "tz",
        "Xrotation": "rx", "Yrotation": "ry", "Zrotation": "rz"}
 _CH_NAME = {v: k for k, v in _CH.items()}
+
+log = logging.getLogger("animsynth.io")
+
+#: Position channels of a non-root joint count as constant when every value
+#: lies within this fraction of the skeleton's size (sum of its bone lengths),
+#: plus half the printed precision, of the channel's mean.
+CHILD_POSITION_REL_TOL = 1e-5
 
 #: Shortest frame time accepted (seconds): 100,000 frames per second.
 MIN_FRAME_TIME = 1e-5
@@ -243,7 +266,8 @@ def read_bvh(path, fps: float | None = None) -> Motion:
         b, lnb = nxt()
         if b != "{":
             raise MotionFormatError(path, lnb, f"expected '{{' after {kw} {name}")
-        rec = {"name": name, "parent": parent, "offset": None, "channels": None, "end": None, "line": ln0}
+        rec = {"name": name, "parent": parent, "offset": None, "channels": None, "end": None, "line": ln0,
+               "chan_line": ln0}
         idx = len(joints)
         joints.append(rec)
         while True:
@@ -269,10 +293,9 @@ def read_bvh(path, fps: float | None = None) -> Motion:
                                             f"unknown channel {bad[0]!r} (expected {', '.join(_CH)})")
                 chans = [c for c, _ in chans]
                 axes_of(chans, "rotation", lnc, name)
-                if axes_of(chans, "position", lnc, name) and parent >= 0:
-                    raise MotionFormatError(path, lnc, f"joint {name!r}: position channels on a non-root joint "
-                                                       "are not supported")
+                axes_of(chans, "position", lnc, name)
                 rec["channels"] = chans
+                rec["chan_line"] = lnc
             elif t == "JOINT":
                 parse_joint(idx, t, ln)
             elif t == "End":
@@ -345,6 +368,8 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     if len(rows) != nframes:
         raise MotionFormatError(path, len(raw), f"header says {nframes} frames, file has {len(rows)} (truncated?)")
     data = np.array(rows, float).reshape(nframes, ncols)
+    joints, data = _drop_dummy_root(path, joints, data)
+    data = _constant_child_positions(path, joints, data)
     # the generic skeleton: DOF = position channels, then rotation channels
     # reversed (intrinsic channel order -> extrinsic DOF order)
     sk_joints, cols, col = [], [], 0
@@ -367,6 +392,73 @@ def read_bvh(path, fps: float | None = None) -> Motion:
         if d in TRANS_DOFS:
             values[:, k] -= root.offset[TRANS_DOFS.index(d)]
     return Motion(values, sk, float(fps) if fps is not None else _frame_rate(ft_s, ftime), sk.name)
+
+
+def _drop_dummy_root(path, joints: list[dict], data: np.ndarray):
+    """Drop a root without channels that has one child (see module docstring)."""
+    root = joints[0]
+    if root["channels"]:
+        return joints, data
+    kids = [k for k, r in enumerate(joints) if r["parent"] == 0]
+    if len(kids) > 1:
+        names = ", ".join(repr(joints[k]["name"]) for k in kids)
+        raise MotionFormatError(path, root["line"],
+                                f"root joint {root['name']!r} has no channels and {len(kids)} children ({names}): "
+                                "an armature with several root bones (Blender writes them under a dummy root); "
+                                "one skeleton with one root per file is supported, export one root bone")
+    if not kids:
+        return joints, data
+    child = joints[1]  # the only child comes first in file order
+    shift = np.asarray(root["offset"], float)
+    child["offset"] = np.asarray(child["offset"], float) + shift
+    data = data.copy()
+    for k, c in enumerate(child["channels"]):  # the dummy has no columns: the child's start at 0
+        if c.endswith("position"):
+            data[:, k] += shift["XYZ".index(c[0])]
+    out = [dict(r, parent=r["parent"] - 1) for r in joints[1:]]
+    log.info("%s: root %r has no channels and one child; %r is the root", os.fspath(path), root["name"],
+             child["name"])
+    return out, data
+
+
+def _constant_child_positions(path, joints: list[dict], data: np.ndarray) -> np.ndarray:
+    """Read constant position channels of non-root joints as their OFFSET.
+
+    Changes ``joints`` in place (offset replaced, position channels removed)
+    and returns ``data`` without those columns; refuses varying ones.
+    """
+    start, col = [], 0
+    for r in joints:
+        start.append(col)
+        col += len(r["channels"])
+    moved = [k for k, r in enumerate(joints) if k > 0 and any(c.endswith("position") for c in r["channels"])]
+    if not moved:
+        return data
+    size = sum(float(np.linalg.norm(r["offset"])) for r in joints[1:])
+    size += sum(float(np.linalg.norm(r["end"])) for r in joints if r["end"] is not None)
+    tol = CHILD_POSITION_REL_TOL * size + 0.5 * 10.0 ** -DECIMALS
+    drop = []
+    for k in moved:
+        r = joints[k]
+        off = np.asarray(r["offset"], float).copy()
+        for i, c in enumerate(r["channels"]):
+            if not c.endswith("position"):
+                continue
+            v = data[:, start[k] + i]
+            dev = float(np.max(np.abs(v - v.mean())))
+            if dev > tol:
+                f = int(np.argmax(np.abs(v - v.mean())))
+                raise MotionFormatError(path, r["chan_line"],
+                                        f"joint {r['name']!r}: {c} varies over the frames by up to {dev:g} from its "
+                                        f"mean (frame {f + 1}; tolerance {tol:g} file units); translation of a "
+                                        "non-root joint is not supported (the skeleton has fixed bone offsets)")
+            off["XYZ".index(c[0])] = v.mean()
+            drop.append(start[k] + i)
+        r["offset"] = off
+        r["channels"] = [c for c in r["channels"] if not c.endswith("position")]
+    log.info("%s: position channels of non-root joint(s) %s are constant; read as their OFFSET",
+             os.fspath(path), ", ".join(joints[k]["name"] for k in moved))
+    return np.delete(data, drop, axis=1)
 
 
 def motion_from_bvh_on(bvh_motion: Motion, skeleton: Skeleton) -> Motion:

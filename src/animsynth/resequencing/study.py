@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
 from ..motion import Motion
 from ..tables import add_paper_differences
 from .distances import PAPER_WEIGHTS, l2_distances, lee_distances
@@ -70,6 +71,36 @@ DEFAULTS = {
     "published": {"table2": "../shared/papers/s2_table2_min_k.csv",
                   "lee_weights": "../shared/papers/s2_lee_weights.csv"},
 }
+
+
+#: N x N float64 arrays the distance steps hold at once (base distances,
+#: method distances, geodesics, the centred kernel / path graph).
+DISTANCE_MATRICES = 4
+
+
+def check_distance_budget(n_frames: int, trial: str, budget_gib: float | None = None) -> None:
+    """Refuse, before any distance matrix is built, a trial whose ``n_frames``
+    x ``n_frames`` matrices would exceed the memory budget.
+
+    Parameters
+    ----------
+    n_frames : int
+        Frames after ``max_frames`` / ``frame_step``.
+    trial : str
+        Named in the error.
+    budget_gib : float, optional
+        The config's ``memory_budget_gib`` (default
+        :data:`~animsynth.limits.DEFAULT_MEMORY_BUDGET_GIB`).
+
+    Raises
+    ------
+    animsynth.limits.BudgetError
+        Naming the trial, the frame count and the estimate.
+    """
+    check_budget(f"re-sequencing trial {trial!r}: {n_frames} frames ({DISTANCE_MATRICES} distance matrices of "
+                 f"{n_frames} x {n_frames}; lower config key 'resequencing.max_frames')",
+                 8.0 * DISTANCE_MATRICES * float(n_frames) ** 2,
+                 DEFAULT_MEMORY_BUDGET_GIB if budget_gib is None else float(budget_gib))
 
 
 def with_defaults(cfg: dict | None) -> dict:
@@ -209,7 +240,8 @@ def fit_embedding(Dm, k: int, always, max_dim: int, emb_cfg: dict):
     return "landmark", res.embedding, graph, np.asarray(res.residual_variance)
 
 
-def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg: dict):
+def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg: dict,
+            budget_gib: float | None = None):
     """Min k, residual variance and 2-D embeddings of every method x metric of one dataset x global flag.
 
     The embeddings, residual variance (``k_mode = "min_k"``) and the paths use
@@ -224,8 +256,14 @@ def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg:
     rv : DataFrame, residual variance per method x metric x k x dimension
     embeddings : dict of arrays for the Fig. 2 plots (``<method>_<metric>_xy``, ``..._edges``)
     timings : DataFrame (machine-dependent seconds)
+
+    Raises
+    ------
+    animsynth.limits.BudgetError
+        The distance matrices would exceed ``budget_gib`` (:func:`check_distance_budget`).
     """
     cfg = with_defaults(cfg)
+    check_distance_budget(motion.n_frames, trial, budget_gib)
     feats = motion_features(motion)
     n = feats.n_frames
     gap = st_kwargs(cfg["stisomap"], motion.fps)["ctn_min_gap"]
@@ -280,7 +318,7 @@ def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg:
     return pd.DataFrame(rows), pd.DataFrame(rv_rows), emb, pd.DataFrame(t_rows)
 
 
-def explain(motion: Motion, dataset: str, trial: str, cfg: dict):
+def explain(motion: Motion, dataset: str, trial: str, cfg: dict, budget_gib: float | None = None):
     """Minimum k over the candidate explanations of the paper's Table 2, and sign flips.
 
     ``motion`` is the trial *before* ``frame_step`` (``max_frames`` applied
@@ -294,9 +332,17 @@ def explain(motion: Motion, dataset: str, trial: str, cfg: dict):
     grid : DataFrame, one row per condition x method x metric
     flips : DataFrame, sign flips per joint (root included) of the ``matrix_naive``
         quaternions per frame step (``continuous`` has none by construction)
+
+    Raises
+    ------
+    animsynth.limits.BudgetError
+        The distance matrices of the smallest frame step would exceed
+        ``budget_gib`` (:func:`check_distance_budget`); checked before any is built.
     """
     cfg = with_defaults(cfg)
     ex = cfg["explanations"]
+    check_distance_budget(prepare_motion(motion, cfg["max_frames"], int(min(ex["frame_steps"]))).n_frames, trial,
+                          budget_gib)
     rows, flip_rows = [], []
     for step in ex["frame_steps"]:
         m = prepare_motion(motion, cfg["max_frames"], int(step))
@@ -387,7 +433,8 @@ def config_graph(motion: Motion, include_global: bool, method: str, metric: str,
 TRANSITION_MEASURES = ["pose_jump_ratio", "velocity_jump_ratio", "accel_jump_ratio", "foot_skate_ratio"]
 
 
-def resequence(motion: Motion, include_global: bool, method: str, metric: str, k: int, cfg: dict, seed: int = 0):
+def resequence(motion: Motion, include_global: bool, method: str, metric: str, k: int, cfg: dict, seed: int = 0,
+               budget_gib: float | None = None):
     """Re-sequence one configuration: Dijkstra paths on the method's graph, played and measured.
 
     Every pair of :func:`path_pairs` gives one path. Each path is played inside
@@ -407,9 +454,15 @@ def resequence(motion: Motion, include_global: bool, method: str, metric: str, k
     main : (int array, Motion), the main path (padded to ``path.pad_to``) and the motion it plays
     per_path : DataFrame, one row per pair
     per_transition : DataFrame, one row per transition
+
+    Raises
+    ------
+    animsynth.limits.BudgetError
+        The distance matrices would exceed ``budget_gib`` (:func:`check_distance_budget`).
     """
     cfg = with_defaults(cfg)
     n = motion.n_frames
+    check_distance_budget(n, motion.name, budget_gib)
     G = config_graph(motion, include_global, method, metric, k, cfg)
     pc = cfg["path"]
     mode = pc["root_playback"]

@@ -12,9 +12,17 @@ not come from any other project:
   everywhere, 120 fps printed as ``0.008333``.
 * ``hips_zxy.bvh``: Mixamo-style ``mixamorig:`` names, ``Zrotation
   Xrotation Yrotation``, 30 fps, a root OFFSET that is not zero.
-* ``blender.bvh``: Blender-exporter style (tab indentation, rigify-style
-  lower-case ``thigh.L`` names, ``Yrotation Xrotation Zrotation``, 24 fps
-  printed as ``0.041667``, an ``End Site`` on every leaf).
+* ``blender.bvh``: what Blender's BVH exporter writes (default
+  ``root_transform_only=False``) for an armature with one root bone: tab
+  indentation, rigify-style lower-case ``thigh.L`` names, ``Yrotation
+  Xrotation Zrotation``, 24 fps printed as ``0.041667``, an ``End Site`` on
+  every leaf, and ``CHANNELS 6 Xposition Yposition Zposition ...`` on every
+  bone not connected to its parent (thighs, shoulders, upper arms) whose
+  positions are constant, equal to the bone's ``OFFSET``.
+* ``multiroot/blender_two_roots.bvh`` (a folder of its own: it is refused, the
+  files above are read): what the exporter writes for an armature with two
+  root bones, a dummy ``ROOT __0`` with ``OFFSET 0.0 0.0 0.0`` and
+  ``CHANNELS 0`` holding both as ``JOINT`` with six channels.
 """
 
 from __future__ import annotations
@@ -63,7 +71,7 @@ def angles(k: int, t: int, fps: float) -> tuple[float, float, float]:
 
 
 def write(name: str, names: dict, root_order: str, order: str, fps: float, frame_time: str, indent: str = "  ",
-          root_offset=(0.0, 0.0, 0.0), extra=(), skip=()) -> None:
+          root_offset=(0.0, 0.0, 0.0), extra=(), skip=(), unconnected=()) -> None:
     body = [b for b in BODY if b[0] not in skip] + list(extra)
     kids = {}
     for role, parent, _ in body:
@@ -80,11 +88,12 @@ def write(name: str, names: dict, root_order: str, order: str, fps: float, frame
         lines.append(f"{ind}{indent}OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}")
         ro = root_order if depth == 0 else order
         rot = " ".join(f"{a}rotation" for a in ro)
-        if depth == 0:
+        six = depth == 0 or role in unconnected
+        if six:
             lines.append(f"{ind}{indent}CHANNELS 6 Xposition Yposition Zposition {rot}")
         else:
             lines.append(f"{ind}{indent}CHANNELS 3 {rot}")
-        chan_order.append((role, depth == 0, ro))
+        chan_order.append((role, depth == 0, six, ro))
         for c in kids.get(role, []):
             emit(c, depth + 1)
         if role not in kids:
@@ -99,9 +108,11 @@ def write(name: str, names: dict, root_order: str, order: str, fps: float, frame
     lines += ["MOTION", f"Frames: {FRAMES}", f"Frame Time: {frame_time}"]
     for t in range(FRAMES):
         row = []
-        for k, (role, is_root, ro) in enumerate(chan_order):
+        for k, (role, is_root, six, ro) in enumerate(chan_order):
             if is_root:
                 row += [1.5 * t, 95.0 + 2.0 * math.sin(t / 3.0), 0.3 * t]
+            elif six:
+                row += list(off[role])  # an unanimated translation: the OFFSET in every frame
             a = dict(zip("XYZ", angles(k, t, fps)))
             row += [a[ax] for ax in ro]
         lines.append(" ".join(f"{v:.6f}" for v in row))
@@ -137,7 +148,24 @@ def main():
                "rshoulder": "shoulder.R", "rarm": "upper_arm.R", "rforearm": "forearm.R", "rhand": "hand.R",
                "lupleg": "thigh.L", "lleg": "shin.L", "lfoot": "foot.L", "ltoe": "toe.L",
                "rupleg": "thigh.R", "rleg": "shin.R", "rfoot": "foot.R", "rtoe": "toe.R"}
-    write("blender.bvh", blender, "YXZ", "YXZ", 24.0, "0.041667", indent="\t")
+    write("blender.bvh", blender, "YXZ", "YXZ", 24.0, "0.041667", indent="\t",
+          unconnected=("lupleg", "rupleg", "lshoulder", "rshoulder", "larm", "rarm"))
+    write_two_roots()
+
+
+def write_two_roots() -> None:
+    """Blender's layout for an armature with two root bones (a body and a prop)."""
+    lines = ["HIERARCHY", "ROOT __0", "{", "\tOFFSET 0.0 0.0 0.0", "\tCHANNELS 0"]
+    for name, off, tip in (("hips", (0.0, 95.0, 0.0), (0.0, 10.0, 0.0)), ("prop", (40.0, 80.0, 5.0), (0.0, 0.0, 30.0))):
+        lines += [f"\tJOINT {name}", "\t{", f"\t\tOFFSET {off[0]:.6f} {off[1]:.6f} {off[2]:.6f}",
+                  "\t\tCHANNELS 6 Xposition Yposition Zposition Yrotation Xrotation Zrotation",
+                  "\t\tEnd Site", "\t\t{", f"\t\t\tOFFSET {tip[0]:.6f} {tip[1]:.6f} {tip[2]:.6f}", "\t\t}", "\t}"]
+    lines += ["}", "MOTION", "Frames: 3", "Frame Time: 0.041667"]
+    for t in range(3):
+        lines.append(" ".join(f"{v:.6f}" for v in (1.5 * t, 95.0, 0.3 * t, *angles(0, t, 24.0),
+                                                   40.0, 80.0 + t, 5.0, *angles(1, t, 24.0))))
+    (HERE / "multiroot").mkdir(exist_ok=True)
+    (HERE / "multiroot" / "blender_two_roots.bvh").write_text("\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":
