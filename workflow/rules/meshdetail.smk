@@ -75,7 +75,7 @@ rule meshdetail_load:
     log:
         L("meshdetail/{mdseq}/load.log"),
     benchmark:
-        B("meshdetail/{mdseq}/load.tsv")
+        B("meshdetail/load/{mdseq}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -116,7 +116,7 @@ rule meshdetail_rig:
     log:
         L("meshdetail/{mdseq}/rig.log"),
     benchmark:
-        B("meshdetail/{mdseq}/rig.tsv")
+        B("meshdetail/rig/{mdseq}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -159,7 +159,7 @@ rule meshdetail_main:
     log:
         L("meshdetail/{mdseq}/main.log"),
     benchmark:
-        B("meshdetail/{mdseq}/main.tsv")
+        B("meshdetail/main/{mdseq}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -192,7 +192,7 @@ rule meshdetail_resolution:
     log:
         L("meshdetail/{mdseq}/resolution.log"),
     benchmark:
-        B("meshdetail/{mdseq}/resolution.tsv")
+        B("meshdetail/resolution/{mdseq}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -219,7 +219,7 @@ rule meshdetail_representations:
     log:
         L("meshdetail/{mdseq}/representations.log"),
     benchmark:
-        B("meshdetail/{mdseq}/representations.tsv")
+        B("meshdetail/representations/{mdseq}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -274,7 +274,7 @@ rule meshdetail_figures:
     log:
         L("meshdetail/{mdseq}/figures.log"),
     benchmark:
-        B("meshdetail/{mdseq}/figures.tsv")
+        B("meshdetail/figures/{mdseq}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -304,7 +304,7 @@ rule meshdetail_verdicts:
     log:
         L("meshdetail/{mdseq}/verdicts.log"),
     benchmark:
-        B("meshdetail/{mdseq}/verdicts.tsv")
+        B("meshdetail/verdicts/{mdseq}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -340,7 +340,7 @@ rule meshdetail_dembones:
     log:
         L("meshdetail/{mdseq}/dembones.log"),
     benchmark:
-        B("meshdetail/{mdseq}/dembones.tsv")
+        B("meshdetail/dembones/{mdseq}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
