@@ -3,7 +3,8 @@ from animsynth.sources import fetch_mesh_frames, read_sha256_list
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
-sums = list(snakemake.input.get("sums") or [])  # noqa: F821  (the sequence's SHA-256 list, or none)
+# the sequence's SHA-256 list, or none
+sums = list(snakemake.input.get("sums") or [])  # noqa: F821
 sums = sums[0] if sums else None
 frames = fetch_mesh_frames(snakemake.params.source, snakemake.output[0],  # noqa: F821
                            sums=read_sha256_list(sums) if sums else None,
