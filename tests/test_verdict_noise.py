@@ -143,7 +143,7 @@ def test_meshdetail_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workf
 
     from animsynth.meshdetail.verdicts import verdicts
 
-    out = tiny_workflow / "results" / "meshdetail"
+    out = tiny_workflow / "results" / "meshdetail" / "character"  # the tiny run's one sequence: the synthetic character
     read = lambda p: pd.read_csv(p, keep_default_na=False, na_values=[""])  # noqa: E731
     tables = [read(out / f"{k}.csv") for k in ("fig5a", "fig5b", "fig5c", "generalisation")]
     cfg = yaml.safe_load((tiny_workflow / "config" / "config.yaml").read_text())["meshdetail"]
