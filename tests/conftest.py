@@ -128,3 +128,14 @@ def pytest_collection_modifyitems(config, items):
            and i.get_closest_marker("workflow") is None]
     if bad:
         raise pytest.UsageError("tests using the tiny workflow run must be marked workflow: " + ", ".join(bad))
+
+
+def write_small_trial(folder: Path, frames: int) -> Path:
+    """A synthetic CMU-layout trial ``c.asf`` + ``c.amc`` (a walk of ``frames`` frames) in ``folder``."""
+    from animsynth.io import write_amc, write_asf
+    from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+    sk = cmu_like_skeleton("c", 1)
+    write_asf(folder / "c.asf", sk, length_unit=0.45)
+    write_amc(folder / "c.amc", generate_motion("walk_straight", frames, 0, sk))
+    return folder

@@ -11,10 +11,9 @@ import numpy as np
 import pytest
 
 from animsynth.cli import main
-from animsynth.io import MotionFormatError, read_amc, read_asf, write_amc, write_asf
+from animsynth.io import MotionFormatError, read_amc, read_asf
 from animsynth.io.bvh import read_bvh, write_bvh
 from animsynth.kinematics import forward_kinematics
-from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 DATA = Path(__file__).resolve().parent / "data" / "bvh"
 FILES = sorted(DATA.glob("*.bvh"))
@@ -310,11 +309,9 @@ def test_frame_rate_survives_a_write(tmp_path, fps, base_text):
 
 @pytest.fixture(scope="module")
 def asf_amc(tmp_path_factory):
-    d = tmp_path_factory.mktemp("amc2bvh")
-    sk = cmu_like_skeleton("c", 1)
-    write_asf(d / "c.asf", sk, length_unit=0.45)
-    write_amc(d / "c.amc", generate_motion("walk_straight", 30, 0, sk))
-    return d
+    from conftest import write_small_trial
+
+    return write_small_trial(tmp_path_factory.mktemp("amc2bvh"), 30)
 
 
 def test_amc2bvh_120_fps_reads_back_as_120(asf_amc, tmp_path):

@@ -7,17 +7,13 @@ import os
 import pytest
 
 from animsynth.cli import main
-from animsynth.io import write_amc, write_asf
-from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 
 @pytest.fixture(scope="module")
 def trial(tmp_path_factory):
-    d = tmp_path_factory.mktemp("cli_limits")
-    sk = cmu_like_skeleton("c", 1)
-    write_asf(d / "c.asf", sk, length_unit=0.45)
-    write_amc(d / "c.amc", generate_motion("walk_straight", 40, 0, sk))
-    return d
+    from conftest import write_small_trial
+
+    return write_small_trial(tmp_path_factory.mktemp("cli_limits"), 40)
 
 
 def _one_line_exit_2(capsys, rc, *needles):
