@@ -62,35 +62,34 @@ def ensure_venv() -> None:
     stamp.write_text(want + "\n")
 
 
+def split_option(args: list[str], names: tuple[str, ...]) -> tuple[list[str], list[str]]:
+    """(``args`` without the options ``names``, the values given to them): ``--opt v1 v2 ...`` (values up to
+    the next argument starting with ``-``) and ``--opt=v`` both count."""
+    rest, values, taking = [], [], False
+    for a in args:
+        opt, eq, val = a.partition("=")
+        if opt in names:
+            taking = not eq
+            if eq:
+                values.append(val)
+        elif a.startswith("-"):
+            taking = False
+            rest.append(a)
+        elif taking:
+            values.append(a)
+        else:
+            rest.append(a)
+    return rest, values
+
+
 def bench_args(argv: list[str]) -> tuple[list[str], list[str]]:
     """Split snakemake arguments into (the others, the KEY=VALUE pairs of a --config option)."""
-    args, pairs, i = [], [], 0
-    while i < len(argv):
-        if argv[i] == "--config":
-            i += 1
-            while i < len(argv) and not argv[i].startswith("-"):
-                pairs.append(argv[i])
-                i += 1
-            continue
-        args.append(argv[i])
-        i += 1
-    return args, pairs
+    return split_option(argv, ("--config",))
 
 
 def configfiles(args: list[str]) -> list[str]:
     """The files given to snakemake's ``--configfile`` / ``--configfiles`` in ``args``."""
-    files, taking = [], False
-    for a in args:
-        opt, eq, val = a.partition("=")
-        if opt in ("--configfile", "--configfiles"):
-            taking = not eq
-            if eq:
-                files.append(val)
-        elif a.startswith("-"):
-            taking = False
-        elif taking:
-            files.append(a)
-    return files
+    return split_option(args, ("--configfile", "--configfiles"))[1]
 
 
 def check_configfiles(files: list[str]) -> str | None:

@@ -89,10 +89,12 @@ def skeleton_gif(path, positions_list, parents, titles=None, fps: float = 30.0, 
         x = i * panel_px + panel_px / 2 + scale * uv[..., 0]
         y = top + (panel_px - top) / 2 - scale * uv[..., 1]
         screen.append(np.stack([x, y], axis=-1))
+    # palette: 0 background, 1 bones, 2 titles, 3 panel separators
+    palette = [255, 255, 255, 31, 119, 180, 0, 0, 0, 200, 200, 200] + [0] * (256 * 3 - 12)
     images = []
     for fi in frames:
         im = Image.new("P", (panel_px * k, panel_px), 0)
-        im.putpalette([255, 255, 255, 31, 119, 180, 0, 0, 0, 200, 200, 200] + [0] * (256 * 3 - 12))
+        im.putpalette(palette)
         draw = ImageDraw.Draw(im)
         for i, (s, t) in enumerate(zip(screen, titles)):
             if i:

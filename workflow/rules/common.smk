@@ -161,7 +161,7 @@ FAMILY_REAL = {
     "data": SOURCE != "synthetic",
     "simplicial": SOURCE != "synthetic",
     "resequencing": SOURCE != "synthetic",
-    "meshdetail": bool(config.get("mesh_dir")),
+    "meshdetail": all(s["mesh_dir"] for s in MD_SEQS.values()),  # every sequence of the run is real
     "facegraph": bool(config["facegraph"].get("ckplus_dir")),
 }
 
