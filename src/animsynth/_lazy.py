@@ -8,7 +8,7 @@ import importlib
 
 
 def lazy_exports(package: str, exports: dict[str, str]):
-    """``__getattr__`` and ``__dir__`` for ``package`` from {name: relative module}."""
+    """``__all__``, ``__getattr__`` and ``__dir__`` for ``package`` from {name: relative module}."""
 
     def __getattr__(name: str):
         try:
@@ -20,4 +20,4 @@ def lazy_exports(package: str, exports: dict[str, str]):
     def __dir__():
         return sorted(exports)
 
-    return __getattr__, __dir__
+    return sorted(exports), __getattr__, __dir__

@@ -31,5 +31,4 @@ _EXPORTS = {
     "save_graphs": ".regiongraph",
     "vinfl": ".similarity",
 }
-__all__ = sorted(_EXPORTS)
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

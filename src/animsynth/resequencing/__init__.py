@@ -43,5 +43,4 @@ _EXPORTS = {
     "temporal_adjacency": ".embedding",
     "transitions": ".metrics",
 }
-__all__ = sorted(_EXPORTS)
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

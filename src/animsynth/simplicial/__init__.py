@@ -37,5 +37,4 @@ _EXPORTS = {
     "run_subset": ".experiment",
     "training_vectors": ".field",
 }
-__all__ = sorted(_EXPORTS)
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
