@@ -1,6 +1,7 @@
 # Shared helpers: config checks beyond the schema, trial lookups, target lists.
 import json
 import re
+from pathlib import Path
 
 from snakemake.io import is_flagged, strip_wildcard_constraints
 
@@ -286,3 +287,24 @@ def run_benchmark_files(wildcards=None):
     }
     files = [f for fam, fn in family_benchmarks.items() if FAMILY_RAN[fam] for f in fn()]
     return files + job_benchmarks("summary") + job_benchmarks("benchmarks")
+
+
+def published_path(family, table):
+    """Absolute path of the published table ``published.<family>.<table>`` (relative config paths are
+    resolved against the workflow's directory, so --directory keeps them); None when unset."""
+    from animsynth.published import resolve
+
+    return resolve(config.get("published", {}).get(family, {}).get(table), workflow.basedir)
+
+
+def published_input(family, table):
+    """Input function: the published table as a list of one path when the file exists, else [] (the
+    job then runs without paper values; animsynth.published logs the WARNING). Declaring it as an input
+    reruns the jobs that show it when the file changes."""
+
+    def published_file(wildcards):
+        p = published_path(family, table)
+        return [str(p)] if p is not None and p.is_file() else []
+
+    published_file.__name__ = f"published_{family}_{table}"
+    return published_file
