@@ -1,5 +1,5 @@
 """Landmark vs exact Isomap on one database size (dense pipeline cross-checked too)."""
-from animsynth import scale
+from animsynth.resequencing.study import landmark_vs_exact
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
@@ -7,7 +7,7 @@ log = setup_logging(snakemake)  # noqa: F821
 cfg = snakemake.params.cfg  # noqa: F821
 c, r = cfg["landmark_vs_exact"], cfg["resequencing"]
 seed = int(snakemake.params.seed)  # noqa: F821
-summary, rv = scale.landmark_vs_exact(int(snakemake.wildcards.scn), metric="l2", method="isomap",  # noqa: F821
+summary, rv = landmark_vs_exact(int(snakemake.wildcards.scn), metric="l2", method="isomap",  # noqa: F821
                                       n_candidates=r["n_candidates"], k=r["k"], n_landmarks=c["n_landmarks"],
                                       seeds=[seed + s for s in range(int(c["landmark_seeds"]))],
                                       max_dim=c["max_dim"], pairs=c["pairs"], seed=seed,

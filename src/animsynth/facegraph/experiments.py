@@ -553,3 +553,28 @@ def verdicts(table1: pd.DataFrame, baseline: pd.DataFrame, uniqueness: pd.DataFr
         f"{_fmt(noisy.distance_mean_px)} px); random peaks too: {int(full.distinct)}/{int(full.runs)}.",
         "facegraph/uniqueness.csv")
     return pd.DataFrame(rows)[VERDICT_COLUMNS]
+
+
+# ----------------------------------------------------------------------------- cost curves (animsynth.scale)
+
+
+def scale_steps(recorder, n: int, seed: int = 0, creation: float = 50.0, merge: float = 30.0, frames_per_sequence: int = 26):
+    """Facial motion graphs of ``n`` synthetic sequences: pre-processing, then creation + merging
+    including both threshold searches."""
+    from threadpoolctl import threadpool_limits
+
+    from .model import FaceGraphModel
+    from .preprocess import FacePreprocessor
+    from ..synth.faces import generate_sequences
+
+    seqs = generate_sequences(n_subjects=max(1, n // 4), n_sequences=n, total_frames=n * frames_per_sequence,
+                              n_unlabelled=0, min_frames=10, max_frames=60, seed=seed)
+    S = recorder("facegraph", n)
+    with S.step("preprocess"):
+        db = FacePreprocessor().fit_transform(seqs, source="synthetic")
+    with S.step("creation_incl_search") as info, threadpool_limits(1):
+        model = FaceGraphModel(creation, merge, seed=seed).fit(db)
+        info["nodes"] = int(sum(g.n_nodes for g in model.graphs_.values()))
+    for r in S.rows:
+        r["frames"] = int(db.lengths.sum())
+    return S.rows

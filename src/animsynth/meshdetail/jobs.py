@@ -205,3 +205,24 @@ def dembones_floor(seq_npz: str, cfg: dict, cv_folds: int, render_frames, out_np
         np.savez_compressed(tmp, frame=np.array(frame), bones=np.array(list(cfg["bones"])),
                             **{f"bones_{b}": p[0] for b, p in preds.items()})
     return table, floor_summary(table)
+
+
+# ----------------------------------------------------------------------------- cost curves (animsynth.scale)
+
+
+def scale_steps(recorder, n: int, resolution: float = 1.0, seed: int = 0, level: float = 5.0, iterations: int = 100,
+                     latent_dim: int = 4):
+    """The hybrid (GP detail) model trained on ``n`` frames of the synthetic skirt character."""
+    from .models import HybridModel, MeshContext
+
+    cfg = {"driver": "cmu_synthetic", "motion": "dance", "frames": int(n), "fps": 30.0}
+    rig, rt, A = driving_motion(cfg, seed)
+    ch = build_character(rig, resolution)
+    V = simulate(ch, rt, A, 30.0, SkirtParams())
+    rig0 = rebase(rig, rt[0], A[0])
+    ang = rebase_pose(rig, rt, A, A[0])
+    ctx = MeshContext(V[0], ch.faces, rig0, ch.weights, max_level=max(level, 5.0))
+    S = recorder("meshdetail", n, vertices=int(V.shape[1]), resolution=resolution)
+    with S.step("training"):
+        HybridModel(level=level, latent_dim=latent_dim, iterations=iterations).fit(ctx, V, rt, ang)
+    return S.rows

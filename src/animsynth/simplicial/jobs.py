@@ -274,3 +274,22 @@ def walk_job(paths, ids, dataset: str, cfg: dict, out: dict) -> None:
     held_in_place.values[:, :n_root] = in_place_root(held)  # same in-place root as the generated walk
     motion_previews(motion, gif_path=out["gif"], bvh_path=out["bvh"], png_path=out["png"], original=held_in_place,
                     titles=[f"held out {tid}", f"generated ({fig['walk_method']})"], fps=float(fig["gif_fps"]))
+
+
+# ----------------------------------------------------------------------------- cost curves (animsynth.scale)
+
+
+def scale_steps(recorder, n: int, seed: int = 0, steps: int = 1000, trial_frames: int = 200, method: str = "delaunay",
+                     k: int = 8, latent_dim: int = 3):
+    """One simplicial fold on ``n`` synthetic training frames plus a ``steps``-step path."""
+    from ..synth.mocap import synthetic_motions
+
+    motions = synthetic_motions(n + trial_frames, trial_frames, seed, kinds=["walk_straight", "walk_turn"])
+    angles = [np.asarray(m.without_root(), float) for m in motions]
+    test, train = angles[0], angles[1:]
+    S = recorder("simplicial", sum(len(a) for a in train), method=method)
+    var = ex.Variant(method, method=method, k=k, latent_dim=latent_dim, derivative="forward",
+                     weights="idw" if method != "delaunay" else "barycentric").check()
+    with S.step("fold_build_and_path", path_steps=steps):
+        ex.run_fold(train, test, var, steps=int(steps))
+    return S.rows

@@ -404,3 +404,22 @@ def write_trial(amc_path, asf_path, kind: str, frames: int, seed: int, subject: 
     write_asf(asf_path, sk, length_unit=LENGTH_UNIT)
     write_amc(amc_path, motion)
     return motion
+
+
+def synthetic_motions(n_frames: int, trial_frames: int = 1000, seed: int = 0, kinds=None):
+    """Synthetic CMU-skeleton trials (:mod:`animsynth.synth.mocap`) totalling ``n_frames``.
+
+    Trial ``t`` has kind ``kinds[t % len(kinds)]`` and seed ``seed * 100003 + t``;
+    the last trial is shortened to hit ``n_frames`` exactly.
+    """
+    kinds = list(kinds or KINDS)
+    sk = cmu_like_skeleton("synscale", seed)
+    out, left, t = [], int(n_frames), 0
+    while left > 0:
+        n = min(int(trial_frames), left)
+        if n < 10:  # the generator needs >= 10 frames: fold the remainder into the previous trial
+            break
+        out.append(generate_motion(kinds[t % len(kinds)], n, seed * 100003 + t, sk, name=f"syn{t:04d}"))
+        left -= n
+        t += 1
+    return out
