@@ -1,4 +1,5 @@
 # Shared helpers: config checks beyond the schema, trial lookups, target lists.
+import importlib
 import json
 import re
 from pathlib import Path
@@ -10,7 +11,13 @@ from animsynth.meshdetail.settings import mesh_sequences
 from animsynth.sources import is_archive, is_url, mesh_source_name, probe_source
 
 
+# Config checks beyond the schema, in one place: the shared ones, then each family's
+# settings.check(config) (which names the offending config key).
 check_config(config)
+for _family in ("simplicial", "resequencing", "facegraph", "meshdetail"):
+    _settings = importlib.import_module(f"animsynth.{_family}.settings")
+    if hasattr(_settings, "check"):
+        _settings.check(config)
 
 TRIALS = {t["id"]: t for t in config["trials"]}
 SUBSETS = {k: v for k, v in config["subsets"].items() if v}  # null drops a subset
