@@ -35,6 +35,7 @@ include: "workflow/rules/simplicial.smk"
 include: "workflow/rules/resequencing.smk"
 include: "workflow/rules/facegraph.smk"
 include: "workflow/rules/meshdetail.smk"
+include: "workflow/rules/compare.smk"
 include: "workflow/rules/report.smk"
 
 

@@ -25,7 +25,10 @@ FAMILY_PAPERS = {
     "resequencing": "Isomap / ST-Isomap re-sequencing",
     "meshdetail": "Hybrid mesh animation",
     "facegraph": "Serra et al. 2018 (facial motion graphs)",
+    "compare": "Beyond the papers: generators side by side",
 }
+#: the section of summary.md and of the report's home page that puts the generators side by side
+SIDE_BY_SIDE = "The generators side by side"
 
 
 def aggregate_rule_benchmarks(paths, root: str = "benchmarks/rules") -> pd.DataFrame:
@@ -253,8 +256,41 @@ def _rst_cell(s: str) -> str:
     return " ".join(str(s).split()).replace("|", "/").replace("*", "\\*").replace("`", "'")
 
 
-def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_outputs=()) -> str:
+def _side_by_side_rst(winners: pd.DataFrame, data: str) -> list[str]:
+    """The home page's section "The generators side by side": which generator wins which metric."""
+    out = [SIDE_BY_SIDE, "~" * len(SIDE_BY_SIDE), "",
+           f"Every generator on the same held-out clips ({_rst_cell(data)}); the best and second-best by median "
+           "(replay and concat, the realism bounds, aside), and whether their interquartile ranges are apart. "
+           "Every table and figure: category *The generators side by side*.", ""]
+    if winners is None or winners.empty:
+        return out + ["(no metric with two generators in this run)", ""]
+    out += [".. list-table::", "   :header-rows: 1", "", "   * - metric", "     - better", "     - best (median)",
+            "     - second (median)", "     - beyond the spread", "     - best wins (share of pairs)"]
+    for _, r in winners.iterrows():
+        cells = [r["metric"], r["better"], f"{r['best']} ({fmt_num(r['best_median'])})",
+                 f"{r['second']} ({fmt_num(r['second_median'])})", "yes" if r["beyond_spread"] else "no",
+                 fmt_num(r["best_wins_share"])]
+        out.append(f"   * - {_rst_cell(cells[0])}")
+        out += [f"     - {_rst_cell(c)}" for c in cells[1:]]
+    return out + [""]
+
+
+def fmt_num(x) -> str:
+    """A number for the summary texts: 4 significant digits, '' for a missing value."""
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return str(x)
+    return "" if not np.isfinite(x) else f"{x:.4g}"
+
+
+def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_outputs=(),
+               side_by_side: pd.DataFrame | None = None, side_by_side_data: str = "",
+               side_by_side_real: bool = False) -> str:
     """The report's home page (reStructuredText): what ran on what, then every claim.
+
+    ``side_by_side`` (``compare/winners.csv``, when the comparison ran) adds the section "The generators
+    side by side" after the claims on the same kind of data (real data first).
 
     A claim's table or figure becomes a link into the report when a rule's
     ``report(...)`` output ends with it and its file name is unique among the
@@ -278,11 +314,14 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
         for _, r in provenance.iterrows():
             out.append(f"- **{_rst_cell(r['family'])}**: {_rst_cell(r['data'])} ({_rst_cell(r['status'])})")
         out.append("")
-    for title, mask in (("Claims on real data", claims["real"]), ("Claims on synthetic data", ~claims["real"])):
+    for title, mask, real in (("Claims on real data", claims["real"], True),
+                              ("Claims on synthetic data", ~claims["real"], False)):
         part = claims[mask.astype(bool)] if len(claims) else claims
         out += [title, "~" * len(title), ""]
         if part.empty:
             out += ["(none in this run)", ""]
+            if side_by_side is not None and side_by_side_real == real:
+                out += _side_by_side_rst(side_by_side, side_by_side_data)
             continue
         out += [".. list-table::", "   :header-rows: 1", "   :widths: 14 26 12 16 12 8 12", "",
                 "   * - paper", "     - claim", "     - paper's number", "     - ours", "     - data",
@@ -293,6 +332,8 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
             out.append(f"   * - {cells[0]}".rstrip())
             out += [f"     - {c}".rstrip() for c in cells[1:]]
         out.append("")
+        if side_by_side is not None and side_by_side_real == real:
+            out += _side_by_side_rst(side_by_side, side_by_side_data)
     return "\n".join(out) + "\n"
 
 
@@ -302,7 +343,8 @@ def build_summary(sections: list[dict], verdict_paths, source_note: str,
     """Markdown summary: the papers' claims first (real data, then synthetic), then every table.
 
     ``sections``: dicts with ``title``, ``csv`` and optional ``note`` (what it
-    reproduces and on which data), in order.
+    reproduces and on which data), in order. Sections with a ``group`` (e.g. "The generators side by
+    side") come right after the claims, under one heading of that name.
     """
     out = ["# animsynth: reproduction summary", ""]
     banner = demo_banner(family_real, demo)
@@ -314,13 +356,28 @@ def build_summary(sections: list[dict], verdict_paths, source_note: str,
         out += ["## Claims of the four papers", "", "(no verdicts were produced)", ""]
     else:
         out.append(claims_markdown(claims, provenance))
+    groups: dict[str, list[dict]] = {}
     for s in sections:
-        df = pd.read_csv(s["csv"], keep_default_na=False, na_values=[""])
-        out += [f"## {s['title']}", "", f"`{s['csv']}`", ""]
-        if s.get("note"):
-            out += [s["note"], ""]
-        if len(df) > s.get("max_rows", 60):
-            out.append(f"(first {s.get('max_rows', 60)} of {len(df)} rows; full table in the CSV)")
-            df = df.head(s.get("max_rows", 60))
-        out.append(to_markdown(df))
+        if s.get("group"):
+            groups.setdefault(s["group"], []).append(s)
+    for group, members in groups.items():
+        out += [f"## {group}", ""]
+        for s in members:
+            out += _summary_section(s, "###")
+    for s in sections:
+        if not s.get("group"):
+            out += _summary_section(s, "##")
     return "\n".join(out) + "\n"
+
+
+def _summary_section(s: dict, level: str) -> list[str]:
+    """One table of summary.md: heading, path, note, the table (at most ``max_rows`` rows)."""
+    df = pd.read_csv(s["csv"], keep_default_na=False, na_values=[""])
+    out = [f"{level} {s['title']}", "", f"`{s['csv']}`", ""]
+    if s.get("note"):
+        out += [s["note"], ""]
+    if len(df) > s.get("max_rows", 60):
+        out.append(f"(first {s.get('max_rows', 60)} of {len(df)} rows; full table in the CSV)")
+        df = df.head(s.get("max_rows", 60))
+    out.append(to_markdown(df))
+    return out

@@ -14,7 +14,7 @@ from animsynth.sources import is_archive, is_url, mesh_source_name, probe_source
 # Config checks beyond the schema, in one place: the shared ones, then each family's
 # settings.check(config) (which names the offending config key).
 check_config(config)
-for _family in ("simplicial", "resequencing", "facegraph", "meshdetail"):
+for _family in ("simplicial", "resequencing", "facegraph", "meshdetail", "compare"):
     _settings = importlib.import_module(f"animsynth.{_family}.settings")
     if hasattr(_settings, "check"):
         _settings.check(config)
@@ -78,6 +78,7 @@ def family_targets():
         "resequencing": RESEQUENCING_TARGETS,
         "facegraph": FACEGRAPH_TARGETS,
         "meshdetail": MESHDETAIL_TARGETS,
+        "compare": COMPARE_TARGETS,
     }
     return [t for fam, ts in targets.items() if FAMILY_RAN[fam] for t in ts]
 
@@ -153,7 +154,8 @@ def _family_status():
         mesh = ("mesh sequences " + ", ".join(f"{n} ({s['mesh_dir']})" for n, s in MD_SEQS.items()), True, "")
     ck = config["facegraph"].get("ckplus_dir")
     faces = _status(f"CK+ from {ck}", ck) if ck else _status("synthetic CK+-layout database (not real CK+)")
-    status = {"data": mocap, "simplicial": mocap, "resequencing": mocap, "meshdetail": mesh, "facegraph": faces}
+    status = {"data": mocap, "simplicial": mocap, "resequencing": mocap, "meshdetail": mesh, "facegraph": faces,
+              "compare": mocap}
     skipped = {}
     for fam, (_label, ok, why) in status.items():
         if not ok and fam != "data":
@@ -171,6 +173,7 @@ FAMILY_REAL = {
     "resequencing": SOURCE != "synthetic",
     "meshdetail": all(s["mesh_dir"] for s in MD_SEQS.values()),  # every sequence of the run is real
     "facegraph": bool(config["facegraph"].get("ckplus_dir")),
+    "compare": SOURCE != "synthetic",  # real when its mocap is real
 }
 
 
@@ -283,6 +286,34 @@ def meshdetail_benchmarks():
     return files + job_benchmarks("meshdetail_compare") + mesh_data_benchmarks()
 
 
+# ---- compare input functions ----
+def compare_trial_npz(wildcards):
+    """The parsed trials of every held-out clip and database of the comparison (order of CMP_TRIALS)."""
+    return [trial_npz(t) for t in CMP_TRIALS]
+
+
+def compare_job_cfg(wildcards):
+    """The config one generator job reads: the shared keys, the generator's own block, and for ST-Isomap the
+    re-sequencing study's stisomap block (a changed block reruns only the jobs that read it)."""
+    cfg = {k: CMP[k] for k in CMP_RUN_KEYS}
+    block = CMP_GEN_BLOCK.get(wildcards.cmpgen)
+    if block:
+        cfg[block] = CMP[block]
+    if wildcards.cmpgen == "stisomap":
+        cfg["stisomap"] = dict(config["resequencing"]["stisomap"])
+    return cfg
+
+
+# Benchmark files of this family's jobs (inputs of rule_benchmarks).
+def compare_benchmarks():
+    return (
+        job_benchmarks("compare_clips")
+        + job_benchmarks("compare_run", cmpgen=CMP_RUN)
+        + job_benchmarks("compare_tables")
+        + job_benchmarks("compare_figures")
+    )
+
+
 def run_benchmark_files(wildcards=None):
     """The benchmark file of every job of this run (the families that run, the summary and the benchmarks)."""
     family_benchmarks = {
@@ -291,6 +322,7 @@ def run_benchmark_files(wildcards=None):
         "resequencing": resequencing_benchmarks,
         "facegraph": facegraph_benchmarks,
         "meshdetail": meshdetail_benchmarks,
+        "compare": compare_benchmarks,
     }
     files = [f for fam, fn in family_benchmarks.items() if FAMILY_RAN[fam] for f in fn()]
     return files + job_benchmarks("summary") + job_benchmarks("benchmarks")

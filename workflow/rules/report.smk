@@ -18,12 +18,14 @@ FAMILY_SUMMARIES = {
     "resequencing": RESEQUENCING_SUMMARY,
     "facegraph": FACEGRAPH_SUMMARY,
     "meshdetail": MESHDETAIL_SUMMARY,
+    "compare": COMPARE_SUMMARY,
 }
 FAMILY_VERDICTS = {
     "simplicial": SIMPLICIAL_VERDICTS,
     "resequencing": RESEQUENCING_VERDICTS,
     "facegraph": FACEGRAPH_VERDICTS,
     "meshdetail": MESHDETAIL_VERDICTS,
+    "compare": COMPARE_VERDICTS,
 }
 SUMMARY_SECTIONS = [s for fam, ss in FAMILY_SUMMARIES.items() if FAMILY_RAN[fam] for s in ss]
 # Machine-dependent tables (wall/CPU time: *_timing.csv, timing.csv) are named
@@ -40,6 +42,7 @@ rule summary:
     input:
         tables=[s["csv"] for s in SUMMARY_SECTIONS],
         verdicts=VERDICT_FILES,
+        side_by_side=[R("compare/winners.csv")] if FAMILY_RAN["compare"] else [],
     output:
         summary=report(
             R("summary.md"),
@@ -63,6 +66,8 @@ rule summary:
         family_real=FAMILY_REAL,
         demo=config["demo"],
         report_outputs=report_outputs,
+        side_by_side_data=FAMILY_STATUS["compare"][0],
+        side_by_side_real=FAMILY_REAL["compare"],
     threads: 1
     resources:
         mem_mb=500,

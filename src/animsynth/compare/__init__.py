@@ -1,0 +1,37 @@
+"""Beyond the papers: every motion generator of the project and the classic motion graph, side by side.
+
+The same held-out clips (CMU's Gauch & Peters subsets by leave one out, the re-sequencing clips by a
+temporal split), the same starts and seeds, one set of metrics (foot skating, seam jumps, smoothness,
+LAFAN1's L2P / L2Q / NPSS, coverage, diversity, novelty) and the cost of each generator. This package
+sits above the four families: it imports their public functions to score them; no family imports it.
+
+Modules
+-------
+generators      the one interface (``fit(database)``, ``generate(start, length, seed)``) and its adapters:
+                delaunay, knn, isomap, stisomap, motion_graph, fairmotion, replay, concat
+motiongraph     the classic motion graph (Kovar, Gleicher & Pighin 2002)
+fairmotion_peer fairmotion's motion graph on the same clips (the peer row), when it can be imported
+metrics         the metrics (pure numpy; metres, m/s)
+jobs            the protocol (held-out clips, starts, seeds), one generator over every clip, the tables
+verdicts        the side-by-side claims, decided over clips x seeds
+plots           metrics per generator with spreads, one skeleton strip per generator
+settings        config checks and what the workflow reads of the ``compare`` block
+"""
+
+from .._lazy import lazy_exports
+
+# name -> module; imported on first use
+_EXPORTS = {
+    "Concat": ".generators",
+    "Database": ".generators",
+    "FieldFollower": ".generators",
+    "GENERATORS": ".generators",
+    "METRICS": ".jobs",
+    "MotionGraph": ".motiongraph",
+    "Replay": ".generators",
+    "Resequencer": ".generators",
+    "make_generator": ".generators",
+    "prepare_clips": ".jobs",
+    "run_generator": ".jobs",
+}
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

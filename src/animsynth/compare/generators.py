@@ -1,0 +1,552 @@
+"""Every motion generator of the side-by-side comparison, behind one interface.
+
+Each generator is a scikit-learn-style estimator::
+
+    gen = make_generator(name, cfg).fit(database)   # database: list of Motion, one skeleton, one fps
+    motion = gen.generate(start, length, seed)      # start: Motion of >= 2 frames (the context)
+
+``generate`` returns a :class:`~animsynth.motion.Motion` of exactly ``length`` frames on the
+database's skeleton and frame rate, all DOF (root included), continuing the start: its first frame
+is the frame after the start's last one. ``meta["seams"]`` holds the frame indices ``t >= 1`` where
+frame ``t`` does not follow frame ``t - 1`` in the source (a transition or a blend start; empty
+for a generator without seams), ``meta["source_frames"]`` the ``(clip, frame)`` of the database frame
+each output frame plays (``-1`` where the frame is synthesised). The entry from the start into the
+generated frames is scored as a seam by the family for every generator but ``replay``
+(:mod:`animsynth.compare.jobs`), whatever a generator records.
+
+Generators (``GENERATORS``):
+
+``delaunay``, ``knn``
+    Gauch & Peters field following (:mod:`animsynth.simplicial`): PCA of the database's joint
+    angles, the training vectors, the interpolated vector field and Euler steps from the start's
+    latent point (moved by a seeded jitter, so seeds differ), decoded to joint angles. Root motion
+    (an extension: the paper has no root) is the capture's own root step of the database frame
+    nearest in latent space, integrated from the start (:func:`animsynth.resequencing.play_path`).
+``isomap``, ``stisomap``
+    re-sequencing on the neighbourhood graph (:mod:`animsynth.resequencing`): L2 between
+    linearised joint rotations, the smallest k that connects the graph (ST-Isomap: with the
+    spatio-temporal adjustment and the adjacent temporal neighbours always in), Dijkstra paths
+    from the database frame nearest the start to seeded random targets, chained until ``length``
+    frames, played with the root integrated.
+``motion_graph``
+    the classic motion graph of Kovar, Gleicher & Pighin 2002 (:mod:`animsynth.compare.motiongraph`).
+``fairmotion``
+    fairmotion's motion graph on the same clips (:mod:`animsynth.compare.fairmotion_peer`), when it
+    can be imported; :func:`unavailable` gives the reason when not.
+``replay``
+    the held-out capture itself (upper bound for realism; the same for every seed).
+``concat``
+    random database segments appended (lower bound): root position made continuous, no blending,
+    no alignment of heading.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
+
+from ..kinematics import local_rotations, root_translation
+from ..motion import Motion
+from ..skeleton import ROT_DOFS, TRANS_DOFS
+
+log = logging.getLogger("animsynth.compare.generators")
+
+__all__ = ["GENERATORS", "REFERENCES", "Database", "FieldFollower", "Resequencer", "Replay", "Concat",
+           "make_generator", "unavailable", "heading", "align_root", "check_generated"]
+
+#: every generator name, in the order of the tables
+GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "replay", "concat")
+#: the two reference rows (bounds, not methods)
+REFERENCES = ("replay", "concat")
+
+
+# ----------------------------------------------------------------------------- root helpers
+
+
+def heading(skeleton, values) -> np.ndarray:
+    """Heading (radians about +Y) of the root's local +Z axis, per frame: shape ``(frames,)``."""
+    f = local_rotations(skeleton, values)[0].apply(np.array([0.0, 0.0, 1.0]))
+    return np.arctan2(f[:, 0], f[:, 2])
+
+
+def _set_root(skeleton, values: np.ndarray, R: Rotation, pos: np.ndarray) -> np.ndarray:
+    """``values`` with the root's DOF set from world rotations ``R`` and positions ``pos`` (skeleton units)."""
+    out = np.array(values, float, copy=True)
+    root = skeleton.joints[0]
+    sl = skeleton.dof_slices()[root.name]
+    rd = [d for d in root.dofs if d in ROT_DOFS]
+    if rd:
+        if len(rd) < 3:
+            raise ValueError("moving the root needs a root with three rotational DOF")
+        C = root.axis_rotation()
+        ang = (C.inv() * R * C).as_euler("".join(d[1] for d in rd), degrees=True)
+        for k, d in enumerate(root.dofs):
+            if d in ROT_DOFS:
+                out[:, sl.start + k] = ang[:, rd.index(d)]
+    for k, d in enumerate(root.dofs):
+        if d in TRANS_DOFS:
+            a = TRANS_DOFS.index(d)
+            out[:, sl.start + k] = pos[:, a] - root.offset[a]
+    return out
+
+
+def align_root(skeleton, values, anchor, index: int = 0) -> np.ndarray:
+    """Move ``values`` rigidly on the ground (a turn about +Y and a horizontal shift) so that frame
+    ``index`` has the root ground position and heading of the pose ``anchor`` (n_dof,).
+
+    Heights and the root's tilt are each frame's own. Returns a new ``(frames, n_dof)`` array.
+    """
+    values = np.asarray(values, float)
+    anchor = np.asarray(anchor, float)[None, :]
+    R = local_rotations(skeleton, values)[0]
+    p = root_translation(skeleton, values)
+    turn = float(heading(skeleton, anchor)[0] - heading(skeleton, values[index:index + 1])[0])
+    Ry = Rotation.from_euler("y", turn)
+    pa = root_translation(skeleton, anchor)[0]
+    q = Ry.apply(p - p[index])
+    q[:, 0] += pa[0]
+    q[:, 2] += pa[2]
+    q[:, 1] = p[:, 1]
+    return _set_root(skeleton, values, Ry * R, q)
+
+
+def check_generated(motion: Motion, length: int, skeleton, name: str = "generator") -> Motion:
+    """Check a generator's output (``length`` frames, the skeleton's DOF, finite); fill missing meta."""
+    v = np.asarray(motion.values)
+    if v.shape != (int(length), skeleton.n_dof):
+        raise ValueError(f"{name}: generated {v.shape}, expected ({int(length)}, {skeleton.n_dof})")
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{name}: generated motion has non-finite values")
+    seams = np.asarray(motion.meta.get("seams", []), np.int64).ravel()
+    if seams.size and (seams.min() < 0 or seams.max() >= length):
+        raise ValueError(f"{name}: seam indices outside 0..{length - 1}")
+    motion.meta["seams"] = np.unique(seams)
+    src = motion.meta.get("source_frames")
+    if src is None:
+        motion.meta["source_frames"] = np.full((int(length), 2), -1, np.int64)
+    return motion
+
+
+# ----------------------------------------------------------------------------- the database
+
+
+class Database:
+    """Clips of one skeleton and frame rate, their frames numbered one after the other.
+
+    Parameters
+    ----------
+    clips : list of Motion (>= 2 frames each, equal columns and fps)
+
+    Attributes
+    ----------
+    values : ndarray (N, n_dof), the clips' frames concatenated
+    clip, frame : int arrays (N,), each frame's clip index and frame within its clip
+    skeleton, fps
+    """
+
+    def __init__(self, clips):
+        clips = list(clips)
+        if not clips:
+            raise ValueError("empty database: no clips")
+        sk, fps = clips[0].skeleton, float(clips[0].fps)
+        for c in clips:
+            if c.columns != sk.columns():
+                raise ValueError(f"database clip {c.name!r} has other DOF columns than {clips[0].name!r}")
+            if abs(float(c.fps) - fps) > 1e-9 * fps:
+                raise ValueError(f"database clip {c.name!r} runs at {c.fps} fps, {clips[0].name!r} at {fps}")
+            if c.n_frames < 2:
+                raise ValueError(f"database clip {c.name!r} has {c.n_frames} frame(s); need >= 2")
+        self.clips, self.skeleton, self.fps = clips, sk, fps
+        self.values = np.vstack([np.asarray(c.values, float) for c in clips])
+        self.clip = np.concatenate([np.full(c.n_frames, i, np.int64) for i, c in enumerate(clips)])
+        self.frame = np.concatenate([np.arange(c.n_frames, dtype=np.int64) for c in clips])
+        self.n_root = len(sk.joints[0].dofs)
+        # play_path reads a step a -> a+1 as motion within one capture: a copy of every clip's first frame
+        # is put before it (never on a path), so no step of the played motion runs from one clip into the next
+        rows, index, k = [], np.empty(self.clip.size, np.int64), 0
+        off = 0
+        for i, c in enumerate(clips):
+            if i:
+                rows.append(np.asarray(c.values[:1], float))
+                k += 1
+            index[off:off + c.n_frames] = k + np.arange(c.n_frames)
+            rows.append(np.asarray(c.values, float))
+            k += c.n_frames
+            off += c.n_frames
+        self._playable = Motion(np.vstack(rows), sk, fps, "database")
+        self._index = index
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.values.shape[0])
+
+    def play(self, path, anchor) -> np.ndarray:
+        """The frames of ``path`` (database frame indices) with the root integrated along the path
+        (:func:`animsynth.resequencing.play_path`: a step within a clip moves the root as the capture
+        did, a jump takes the destination frame's own step) and the whole placed so that the path's
+        first frame has the root ground position and heading of ``anchor`` (n_dof,).
+        Returns ``(len(path), n_dof)``."""
+        from ..resequencing.paths import play_path
+
+        path = np.asarray(path, np.int64)
+        played = play_path(self._playable, self._index[path], root="integrate", same_pass=1)
+        return align_root(self.skeleton, played.values, anchor)
+
+    def seams(self, path) -> np.ndarray:
+        """Positions ``t >= 1`` of ``path`` where frame ``t`` is not the frame after ``t - 1`` in one clip."""
+        path = np.asarray(path, np.int64)
+        if path.size < 2:
+            return np.zeros(0, np.int64)
+        follows = (self.clip[path[1:]] == self.clip[path[:-1]]) & (self.frame[path[1:]] == self.frame[path[:-1]] + 1)
+        return np.flatnonzero(~follows) + 1
+
+    def sources(self, path) -> np.ndarray:
+        """``(len(path), 2)`` int array: (clip, frame) of every path frame."""
+        path = np.asarray(path, np.int64)
+        return np.stack([self.clip[path], self.frame[path]], axis=1)
+
+
+class Generator:
+    """Base class: ``fit(database)`` then ``generate(start, length, seed)``."""
+
+    name = "generator"
+
+    def fit(self, database) -> "Generator":  # pragma: no cover - every generator overrides it
+        raise NotImplementedError
+
+    def generate(self, start: Motion, length: int, seed: int) -> Motion:  # pragma: no cover
+        raise NotImplementedError
+
+    def _check_start(self, start: Motion, length: int) -> None:
+        if not hasattr(self, "db_"):
+            raise RuntimeError(f"{self.name}: call fit(database) before generate")
+        if start.n_frames < 2:
+            raise ValueError(f"{self.name}: the start needs >= 2 frames, has {start.n_frames}")
+        if start.columns != self.db_.skeleton.columns():
+            raise ValueError(f"{self.name}: the start's DOF columns differ from the database's")
+        if int(length) < 1:
+            raise ValueError(f"{self.name}: length must be >= 1, got {length}")
+
+    def _motion(self, values, length: int, seams, sources, **meta) -> Motion:
+        m = Motion(np.asarray(values, float), self.db_.skeleton, self.db_.fps, self.name,
+                   dict(seams=np.asarray(seams, np.int64), source_frames=np.asarray(sources, np.int64), **meta))
+        return check_generated(m, length, self.db_.skeleton, self.name)
+
+
+# ----------------------------------------------------------------------------- field followers
+
+
+class FieldFollower(Generator):
+    """Gauch & Peters field following, decoded to poses, the root from the nearest database frame.
+
+    Parameters
+    ----------
+    method : {"delaunay", "knn"}
+    latent_dim : int, PCA dimension of the joint angles (paper: 2)
+    k : int, k-NN neighbours (and Delaunay's outside-hull fallback; paper: 16)
+    derivative : {"half", "forward", "central"}, training vectors; ``half`` moves half a frame per
+        step, so two steps make one output frame, the others one step per frame
+    jitter : float, the start's latent point moves by this fraction of the latent bounding-box
+        diagonal in a seeded random direction (the field is deterministic: seeds differ by this)
+
+    Attributes
+    ----------
+    db_ : Database
+    pca_ : sklearn PCA
+    field_ : animsynth.simplicial.VectorField
+    latent_ : ndarray (N, latent_dim), the database frames in latent space
+    scale_ : float, latent bounding-box diagonal
+    steps_per_frame_ : int
+    """
+
+    def __init__(self, method: str = "delaunay", latent_dim: int = 2, k: int = 16, derivative: str = "half",
+                 jitter: float = 0.01):
+        self.method = method
+        self.latent_dim = latent_dim
+        self.k = k
+        self.derivative = derivative
+        self.jitter = jitter
+        self.name = method
+
+    def fit(self, database) -> "FieldFollower":
+        from sklearn.decomposition import PCA
+
+        from ..simplicial.field import VectorField, training_vectors
+        from ..simplicial.geometry import bbox_diagonal
+
+        if self.method not in ("delaunay", "knn"):
+            raise ValueError(f"field follower method must be delaunay or knn, got {self.method!r}")
+        self.db_ = db = Database(database)
+        angles = db.values[:, db.n_root:]
+        d = int(self.latent_dim)
+        if not 1 <= d <= min(angles.shape):
+            raise ValueError(f"latent_dim {d} outside 1..{min(angles.shape)} for {angles.shape[0]} frames x "
+                             f"{angles.shape[1]} angles")
+        self.pca_ = PCA(n_components=d, svd_solver="full").fit(angles)
+        latent = [self.pca_.transform(np.asarray(c.values, float)[:, db.n_root:]) for c in db.clips]
+        self.latent_ = np.vstack(latent)
+        self.field_ = VectorField(self.method, int(self.k)).fit(self.latent_, training_vectors(latent, self.derivative))
+        self.tree_ = cKDTree(self.latent_)
+        self.scale_ = float(bbox_diagonal(self.latent_))
+        self.steps_per_frame_ = 2 if self.derivative == "half" else 1
+        return self
+
+    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+        from ..simplicial.path import follow_field
+
+        self._check_start(start, length)
+        db, spf, length = self.db_, self.steps_per_frame_, int(length)
+        x0 = self.pca_.transform(np.asarray(start.values, float)[-1:, db.n_root:])[0]
+        u = np.random.default_rng(seed).normal(size=x0.size)
+        x0 = x0 + float(self.jitter) * self.scale_ * u / max(float(np.linalg.norm(u)), 1e-300)
+        path = follow_field(self.field_, x0, length * spf)
+        pts = path.points[spf::spf]
+        _, near = self.tree_.query(np.vstack([x0[None, :], pts]))
+        values = db.play(near, start.values[-1])[1:]
+        values[:, db.n_root:] = self.pca_.inverse_transform(pts)
+        return self._motion(values, length, [], np.full((length, 2), -1),
+                            fallback_share=float(path.fallback.mean()) if path.fallback.size else 0.0)
+
+
+# ----------------------------------------------------------------------------- re-sequencers
+
+
+def st_parameters(st: dict, fps: float) -> dict:
+    """ST-Isomap keyword arguments (frames) from the re-sequencing study's ``stisomap`` block (seconds)."""
+    tw = int(st["temporal_window"])
+    return {"temporal_window": tw, "c_atn": float(st["c_atn"]), "c_ctn": float(st["c_ctn"]),
+            "ctn_neighbors": int(st["ctn_neighbors"]),
+            "ctn_min_gap": max(tw, int(round(float(st["ctn_min_gap_s"]) * fps))),
+            "ctn_tolerance": int(st["ctn_tolerance"]),
+            "ctn_reach": max(1, int(round(float(st["ctn_reach_s"]) * fps)))}
+
+
+class Resequencer(Generator):
+    """Isomap / ST-Isomap re-sequencing: Dijkstra paths on the neighbourhood graph between seeded targets.
+
+    Parameters
+    ----------
+    method : {"isomap", "stisomap"}
+    n_candidates : int, neighbours listed per frame (doubled until the smallest connecting k fits)
+    k : int or None, neighbours of the graph; None or smaller than the smallest k that connects the
+        graph: that k (as the re-sequencing study)
+    min_target_gap_s : float, a random target lies at least this far (seconds of database) from the
+        current frame in the same clip
+    stisomap : dict, the re-sequencing study's ``stisomap`` block (seconds; ST-Isomap only)
+
+    Attributes
+    ----------
+    db_ : Database
+    graph_ : scipy.sparse csr matrix (N, N), the weighted neighbourhood graph
+    k_ : int, neighbours used; min_k_ : the smallest connecting k
+    """
+
+    def __init__(self, method: str = "isomap", n_candidates: int = 20, k=None, min_target_gap_s: float = 0.5,
+                 stisomap: dict | None = None):
+        self.method = method
+        self.n_candidates = n_candidates
+        self.k = k
+        self.min_target_gap_s = min_target_gap_s
+        self.stisomap = stisomap
+        self.name = method
+
+    def fit(self, database) -> "Resequencer":
+        from ..resequencing import sparse as sp
+        from ..resequencing.features import motion_features
+
+        if self.method not in ("isomap", "stisomap"):
+            raise ValueError(f"re-sequencing method must be isomap or stisomap, got {self.method!r}")
+        if self.method == "stisomap" and not self.stisomap:
+            raise ValueError("stisomap needs its parameters (the re-sequencing study's stisomap block)")
+        self.db_ = db = Database(database)
+        feats, seq = sp.concat_features([motion_features(c) for c in db.clips])
+        X = np.vstack([f.linearised(False) for f in feats])
+        n = X.shape[0]
+
+        def pair(i, j):
+            return np.linalg.norm(X[i] - X[j], axis=1)
+
+        m = min(int(self.n_candidates), n - 1)
+        while True:
+            dist, idx = sp.l2_neighbours(X, m)
+            always = None
+            if self.method == "stisomap":
+                st = st_parameters(self.stisomap, db.fps)
+                dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
+                always = sp.st_always_edges(seq, st["temporal_window"], st["c_atn"], pair)
+            try:
+                kmin = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
+                break
+            except sp.CandidateCountError:
+                if m >= n - 1:
+                    raise
+                m = min(2 * m, n - 1)
+        self.min_k_ = int(kmin)
+        self.k_ = max(self.min_k_, int(self.k or 0))
+        if self.k_ > idx.shape[1]:
+            dist, idx = sp.l2_neighbours(X, min(self.k_, n - 1))
+            if self.method == "stisomap":
+                dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
+        self.graph_ = sp.sparse_knn_graph(dist, idx, self.k_, always=always)
+        self.features_ = X
+        self.tree_ = cKDTree(X)
+        return self
+
+    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+        from ..resequencing.features import motion_features
+        from ..resequencing.paths import shortest_path_frames
+
+        self._check_start(start, length)
+        db, length = self.db_, int(length)
+        x = motion_features(start).linearised(False)[-1]
+        path = [int(self.tree_.query(x)[1])]
+        rng = np.random.default_rng(seed)
+        gap = max(1, int(round(float(self.min_target_gap_s) * db.fps)))
+        n = db.n_frames
+        while len(path) < length + 1:
+            cur = path[-1]
+            far = (db.clip != db.clip[cur]) | (np.abs(db.frame - db.frame[cur]) >= gap)
+            choices = np.flatnonzero(far)
+            target = int(rng.choice(choices)) if choices.size else int((cur + 1 + rng.integers(n - 1)) % n)
+            p, _ = shortest_path_frames(self.graph_, cur, target)
+            path.extend(int(f) for f in p[1:])
+        path = np.asarray(path[:length + 1], np.int64)
+        values = db.play(path, start.values[-1])[1:]
+        seams = db.seams(path)  # positions in path; output frame t = path position t + 1
+        seams = seams[seams >= 2] - 1
+        return self._motion(values, length, seams, db.sources(path[1:]))
+
+
+# ----------------------------------------------------------------------------- references
+
+
+class Replay(Generator):
+    """The held-out capture itself: the frames that follow the start (the same for every seed).
+
+    Parameters
+    ----------
+    held_out : Motion, the held-out clip whose first frames are the start
+    """
+
+    def __init__(self, held_out: Motion | None = None):
+        self.held_out = held_out
+        self.name = "replay"
+
+    def fit(self, database) -> "Replay":
+        if self.held_out is None:
+            raise ValueError("replay needs the held-out clip (Replay(held_out=...))")
+        self.db_ = Database(database)
+        return self
+
+    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+        self._check_start(start, length)
+        h = np.asarray(self.held_out.values, float)
+        c, length = start.n_frames, int(length)
+        if not np.array_equal(h[:c], np.asarray(start.values, float)):
+            raise ValueError("replay: the start is not the held-out clip's first frames")
+        if c + length > h.shape[0]:
+            raise ValueError(f"replay: the held-out clip has {h.shape[0]} frames, {c} + {length} asked for")
+        return self._motion(h[c:c + length], length, [], np.full((length, 2), -1))
+
+
+class Concat(Generator):
+    """Random database segments appended without blending (the lower bound).
+
+    Each segment (a random clip, weighted by its frames, a random first frame, a length drawn
+    uniformly between ``min_segment_s`` and ``max_segment_s``) keeps its own poses and heading;
+    only its root is shifted on the ground so that its first frame stands where the previous frame
+    stood (the first segment: where the start's last frame stands).
+
+    Attributes
+    ----------
+    db_ : Database
+    """
+
+    def __init__(self, min_segment_s: float = 0.5, max_segment_s: float = 1.5):
+        self.min_segment_s = min_segment_s
+        self.max_segment_s = max_segment_s
+        self.name = "concat"
+
+    def fit(self, database) -> "Concat":
+        if not 0 < float(self.min_segment_s) <= float(self.max_segment_s):
+            raise ValueError(f"concat segments: need 0 < min_segment_s <= max_segment_s, got "
+                             f"{self.min_segment_s}, {self.max_segment_s}")
+        self.db_ = Database(database)
+        return self
+
+    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+        self._check_start(start, length)
+        db, length = self.db_, int(length)
+        sk = db.skeleton
+        rng = np.random.default_rng(seed)
+        lo = max(1, int(round(float(self.min_segment_s) * db.fps)))
+        hi = max(lo, int(round(float(self.max_segment_s) * db.fps)))
+        sizes = np.array([c.n_frames for c in db.clips], float)
+        last = np.asarray(start.values, float)[-1]
+        parts, seams, sources, t = [], [], [], 0
+        while t < length:
+            c = int(rng.choice(len(db.clips), p=sizes / sizes.sum()))
+            n_c = db.clips[c].n_frames
+            size = int(min(rng.integers(lo, hi + 1), n_c, length - t))
+            f0 = int(rng.integers(0, n_c - size + 1))
+            seg = np.asarray(db.clips[c].values[f0:f0 + size], float)
+            p = root_translation(sk, seg)
+            target = root_translation(sk, last[None, :])[0]
+            shift = np.array([target[0] - p[0, 0], 0.0, target[2] - p[0, 2]])
+            seg = _set_root(sk, seg, local_rotations(sk, seg)[0], p + shift)
+            parts.append(seg)
+            seams.append(t)
+            sources.append(np.stack([np.full(size, c), np.arange(f0, f0 + size)], 1))
+            last = seg[-1]
+            t += size
+        seams = [s for s in seams if s > 0]
+        return self._motion(np.vstack(parts), length, seams, np.vstack(sources))
+
+
+# ----------------------------------------------------------------------------- the factory
+
+
+def unavailable(name: str) -> str:
+    """Why generator ``name`` cannot run here ('' when it can): fairmotion needs its package."""
+    if name != "fairmotion":
+        return ""
+    try:
+        from .fairmotion_peer import FairmotionUnavailable, check_available
+    except ImportError as exc:  # the peer module itself is missing
+        return f"the fairmotion adapter cannot be imported ({exc})"
+    try:
+        check_available()
+    except FairmotionUnavailable as exc:
+        return str(exc)
+    return ""
+
+
+def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Generator:
+    """An unfitted generator from the ``compare`` config block (``cfg``).
+
+    Parameters
+    ----------
+    name : one of :data:`GENERATORS`
+    cfg : dict, the ``compare`` block with ``stisomap`` (the re-sequencing study's block) added
+    held_out : Motion, the held-out clip (``replay`` only)
+    """
+    if name in ("delaunay", "knn"):
+        return FieldFollower(method=name, **cfg["field"])
+    if name in ("isomap", "stisomap"):
+        return Resequencer(method=name, stisomap=cfg.get("stisomap"), **cfg["resequencing_graph"])
+    if name == "motion_graph":
+        from .motiongraph import MotionGraph
+
+        return MotionGraph(**cfg["motion_graph"])
+    if name == "fairmotion":
+        from .fairmotion_peer import FairmotionGraph
+
+        return FairmotionGraph(**cfg["fairmotion"])
+    if name == "replay":
+        return Replay(held_out)
+    if name == "concat":
+        return Concat(**cfg["concat"])
+    raise ValueError(f"config key 'compare.generators': unknown generator {name!r} (one of {list(GENERATORS)})")

@@ -1,0 +1,608 @@
+"""Workflow steps of the compare family (the scripts in workflow/scripts only call these).
+
+Protocol (docs/compare.md, "Protocol"):
+
+* Every trial is resampled to the working rate ``compare.fps`` by keeping every n-th frame
+  (n = trial fps / working fps, an integer).
+* **Leave one out** (each Gauch & Peters subset of ``compare.subsets``): every trial is held out
+  once; the database is the subset's other trials.
+* **Temporal split** (each re-sequencing clip of ``compare.resequencing``): the last part of the
+  clip is held out (``compare.holdout_fraction`` of it, at least ``context + min_length``
+  frames); the database is the frames before it.
+* The start is the held-out clip's first ``compare.context`` frames; every generator makes
+  ``length = min(compare.length, held-out frames - context)`` frames from it; the ground truth
+  is the held-out frames that follow the start (the ``replay`` row).
+* Every clip runs ``compare.seeds`` seeds, seed ``i`` of clip ``c`` derived from the master seed,
+  ``compare.seed``, ``c`` and ``i`` (the same for every generator, so generators are compared
+  seed by seed).
+
+Files between steps: ``compare/clips.npz`` (every clip's database, held-out clip and length:
+:func:`save_clips` / :func:`load_clips`), per generator ``compare/runs/<generator>.csv`` (metrics,
+one row per clip x seed), ``<generator>_timing.csv`` (build and generation cost, one row per clip)
+and ``<generator>_showcase.npz`` (the showcase clip's start and generated frames).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+import tracemalloc
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from ..config import derive_seed
+from ..io.atomic import atomic_path
+from ..motion import Motion
+from ..skeleton import Skeleton
+from .generators import REFERENCES, make_generator
+
+log = logging.getLogger("animsynth.compare.jobs")
+
+#: every metric column of metrics.csv: (column, unit, which way is better: "lower", "higher" or "" for
+#: a descriptive number)
+METRICS = (
+    ("contact_share", "share of foot joint-frames", ""),
+    ("skate_share", "share of contact joint-frames", "lower"),
+    ("skate_m_per_contact_frame", "m", "lower"),
+    ("transition_skate_share", "share of contact joint-frames near seams", "lower"),
+    ("n_seams", "seams", ""),
+    ("seams_per_s", "1/s", ""),
+    ("velocity_jump", "m/s", "lower"),
+    ("velocity_jump_ratio", "x capture median", "lower"),
+    ("velocity_jump_pct", "percentile in capture", "lower"),
+    ("accel_jump", "m/s^2", "lower"),
+    ("accel_jump_ratio", "x capture median", "lower"),
+    ("accel_jump_pct", "percentile in capture", "lower"),
+    ("ldlj", "log dimensionless jerk", "higher"),
+    ("sparc", "spectral arc length", "higher"),
+    ("l2p", "LAFAN1 L2P", "lower"),
+    ("l2q", "LAFAN1 L2Q", "lower"),
+    ("npss", "NPSS", "lower"),
+    ("coverage", "share of database windows", "higher"),
+    ("local_diversity_m", "m", ""),
+    ("seed_diversity_m", "m", "higher"),
+    ("novelty_median_m", "m", ""),
+    ("copy_share", "share of frames", ""),
+)
+METRIC_NAMES = [m for m, _u, _b in METRICS]
+KEY_COLUMNS = ["clip", "group", "protocol", "generator", "seed"]
+TIMING_COLUMNS = ["generator", "clip", "database_frames", "build_cpu_s", "build_wall_s", "generate_cpu_s",
+                  "generate_wall_s", "frames_generated", "peak_mb"]
+
+
+# ----------------------------------------------------------------------------- clips
+
+
+@dataclass
+class Clip:
+    """One held-out clip with its database (all at the working rate).
+
+    Attributes
+    ----------
+    clip : str, ``<group>/<trial>`` (e.g. ``w1/35_16``, ``walk/35_01``)
+    group : str, the subset or re-sequencing dataset
+    protocol : str, ``leave one out`` or ``temporal split``
+    trial : str, the held-out trial
+    held_out : Motion, the held-out frames (the start, then the ground truth)
+    database : list of Motion
+    context, length : int, start frames and generated frames
+    """
+
+    clip: str
+    group: str
+    protocol: str
+    trial: str
+    held_out: Motion
+    database: list
+    context: int
+    length: int
+    database_names: list = field(default_factory=list)
+
+    @property
+    def start(self) -> Motion:
+        h = self.held_out
+        return Motion(np.asarray(h.values[:self.context], float), h.skeleton, h.fps, f"{self.clip}:start")
+
+    @property
+    def truth(self) -> Motion:
+        h = self.held_out
+        return Motion(np.asarray(h.values[self.context:self.context + self.length], float), h.skeleton, h.fps,
+                      f"{self.clip}:truth")
+
+
+def resample(motion: Motion, fps: float, key: str = "compare.fps") -> Motion:
+    """Every n-th frame of ``motion`` for the working rate ``fps`` (n = motion.fps / fps, an integer)."""
+    ratio = float(motion.fps) / float(fps)
+    step = int(round(ratio))
+    if step < 1 or abs(ratio - step) > 1e-6:
+        raise ValueError(f"config key '{key}': {fps} fps is not the rate of trial {motion.name!r} "
+                         f"({motion.fps} fps) divided by a whole number")
+    return Motion(np.asarray(motion.values[::step], float), motion.skeleton, float(motion.fps) / step, motion.name)
+
+
+def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) -> list[Clip]:
+    """Every held-out clip of the protocol.
+
+    Parameters
+    ----------
+    trials : {trial id: Motion} (parsed trials at their own rate)
+    subsets : {subset: [trial ids]}, the subsets of ``compare.subsets`` (leave one out)
+    resequencing : {dataset: trial id}, the clips of ``compare.resequencing`` (temporal split)
+    cfg : the ``compare`` config block (``fps``, ``context``, ``length``, ``min_length``,
+        ``holdout_fraction``)
+    """
+    fps, context = float(cfg["fps"]), int(cfg["context"])
+    length, min_length = int(cfg["length"]), int(cfg["min_length"])
+    work = {t: resample(m, fps) for t, m in trials.items()}
+    clips = []
+
+    def add(clip_id, group, protocol, trial, held, db, db_names):
+        n_after = held.n_frames - context
+        L = min(length, n_after)
+        if L < min_length:
+            raise ValueError(f"clip {clip_id}: the held-out part has {held.n_frames} frames at {fps:g} fps, "
+                             f"{context} of them the start, leaving {n_after} < {min_length} to generate "
+                             "(config keys 'compare.context', 'compare.min_length', 'compare.fps')")
+        for d in db:
+            if d.n_frames < max(4, context):
+                raise ValueError(f"clip {clip_id}: database clip {d.name!r} has {d.n_frames} frames at {fps:g} fps "
+                                 f"(need >= {max(4, context)}; config keys 'compare.fps', 'compare.holdout_fraction')")
+        clips.append(Clip(clip_id, group, protocol, trial, held, db, context, L, db_names))
+
+    for group, ids in subsets.items():
+        if len(ids) < 2:
+            raise ValueError(f"config key 'compare.subsets': subset {group!r} needs >= 2 trials for leave one out")
+        for t in ids:
+            others = [o for o in ids if o != t]
+            add(f"{group}/{t}", group, "leave one out", t, work[t], [work[o] for o in others], others)
+    for group, t in resequencing.items():
+        m = work[t]
+        n = m.n_frames
+        hold = max(int(round(float(cfg["holdout_fraction"]) * n)), context + min_length)
+        if n - hold < max(4, context):
+            raise ValueError(f"clip {group}/{t}: {n} frames at {fps:g} fps leave {n - hold} for the database "
+                             "after the held-out part (config keys 'compare.holdout_fraction', 'compare.length')")
+        db = Motion(m.values[:n - hold], m.skeleton, m.fps, f"{t}[0:{n - hold}]")
+        held = Motion(m.values[n - hold:], m.skeleton, m.fps, f"{t}[{n - hold}:{n}]")
+        add(f"{group}/{t}", group, "temporal split", t, held, [db], [f"{t} frames 0-{n - hold - 1}"])
+    return clips
+
+
+def save_clips(path, clips: list[Clip]) -> None:
+    """Store clips in one ``.npz``: a JSON manifest, one array per motion, one JSON per skeleton."""
+    arrays, skeletons, manifest = {}, {}, []
+    for i, c in enumerate(clips):
+        sk = c.held_out.skeleton.to_json()
+        key = skeletons.setdefault(sk, f"skeleton{len(skeletons)}")
+        arrays[f"c{i}_held"] = np.asarray(c.held_out.values, float)
+        for j, d in enumerate(c.database):
+            arrays[f"c{i}_db{j}"] = np.asarray(d.values, float)
+        manifest.append({"clip": c.clip, "group": c.group, "protocol": c.protocol, "trial": c.trial,
+                         "context": c.context, "length": c.length, "fps": c.held_out.fps, "skeleton": key,
+                         "held_name": c.held_out.name, "database": [d.name for d in c.database],
+                         "database_names": list(c.database_names)})
+    for sk, key in skeletons.items():
+        arrays[key] = np.array(sk)
+    arrays["manifest"] = np.array(json.dumps(manifest))
+    with atomic_path(path, suffix=".npz") as tmp:
+        np.savez_compressed(tmp, **arrays)
+
+
+def load_clips(path) -> list[Clip]:
+    """The clips stored by :func:`save_clips`."""
+    with np.load(path, allow_pickle=False) as z:
+        manifest = json.loads(str(z["manifest"]))
+        sks = {k: Skeleton.from_json(str(z[k])) for k in z.files if k.startswith("skeleton")}
+        clips = []
+        for i, m in enumerate(manifest):
+            sk, fps = sks[m["skeleton"]], float(m["fps"])
+            held = Motion(np.array(z[f"c{i}_held"]), sk, fps, m["held_name"])
+            db = [Motion(np.array(z[f"c{i}_db{j}"]), sk, fps, name) for j, name in enumerate(m["database"])]
+            clips.append(Clip(m["clip"], m["group"], m["protocol"], m["trial"], held, db, int(m["context"]),
+                              int(m["length"]), list(m["database_names"])))
+    return clips
+
+
+def clips_table(clips: list[Clip]) -> pd.DataFrame:
+    """The protocol as a table: one row per held-out clip."""
+    return pd.DataFrame([{
+        "clip": c.clip, "group": c.group, "protocol": c.protocol, "held_out": c.held_out.name,
+        "database": " ".join(c.database_names), "database_frames": int(sum(d.n_frames for d in c.database)),
+        "held_out_frames": c.held_out.n_frames, "fps": c.held_out.fps, "context": c.context, "length": c.length,
+    } for c in clips])
+
+
+# ----------------------------------------------------------------------------- scoring
+
+
+@dataclass
+class Reference:
+    """What scoring needs from one clip's database (computed once per clip).
+
+    Attributes
+    ----------
+    foot_idx : int array, the foot joints
+    floor : float, the floor height (m)
+    jumps : metrics.JumpReference, the database's own frame-to-frame jumps
+    std : ndarray (J, 3), LAFAN1 position statistics of the database's windows
+    features : list of ndarray, the database clips' pose features
+    truth_pos, truth_q : the ground truth's positions (m) and global quaternions
+    truth_forward : ndarray (2,), the ground truth's facing at the last start frame
+    """
+
+    foot_idx: np.ndarray
+    floor: float
+    jumps: object
+    std: np.ndarray
+    features: list
+    truth_pos: np.ndarray
+    truth_q: np.ndarray
+    truth_forward: np.ndarray
+
+
+def reference(clip: Clip, mcfg: dict, roles: dict | None = None) -> Reference:
+    """The database side of every metric of ``clip`` (``mcfg``: the ``compare.metrics`` block)."""
+    from . import metrics as M
+
+    sk = clip.held_out.skeleton
+    fps = clip.held_out.fps
+    foot = M.foot_indices(sk, roles)
+    db_pos = [M.positions(d) for d in clip.database]
+    db_fwd = [M.facing(d, roles) for d in clip.database]
+    floor = M.floor_height(db_pos, foot) if mcfg["floor_m"] is None else float(mcfg["floor_m"])
+    window = min(clip.context + clip.length, max(p.shape[0] for p in db_pos))
+    _mean, std = M.position_stats(db_pos, db_fwd, window, int(mcfg["l2p_stride"]), min(clip.context, window))
+    held_pos = M.positions(clip.held_out)
+    held_fwd = M.facing(clip.held_out, roles)
+    truth = clip.truth
+    return Reference(foot, floor, M.jump_reference(db_pos, fps), std,
+                     [M.pose_features(p, f) for p, f in zip(db_pos, db_fwd)],
+                     held_pos[clip.context:clip.context + clip.length], M.global_quaternions(truth),
+                     held_fwd[clip.context - 1])
+
+
+def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict,
+          roles: dict | None = None) -> tuple[dict, np.ndarray]:
+    """Every per-seed metric of one generated motion; returns the row and its pose features.
+
+    The start and the generated frames are scored together where a measure needs frames before the
+    first generated one (foot speed at the first frame, the jump at the entry seam); the entry
+    (generated frame 0) is a seam for every generator but ``replay``.
+    """
+    from . import metrics as M
+
+    fps = float(motion.fps)
+    start = clip.start
+    joined = Motion(np.vstack([start.values, motion.values]), motion.skeleton, fps, motion.name)
+    pos = M.positions(joined)
+    c = clip.context
+    gen_pos = pos[c:]
+    seams = np.asarray(motion.meta.get("seams", []), np.int64)
+    if generator != "replay":
+        seams = np.union1d(seams, [0])
+    row = {}
+    height, speed = float(mcfg["contact_height_m"]), float(mcfg["skate_speed_m_s"])
+    row.update(M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, speed, ref.floor))
+    # skating near seams: frames within transition_window of a seam, pooled over seams
+    w = int(mcfg["transition_window"])
+    n_contact = n_skate = 0.0
+    for s in seams:
+        lo, hi = c + max(int(s) - w, 0), c + min(int(s) + w, motion.n_frames - 1)
+        part = M.foot_skating(pos[lo - 1:hi + 1], fps, ref.foot_idx, height, speed, ref.floor)
+        nc = part["contact_share"] * (hi - lo + 1) * len(ref.foot_idx)
+        n_contact += nc
+        n_skate += (part["skate_share"] * nc) if nc else 0.0
+    row["transition_skate_share"] = n_skate / n_contact if n_contact else np.nan
+    jumps = M.seam_jumps(pos, fps, seams + c, ref.jumps)
+    row["n_seams"] = int(seams.size)
+    row["seams_per_s"] = seams.size / (motion.n_frames / fps)
+    for k in ("velocity_jump", "velocity_jump_ratio", "velocity_jump_pct", "accel_jump", "accel_jump_ratio",
+              "accel_jump_pct"):
+        row[k] = jumps[k]
+    row["ldlj"] = M.ldlj(gen_pos, fps)
+    row["sparc"] = M.sparc(gen_pos, fps)
+    row["l2p"] = M.l2p(gen_pos, ref.truth_pos, ref.std, forward=ref.truth_forward)
+    q = M.global_quaternions(motion)
+    row["l2q"] = M.l2q(q, ref.truth_q)
+    row["npss"] = M.npss(q, ref.truth_q, spectrum=mcfg["npss_spectrum"], quaternions=True)
+    feats = M.pose_features(gen_pos, M.facing(motion, roles))
+    win = M.window_scores(feats, ref.features, min(int(mcfg["window"]), motion.n_frames),
+                          float(mcfg["coverage_threshold_m"]))
+    row["coverage"] = win["coverage"]
+    row["local_diversity_m"] = win["local_diversity"]
+    row.update(M.novelty(feats, ref.features, float(mcfg["copy_tolerance_m"])))
+    return row, feats
+
+
+# ----------------------------------------------------------------------------- one generator over every clip
+
+
+def clip_seeds(master: int, family_seed: int, clip: str, n: int) -> list[int]:
+    """The seeds of one clip: the same for every generator."""
+    return [derive_seed(master, "compare", family_seed, clip, i) for i in range(int(n))]
+
+
+def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int, roles: dict | None = None,
+                  showcase: tuple[str, int] | None = None):
+    """Fit ``generator`` on every clip's database, generate every seed from the clip's start, score.
+
+    Parameters
+    ----------
+    clips : list of Clip
+    generator : a name of :data:`animsynth.compare.generators.GENERATORS`
+    cfg : the ``compare`` block (with the re-sequencing study's ``stisomap`` block added)
+    master_seed : the config's ``seed``
+    roles : joint-role overrides (config ``joint_roles``)
+    showcase : (clip id, seed index) whose motion is returned
+
+    Returns
+    -------
+    metrics : DataFrame, one row per clip x seed (:data:`KEY_COLUMNS` + :data:`METRIC_NAMES`)
+    timing : DataFrame, one row per clip (:data:`TIMING_COLUMNS`): CPU and wall seconds of the build
+        and of the generation, the Python heap's peak (tracemalloc) of a second, traced build and
+        generation of the first clip
+    shown : Motion or None, the showcase clip's start and generated frames joined
+        (``meta["context"]``: start frames)
+    """
+    mcfg = cfg["metrics"]
+    rows, trows, shown = [], [], None
+    for k, clip in enumerate(clips):
+        seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
+        gen = make_generator(generator, cfg, held_out=clip.held_out)
+        c0, w0 = time.process_time(), time.perf_counter()
+        gen.fit(clip.database)
+        build_cpu, build_wall = time.process_time() - c0, time.perf_counter() - w0
+        start = clip.start
+        ref = reference(clip, mcfg, roles)
+        gen_cpu = gen_wall = 0.0
+        feats = []
+        for i, s in enumerate(seeds):
+            c0, w0 = time.process_time(), time.perf_counter()
+            m = gen.generate(start, clip.length, s)
+            gen_cpu += time.process_time() - c0
+            gen_wall += time.perf_counter() - w0
+            row, f = score(clip, ref, m, generator, mcfg, roles)
+            feats.append(f)
+            rows.append({"clip": clip.clip, "group": clip.group, "protocol": clip.protocol,
+                         "generator": generator, "seed": i, **row})
+            if showcase is not None and (clip.clip, i) == tuple(showcase):
+                seams = np.asarray(m.meta["seams"], np.int64)
+                if generator != "replay":  # the entry is a seam, as scored
+                    seams = np.union1d(seams, [0])
+                shown = Motion(np.vstack([start.values, m.values]), m.skeleton, m.fps, f"{generator} {clip.clip}",
+                               {"context": clip.context, "seams": seams + clip.context})
+        from .metrics import seed_diversity
+
+        div = seed_diversity(feats)
+        for r in rows[-len(seeds):]:
+            r["seed_diversity_m"] = div
+        peak = np.nan
+        if k == 0:  # the Python heap's peak of a build and one generation, traced apart from the timed runs
+            g2 = make_generator(generator, cfg, held_out=clip.held_out)
+            tracemalloc.start()
+            try:
+                g2.fit(clip.database)
+                g2.generate(start, clip.length, seeds[0])
+                peak = tracemalloc.get_traced_memory()[1] / 2**20
+            finally:
+                tracemalloc.stop()
+        trows.append({"generator": generator, "clip": clip.clip,
+                      "database_frames": int(sum(d.n_frames for d in clip.database)),
+                      "build_cpu_s": build_cpu, "build_wall_s": build_wall, "generate_cpu_s": gen_cpu,
+                      "generate_wall_s": gen_wall, "frames_generated": clip.length * len(seeds), "peak_mb": peak})
+        log.info("%s on %s: build %.3f s CPU, %d seeds x %d frames in %.3f s CPU", generator, clip.clip, build_cpu,
+                 len(seeds), clip.length, gen_cpu)
+    metrics = pd.DataFrame(rows)
+    metrics = metrics[KEY_COLUMNS + METRIC_NAMES]
+    return metrics, pd.DataFrame(trows, columns=TIMING_COLUMNS), shown
+
+
+def skipped_run(generator: str, reason: str) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The tables of a generator that cannot run here: no rows (the reason is logged and documented)."""
+    log.warning("generator %s left out: %s", generator, reason)
+    return pd.DataFrame(columns=KEY_COLUMNS + METRIC_NAMES), pd.DataFrame(columns=TIMING_COLUMNS)
+
+
+# ----------------------------------------------------------------------------- tables
+
+
+def _better(metric: str) -> str:
+    return {m: b for m, _u, b in METRICS}[metric]
+
+
+def _unit(metric: str) -> str:
+    return {m: u for m, u, _b in METRICS}[metric]
+
+
+def order_generators(names, order) -> list[str]:
+    """``names`` in the order of ``order`` (the config's generator list)."""
+    return [g for g in order if g in set(names)]
+
+
+def summary_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
+    """Per generator and metric: n (clip x seed rows with a value), median, IQR and 5-95 % range."""
+    out = []
+    for g in order_generators(metrics["generator"].unique(), order):
+        sub = metrics[metrics["generator"] == g]
+        for m in METRIC_NAMES:
+            x = pd.to_numeric(sub[m], errors="coerce").to_numpy(float)
+            x = x[np.isfinite(x)]
+            q = np.percentile(x, [5, 25, 50, 75, 95]) if x.size else np.full(5, np.nan)
+            out.append({"generator": g, "metric": m, "unit": _unit(m), "better": _better(m), "n": int(x.size),
+                        "median": q[2], "q25": q[1], "q75": q[3], "p05": q[0], "p95": q[4]})
+    return pd.DataFrame(out, columns=["generator", "metric", "unit", "better", "n", "median", "q25", "q75", "p05",
+                                      "p95"])
+
+
+def paired_share(metrics: pd.DataFrame, a: str, b: str, metric: str, better: str = "lower"):
+    """Over the clip x seed pairs where both generators have a value: (a better, b better, ties)."""
+    key = ["clip", "seed"]
+    A = metrics[metrics["generator"] == a].set_index(key)[metric]
+    B = metrics[metrics["generator"] == b].set_index(key)[metric]
+    j = pd.concat([A.rename("a"), B.rename("b")], axis=1, join="inner").apply(pd.to_numeric, errors="coerce")
+    j = j[np.isfinite(j["a"]) & np.isfinite(j["b"])]
+    d = (j["a"] - j["b"]).to_numpy(float)
+    if better == "higher":
+        d = -d
+    return int(np.sum(d < 0)), int(np.sum(d > 0)), int(np.sum(d == 0))
+
+
+def winners_table(metrics: pd.DataFrame, summary: pd.DataFrame, order) -> pd.DataFrame:
+    """Per metric with a direction: the best and the second-best generator (reference rows aside) by
+    median, the margin, whether the IQRs are apart ("beyond the spread"), the share of clip x seed pairs
+    in which the best beats the second, and the two reference rows' medians."""
+    rows = []
+    for m in METRIC_NAMES:
+        better = _better(m)
+        if not better:
+            continue
+        s = summary[(summary["metric"] == m) & ~summary["generator"].isin(REFERENCES) & (summary["n"] > 0)]
+        if len(s) < 2:
+            continue
+        s = s.sort_values("median", ascending=(better == "lower"), kind="stable")
+        a, b = s.iloc[0], s.iloc[1]
+        apart = (a["q75"] < b["q25"]) if better == "lower" else (a["q25"] > b["q75"])
+        wins, losses, ties = paired_share(metrics, a["generator"], b["generator"], m, better)
+        ref = {g: summary[(summary["metric"] == m) & (summary["generator"] == g)]["median"] for g in REFERENCES}
+        rows.append({"metric": m, "unit": _unit(m), "better": better, "best": a["generator"],
+                     "best_median": a["median"], "best_q25": a["q25"], "best_q75": a["q75"],
+                     "second": b["generator"], "second_median": b["median"], "second_q25": b["q25"],
+                     "second_q75": b["q75"], "margin": abs(a["median"] - b["median"]),
+                     "beyond_spread": bool(apart),
+                     "best_wins_share": wins / (wins + losses) if wins + losses else np.nan,
+                     "pairs": wins + losses + ties,
+                     **{f"{g}_median": (float(v.iloc[0]) if len(v) else np.nan) for g, v in ref.items()}})
+    return pd.DataFrame(rows)
+
+
+def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
+    """Per generator: builds, median and total build CPU and wall seconds, generation frames per CPU
+    and wall second, the traced peak of the Python heap (MB). Machine-dependent (a timing table)."""
+    rows = []
+    for g in order_generators(timing["generator"].unique(), order):
+        t = timing[timing["generator"] == g]
+        frames = float(t["frames_generated"].sum())
+        rows.append({"generator": g, "builds": len(t), "build_cpu_s_median": float(t["build_cpu_s"].median()),
+                     "build_wall_s_median": float(t["build_wall_s"].median()),
+                     "build_cpu_s_total": float(t["build_cpu_s"].sum()),
+                     "build_wall_s_total": float(t["build_wall_s"].sum()),
+                     "generate_fps_cpu": frames / float(t["generate_cpu_s"].sum()) if t["generate_cpu_s"].sum() > 0
+                     else np.nan,
+                     "generate_fps_wall": frames / float(t["generate_wall_s"].sum())
+                     if t["generate_wall_s"].sum() > 0 else np.nan,
+                     "peak_mb": float(pd.to_numeric(t["peak_mb"], errors="coerce").max())})
+    return pd.DataFrame(rows)
+
+
+# ----------------------------------------------------------------------------- files of one generator job
+
+
+def save_shown(path, motion: Motion) -> None:
+    """Store the showcase motion (start + generated frames) with its start length and seams."""
+    with atomic_path(path, suffix=".npz") as tmp:
+        np.savez_compressed(tmp, values=np.asarray(motion.values, float), fps=np.float64(motion.fps),
+                            name=np.array(motion.name), skeleton=np.array(motion.skeleton.to_json()),
+                            context=np.int64(motion.meta["context"]),
+                            seams=np.asarray(motion.meta.get("seams", []), np.int64))
+
+
+def load_shown(path) -> Motion:
+    """The motion stored by :func:`save_shown` (``meta``: ``context``, ``seams``)."""
+    with np.load(path, allow_pickle=False) as z:
+        return Motion(np.array(z["values"]), Skeleton.from_json(str(z["skeleton"])), float(z["fps"]), str(z["name"]),
+                      {"context": int(z["context"]), "seams": np.array(z["seams"])})
+
+
+def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase, out: dict) -> None:
+    """One generator over every clip and seed (one workflow job): ``out`` names ``metrics``, ``timing``,
+    ``shown`` and ``bvh`` (the showcase as BVH, start frames included)."""
+    from threadpoolctl import threadpool_limits
+
+    from ..io.bvh import write_bvh
+    from ..tables import write_table
+
+    clips = load_clips(clips_path)
+    # one BLAS thread, as the job's threads: 1 (the simplex searches make many small LAPACK calls)
+    with threadpool_limits(1, user_api="blas"):
+        metrics, timing, shown = run_generator(clips, generator, cfg, master_seed, roles, showcase)
+    if shown is None:
+        raise ValueError(f"config key 'compare.showcase': clip {showcase[0]!r} seed {showcase[1]} was not run")
+    write_table(metrics, out["metrics"], md=False)
+    write_table(timing, out["timing"], md=False)
+    save_shown(out["shown"], shown)
+    write_bvh(out["bvh"], shown)
+
+
+# ----------------------------------------------------------------------------- the family's summary
+
+
+def data_label(source: str, clips: pd.DataFrame, seeds: int) -> str:
+    """What the comparison ran on, e.g. ``CMU mocap: 19 held-out clips x 5 seeds``."""
+    kind = {"cmu": "CMU mocap", "synthetic": "synthetic mocap", "user": "user mocap"}.get(source, source)
+    return f"{kind}: {len(clips)} held-out clips x {int(seeds)} seeds"
+
+
+def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.DataFrame, generators, left_out: dict,
+                     data: str, cfg: dict) -> str:
+    """``compare/summary.md``: the protocol in numbers, which generator wins which metric, the verdicts.
+    Generated from the tables (no timing: cost is in ``cost_timing.csv``)."""
+    from ..tables import to_markdown
+
+    out = ["# The generators side by side", "",
+           f"Data: {data}. Working rate {_num(cfg['fps'])} fps; start = the held-out clip's first "
+           f"{cfg['context']} frames; up to {cfg['length']} frames generated from it; generators: "
+           + ", ".join(generators) + ".", ""]
+    if left_out:
+        out += ["Left out: " + "; ".join(f"**{g}**: {why}" for g, why in left_out.items()) + ".", ""]
+    out += ["## Which generator wins which metric", "",
+            "Best and second-best by median over clips x seeds (the reference rows replay and concat aside); "
+            "`beyond_spread`: the two IQRs do not overlap; `best_wins_share`: share of clip x seed pairs in "
+            "which the best beats the second.", ""]
+    if winners.empty:
+        out += ["(no metric with two generators)", ""]
+    else:
+        cols = ["metric", "better", "best", "best_median", "second", "second_median", "margin", "beyond_spread",
+                "best_wins_share", "replay_median", "concat_median"]
+        out += [to_markdown(winners[[c for c in cols if c in winners]]), ""]
+    out += ["## Verdicts", "", to_markdown(verdicts[["claim", "ours", "verdict", "evidence"]]), "",
+            "## Clips", "", to_markdown(clips), "",
+            "Per clip x seed values: `metrics.csv`; medians and spreads: `summary.csv`; build time, generation "
+            "speed and memory: `cost_timing.csv` (machine-dependent, not shown here).", ""]
+    return "\n".join(out)
+
+
+def _num(x) -> str:
+    from ..verdicts import fmt
+
+    return fmt(x, 4)
+
+
+def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str) -> None:
+    """Assemble the family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``,
+    ``timing`` lists) into ``out``: ``metrics``, ``metrics_timing``, ``summary``, ``winners``, ``cost``,
+    ``verdicts``, ``summary_md``."""
+    from ..io.atomic import atomic_write_text
+    from ..tables import write_table
+    from .verdicts import build
+
+    order = list(cfg["generators"])
+    metrics = pd.concat([pd.read_csv(p) for p in inp["metrics"]], ignore_index=True)
+    metrics["_g"] = metrics["generator"].map({g: i for i, g in enumerate(order)})
+    clips = pd.read_csv(inp["clips"], dtype={"held_out": str})
+    metrics["_c"] = metrics["clip"].map({c: i for i, c in enumerate(clips["clip"])})
+    metrics = metrics.sort_values(["_c", "_g", "seed"], kind="stable").drop(columns=["_g", "_c"])
+    timing = pd.concat([pd.read_csv(p) for p in inp["timing"]], ignore_index=True)
+    summary = summary_table(metrics, order)
+    winners = winners_table(metrics, summary, order)
+    data = data_label(source, clips, cfg["seeds"])
+    verdicts = build(metrics, cfg["verdicts"], data, left_out)
+    write_table(metrics, out["metrics"])
+    write_table(timing, out["metrics_timing"])
+    write_table(summary, out["summary"])
+    write_table(winners, out["winners"])
+    write_table(cost_table(timing, order), out["cost"])
+    write_table(verdicts, out["verdicts"])
+    atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg))

@@ -1,0 +1,117 @@
+"""Figures of the comparison: metrics per generator with their spread, one skeleton strip per generator."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..io.atomic import atomic_path
+from .generators import REFERENCES
+from .jobs import METRICS
+
+__all__ = ["FIGURE_METRICS", "metrics_figure", "strips_figure"]
+
+#: the panels of metrics.png: (column, title)
+FIGURE_METRICS = (
+    ("skate_share", "foot skating: share of contact frames"),
+    ("transition_skate_share", "skating near seams: share"),
+    ("velocity_jump_pct", "velocity jump at seams: percentile in capture"),
+    ("ldlj", "smoothness: log dimensionless jerk (higher smoother)"),
+    ("l2p", "L2P vs held-out continuation"),
+    ("npss", "NPSS vs held-out continuation"),
+    ("coverage", "coverage of database windows"),
+    ("novelty_median_m", "novelty: distance to nearest database frame (m)"),
+    ("seed_diversity_m", "diversity across seeds (m)"),
+)
+_BETTER = {m: b for m, _u, b in METRICS}
+
+
+def metrics_figure(path, metrics: pd.DataFrame, order, title: str = "") -> None:
+    """One panel per metric of :data:`FIGURE_METRICS`: every generator's values over clips x seeds as a box
+    (median, IQR, whiskers at 5-95 %); the reference rows (replay, concat) in grey."""
+    import matplotlib.pyplot as plt
+
+    gens = [g for g in order if g in set(metrics["generator"])]
+    n = len(FIGURE_METRICS)
+    cols = 3
+    rows = int(np.ceil(n / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.1 * rows), dpi=100, squeeze=False)
+    for ax, (m, label) in zip(axes.ravel(), FIGURE_METRICS):
+        data, names, colours = [], [], []
+        for g in gens:
+            x = pd.to_numeric(metrics.loc[metrics["generator"] == g, m], errors="coerce").to_numpy(float)
+            x = x[np.isfinite(x)]
+            if x.size:
+                data.append(x)
+                names.append(g)
+                colours.append("0.75" if g in REFERENCES else "tab:blue")
+        if data:
+            bp = ax.boxplot(data, whis=(5, 95), showfliers=False, patch_artist=True, widths=0.6)
+            for patch, c in zip(bp["boxes"], colours):
+                patch.set_facecolor(c)
+                patch.set_alpha(0.7)
+            for med in bp["medians"]:
+                med.set_color("black")
+            ax.set_xticks(range(1, len(names) + 1), names, rotation=40, ha="right", fontsize=8)
+        else:
+            ax.text(0.5, 0.5, "no values", ha="center", va="center", transform=ax.transAxes)
+        better = _BETTER.get(m, "")
+        ax.set_title(label + (f" ({better} is better)" if better and "higher" not in label else ""), fontsize=8.5)
+        ax.tick_params(axis="y", labelsize=8)
+        ax.grid(axis="y", alpha=0.3)
+    for ax in axes.ravel()[n:]:
+        ax.axis("off")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp)
+    plt.close(fig)
+
+
+def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None:
+    """One row per generator: the last start frame (grey) and ``n_panels - 1`` evenly spaced generated
+    frames (seam frames in red), side view along the start's direction of travel, every pose centred on
+    its root.
+
+    Parameters
+    ----------
+    shown : {generator: Motion}, the start and generated frames joined (``meta["context"]``: start frames,
+        ``meta["seams"]``: seam frames of the joined motion)
+    """
+    import matplotlib.pyplot as plt
+
+    from .metrics import positions
+
+    names = list(shown)
+    fig, axes = plt.subplots(len(names), 1, figsize=(1.5 * n_panels, 1.9 * len(names)), dpi=100, squeeze=False)
+    first = shown[names[0]]
+    p0 = positions(first)
+    c0 = int(first.meta["context"])
+    d = p0[c0 - 1, 0, [0, 2]] - p0[0, 0, [0, 2]]
+    fwd = d / np.linalg.norm(d) if np.linalg.norm(d) > 1e-6 else np.array([0.0, 1.0])
+    height = float(np.ptp(p0[:, :, 1])) or 1.0
+    for ax, g in zip(axes[:, 0], names):
+        m = shown[g]
+        pos = positions(m)
+        c = int(m.meta["context"])
+        seams = set(int(s) for s in np.asarray(m.meta.get("seams", [])))
+        idx = np.unique(np.concatenate([[c - 1], np.linspace(c, pos.shape[0] - 1, n_panels - 1).round().astype(int)]))
+        parents = m.skeleton.parents()
+        for k, f in enumerate(idx):
+            q = pos[f] - pos[f, :1] * np.array([1.0, 0.0, 1.0])
+            x = q[:, 0] * fwd[0] + q[:, 2] * fwd[1] + k * height * 0.9
+            colour = "0.6" if f < c else ("tab:red" if any(abs(f - s) <= 1 for s in seams) else "tab:blue")
+            for j, p in enumerate(parents):
+                if p >= 0:
+                    ax.plot([x[p], x[j]], [q[p, 1], q[j, 1]], "-", color=colour, lw=1.3)
+            ax.text(k * height * 0.9, pos[:, :, 1].min() - 0.08 * height, str(f - c), ha="center", fontsize=6)
+        ax.set_aspect("equal")
+        ax.axis("off")
+        ax.set_title(g, fontsize=8.5, loc="left")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp)
+    plt.close(fig)

@@ -1,0 +1,100 @@
+"""Cross-key checks of the ``compare`` config block (beyond the JSON Schema) and what the workflow reads of it.
+
+Defaults live only in ``config/schema.yaml`` (the validator fills them in); every key is documented in
+``config/README.md`` and ``docs/compare.md``.
+"""
+
+from __future__ import annotations
+
+from ..config import ConfigError
+
+__all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "generator_cfg"]
+
+
+def groups(config: dict) -> tuple[dict, dict]:
+    """The databases of the comparison: ``({subset: [trial ids]}, {dataset: trial id})`` in config order
+    (the subsets of ``compare.subsets`` that the run has, the clips of ``compare.resequencing``)."""
+    cmp = config["compare"]
+    subsets = {k: list(v) for k, v in config["subsets"].items() if v}
+    reseq = dict(config["resequencing_trials"])
+    return ({s: subsets[s] for s in cmp["subsets"] if s in subsets},
+            {d: reseq[d] for d in cmp["resequencing"] if d in reseq})
+
+
+def clip_ids(config: dict) -> list[str]:
+    """Every held-out clip of the protocol: ``<subset>/<trial>`` then ``<dataset>/<trial>``."""
+    subsets, reseq = groups(config)
+    return [f"{s}/{t}" for s, ids in subsets.items() for t in ids] + [f"{d}/{t}" for d, t in reseq.items()]
+
+
+def showcase(config: dict) -> tuple[str, int]:
+    """The clip and seed index of the strips figure and the BVH files (default: the first clip, seed 0)."""
+    sc = config["compare"]["showcase"]
+    return (sc["clip"] or clip_ids(config)[0], int(sc["seed"]))
+
+
+def run_generators(config: dict) -> tuple[list[str], dict]:
+    """``(generators that run, {generator left out: reason})``: fairmotion is left out when its package
+    cannot be imported here (:func:`animsynth.compare.generators.unavailable`)."""
+    from .generators import unavailable
+
+    run, left = [], {}
+    for g in config["compare"]["generators"]:
+        why = unavailable(g)
+        if why:
+            left[g] = why
+        else:
+            run.append(g)
+    return run, left
+
+
+def generator_cfg(config: dict) -> dict:
+    """The config a generator job reads: the ``compare`` block plus the re-sequencing study's ST-Isomap
+    parameters (``resequencing.stisomap``: the compare family runs that study's method)."""
+    return dict(config["compare"], stisomap=dict(config["resequencing"]["stisomap"]))
+
+
+def check(config: dict) -> None:
+    """Raise :class:`ConfigError` naming the key for values the schema cannot check."""
+    cmp = config["compare"]
+    have = {k for k, v in config["subsets"].items() if v}
+    for s in cmp["subsets"]:
+        if s not in have:
+            raise ConfigError(f"config key 'compare.subsets': {s!r} is not a subset of this run ({sorted(have)})")
+    for d in cmp["resequencing"]:
+        if d not in config["resequencing_trials"]:
+            raise ConfigError(f"config key 'compare.resequencing': {d!r} is not a key of resequencing_trials "
+                              f"({sorted(config['resequencing_trials'])})")
+    if not cmp["subsets"] and not cmp["resequencing"]:
+        raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': both empty, no clip to compare")
+    subsets, _reseq = groups(config)
+    for s, ids in subsets.items():
+        if len(ids) < 2:
+            raise ConfigError(f"config key 'compare.subsets': subset {s!r} has {len(ids)} trial; leave one out "
+                              "needs at least 2")
+    if config["mocap_source"] != "user":  # AMC trials run at the config's fps (BVH files carry their own)
+        ratio = float(config["fps"]) / float(cmp["fps"])
+        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+            raise ConfigError(f"config key 'compare.fps': {cmp['fps']} must be the trials' rate (fps: "
+                              f"{config['fps']}) divided by a whole number")
+    if cmp["min_length"] > cmp["length"]:
+        raise ConfigError(f"config key 'compare.min_length': {cmp['min_length']} exceeds compare.length "
+                          f"({cmp['length']})")
+    c = cmp["concat"]
+    if c["min_segment_s"] > c["max_segment_s"]:
+        raise ConfigError(f"config key 'compare.concat.min_segment_s': {c['min_segment_s']} exceeds "
+                          f"compare.concat.max_segment_s ({c['max_segment_s']})")
+    mg = cmp["motion_graph"]
+    if mg["blend"] is not None and mg["blend"] > mg["window"]:
+        raise ConfigError(f"config key 'compare.motion_graph.blend': {mg['blend']} exceeds the window "
+                          f"({mg['window']} frames)")
+    sc = cmp["showcase"]
+    if sc["clip"] is not None and sc["clip"] not in clip_ids(config):
+        raise ConfigError(f"config key 'compare.showcase.clip': {sc['clip']!r} is not a clip of this run "
+                          f"({clip_ids(config)})")
+    if sc["seed"] >= cmp["seeds"]:
+        raise ConfigError(f"config key 'compare.showcase.seed': seed index {sc['seed']} but compare.seeds is "
+                          f"{cmp['seeds']}")
+    if cmp["metrics"]["window"] > cmp["min_length"]:
+        raise ConfigError(f"config key 'compare.metrics.window': {cmp['metrics']['window']} frames exceed "
+                          f"compare.min_length ({cmp['min_length']}): a short clip would have no window")

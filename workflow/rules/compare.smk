@@ -1,0 +1,209 @@
+# Beyond the papers: every generator of the project and the classic motion graph side by side
+# (animsynth.compare, docs/compare.md). compare_clips builds every held-out clip's database and start
+# (leave one out within each Gauch & Peters subset, a temporal split of each re-sequencing clip) at the
+# working rate; one job per generator fits it on every clip's database and runs every seed from the clip's
+# start, scoring each motion (its benchmark file is the generator's whole cost); compare_tables and
+# compare_figures gather them. A generator that cannot run here (fairmotion without its package) is left
+# out at parse time with one line, and the tables and docs say why. Every job gets only the config keys it
+# uses. Resources: measured on CMU (the paper run) with headroom.
+from animsynth.compare.settings import clip_ids, groups, run_generators, showcase
+
+CMP = config["compare"]
+CMP_SUBSETS, CMP_RESEQ = groups(config)
+CMP_RUN, CMP_LEFT_OUT = run_generators(config)
+for _gen, _why in CMP_LEFT_OUT.items():
+    print(f"animsynth: compare: generator {_gen} left out ({_why})", file=sys.stderr)
+CMP_SHOWCASE = list(showcase(config))
+CMP_TRIALS = list(dict.fromkeys([t for ids in CMP_SUBSETS.values() for t in ids] + list(CMP_RESEQ.values())))
+CMP_CLIP_KEYS = ("fps", "context", "length", "min_length", "holdout_fraction")
+CMP_RUN_KEYS = ("seed", "seeds", "fps", "metrics")
+# each generator's own config block (a changed block reruns only that generator's job)
+CMP_GEN_BLOCK = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph", "stisomap": "resequencing_graph",
+                 "motion_graph": "motion_graph", "fairmotion": "fairmotion", "concat": "concat"}
+CMP_CLIPS = R("compare/clips.npz")
+CMP_OUT = {
+    "metrics": R("compare/runs/{cmpgen}.csv"),
+    "timing": R("compare/runs/{cmpgen}_timing.csv"),
+    "shown": R("compare/runs/{cmpgen}_showcase.npz"),
+}
+
+
+wildcard_constraints:
+    cmpgen="|".join(CMP_RUN),
+
+
+rule compare_clips:
+    input:
+        compare_trial_npz,
+    output:
+        clips=CMP_CLIPS,
+        table=report(
+            R("compare/clips.csv"),
+            caption="../report/compare_clips.rst",
+            category="The generators side by side",
+        ),
+    params:
+        trials=CMP_TRIALS,
+        subsets=CMP_SUBSETS,
+        resequencing=CMP_RESEQ,
+        cfg={k: CMP[k] for k in CMP_CLIP_KEYS},
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    log:
+        L("compare/clips.log"),
+    benchmark:
+        B("compare/clips.tsv")
+    conda:
+        "../envs/animsynth.yaml"
+    script:
+        "../scripts/compare_clips.py"
+
+
+rule compare_run:
+    input:
+        CMP_CLIPS,
+    output:
+        metrics=CMP_OUT["metrics"],
+        timing=CMP_OUT["timing"],
+        shown=CMP_OUT["shown"],
+        bvh=R("compare/bvh/{cmpgen}.bvh"),
+    params:
+        cfg=compare_job_cfg,
+        seed=config["seed"],
+        roles=config["joint_roles"],
+        showcase=CMP_SHOWCASE,
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=30,
+    log:
+        L("compare/run/{cmpgen}.log"),
+    benchmark:
+        B("compare/run/{cmpgen}.tsv")
+    conda:
+        "../envs/animsynth.yaml"
+    script:
+        "../scripts/compare_run.py"
+
+
+rule compare_tables:
+    input:
+        clips=R("compare/clips.csv"),
+        metrics=expand(CMP_OUT["metrics"], cmpgen=CMP_RUN),
+        timing=expand(CMP_OUT["timing"], cmpgen=CMP_RUN),
+    output:
+        metrics=report(
+            R("compare/metrics.csv"),
+            caption="../report/compare_metrics.rst",
+            category="The generators side by side",
+        ),
+        metrics_timing=R("compare/metrics_timing.csv"),
+        summary=report(
+            R("compare/summary.csv"),
+            caption="../report/compare_summary.rst",
+            category="The generators side by side",
+        ),
+        winners=report(
+            R("compare/winners.csv"),
+            caption="../report/compare_winners.rst",
+            category="The generators side by side",
+        ),
+        cost=report(
+            R("compare/cost_timing.csv"),
+            caption="../report/compare_cost.rst",
+            category="The generators side by side",
+        ),
+        verdicts=report(
+            R("compare/verdicts.csv"),
+            caption="../report/compare_verdicts.rst",
+            category="The generators side by side",
+        ),
+        summary_md=report(
+            R("compare/summary.md"),
+            caption="../report/compare_summary_md.rst",
+            category="The generators side by side",
+        ),
+    params:
+        generators=CMP_RUN,
+        left_out=CMP_LEFT_OUT,
+        cfg={k: CMP[k] for k in ("generators", "seeds", "fps", "context", "length", "verdicts")},
+        source=SOURCE,
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    log:
+        L("compare/tables.log"),
+    benchmark:
+        B("compare/tables.tsv")
+    conda:
+        "../envs/animsynth.yaml"
+    script:
+        "../scripts/compare_tables.py"
+
+
+rule compare_figures:
+    input:
+        metrics=R("compare/metrics.csv"),
+        shown=expand(CMP_OUT["shown"], cmpgen=CMP_RUN),
+    output:
+        metrics=report(
+            R("compare/metrics.png"),
+            caption="../report/compare_metrics_png.rst",
+            category="The generators side by side",
+        ),
+        strips=report(
+            R("compare/strips.png"),
+            caption="../report/compare_strips.rst",
+            category="The generators side by side",
+        ),
+    params:
+        generators=CMP_RUN,
+        showcase=CMP_SHOWCASE,
+        source=SOURCE,
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    log:
+        L("compare/figures.log"),
+    benchmark:
+        B("compare/figures.tsv")
+    conda:
+        "../envs/animsynth.yaml"
+    script:
+        "../scripts/compare_figures.py"
+
+
+COMPARE_TARGETS = [
+    R("compare/clips.csv"),
+    R("compare/metrics.csv"),
+    R("compare/summary.csv"),
+    R("compare/winners.csv"),
+    R("compare/cost_timing.csv"),
+    R("compare/verdicts.csv"),
+    R("compare/summary.md"),
+    R("compare/metrics.png"),
+    R("compare/strips.png"),
+] + expand(R("compare/bvh/{cmpgen}.bvh"), cmpgen=CMP_RUN)
+
+# Tables for results/summary.md (its section "The generators side by side") and the verdict file.
+COMPARE_SUMMARY = [
+    {
+        "title": "Which generator wins which metric",
+        "csv": R("compare/winners.csv"),
+        "group": "The generators side by side",
+        "note": f"On {FAMILY_STATUS['compare'][0]}. Best and second-best generator by median over held-out clips x seeds (replay and concat, the "
+        "realism bounds, aside), whether their IQRs are apart, and the share of clip x seed pairs the best wins; "
+        "every metric's median and spread per generator: compare/summary.csv, figure compare/metrics.png.",
+    },
+    {
+        "title": "Held-out clips",
+        "csv": R("compare/clips.csv"),
+        "group": "The generators side by side",
+        "note": "Leave one out within each Gauch & Peters subset; temporal split of each re-sequencing clip.",
+    },
+]
+COMPARE_VERDICTS = [R("compare/verdicts.csv")]

@@ -1,0 +1,9 @@
+"""metrics.csv, summary.csv, winners.csv, cost_timing.csv, verdicts.csv and summary.md of the comparison."""
+from animsynth.compare.jobs import tables_job
+from animsynth.workflow_utils import setup_logging
+
+log = setup_logging(snakemake)  # noqa: F821
+p = snakemake.params  # noqa: F821
+inp = snakemake.input  # noqa: F821
+tables_job({"clips": inp.clips, "metrics": list(inp.metrics), "timing": list(inp.timing)},
+           dict(snakemake.output), list(p.generators), dict(p.left_out), dict(p.cfg), p.source)  # noqa: F821
