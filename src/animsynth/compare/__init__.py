@@ -1,0 +1,2 @@
+"""Every motion generator of the project and the classic motion graph, on the same clips, scored by one set of
+metrics (:mod:`animsynth.compare.metrics`)."""
