@@ -510,16 +510,20 @@ class Concat(Generator):
 
 
 def unavailable(name: str) -> str:
-    """Why generator ``name`` cannot run here ('' when it can): fairmotion needs its package."""
+    """Why generator ``name`` cannot run here ('' when it can): fairmotion needs its package
+    (:func:`animsynth.compare.fairmotion_peer.check_available` says why not)."""
     if name != "fairmotion":
         return ""
     try:
-        from .fairmotion_peer import FairmotionUnavailable, check_available
-    except ImportError as exc:  # the peer module itself is missing
+        from . import fairmotion_peer
+    except ImportError as exc:  # the adapter itself is missing
         return f"the fairmotion adapter cannot be imported ({exc})"
+    check = getattr(fairmotion_peer, "check_available", None)
+    if check is None:
+        return "the fairmotion adapter has no check_available()"
     try:
-        check_available()
-    except FairmotionUnavailable as exc:
+        check()
+    except fairmotion_peer.FairmotionUnavailable as exc:
         return str(exc)
     return ""
 

@@ -274,11 +274,16 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     """
     from . import metrics as M
 
+    from ..kinematics import forward_kinematics
+
     fps = float(motion.fps)
     start = clip.start
     joined = Motion(np.vstack([start.values, motion.values]), motion.skeleton, fps, motion.name)
-    pos = M.positions(joined)
     c = clip.context
+    # one forward kinematics pass for positions (M.positions) and world rotations (M.global_quaternions)
+    pos, W = forward_kinematics(joined.skeleton, joined.values, ends=True, world_rotations=True)
+    pos = pos * float(joined.skeleton.length_to_m)
+    q = M.align_quaternions(np.stack([r.as_quat() for r in W], axis=1)[c:])
     gen_pos = pos[c:]
     seams = np.asarray(motion.meta.get("seams", []), np.int64)
     if generator != "replay":
@@ -305,10 +310,9 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     row["ldlj"] = M.ldlj(gen_pos, fps)
     row["sparc"] = M.sparc(gen_pos, fps)
     row["l2p"] = M.l2p(gen_pos, ref.truth_pos, ref.std, forward=ref.truth_forward)
-    q = M.global_quaternions(motion)
     row["l2q"] = M.l2q(q, ref.truth_q)
     row["npss"] = M.npss(q, ref.truth_q, spectrum=mcfg["npss_spectrum"], quaternions=True)
-    feats = M.pose_features(gen_pos, M.facing(motion, roles))
+    feats = M.pose_features(gen_pos, M.facing(joined, roles)[c:])
     win = M.window_scores(feats, ref.features, min(int(mcfg["window"]), motion.n_frames),
                           float(mcfg["coverage_threshold_m"]))
     row["coverage"] = win["coverage"]

@@ -1,0 +1,318 @@
+"""The compare family: generators behind one interface, the protocol, the verdict builder, the config checks."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from animsynth.compare import generators as G
+from animsynth.compare import jobs
+from animsynth.compare import settings
+from animsynth.compare import verdicts as CV
+from animsynth.config import ConfigError, validate_config
+from animsynth.kinematics import root_translation
+from animsynth.motion import Motion
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+from animsynth.verdicts import VOCABULARY, VerdictError
+
+from conftest import REPO
+
+ST = {"temporal_window": 1, "c_atn": 10.0, "c_ctn": 10.0, "ctn_neighbors": 4, "ctn_min_gap_s": 0.25,
+      "ctn_tolerance": 2, "ctn_reach_s": 0.05}
+
+
+def _config() -> dict:
+    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
+    return cfg
+
+
+@pytest.fixture(scope="module")
+def cfg():
+    return dict(settings.generator_cfg(_config()), seeds=2)
+
+
+@pytest.fixture(scope="module")
+def walks():
+    """Four short synthetic walks of one subject at 30 fps (120 fps trials, every 4th frame)."""
+    sk = cmu_like_skeleton("cmp", 3)
+    return [jobs.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
+
+
+def _start(m: Motion, n: int = 8) -> Motion:
+    return Motion(m.values[:n].copy(), m.skeleton, m.fps, "start")
+
+
+@pytest.fixture(scope="module")
+def fitted(walks, cfg):
+    out = {}
+    for name in ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "replay", "concat"):
+        out[name] = G.make_generator(name, cfg, held_out=walks[0]).fit(walks[1:])
+    return out
+
+
+@pytest.mark.parametrize("name", ["delaunay", "knn", "isomap", "stisomap", "motion_graph", "replay", "concat"])
+def test_generator_returns_length_frames_on_the_skeleton_and_is_seeded(fitted, walks, name):
+    gen, start, length = fitted[name], _start(walks[0]), 20
+    a = gen.generate(start, length, 5)
+    assert a.values.shape == (length, walks[0].skeleton.n_dof)
+    assert a.skeleton.columns() == walks[0].skeleton.columns() and a.fps == 30.0
+    assert np.all(np.isfinite(a.values))
+    seams = np.asarray(a.meta["seams"])
+    assert seams.ndim == 1 and (seams.size == 0 or (seams.min() >= 0 and seams.max() < length))
+    src = np.asarray(a.meta["source_frames"])
+    assert src.shape == (length, 2)
+    b = gen.generate(start, length, 5)
+    assert np.array_equal(a.values, b.values) and np.array_equal(seams, b.meta["seams"])
+    c = gen.generate(start, length, 6)
+    if name == "replay":
+        assert np.array_equal(a.values, c.values)  # the capture itself, whatever the seed
+    else:
+        assert not np.array_equal(a.values, c.values), f"{name}: the seed changes nothing"
+    # the output continues the start where it stands: its first root is within a stride of the start's last
+    step = np.linalg.norm(np.diff(root_translation(start.skeleton, walks[0].values)[:, [0, 2]], axis=0), axis=1)
+    gap = np.linalg.norm(root_translation(a.skeleton, a.values[:1])[0, [0, 2]]
+                         - root_translation(start.skeleton, start.values[-1:])[0, [0, 2]])
+    assert gap < 6 * step.max(), (name, gap, step.max())
+
+
+def test_replay_is_the_held_out_continuation_and_refuses_another_start(fitted, walks):
+    m = fitted["replay"].generate(_start(walks[0]), 10, 0)
+    assert np.array_equal(m.values, walks[0].values[8:18]) and m.meta["seams"].size == 0
+    with pytest.raises(ValueError, match="not the held-out"):
+        fitted["replay"].generate(_start(walks[1]), 10, 0)
+
+
+def test_resequencers_copy_database_frames_and_record_their_sources(fitted, walks):
+    db = G.Database(walks[1:])
+    for name in ("isomap", "stisomap"):
+        m = fitted[name].generate(_start(walks[0]), 25, 1)
+        src = m.meta["source_frames"]
+        angles = np.array([walks[1 + c].values[f, 6:] for c, f in src])
+        assert np.allclose(m.values[:, 6:], angles)  # joint angles are the database frames' own
+        follows = (src[1:, 0] == src[:-1, 0]) & (src[1:, 1] == src[:-1, 1] + 1)
+        assert set(np.flatnonzero(~follows) + 1) == set(m.meta["seams"])
+        assert db.n_frames == sum(w.n_frames for w in walks[1:])
+
+
+def test_concat_segments_keep_their_heading_and_continue_the_root_position(fitted, walks):
+    m = fitted["concat"].generate(_start(walks[0]), 40, 3)
+    seams = m.meta["seams"]
+    assert seams.size >= 1  # 40 frames of 15-45 frame segments
+    p = root_translation(m.skeleton, m.values)
+    for s in seams:
+        assert np.allclose(p[s, [0, 2]], p[s - 1, [0, 2]])  # root position made continuous, no step
+    p0 = root_translation(m.skeleton, m.values[:1])[0]
+    assert np.allclose(p0[[0, 2]], root_translation(m.skeleton, walks[0].values[7:8])[0, [0, 2]])
+
+
+def test_align_root_puts_the_frame_on_the_anchor(walks):
+    sk, v = walks[1].skeleton, walks[1].values[:20]
+    anchor = walks[2].values[5]
+    out = G.align_root(sk, v, anchor, index=3)
+    assert np.allclose(root_translation(sk, out[3:4])[0, [0, 2]], root_translation(sk, anchor[None])[0, [0, 2]])
+    assert np.isclose(G.heading(sk, out[3:4])[0], G.heading(sk, anchor[None])[0])
+    assert np.allclose(out[:, 6:], v[:, 6:])  # joint angles untouched
+    d_in = np.linalg.norm(np.diff(root_translation(sk, v), axis=0), axis=1)
+    d_out = np.linalg.norm(np.diff(root_translation(sk, out), axis=0), axis=1)
+    assert np.allclose(d_in, d_out)  # a rigid move on the ground
+
+
+def test_database_refuses_mixed_rates_and_counts_seams(walks):
+    other = Motion(walks[1].values, walks[1].skeleton, 60.0, "fast")
+    with pytest.raises(ValueError, match="fps"):
+        G.Database([walks[0], other])
+    db = G.Database(walks[:2])
+    n0 = walks[0].n_frames
+    path = [0, 1, 2, 5, 6, n0 - 2, n0 - 1, n0, n0 + 1]  # a skip, a jump, then from clip 0's end into clip 1
+    assert list(db.seams(path)) == [3, 5, 7]
+
+
+def test_unknown_generator_names_the_key(cfg):
+    with pytest.raises(ValueError, match="compare.generators"):
+        G.make_generator("nope", cfg)
+
+
+# ----------------------------------------------------------------------------- the protocol
+
+
+def test_clips_leave_one_out_and_temporal_split(walks):
+    trials = {f"t{i}": Motion(w.values, w.skeleton, 30.0, f"t{i}") for i, w in enumerate(walks)}
+    cc = {"fps": 15, "context": 4, "length": 40, "min_length": 6, "holdout_fraction": 0.3}
+    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
+    assert [c.clip for c in clips] == ["w1/t0", "w1/t1", "w1/t2", "walk/t3"]
+    c0 = clips[0]
+    assert [d.name for d in c0.database] == ["t1", "t2"] and c0.held_out.fps == 15.0
+    assert c0.length == min(40, c0.held_out.n_frames - 4) and c0.start.n_frames == 4
+    assert np.array_equal(c0.held_out.values, walks[0].values[::2])
+    t = clips[-1]
+    n = walks[3].values[::2].shape[0]
+    hold = max(round(0.3 * n), 4 + 6)
+    assert t.held_out.n_frames == hold and t.database[0].n_frames == n - hold
+    assert np.array_equal(np.vstack([t.database[0].values, t.held_out.values]), walks[3].values[::2])
+    assert np.array_equal(t.truth.values, t.held_out.values[4:4 + t.length])
+
+
+def test_clips_round_trip_and_table(tmp_path, walks):
+    trials = {f"t{i}": w for i, w in enumerate(walks)}
+    cc = {"fps": 30, "context": 6, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
+    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1"]}, {"walk": "t2"}, cc)
+    jobs.save_clips(tmp_path / "c.npz", clips)
+    back = jobs.load_clips(tmp_path / "c.npz")
+    for a, b in zip(clips, back):
+        assert (a.clip, a.protocol, a.length, a.context) == (b.clip, b.protocol, b.length, b.context)
+        assert np.array_equal(a.held_out.values, b.held_out.values)
+        assert all(np.array_equal(x.values, y.values) for x, y in zip(a.database, b.database))
+        assert b.held_out.skeleton.columns() == a.held_out.skeleton.columns()
+    table = jobs.clips_table(back)
+    assert list(table["protocol"]) == ["leave one out", "leave one out", "temporal split"]
+
+
+def test_clip_errors_name_the_keys(walks):
+    trials = {"a": walks[0], "b": walks[1]}
+    cc = {"fps": 30, "context": 8, "length": 20, "min_length": 200, "holdout_fraction": 0.3}
+    with pytest.raises(ValueError, match="compare.min_length"):
+        jobs.prepare_clips(trials, {"w1": ["a", "b"]}, {}, cc)
+    with pytest.raises(ValueError, match="compare.fps"):
+        jobs.prepare_clips(trials, {"w1": ["a", "b"]}, {}, dict(cc, fps=7, min_length=6))
+
+
+def test_seeds_are_the_same_for_every_generator_and_differ_by_clip():
+    assert jobs.clip_seeds(1, 11, "w1/a", 3) == jobs.clip_seeds(1, 11, "w1/a", 3)
+    assert jobs.clip_seeds(1, 11, "w1/a", 3) != jobs.clip_seeds(1, 11, "w1/b", 3)
+    assert len(set(jobs.clip_seeds(1, 11, "w1/a", 5))) == 5
+
+
+def test_run_generator_scores_every_clip_and_seed_and_writes_a_bvh_our_reader_reads(tmp_path, walks, cfg):
+    from animsynth.io.bvh import read_bvh
+    from animsynth.kinematics import forward_kinematics
+
+    trials = {f"t{i}": w for i, w in enumerate(walks)}
+    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
+    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
+    jobs.save_clips(tmp_path / "clips.npz", clips)
+    out = {k: str(tmp_path / f"{k}{ext}") for k, ext in
+           (("metrics", ".csv"), ("timing", "_timing.csv"), ("shown", ".npz"), ("bvh", ".bvh"))}
+    jobs.run_job(tmp_path / "clips.npz", "stisomap", cfg, 7, None, ("w1/t1", 1), out)
+    m = pd.read_csv(out["metrics"])
+    assert len(m) == 3 * cfg["seeds"] and list(m.columns) == jobs.KEY_COLUMNS + jobs.METRIC_NAMES
+    assert (m["n_seams"] >= 1).all()  # the entry is a seam
+    assert m["copy_share"].between(0.99, 1).all()  # a re-sequencer copies database poses
+    t = pd.read_csv(out["timing"])
+    assert len(t) == 3 and np.isfinite(t.loc[0, "peak_mb"]) and t["peak_mb"].iloc[1:].isna().all()
+    shown = jobs.load_shown(out["shown"])
+    assert shown.n_frames == clips[1].context + clips[1].length and shown.meta["context"] == clips[1].context
+    back = read_bvh(out["bvh"])
+    assert back.n_frames == shown.n_frames and np.isclose(back.fps, shown.fps)
+    a = forward_kinematics(shown.skeleton, shown.values, ends=False)
+    b = forward_kinematics(back.skeleton, back.values, ends=False)
+    assert np.allclose(a, b, atol=1e-3)  # same joint positions, in the file's units
+
+
+# ----------------------------------------------------------------------------- tables and verdicts
+
+
+def _metrics(values: dict) -> pd.DataFrame:
+    """A metrics table: {generator: list of skate shares over clips x seeds} (two groups of clips)."""
+    rows = []
+    for g, vals in values.items():
+        for i, v in enumerate(vals):
+            row = {"clip": f"{'ab'[i % 2]}/c{i // 4}", "group": "ab"[i % 2], "protocol": "leave one out",
+                   "generator": g, "seed": i // 2 % 2}
+            row.update({m: np.nan for m in jobs.METRIC_NAMES})
+            row.update(skate_share=v, transition_skate_share=v, velocity_jump=v, l2p=v, novelty_median_m=v)
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def test_decide_follows_the_share_and_the_sign_test():
+    assert CV.decide(20, 0, 0.75, 0.05)[0] == "reproduced"
+    assert CV.decide(0, 20, 0.75, 0.05)[0] == "contradicted"
+    assert CV.decide(11, 9, 0.75, 0.05)[0] == "within noise"
+    assert CV.decide(4, 0, 0.75, 0.05)[0] == "within noise"  # every pair agrees, but four pairs prove little
+    assert CV.decide(0, 0, 0.75, 0.05)[0] == "not reproduced"
+
+
+def test_verdict_builder_on_known_outcomes():
+    n = 16
+    lo, hi = list(np.linspace(0.1, 0.2, n)), list(np.linspace(0.3, 0.4, n))
+    metrics = _metrics({"motion_graph": lo, "stisomap": hi, "isomap": [0.0] * n, "delaunay": hi, "knn": hi,
+                        "concat": hi, "replay": [0.05] * n})
+    vc = {"share": 0.75, "alpha": 0.05, "novelty_copy_m": 0.01}
+    v = CV.build(metrics, vc, "test data", {"fairmotion": "not installed here"}).set_index("claim")
+    assert set(v["verdict"]) <= set(VOCABULARY)
+    assert v.loc["the classic motion graph skates less than ST-Isomap re-sequencing", "verdict"] == "reproduced"
+    assert "16 of 16" in v.loc["the classic motion graph skates less than ST-Isomap re-sequencing", "evidence"]
+    fm = v.loc["our motion graph's transitions skate less than fairmotion's"]
+    assert fm["verdict"] == "not reproduced" and "not installed here" in fm["evidence"]
+    assert v.loc["ST-Isomap re-sequencing jumps less at its seams than Isomap re-sequencing",
+                 "verdict"] == "contradicted"
+    copy = v.loc["re-sequencers copy database frames (novelty ~ 0) while field followers synthesise new poses"]
+    assert copy["verdict"] == "contradicted"  # stisomap (0.3 m) copies nothing here
+    capture = v.loc["the held-out capture skates less than every generator (the realism upper bound holds for "
+                    "this metric)"]
+    assert capture["verdict"] == "reproduced" and "over a quarter of their pairs: isomap" in capture["evidence"]
+    # a claim whose generators are not configured gives no row
+    v2 = CV.build(metrics[metrics["generator"] != "concat"], vc, "test data", {})
+    assert not v2["claim"].str.contains("concatenation").any()
+
+
+def test_verdict_rows_use_the_common_vocabulary():
+    from animsynth import verdicts as V
+
+    with pytest.raises(VerdictError):
+        V.row("a claim", "holds")
+
+
+def test_summary_and_winners_tables():
+    n = 8
+    metrics = _metrics({"motion_graph": [0.1] * n, "stisomap": [0.2] * n, "isomap": [0.3] * n,
+                        "replay": [0.0] * n, "concat": [0.5] * n})
+    order = list(G.GENERATORS)
+    s = jobs.summary_table(metrics, order)
+    row = s[(s["generator"] == "stisomap") & (s["metric"] == "skate_share")].iloc[0]
+    assert row["n"] == n and row["median"] == pytest.approx(0.2) and row["better"] == "lower"
+    assert list(dict.fromkeys(s["generator"])) == ["isomap", "stisomap", "motion_graph", "replay", "concat"]
+    w = jobs.winners_table(metrics, s, order).set_index("metric")
+    r = w.loc["skate_share"]
+    assert (r["best"], r["second"], bool(r["beyond_spread"])) == ("motion_graph", "stisomap", True)
+    assert r["best_wins_share"] == 1.0 and r["replay_median"] == 0.0 and r["concat_median"] == 0.5
+
+
+# ----------------------------------------------------------------------------- config checks
+
+
+@pytest.mark.parametrize("mutate, key", [
+    (lambda c: c["compare"].update(subsets=["w1", "w9"]), "compare.subsets"),
+    (lambda c: c["subsets"].update(w2=None), "compare.subsets"),
+    (lambda c: c["compare"].update(resequencing=["walk", "hop"]), "compare.resequencing"),
+    (lambda c: c["compare"].update(fps=50), "compare.fps"),
+    (lambda c: c["compare"].update(min_length=100), "compare.min_length"),
+    (lambda c: c["compare"]["showcase"].update(clip="w1/nope"), "compare.showcase.clip"),
+    (lambda c: c["compare"]["showcase"].update(seed=9), "compare.showcase.seed"),
+    (lambda c: c["compare"]["concat"].update(min_segment_s=2.0), "compare.concat.min_segment_s"),
+    (lambda c: c["compare"]["motion_graph"].update(blend=20), "compare.motion_graph.blend"),
+    (lambda c: c["compare"]["metrics"].update(window=50), "compare.metrics.window"),
+    (lambda c: c["compare"].update(subsets=[], resequencing=[]), "compare.subsets"),
+])
+def test_settings_check_names_the_key(mutate, key):
+    cfg = _config()
+    settings.check(cfg)
+    bad = copy.deepcopy(cfg)
+    mutate(bad)
+    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
+        settings.check(bad)
+
+
+def test_settings_lists_clips_and_showcase():
+    cfg = _config()
+    ids = settings.clip_ids(cfg)
+    assert ids[0] == f"w1/{cfg['subsets']['w1'][0]}" and ids[-1] == f"dance/{cfg['resequencing_trials']['dance']}"
+    assert settings.showcase(cfg) == (ids[0], 0)
+    run, left = settings.run_generators(cfg)
+    assert set(run) | set(left) == set(cfg["compare"]["generators"]) and "motion_graph" in run
+    assert all(why for why in left.values())
