@@ -190,3 +190,25 @@ def test_resequencing_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_wor
     assert len(want) >= 4
     assert got["verdict"].tolist() == want["verdict"].tolist(), pd.concat(
         [want[["claim", "verdict"]], got["verdict"].rename("noisy")], axis=1).to_string()
+
+
+@pytest.mark.workflow
+@pytest.mark.parametrize("seed", [0, 1])
+def test_compare_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow, seed):
+    from animsynth.compare.jobs import data_label
+    from animsynth.compare.verdicts import build
+
+    out = tiny_workflow / "results" / "compare"
+    cmp = _tiny_config(tiny_workflow)["compare"]
+    metrics = pd.read_csv(out / "metrics.csv")
+    clips = pd.read_csv(out / "clips.csv")
+    data = data_label("synthetic", clips, cmp["seeds"])
+    left_out = {g: "left out" for g in cmp["generators"] if g not in set(metrics["generator"])}
+    want = build(metrics, cmp["verdicts"], data, left_out)
+    written = pd.read_csv(out / "verdicts.csv")
+    assert want[["claim", "verdict"]].equals(written[["claim", "verdict"]])  # the rule's inputs, rebuilt
+    got = build(perturbed(metrics, seed), cmp["verdicts"], data, left_out)
+    assert len(want) >= 5
+    assert got["verdict"].tolist() == want["verdict"].tolist(), pd.concat(
+        [want[["claim", "verdict"]], got["verdict"].rename("noisy")], axis=1).to_string()
+
