@@ -288,7 +288,7 @@ def test_summary_and_winners_tables():
 
 @pytest.mark.parametrize("mutate, key", [
     (lambda c: c["compare"].update(subsets=["w1", "w9"]), "compare.subsets"),
-    (lambda c: c["subsets"].update(w2=None), "compare.subsets"),
+    (lambda c: (c["subsets"].update(w2=None), c["compare"].update(subsets=["w1", "w2"])), "compare.subsets"),
     (lambda c: c["compare"].update(resequencing=["walk", "hop"]), "compare.resequencing"),
     (lambda c: c["compare"].update(fps=50), "compare.fps"),
     (lambda c: c["compare"].update(min_length=100), "compare.min_length"),

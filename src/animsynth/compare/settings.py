@@ -13,12 +13,14 @@ __all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "generat
 
 def groups(config: dict) -> tuple[dict, dict]:
     """The databases of the comparison: ``({subset: [trial ids]}, {dataset: trial id})`` in config order
-    (the subsets of ``compare.subsets`` that the run has, the clips of ``compare.resequencing``)."""
+    (the subsets of ``compare.subsets`` that the run has, the clips of ``compare.resequencing``; null: every
+    subset / re-sequencing clip of the run)."""
     cmp = config["compare"]
     subsets = {k: list(v) for k, v in config["subsets"].items() if v}
     reseq = dict(config["resequencing_trials"])
-    return ({s: subsets[s] for s in cmp["subsets"] if s in subsets},
-            {d: reseq[d] for d in cmp["resequencing"] if d in reseq})
+    use_s = list(subsets) if cmp["subsets"] is None else cmp["subsets"]
+    use_r = list(reseq) if cmp["resequencing"] is None else cmp["resequencing"]
+    return ({s: subsets[s] for s in use_s if s in subsets}, {d: reseq[d] for d in use_r if d in reseq})
 
 
 def clip_ids(config: dict) -> list[str]:
@@ -58,16 +60,16 @@ def check(config: dict) -> None:
     """Raise :class:`ConfigError` naming the key for values the schema cannot check."""
     cmp = config["compare"]
     have = {k for k, v in config["subsets"].items() if v}
-    for s in cmp["subsets"]:
+    for s in cmp["subsets"] or []:
         if s not in have:
             raise ConfigError(f"config key 'compare.subsets': {s!r} is not a subset of this run ({sorted(have)})")
-    for d in cmp["resequencing"]:
+    for d in cmp["resequencing"] or []:
         if d not in config["resequencing_trials"]:
             raise ConfigError(f"config key 'compare.resequencing': {d!r} is not a key of resequencing_trials "
                               f"({sorted(config['resequencing_trials'])})")
-    if not cmp["subsets"] and not cmp["resequencing"]:
-        raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': both empty, no clip to compare")
-    subsets, _reseq = groups(config)
+    subsets, reseq = groups(config)
+    if not subsets and not reseq:
+        raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': no clip to compare")
     for s, ids in subsets.items():
         if len(ids) < 2:
             raise ConfigError(f"config key 'compare.subsets': subset {s!r} has {len(ids)} trial; leave one out "
