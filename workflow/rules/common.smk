@@ -315,3 +315,54 @@ def published_input(family, table):
 
     published_file.__name__ = f"published_{family}_{table}"
     return published_file
+
+
+# ---- data input functions ----
+def trial_spec(wildcards):
+    """The config record of one trial (synthetic generation parameters)."""
+    return TRIALS[wildcards.trial]
+
+
+def synthetic_trial_seed(wildcards):
+    return seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], wildcards.trial)
+
+
+def trial_field(field, required=True):
+    """Params function: one field of a trial's config record (None when optional and absent)."""
+
+    def trial_value(wildcards):
+        rec = TRIALS[wildcards.trial]
+        return rec[field] if required else rec.get(field)
+
+    trial_value.__name__ = f"trial_{field}"
+    return trial_value
+
+
+def mesh_fetch_sums(wildcards):
+    return MESH_FETCH_SUMS[wildcards.meshsrc]
+
+
+def mesh_fetch_source(wildcards):
+    return MESH_FETCH[wildcards.meshsrc]
+
+
+def mesh_sequence_frames(wildcards):
+    return MD_FRAMES[wildcards.mdseq]
+
+
+def mesh_sequence_sums(wildcards):
+    return MD_SEQS[wildcards.mdseq]["mesh_sha256"]
+
+
+# ---- scale input functions ----
+def scale_point_seed(wildcards):
+    return seed_for("scale", wildcards.scfamily, wildcards.scpoint)
+
+
+def scale_point_mem_mb(wildcards):
+    """Memory of one cost-curve point: the re-sequencing budget from config, 3 GB for the others."""
+    return SCALE["resequencing"]["mem_mb"] if wildcards.scfamily == "resequencing" else 3000
+
+
+def landmark_vs_exact_seed(wildcards):
+    return seed_for("scale", "landmark_vs_exact", wildcards.scn)

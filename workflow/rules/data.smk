@@ -19,8 +19,8 @@ if SOURCE == "synthetic":
             amc="resources/mocap/{trial}.amc",
             asf="resources/mocap/{trial}.asf",
         params:
-            spec=lambda wc: TRIALS[wc.trial],
-            seed=lambda wc: seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], wc.trial),
+            spec=trial_spec,
+            seed=synthetic_trial_seed,
             subject_seed=config["synthetic_mocap"]["seed"],
             fps=config["fps"],
         threads: 1
@@ -44,10 +44,10 @@ else:
             asf="resources/mocap/{trial}.asf",
         params:
             source=MOCAP_MIRROR,
-            amc=lambda wc: TRIALS[wc.trial]["amc"],
-            asf=lambda wc: TRIALS[wc.trial]["asf"],
-            sha256=lambda wc: TRIALS[wc.trial].get("sha256"),
-            asf_sha256=lambda wc: TRIALS[wc.trial].get("asf_sha256"),
+            amc=trial_field("amc"),
+            asf=trial_field("asf"),
+            sha256=trial_field("sha256", required=False),
+            asf_sha256=trial_field("asf_sha256", required=False),
         threads: 1
         resources:
             mem_mb=500,
@@ -66,8 +66,8 @@ else:
             bvh="resources/mocap/{trial}.bvh",
         params:
             source=MOCAP_MIRROR,
-            bvh=lambda wc: TRIALS[wc.trial]["bvh"],
-            sha256=lambda wc: TRIALS[wc.trial].get("sha256"),
+            bvh=trial_field("bvh"),
+            sha256=trial_field("sha256", required=False),
         threads: 1
         resources:
             mem_mb=500,
@@ -165,11 +165,11 @@ if MESH_FETCH:
 
     rule mesh_fetch:
         input:
-            sums=lambda w: MESH_FETCH_SUMS[w.meshsrc],
+            sums=mesh_fetch_sums,
         output:
             directory("resources/mesh/{meshsrc}"),
         params:
-            source=lambda w: MESH_FETCH[w.meshsrc],
+            source=mesh_fetch_source,
             max_unpacked_mb=config.get("meshdetail", {}).get("max_unpacked_mb", 8000),
         log:
             L("data/mesh_fetch/{meshsrc}.log"),
@@ -191,8 +191,8 @@ if MESH_CHECK:
 
     rule mesh_checksums:
         input:
-            frames=lambda w: MD_FRAMES[w.mdseq],
-            sums=lambda w: MD_SEQS[w.mdseq]["mesh_sha256"],
+            frames=mesh_sequence_frames,
+            sums=mesh_sequence_sums,
         output:
             R("data/mesh_checksums/{mdseq}.csv"),
         log:
