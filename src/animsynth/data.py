@@ -100,11 +100,6 @@ def fetch_file(source: str, rel: str, dest, sha256: str | None, attempts: int = 
     return got
 
 
-def copy_local(src, dest) -> None:
-    with atomic_path(dest) as tmp:
-        shutil.copyfile(src, tmp)
-
-
 def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
                bvh_length_to_m: float = 1.0) -> Motion:
     """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion`.
