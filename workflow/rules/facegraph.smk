@@ -8,11 +8,10 @@
 # figures use the graphs of the showcase configuration. Every job gets only
 # the config keys it uses.
 
-from animsynth.facegraph.settings import (check_facegraph_config, configurations, showcase,
-                                          sweep_configurations)
+# Config checks: animsynth.facegraph.settings.check, called with the others from common.smk.
+from animsynth.facegraph.settings import configurations, showcase, sweep_configurations
 
 FG = config["facegraph"]
-check_facegraph_config(FG)
 FG_TABLE_CONFIGS = configurations(FG)
 FG_SWEEP_CONFIGS = sweep_configurations(FG)
 FG_SHOWCASE_CONF = showcase(FG)
@@ -41,8 +40,8 @@ if FG_SYNTHETIC:
             seed=seed_for("facegraph", FG["seed"], "synthetic"),
         threads: 1
         resources:
-            mem_mb=lambda wc, attempt: 500 * attempt,
-            runtime=lambda wc, attempt: int(10 * FG_SCALE * attempt),
+            mem_mb=fg_mem_mb(500),
+            runtime=fg_runtime(10),
         log:
             L("facegraph/synth_db.log"),
         benchmark:
@@ -70,8 +69,8 @@ rule facegraph_prepare:
         source=FG_SOURCE,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 1000 * attempt,
-        runtime=lambda wc, attempt: int(20 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(1000),
+        runtime=fg_runtime(20),
     log:
         L("facegraph/prepare.log"),
     benchmark:
@@ -100,8 +99,8 @@ rule facegraph_graphs:
         seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 1000 * attempt,
-        runtime=lambda wc, attempt: int(len(FG_MAIN_NAMES) * 5 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(1000),
+        runtime=fg_runtime(5 * len(FG_MAIN_NAMES)),
     log:
         L("facegraph/graphs.log"),
     benchmark:
@@ -125,8 +124,8 @@ if FG_SWEEP_NAMES:
             seed=FG_SEED_GRAPH,
         threads: 1
         resources:
-            mem_mb=lambda wc, attempt: 1000 * attempt,
-            runtime=lambda wc, attempt: int(len(FG_SWEEP_NAMES) * 5 * FG_SCALE * attempt),
+            mem_mb=fg_mem_mb(1000),
+            runtime=fg_runtime(5 * len(FG_SWEEP_NAMES)),
         log:
             L("facegraph/sweep_graphs.log"),
         benchmark:
@@ -141,6 +140,7 @@ rule facegraph_table1:
     input:
         runs=[R(f"facegraph/runs/{c['name']}.json") for c in FG_TABLE_CONFIGS],
         db=R("facegraph/preprocessed.npz"),
+        paper=published_input("facegraph", "table1"),
     output:
         csv=report(
             R("facegraph/table1.csv"),
@@ -159,7 +159,6 @@ rule facegraph_table1:
         thresholds_md=R("facegraph/thresholds.md"),
     params:
         order=[c["name"] for c in FG_TABLE_CONFIGS],
-        paper=FG["paper_table1"],
         title="Table 1: region motion graphs for the paper's 15 compression configurations",
     threads: 1
     resources:
@@ -194,7 +193,6 @@ if FG_SWEEP_CONFIGS:
             thresholds_md=R("facegraph/sweep_thresholds.md"),
         params:
             order=[c["name"] for c in FG_SWEEP_CONFIGS],
-            paper=None,
             title="Optional sweep: creation x merge targets (one tolerance)",
         threads: 1
         resources:
@@ -229,8 +227,8 @@ rule facegraph_baseline:
         seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 3000 * attempt,
-        runtime=lambda wc, attempt: int(30 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(3000),
+        runtime=fg_runtime(30),
     log:
         L("facegraph/baseline.log"),
     benchmark:
@@ -259,8 +257,8 @@ rule facegraph_uniqueness:
         seed=seed_for("facegraph", FG["seed"], "uniqueness"),
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 800 * attempt,
-        runtime=lambda wc, attempt: int(15 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(800),
+        runtime=fg_runtime(15),
     log:
         L("facegraph/uniqueness.log"),
     benchmark:
@@ -301,8 +299,8 @@ rule facegraph_figures:
         graph_seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 1000 * attempt,
-        runtime=lambda wc, attempt: int(15 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(1000),
+        runtime=fg_runtime(15),
     log:
         L("facegraph/figures.log"),
     benchmark:
@@ -332,8 +330,8 @@ rule facegraph_verdicts:
         order=[c["name"] for c in FG_TABLE_CONFIGS],
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 500 * attempt,
-        runtime=lambda wc, attempt: int(5 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(500),
+        runtime=fg_runtime(5),
     log:
         L("facegraph/verdicts.log"),
     benchmark:
@@ -362,7 +360,7 @@ FACEGRAPH_SUMMARY = [
     {
         "title": "Serra et al. 2018 Table 1: region motion graphs for the paper's 15 configurations",
         "csv": R("facegraph/table1.csv"),
-        "note": f"{_FG_DATA_NOTE} paper_* columns: the published values (facegraph.paper_table1), empty if that "
+        "note": f"{_FG_DATA_NOTE} paper_* columns: the published values (published.facegraph.table1), empty if that "
         "file is missing. Creation/synthesis times (CPU and wall) are in table1_timing.csv.",
     },
     {
