@@ -4,7 +4,8 @@
 # pre-processed once. Table 1: one job fits every compression configuration (the
 # paper's 15 targets with tolerances by default; per-sample threshold search,
 # graph build, re-synthesis of every sequence), aggregated by facegraph_table1
-# with the published values beside ours. The baseline, uniqueness study and
+# with the published values beside ours (published.facegraph.table1, a declared
+# input: a changed file reruns Table 1). The baseline, uniqueness study and
 # figures use the graphs of the showcase configuration. Every job gets only
 # the config keys it uses.
 
@@ -26,7 +27,8 @@ FG_SHOWCASE_GRAPH = R(f"facegraph/graphs/{FG_SHOWCASE}.npz")
 # Resources sized from measured use with headroom (rule benchmarks, 70 sequences / CK+ scale): peak RSS
 # synth_db 107 / 115 MB, prepare 147 / 161 MB (13 / 66 s CPU), graph 230 / 475 MB (5-12 / 10-20 s CPU),
 # baseline 446 / 685 MB (face graphs capped at baseline.max_nodes poses), table1/verdicts/uniqueness ~160 MB. Runtimes (minutes)
-# allow for a machine shared by several jobs (wall up to 20x CPU seen) and scale with the database size.
+# allow for a machine shared by several jobs (wall up to 20x CPU seen) and scale with the database size
+# (fg_mem_mb / fg_runtime in common.smk's facegraph block: times the attempt; runtimes also times FG_SCALE).
 FG_SCALE = max(1.0, FG["synthetic"]["n_sequences"] / 70.0) if FG_SYNTHETIC else 5.0
 
 
