@@ -339,7 +339,6 @@ def merge_sample(s, T, trial, lam, eps, procrustes, st,
     qv = np.empty((Lr, 2))
     qvt = np.empty((Lr, 2))
     qdr = np.empty((Lr, 2))
-    dist = np.empty(Lr)
     cdist = np.empty(Lr)
     qn = np.empty(Lr)
     prod = np.empty(Lr)
