@@ -119,7 +119,7 @@ def test_simplicial_verdicts_survive_last_digit_noise(simplicial_runs, seed):
 @pytest.mark.parametrize("seed", [0, 1])
 def test_facegraph_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow, seed):
     """The tiny run's own tables (as its verdicts rule reads them), then the same with noise."""
-    from animsynth.facegraph.experiments import verdicts
+    from animsynth.facegraph.verdicts import verdicts
 
     out = tiny_workflow / "results" / "facegraph"
     read = lambda p: pd.read_csv(p, keep_default_na=False, na_values=[""])  # noqa: E731

@@ -243,6 +243,8 @@ def resequencing_benchmarks():
     )
 
 
+# ---- facegraph input functions ----
+# (the functions of workflow/rules/facegraph.smk; FG_* are defined there and looked up when called)
 def fg_graph_outputs(names):
     """Per-configuration outputs of one graphs job, in the order of ``names``."""
     return dict(
@@ -253,6 +255,25 @@ def fg_graph_outputs(names):
     )
 
 
+def fg_mem_mb(mb):
+    """Resource function of a facegraph rule: ``mb`` MB of memory, times the attempt on a retry."""
+
+    def facegraph_mem_mb(wildcards, attempt):
+        return mb * attempt
+
+    return facegraph_mem_mb
+
+
+def fg_runtime(minutes):
+    """Resource function of a facegraph rule: ``minutes`` at the default database size, scaled by the
+    database size (FG_SCALE) and by the attempt on a retry."""
+
+    def facegraph_runtime(wildcards, attempt):
+        return int(minutes * FG_SCALE * attempt)
+
+    return facegraph_runtime
+
+
 # Benchmark files of this family's jobs (inputs of rule_benchmarks).
 def facegraph_benchmarks():
     rules_run = (["facegraph_synth_db"] if FG_SYNTHETIC else []) + ["facegraph_prepare", "facegraph_graphs"]
@@ -260,6 +281,7 @@ def facegraph_benchmarks():
     rules_run += (["facegraph_sweep"] if FG_SWEEP_CONFIGS else []) + [
         "facegraph_baseline", "facegraph_uniqueness", "facegraph_figures", "facegraph_verdicts"]
     return [f for r in rules_run for f in job_benchmarks(r)]
+# ---- end facegraph input functions ----
 
 
 def md_truth(wildcards):

@@ -145,12 +145,6 @@ def au_field(au) -> np.ndarray:
     return field
 
 
-def mean_face_px() -> np.ndarray:
-    """The mean face in pixels, centred in a 640 x 490 image."""
-    u = MEAN_FACE_UNIT - MEAN_FACE_UNIT.mean(0)
-    return u * FACE_SCALE_PX + np.array([IMAGE_SIZE[0] / 2, IMAGE_SIZE[1] / 2 + 25])
-
-
 def _rot(theta):
     c, s = np.cos(theta), np.sin(theta)
     return np.array([[c, -s], [s, c]])

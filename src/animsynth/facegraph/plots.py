@@ -1,4 +1,4 @@
-"""Figures of the facegraph experiments (matplotlib)."""
+"""Figures of the facegraph family (matplotlib): region graphs, trajectories, animated GIF."""
 
 from __future__ import annotations
 
