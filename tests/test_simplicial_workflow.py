@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from animsynth.simplicial import experiment as ex
-from animsynth.simplicial.verdicts import VERDICT_COLUMNS
+from animsynth.simplicial import folds as fl
+from animsynth.verdicts import COLUMNS
 
 OUTPUTS = [
     "results/simplicial/folds.csv", "results/simplicial/table2.csv", "results/simplicial/table2.md",
@@ -28,7 +28,7 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
     missing = [p for p in OUTPUTS if not (wd / p).exists()]
     assert not missing, missing
     folds = pd.read_csv(wd / "results/simplicial/folds.csv")
-    assert list(folds.columns) == ex.FOLD_COLUMNS
+    assert list(folds.columns) == fl.FOLD_COLUMNS
     # one JSON per dataset, holding every leave-one-out fold of its subset (3 trials each in the tiny config)
     jsons = sorted((wd / "results/simplicial/folds").glob("*.json"))
     assert [p.stem for p in jsons] == sorted(["w1", "w2", "r1", "r2"])
@@ -52,11 +52,11 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
         assert t2[f"{d}_minus_paper"].notna().all()
         np.testing.assert_allclose(t2[f"{d}_minus_paper"], t2[d] - t2[f"paper_{d}"], rtol=0, atol=1e-5)
     v = pd.read_csv(wd / "results/simplicial/verdicts.csv")
-    assert list(v.columns) == VERDICT_COLUMNS and len(v) >= 8
+    assert list(v.columns) == list(COLUMNS) and len(v) >= 8
     assert set(v["verdict"]) <= {"reproduced", "partly", "not reproduced", "contradicted", "within noise"}
     assert not v["evidence"].str.contains("not available").any()
     row = json.loads(next((wd / "results/simplicial/folds").glob("*.json")).read_text())
-    assert set(row["rows"][0]) == set(ex.FOLD_COLUMNS) and set(row["members"][0]) == set(ex.MEMBER_COLUMNS)
+    assert set(row["rows"][0]) == set(fl.FOLD_COLUMNS) and set(row["members"][0]) == set(fl.MEMBER_COLUMNS)
     assert (wd / "results/simplicial/figures/fig7_walk.bvh").read_text().startswith("HIERARCHY")
 
 
@@ -88,7 +88,7 @@ def test_real_cmu_runs_fold(cmu_dir):
     ids = ["35_17", "35_22", "35_18", "35_19"]
     trials = {t: read_amc(cmu_dir / "35" / f"{t}.amc", sk).without_root() for t in ids}
     assert all(a.shape[1] == 56 for a in trials.values())
-    res = ex.run_fold([trials[t] for t in ids[1:]], trials[ids[0]], ex.Variant("delaunay"), dataset="r1",
+    res = fl.run_fold([trials[t] for t in ids[1:]], trials[ids[0]], fl.Variant("delaunay"), dataset="r1",
                       held_out=ids[0])
     r = res.row
     assert r["steps"] == trials[ids[0]].shape[0] and np.isfinite(r["error_a"]) and r["error_a"] > 0
