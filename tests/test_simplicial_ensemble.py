@@ -10,6 +10,7 @@ from animsynth.simplicial import folds as fl, stats as st, tables as tb
 from animsynth.simplicial.field import FieldStack, VectorField, training_vectors
 from animsynth.simplicial.geometry import SafeDelaunay
 from animsynth.simplicial.path import follow_batch, follow_field
+from animsynth.published import PublishedError
 from animsynth.simplicial.settings import paper_claim_from, read_paper_table2
 from animsynth.simplicial.verdicts import build_verdicts
 from animsynth.verdicts import COLUMNS, VOCABULARY, VerdictError
@@ -121,8 +122,10 @@ def test_jittered_starts_are_seeded_and_at_the_given_distance():
         fl.jittered_starts(s, 2, -1.0, 1.0, seed=0)
 
 
-def test_missing_paper_file_means_no_published_values(tmp_path):
-    assert read_paper_table2(tmp_path / "absent.csv") is None
+def test_missing_paper_file_means_no_published_values(tmp_path, caplog):
+    with caplog.at_level("WARNING", logger="animsynth.published"):
+        assert read_paper_table2(tmp_path / "absent.csv") is None
+    assert "absent.csv" in caplog.text and "published.simplicial.table2" in caplog.text
     assert read_paper_table2(None) is None
     assert paper_claim_from(None, "knn_better") == "knn_better"
     trials = _trials()
@@ -136,15 +139,24 @@ def test_missing_paper_file_means_no_published_values(tmp_path):
 
 def test_paper_file_is_read_and_knn16_maps_to_knn(tmp_path):
     p = tmp_path / "t2.csv"
-    p.write_text("metric,method,w1,all\nerror_a,delaunay,0.02,0.068\nerror_a,knn16,0.03,0.079\n"
-                 "error_f,delaunay,0.02,0.041\nerror_f,knn16,0.05,0.042\n")
+    p.write_text("metric,method,w1,w2,r1,r2,all\nerror_a,delaunay,0.02,,0.1,0.1,0.068\n"
+                 "error_a,knn16,0.03,0.1,0.1,0.1,0.079\nerror_f,delaunay,0.02,0.1,0.1,0.1,0.041\n"
+                 "error_f,knn16,0.05,0.1,0.1,0.1,0.042\n")
     paper = read_paper_table2(p)
     assert paper["method"].tolist() == ["delaunay", "knn", "delaunay", "knn"]
+    assert paper["paper_method"].tolist() == ["delaunay", "knn16", "delaunay", "knn16"]
+    assert paper.loc[0, "all"] == 0.068 and np.isnan(paper.loc[0, "w2"])  # an empty cell: no published value
     assert paper_claim_from(paper, "unknown") == "delaunay_better"
-    bad = tmp_path / "bad.csv"
-    bad.write_text("metric,method,w1\nerror_a,delaunay,zero\n")
-    with pytest.raises(ValueError, match=r"bad.csv: line 2"):
-        read_paper_table2(bad)
+    for name, text, where in [
+        ("number", "metric,method,w1,w2,r1,r2,all\nerror_a,delaunay,zero,1,1,1,1\n", r"number.csv, line 2: column 'w1'"),
+        ("metric", "metric,method,w1,w2,r1,r2,all\nerror_a,knn,1,1,1,1,1\nerror_z,knn,1,1,1,1,1\n",
+         r"metric.csv, line 3: metric must be one of"),
+        ("column", "metric,method,w1,all\nerror_a,delaunay,1,1\n", r"column.csv, line 1: .*lacks column"),
+    ]:
+        bad = tmp_path / f"{name}.csv"
+        bad.write_text(text)
+        with pytest.raises(PublishedError, match=where):
+            read_paper_table2(bad)
 
 
 def test_ensemble_tables_and_verdicts_on_toy_data(tmp_path):

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import json
+import re
+import shutil
+import subprocess
 
 import numpy as np
 import pandas as pd
@@ -10,6 +13,7 @@ import pytest
 
 from animsynth.simplicial import folds as fl
 from animsynth.verdicts import COLUMNS
+from conftest import SAFETY_TIMEOUT, SNAKEMAKE, copy_workflow, place_papers
 
 OUTPUTS = [
     "results/simplicial/folds.csv", "results/simplicial/table2.csv", "results/simplicial/table2.md",
@@ -77,6 +81,39 @@ def test_without_published_table_the_paper_columns_are_empty(tiny_workflow, tiny
     ds_paper = pd.read_csv(tiny_workflow / "results/data/datasets.csv")
     extra = [c for c in ds.columns if "paper" in c]
     assert extra and ds[extra].isna().all().all() and ds_paper[extra].notna().any().all()
+
+
+def _dry_run_inputs(project, workdir) -> dict:
+    """Rule name -> input line of each simplicial job that shows published values, from a dry run of
+    ``project``'s workflow in another working directory (``--directory``)."""
+    cfg = [str(project / "config" / "config.yaml"), str(project / "config" / "test.yaml")]
+    res = subprocess.run([SNAKEMAKE, "-n", "-s", str(project / "Snakefile"), "--directory", str(workdir),
+                          "results/data/datasets.csv", "results/simplicial/verdicts.csv", "--configfile", *cfg],
+                         cwd=workdir, capture_output=True, text=True, timeout=SAFETY_TIMEOUT)
+    assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
+    jobs = dict(re.findall(r"^rule (simplicial_table1|simplicial_table|simplicial_summary):\n\s+input: (.*)$",
+                           res.stdout, re.M))
+    assert sorted(jobs) == ["simplicial_summary", "simplicial_table", "simplicial_table1"], res.stdout[-3000:]
+    return jobs
+
+
+@pytest.mark.workflow
+def test_published_tables_are_found_from_another_working_directory(tmp_path):
+    """published.simplicial.table1/table2 are resolved against the workflow's own folder, not the working
+    directory: a run with --directory elsewhere still declares them as inputs of the jobs that fill the
+    paper_* columns; without the files the same jobs run with no such input (and empty columns)."""
+    project = copy_workflow(tmp_path / "project")
+    papers = place_papers(project)  # <project>/../shared/papers, as the default config names them
+    elsewhere = tmp_path / "other" / "run"
+    elsewhere.mkdir(parents=True)
+    assert not (elsewhere / "../shared/papers").exists()  # resolved against the working directory: nothing
+    jobs = _dry_run_inputs(project, elsewhere)
+    assert str(papers / "s1_table1.csv") in jobs["simplicial_table1"]
+    assert str(papers / "s1_table2.csv") in jobs["simplicial_table"]
+    assert str(papers / "s1_table2.csv") in jobs["simplicial_summary"]
+    shutil.rmtree(papers)
+    jobs = _dry_run_inputs(project, elsewhere)
+    assert not any("s1_table" in line for line in jobs.values()), jobs
 
 
 @pytest.mark.realdata

@@ -204,7 +204,7 @@ def data_benchmarks():
         raw = (job_benchmarks("download_trial", trial=amc) if amc else []) + (
             job_benchmarks("download_bvh_trial", trial=bvh) if bvh else []
         )
-    return raw + job_benchmarks("parse_trial", trial=USED_TRIALS) + job_benchmarks("datasets_table")
+    return raw + job_benchmarks("parse_trial", trial=USED_TRIALS)
 
 
 def mesh_data_benchmarks():
@@ -213,11 +213,23 @@ def mesh_data_benchmarks():
     return fetch + (job_benchmarks("mesh_checksums", mdseq=list(MESH_CHECK)) if MESH_CHECK else [])
 
 
+# ---- simplicial input functions ----
+def simplicial_subset_ids(wildcards):
+    """Trial ids of the subset of one fold or grid job, in config order (fold i holds trial i out)."""
+    return SUBSETS[wildcards.dataset]
+
+
+def simplicial_grid_cfg(wildcards):
+    """The config keys one grid job (derivative or beyond) depends on."""
+    return SIMP_GRID_CFG[wildcards.grid]
+
+
 # Benchmark files of this family's jobs (inputs of rule_benchmarks).
 def simplicial_benchmarks():
     grids = [(g, d) for g in ("derivative", "beyond") for d in SIMP_DATASETS]
     return (
-        job_benchmarks("simplicial_fold", dataset=SIMP_DATASETS)
+        job_benchmarks("simplicial_table1")
+        + job_benchmarks("simplicial_fold", dataset=SIMP_DATASETS)
         + job_benchmarks("simplicial_table")
         + job_benchmarks("simplicial_grid", grid=[g for g, _ in grids], dataset=[d for _, d in grids])
         + job_benchmarks("simplicial_summary")

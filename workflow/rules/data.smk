@@ -1,6 +1,7 @@
 # Data layer: get every trial (generate synthetic ASF/AMC, or download real
-# CMU / copy user files with checksums), parse it with the real readers into
-# results/data/trials/{trial}.npz, and write Gauch & Peters Table I.
+# CMU / copy user files with checksums) and parse it with the real readers into
+# results/data/trials/{trial}.npz (Gauch & Peters Table I of the subsets,
+# results/data/datasets.csv, is the simplicial family's: simplicial.smk).
 # Downloads are not retried by Snakemake: animsynth.data retries network
 # failures itself, and a checksum mismatch is deterministic.
 # threads/resources (mem_mb in MB, runtime in minutes) are sized from the
@@ -107,36 +108,7 @@ rule parse_trial:
         "../scripts/data_parse_trial.py"
 
 
-rule datasets_table:
-    input:
-        lambda wc: [trial_npz(t) for ids in SUBSETS.values() for t in ids],
-    output:
-        csv=report(
-            R("data/datasets.csv"),
-            caption="../report/data_datasets.rst",
-            category="1. Data",
-            labels={"table": "Gauch & Peters Table I"},
-        ),
-        md=R("data/datasets.md"),
-    params:
-        subsets=SUBSETS,
-        source=SOURCE,
-        paper_table1=config.get("simplicial", {}).get("paper_table1"),
-    threads: 1
-    resources:
-        mem_mb=500,
-        runtime=10,
-    log:
-        L("data/datasets_table.log"),
-    benchmark:
-        B("data/datasets_table.tsv")
-    conda:
-        "../envs/animsynth.yaml"
-    script:
-        "../scripts/data_datasets_table.py"
-
-
-DATA_TARGETS = [R("data/datasets.csv")] + [trial_npz(t) for t in USED_TRIALS]
+DATA_TARGETS = [trial_npz(t) for t in USED_TRIALS]
 
 
 # ---- mesh sequences of the hybrid mesh experiments -------------------------

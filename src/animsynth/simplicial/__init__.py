@@ -10,7 +10,8 @@ metrics     Error A / Error F and point-to-polyline distances
 folds       leave-one-sequence-out folds, ensembles of starts, variant grids (the fold and member rows)
 tables      Table II in the paper's layout, in every unit, over the ensemble of starts, per fold
 stats       stability over the ensemble, paired tests, bootstrap CIs, derivative and variant summaries
-settings    the published values (paper Table II) and the paper's conclusion
+table1      Gauch & Peters Table I of the run's data (results/data/datasets.csv)
+settings    config checks, the published values (paper Tables I and II) and the paper's conclusion
 verdicts    the claims checked, decided from the tables
 plots       the paper's figures and the beyond-the-paper figure
 jobs        one function per workflow job (the Snakemake scripts stay thin)
@@ -28,6 +29,7 @@ _EXPORTS = {
     "TargetPlanner": ".path",
     "Variant": ".folds",
     "VectorField": ".field",
+    "datasets_table": ".table1",
     "error_a": ".metrics",
     "error_f": ".metrics",
     "follow_batch": ".path",

@@ -19,8 +19,9 @@ from ..io.atomic import atomic_write_text
 from ..tables import write_table
 from .folds import (FOLD_COLUMNS, MEMBER_COLUMNS, Variant, beyond_variants, derivative_variants, order_folds,
                     run_fold, run_fold_ensemble, run_subset, to_jsonable)
-from .settings import paper_claim_from, read_paper_table2
+from .settings import check_figure_folds, paper_claim_from, read_paper_table1, read_paper_table2
 from .stats import derivative_summary, paired_comparison, summarise_variants
+from .table1 import datasets_table
 from .tables import fold_ensemble, table2, table2_ensemble, table2_units
 
 log = logging.getLogger("animsynth.simplicial.jobs")
@@ -41,6 +42,32 @@ def load_trials(paths, ids) -> tuple[dict, dict]:
             raise ValueError(f"trial file {p}: joint angles contain NaN/inf")
         angles[tid], motions[tid] = a, m
     return angles, motions
+
+
+def table1_job(trial_paths, subsets: dict, source: str, out: dict, paper_table1=None, paper_label=None) -> None:
+    """Gauch & Peters Table I of the run's subsets, the published lengths beside ours (``out["csv"]`` + ``.md``).
+
+    Parameters
+    ----------
+    trial_paths : parsed trials (``<trial id>.npz``) of every subset
+    subsets : subset name -> trial ids, in order
+    source : ``synthetic``, ``cmu`` or ``user``
+    paper_table1 : the published Table I file, or None (no published lengths: the ``paper_*`` columns stay
+        empty); ``paper_label`` names it in the note (the configured path).
+    """
+    motions = {os.path.splitext(os.path.basename(os.fspath(p)))[0]: Motion.load_npz(p) for p in trial_paths}
+    paper = read_paper_table1(paper_table1)
+    df = datasets_table(subsets, motions, source, paper if paper is not None else {})
+    if paper:
+        diff = [f"{r.dataset}: {r.length_match}" for r in df.itertuples()
+                if r.length_match and not r.length_match.startswith("all")]
+        note = (f"`paper_*`: Gauch & Peters Table I, read from {paper_label}. "
+                + ("Subsets whose lengths differ from the paper's (same position): " + "; ".join(diff) + "."
+                   if diff else "Every trial has the paper's length."))
+    else:
+        note = f"No published Table I at {paper_label!r}: paper columns left empty."
+    write_table(df, out["csv"], md=True, title=f"Table I: datasets ({source} data)", note=note)
+    log.info("wrote Table I with %d subsets", len(df))
 
 
 def main_variant(cfg: dict, method: str) -> Variant:
@@ -106,16 +133,21 @@ def _fallback_note(folds: pd.DataFrame, method: str = "delaunay") -> str:
     return f"Share of {method} steps outside the hull (k-NN fallback), held-out start, per fold: " + ", ".join(parts) + "."
 
 
-def table_job(fold_paths, datasets, methods, cfg: dict, out: dict) -> None:
-    """folds.csv, members.csv, table2 (paper layout), table2_units, table2_ensemble, fold_ensemble, paired."""
+def table_job(fold_paths, datasets, methods, cfg: dict, out: dict, paper_table2=None, paper_label=None) -> None:
+    """folds.csv, members.csv, table2 (paper layout), table2_units, table2_ensemble, fold_ensemble, paired.
+
+    ``paper_table2`` is the published Table II file (None: none; see
+    :func:`~animsynth.simplicial.settings.read_paper_table2`), ``paper_label`` how the notes name it
+    (the configured path).
+    """
     folds, members = read_fold_jsons(fold_paths)
     folds = order_folds(folds, datasets)
     members = order_folds(members, datasets)
     write_table(folds, out["folds"], md=False)
     write_table(members, out["members"], md=False)
-    paper = read_paper_table2(cfg.get("paper_table2"))
-    src = (f"`paper_*`: the paper's Table II, read from {cfg.get('paper_table2')} (its `knn16` row is our `knn`)"
-           if paper is not None else f"`paper_*` empty: no published values file at {cfg.get('paper_table2')!r}")
+    paper = read_paper_table2(paper_table2)
+    src = (f"`paper_*`: the paper's Table II, read from {paper_label} (its `knn16` row is our `knn`)"
+           if paper is not None else f"`paper_*` empty: no published values file at {paper_label!r}")
     ens = cfg["ensemble"]
     fb = _fallback_note(folds, methods[0])
     t2 = table2(folds, datasets, methods, paper)
@@ -172,8 +204,12 @@ def grid_job(paths, ids, dataset: str, grid: str, cfg: dict, seed: int, out: dic
     write_table(members, out["members"], md=False)
 
 
-def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out: dict) -> None:
-    """derivative.csv, beyond.csv, beyond_folds.csv, verdicts.csv and their figures."""
+def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out: dict, paper_table2=None) -> None:
+    """derivative.csv, beyond.csv, beyond_folds.csv, verdicts.csv and their figures.
+
+    ``paper_table2``: the published Table II file (None: none); its overall medians give the paper's
+    ordering, else config ``simplicial.paper_claim``.
+    """
     from .plots import plot_beyond, plot_derivative
     from .verdicts import build_verdicts
 
@@ -189,7 +225,7 @@ def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out:
     bmem = order_folds(cat(beyond_paths["members"]), datasets)
     seed, n_boot, alpha = int(cfg["seed_value"]), int(cfg["bootstrap"]), float(cfg["alpha"])
     methods = tuple(cfg["methods"])
-    paper = read_paper_table2(cfg.get("paper_table2"))
+    paper = read_paper_table2(paper_table2)
     claim = paper_claim_from(paper, cfg["paper_claim"], methods)
     ens = cfg["ensemble"]
     dsum = derivative_summary(dfold, methods, claim, n_boot=n_boot, seed=seed, members=dmem)
@@ -220,7 +256,7 @@ def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out:
     t2 = read(main["table2"])
     t2e = read(main["table2_ensemble"])
     n_folds = int(folds.groupby("method").size().max()) if len(folds) else 0
-    data = f"{cfg.get('data_label', '')} {' '.join(datasets)} ({n_folds} folds x {int(ens['n_starts']) + 1} starts)".strip()
+    data = f"{cfg['data_label']} {' '.join(datasets)} ({n_folds} folds x {int(ens['n_starts']) + 1} starts)".strip()
     verdicts = build_verdicts(table2=t2, table2_ens=t2e, members=members, paired=paired, deriv=dsum, folds=folds,
                               beyond=bsum, beyond_folds=bfold, beyond_members=bmem, claim=claim,
                               main_derivative=cfg["derivative"], baseline=baseline, datasets=datasets, data=data,
@@ -236,10 +272,8 @@ def figures_job(paths, ids, dataset: str, cfg: dict, out: dict) -> None:
 
     angles, _ = load_trials(paths, ids)
     fig = cfg["figures"]
+    check_figure_folds(fig, len(ids), dataset)
     graph_folds = [int(i) for i in fig["folds"]]
-    for i in graph_folds + [int(fig["field_fold"])]:
-        if not 0 <= i < len(ids):
-            raise ValueError(f"config key 'simplicial.figures': fold index {i} outside 0..{len(ids) - 1}")
     results = {}
     for m in ("knn", "delaunay"):
         v = main_variant(cfg, m)
@@ -264,9 +298,8 @@ def walk_job(paths, ids, dataset: str, cfg: dict, out: dict) -> None:
 
     angles, motions = load_trials(paths, ids)
     fig = cfg["figures"]
+    check_figure_folds(fig, len(ids), dataset)
     i = int(fig["walk_fold"])
-    if not 0 <= i < len(ids):
-        raise ValueError(f"config key 'simplicial.figures.walk_fold': {i} outside 0..{len(ids) - 1}")
     tid = ids[i]
     res = run_fold([angles[t] for t in ids if t != tid], angles[tid], main_variant(cfg, fig["walk_method"]),
                    dataset=dataset, held_out=tid, fold=i, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]),
