@@ -20,7 +20,7 @@ import urllib.request
 from .config import ConfigError, resolve_inside
 from .io.amc import read_amc
 from .io.asf import read_asf
-from .io.atomic import atomic_path
+from .atomic import atomic_path
 from .motion import Motion
 
 log = logging.getLogger("animsynth.data")

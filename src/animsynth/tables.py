@@ -7,7 +7,7 @@ import os
 import numpy as np
 import pandas as pd
 
-from .io.atomic import atomic_path, atomic_write_text
+from .atomic import atomic_path, atomic_write_text
 
 
 def _fmt(v) -> str:

@@ -7,7 +7,7 @@ import pandas as pd
 from animsynth.facegraph.jobs import assemble_table1, assemble_timing, data_note
 from animsynth.facegraph.preprocess import FaceDatabase
 from animsynth.facegraph.settings import published_table1
-from animsynth.io.atomic import atomic_write_text
+from animsynth.atomic import atomic_write_text
 from animsynth.tables import to_markdown, write_table
 from animsynth.workflow_utils import setup_logging
 

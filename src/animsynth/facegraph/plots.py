@@ -7,7 +7,7 @@ import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.collections import LineCollection
 
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 from ..io.ckplus import EMOTIONS
 
 #: Polylines of the 68-point face (closed ones repeat their first point).

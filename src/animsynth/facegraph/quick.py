@@ -53,7 +53,7 @@ def synthesise_from_labels(labels, out: str, ckplus_dir: str | None = None, seed
     if out.endswith(".csv"):
         import pandas as pd
 
-        from ..io.atomic import atomic_path
+        from ..atomic import atomic_path
 
         f, k = np.meshgrid(np.arange(pos.shape[0]), np.arange(pos.shape[1]), indexing="ij")
         df = pd.DataFrame({"frame": f.ravel(), "landmark": k.ravel(), "x": pos[..., 0].ravel(), "y": pos[..., 1].ravel()})

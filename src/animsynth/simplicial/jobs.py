@@ -15,7 +15,7 @@ import pandas as pd
 
 from ..config import derive_seed
 from ..motion import Motion
-from ..io.atomic import atomic_write_text
+from ..atomic import atomic_write_text
 from ..tables import write_table
 from .folds import (FOLD_COLUMNS, MEMBER_COLUMNS, Variant, beyond_variants, derivative_variants, order_folds,
                     run_fold, run_fold_ensemble, run_subset, to_jsonable)

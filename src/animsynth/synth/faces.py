@@ -52,7 +52,7 @@ import os
 import numpy as np
 import pandas as pd
 
-from ..io.atomic import atomic_write_text
+from ..atomic import atomic_write_text
 from ..io.ckplus import EMOTIONS, CKSequence, write_sequence
 
 # Unit mean face (x right, y down), iBUG 68-point order, hand-made after the
