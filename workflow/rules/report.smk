@@ -82,11 +82,12 @@ rule benchmarks:
         scripts=expand("benchmarks/bench_{name}.py", name=BENCH_SCRIPTS),
         extra=BENCH_EXTRA,
     output:
-        report(
+        csv=report(
             R("benchmarks.csv"),
             caption="../report/benchmarks.rst",
             category="0. Summary",
         ),
+        md=R("benchmarks.md"),
     params:
         size=config["benchmark_size"],
     # full size: ~160 s CPU, 254 MB peak; demo size: seconds
@@ -120,6 +121,8 @@ rule rule_benchmarks:
             caption="../report/rule_benchmarks_per_family.rst",
             category="0. Summary",
         ),
+        per_rule_md=R("rule_benchmarks_per_rule.md"),
+        per_family_md=R("rule_benchmarks_per_family.md"),
     params:
         root=BENCH_ROOT,
     threads: 1
