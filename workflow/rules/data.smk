@@ -92,8 +92,8 @@ rule parse_trial:
         R("data/trials/{trial}.npz"),
     params:
         fps=config["fps"],
-        joint_roles=config.get("joint_roles") or {},
-        bvh_length_to_m=config.get("bvh_length_to_m", 1.0),
+        joint_roles=config["joint_roles"],
+        bvh_length_to_m=config["bvh_length_to_m"],
     threads: 1
     resources:
         mem_mb=500,
@@ -142,7 +142,7 @@ if MESH_FETCH:
             directory("resources/mesh/{meshsrc}"),
         params:
             source=mesh_fetch_source,
-            max_unpacked_mb=config.get("meshdetail", {}).get("max_unpacked_mb", 8000),
+            max_unpacked_mb=config["meshdetail"]["max_unpacked_mb"],
         log:
             L("data/mesh_fetch/{meshsrc}.log"),
         benchmark:

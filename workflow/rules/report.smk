@@ -33,7 +33,7 @@ SUMMARY_TIMING = [s["csv"] for s in SUMMARY_SECTIONS if re.search(r"(^|_)timing\
 VERDICT_FILES = [v for fam, vs in FAMILY_VERDICTS.items() if FAMILY_RAN[fam] for v in vs]
 BENCH_SCRIPTS = sorted(glob_wildcards("benchmarks/bench_{name}.py").name)
 # With the scale study on, its 100,000-frame re-sequencing rows join benchmarks.csv.
-BENCH_EXTRA = [R("scale/benchmarks.csv")] if config.get("scale", {}).get("enabled", False) else []
+BENCH_EXTRA = [R("scale/benchmarks.csv")] if config["scale"]["enabled"] else []
 
 
 rule summary:
@@ -57,7 +57,7 @@ rule summary:
         timing=SUMMARY_TIMING,
         source=SOURCE,
         mesh_dir=config["mesh_dir"],
-        faces=config["facegraph"].get("ckplus_dir"),
+        faces=config["facegraph"]["ckplus_dir"],
         provenance=provenance_rows(),
         family_data={fam: label for fam, (label, _ok, _why) in FAMILY_STATUS.items()},
         family_real=FAMILY_REAL,
