@@ -344,7 +344,12 @@ class FairmotionGraph:
         n_out = out.num_frames()
         if n_out < length:
             raise ValueError(f"fairmotion's walk stopped after {n_out} of {length} frames (a dead end)")
-        n_blend = int(np.floor(self._seconds(self.blend, self.fps_) * self.fps_ + 1e-9))
+        n_blend, t = 0, 0.0  # the frames append_and_blend blends: its running time, summed as it sums it
+        while True:
+            t += 1 / self.fps_
+            if t > graph.blend_length:
+                break
+            n_blend += 1
         src = np.full((n_out, 2), -1, int)
         seams = []
         for (first, n2, blended), n in zip(pieces, visited):  # one appended piece per visited node, in order
