@@ -41,7 +41,12 @@ Known defects of 0.0.4 that are left as released (the peer row measures what a u
 ``create_random_motion`` builds the output at fairmotion's default 60 fps whatever the data's rate, so the
 cut before each appended piece is placed at the wrong frame, and ``append_and_blend`` computes the blend's
 source time as ``fps * frame`` instead of ``frame / fps``, so it blends from the last pose of the previous
-piece, held still. Both were changed upstream after the release.
+piece, held still. Together these keep about a third of every appended piece (5 of 15 frames at 30 fps)
+and blend nearly every output frame. Its ``ops.motion.cut`` also shares the Pose objects with the loaded
+clips and ``append_and_blend`` moves them in place, so a walk displaces poses that later pieces of the same
+walk reuse (a node visited twice, the blend frames shared by consecutive nodes). All of this was changed
+upstream after the release. Only between walks do we step in: every :meth:`FairmotionGraph.generate` walks
+a fresh copy of the loaded clips, so walks are reproducible and do not depend on each other.
 
 Random choices: fairmotion's walk draws from Python's global ``random`` module; :meth:`FairmotionGraph.generate`
 seeds it with ``seed`` and restores its previous state afterwards.
