@@ -1,0 +1,615 @@
+"""The classic motion graph of Kovar, Gleicher & Pighin ("Motion Graphs", SIGGRAPH 2002), written from the paper.
+
+Why it is written here
+----------------------
+No maintained library implements Kovar et al.'s graph. The one public motion-graph module, fairmotion's
+``tasks/motion_graph`` (the peer row, :mod:`animsynth.compare.fairmotion_peer`), builds a different graph:
+fixed-length segments as nodes, a joint-angle and end-effector similarity at the segment boundaries, every
+pair below a threshold an edge, no point-cloud alignment and no local-minimum selection. What comes from
+libraries here: forward kinematics (:mod:`animsynth.kinematics`), the all-pairs window terms as three matrix
+products (numpy / BLAS), local minima (``scipy.ndimage.minimum_filter``), strongly connected components and
+Dijkstra (``scipy.sparse.csgraph``), rotations and their interpolation (``scipy.spatial.transform.Rotation``).
+Written here, each in a few lines: the paper's closed-form alignment, the graph bookkeeping, the walk and the
+transition blend.
+
+The method (the paper's steps)
+------------------------------
+Candidate transitions. Frame ``i`` of clip A and frame ``j`` of clip B are compared through point clouds
+    over windows of ``k`` frames: ``A_i .. A_{i+k-1}`` (the window that *starts* at A_i) and
+    ``B_{j-k+1} .. B_j`` (the window that *ends* at B_j). The points are the joint positions of every frame
+    of the window (forward kinematics, metres). ``D(A_i, B_j) = min_{theta, x0, z0} sum_n w_n
+    |p_n - T(theta, x0, z0) p'_n|^2``, ``T`` a rotation by ``theta`` about the vertical (y) axis followed by
+    the floor translation ``(x0, 0, z0)``, solved in closed form (:func:`floor_alignment`). With
+    ``sum w_n = 1`` D is a weighted mean squared distance (m^2); we report and threshold ``sqrt(D)``, the
+    RMS point distance in metres (monotone in D: the same minima).
+Transition points: the local minima of D over ``(i, j)`` below a threshold.
+Creating transitions. A transition from A_i to B_j blends the ``k`` frame pairs of the two windows after
+    B has been moved by the aligning transform: for ``p = 0 .. k-1`` the root position is interpolated
+    linearly and every joint rotation spherically, with A's weight
+    ``alpha(p) = 2((p+1)/k)^3 - 3((p+1)/k)^2 + 1`` (``alpha(k-1) = 0``: the last blended frame is B_j).
+    Playback then continues at ``B_{j+1}``.
+Pruning: only the largest strongly connected component is kept (no dead ends; every node reaches every
+    other).
+Extracting motion: random walks (:meth:`MotionGraph.generate`) and a shortest path to the node nearest a
+    target pose (:meth:`MotionGraph.search`; the paper's branch-and-bound over a user error function is
+    replaced by Dijkstra on the playback time, the plainest well-defined graph search).
+
+Choices the paper leaves open (ours)
+------------------------------------
+* The graph is kept at frame level: a node is "about to play database frame g"; its out-edges are the
+  next frame of the same clip (one frame long) and the transitions that leave there (``blend`` frames
+  long). Kovar's compressed graph (nodes only at transition points, edges = pieces of clips) is this graph
+  with its chains of single-exit nodes merged; a walk that picks uniformly among the out-edges at every
+  node is the walk on the compressed graph.
+* Weights: uniform over joints and over the frames of the window unless ``joint_weights`` is given (the
+  paper allows joint weights and a taper towards the end of the window and names no values).
+* Local minima: of D over a ``(2r+1) x (2r+1)`` neighbourhood (``minima_radius`` r) within each pair of
+  clips. Within one clip, overlapping windows (``|i - (j-k+1)| < k``) are no candidates: the diagonal
+  ``D = 0`` there is the clip playing on.
+* Threshold (``threshold``, metres RMS): ``None`` resolves it from the data as the ``threshold_quantile``
+  quantile of the candidate local minima (default the median: half the candidates become transitions).
+  This default was chosen so that it means the same for any skeleton, unit and database; it is not tuned
+  to any published number (the paper leaves the threshold to the user and names none).
+* ``blend`` b <= k blends only the last b frame pairs of the two windows (b = k is the paper's transition).
+* Start of generation: the walk starts at the database frame that follows the frame whose preceding window
+  is nearest (the same aligned distance) to the last frames of ``start``, and the whole output is moved by
+  that alignment, so it continues the start context in place and heading.
+* Not implemented: the paper's constraint handling during transitions (foot-plant annotations and the
+  footskate clean-up of Kovar, Schreiner & Gleicher 2002). Transitions here blend only; foot sliding they
+  cause is measured by the compare metrics, not repaired.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from scipy.ndimage import minimum_filter
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components, dijkstra
+from scipy.spatial.transform import Rotation
+
+from ..kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation
+from ..motion import Motion
+
+__all__ = ["MotionGraph", "apply_floor_transform", "floor_alignment", "kovar_alpha", "compose_floor_transforms"]
+
+
+# --------------------------------------------------------------------------------------------------
+# the closed-form alignment
+# --------------------------------------------------------------------------------------------------
+def _normalised_weights(weights, n: int) -> np.ndarray:
+    w = np.ones(n) if weights is None else np.asarray(weights, float).reshape(-1)
+    if w.shape != (n,):
+        raise ValueError(f"weights must have one value per point ({n}), got {w.shape[0]}")
+    if not np.all(np.isfinite(w)) or np.any(w < 0) or w.sum() <= 0:
+        raise ValueError("weights must be finite, >= 0 and not all 0")
+    return w / w.sum()
+
+
+def apply_floor_transform(points, theta, x0, z0) -> np.ndarray:
+    """Rotate ``points`` by ``theta`` about the vertical y axis, then translate by ``(x0, 0, z0)``.
+
+    Parameters
+    ----------
+    points : array (..., n, 3)
+    theta, x0, z0 : float or array (...)
+        Radians and the points' length unit. ``theta`` turns +z towards +x (the right-handed rotation
+        about +y, ``Rotation.from_euler("y", theta)``).
+
+    Returns
+    -------
+    array (..., n, 3)
+    """
+    p = np.asarray(points, float)
+    th = np.asarray(theta, float)[..., None]
+    c, s = np.cos(th), np.sin(th)
+    out = p.copy()
+    out[..., 0] = c * p[..., 0] + s * p[..., 2] + np.asarray(x0, float)[..., None]
+    out[..., 2] = -s * p[..., 0] + c * p[..., 2] + np.asarray(z0, float)[..., None]
+    return out
+
+
+def floor_alignment(p, q, weights=None):
+    """The rotation about y and floor translation that best map point cloud ``q`` onto ``p`` (closed form).
+
+    Minimises ``sum_n w_n |p_n - T q_n|^2`` over ``T`` = rotation by ``theta`` about the vertical y axis
+    followed by ``(x0, 0, z0)`` (the closed form of Kovar, Gleicher & Pighin 2002). With ``xb = sum w x`` etc.
+    (weights normalised to sum 1)::
+
+        theta = atan2(sum w (x z' - x' z) - (xb zb' - xb' zb), sum w (x x' + z z') - (xb xb' + zb zb'))
+        x0 = xb - xb' cos(theta) - zb' sin(theta)
+        z0 = zb + xb' sin(theta) - zb' cos(theta)
+
+    (``atan2`` rather than the paper's ``arctan`` of the quotient, which is ambiguous by pi: atan2 picks the
+    minimum, not the maximum.)
+
+    Parameters
+    ----------
+    p, q : array (..., n, 3)
+        Corresponding points; y is up.
+    weights : array (n,), optional
+        Non-negative point weights (uniform if omitted), normalised to sum 1.
+
+    Returns
+    -------
+    theta, x0, z0, d2 : arrays (...)
+        The transform and the weighted mean squared distance ``sum w |p - T q|^2`` after it.
+    """
+    p = np.asarray(p, float)
+    q = np.asarray(q, float)
+    if p.shape != q.shape or p.ndim < 2 or p.shape[-1] != 3:
+        raise ValueError(f"p and q must both have shape (..., n, 3), got {p.shape} and {q.shape}")
+    w = _normalised_weights(weights, p.shape[-2])
+    x, z, xq, zq = p[..., 0], p[..., 2], q[..., 0], q[..., 2]
+    xb, zb, xqb, zqb = x @ w, z @ w, xq @ w, zq @ w
+    a = (x * xq + z * zq) @ w - (xb * xqb + zb * zqb)
+    b = (x * zq - xq * z) @ w - (xb * zqb - xqb * zb)
+    theta = np.arctan2(b, a)
+    c, s = np.cos(theta), np.sin(theta)
+    x0 = xb - xqb * c - zqb * s
+    z0 = zb + xqb * s - zqb * c
+    d2 = (((p - apply_floor_transform(q, theta, x0, z0)) ** 2).sum(-1)) @ w
+    return theta, x0, z0, d2
+
+
+def compose_floor_transforms(outer, inner):
+    """``outer o inner`` of two floor transforms ``(theta, x0, z0)`` (apply ``inner`` first)."""
+    th_o, xo, zo = outer
+    th_i, xi, zi = inner
+    c, s = np.cos(th_o), np.sin(th_o)
+    return th_o + th_i, c * xi + s * zi + xo, -s * xi + c * zi + zo
+
+
+def kovar_alpha(n: int) -> np.ndarray:
+    """Blend weights of the source clip over an ``n``-frame transition: ``2((p+1)/n)^3 - 3((p+1)/n)^2 + 1``.
+
+    Returns array (n,), decreasing from about 1 to exactly 0 (the last frame is the target clip's).
+    """
+    u = (np.arange(n) + 1.0) / n
+    return 2.0 * u**3 - 3.0 * u**2 + 1.0
+
+
+def _window_clouds(pos: np.ndarray, k: int) -> np.ndarray:
+    """(T, J, 3) -> (T-k+1, k*J, 3): the point cloud of every window of ``k`` frames, frame-major."""
+    v = np.lib.stride_tricks.sliding_window_view(pos, k, axis=0)  # (T-k+1, J, 3, k)
+    return np.ascontiguousarray(np.moveaxis(v, -1, 1)).reshape(v.shape[0], k * pos.shape[1], 3)
+
+
+def _pair_terms(P: np.ndarray, Q: np.ndarray, w: np.ndarray):
+    """Closed-form terms for every pair (row of P, row of Q) of point clouds, as matrix products.
+
+    P (m, n, 3), Q (l, n, 3), w (n,) summing to 1. Returns ``d2`` (m, l) = the aligned weighted mean squared
+    distance, ``a``, ``b`` (m, l) with ``theta = atan2(b, a)`` (Q onto P), and the xz centroids of P and Q.
+    Centring x and z per cloud first (the optimal translation removes them anyway) keeps the differences of
+    large numbers out of the products.
+    """
+    xp, yp, zp = P[..., 0], P[..., 1], P[..., 2]
+    xq, yq, zq = Q[..., 0], Q[..., 1], Q[..., 2]
+    xpb, zpb, xqb, zqb = xp @ w, zp @ w, xq @ w, zq @ w
+    xp, zp = xp - xpb[:, None], zp - zpb[:, None]
+    xq, zq = xq - xqb[:, None], zq - zqb[:, None]
+    left = np.hstack([xp * w, zp * w])
+    a = left @ np.hstack([xq, zq]).T  # sum w (x x' + z z')
+    b = left @ np.hstack([zq, -xq]).T  # sum w (x z' - z x')
+    cyy = (yp * w) @ yq.T
+    sp = (yp**2 + xp**2 + zp**2) @ w
+    sq = (yq**2 + xq**2 + zq**2) @ w
+    d2 = sp[:, None] + sq[None, :] - 2.0 * cyy - 2.0 * np.hypot(a, b)
+    return np.maximum(d2, 0.0), a, b, (xpb, zpb), (xqb, zqb)
+
+
+def _transform_from_terms(a, b, cp, cq):
+    """``(theta, x0, z0)`` mapping Q onto P from the terms of :func:`_pair_terms` (arrays of equal shape)."""
+    theta = np.arctan2(b, a)
+    c, s = np.cos(theta), np.sin(theta)
+    (xpb, zpb), (xqb, zqb) = cp, cq
+    return theta, xpb - xqb * c - zqb * s, zpb + xqb * s - zqb * c
+
+
+def _positions_m(motion: Motion) -> np.ndarray:
+    """World joint positions (segment ends) in metres, (T, J, 3)."""
+    return forward_kinematics(motion.skeleton, motion.values, ends=True) * motion.skeleton.length_to_m
+
+
+# --------------------------------------------------------------------------------------------------
+# the graph
+# --------------------------------------------------------------------------------------------------
+class MotionGraph:
+    """Kovar et al.'s motion graph on a database of clips (see the module docstring for the method).
+
+    Parameters
+    ----------
+    window : int
+        ``k``: frames (at the database's frame rate) of the point-cloud windows and of a transition
+        (10: 1/3 s at 30 fps).
+    threshold : float or None
+        Largest RMS aligned point distance (metres) of a transition; ``None``: resolved from the data as
+        the ``threshold_quantile`` quantile of the candidate local minima.
+    threshold_quantile : float
+        In (0, 1]; used when ``threshold`` is None.
+    blend : int or None
+        Frames blended per transition, ``1 <= blend <= window``; ``None``: ``window`` (the paper's).
+    minima_radius : int
+        Local minima over a ``(2r+1)^2`` neighbourhood of the distance matrix.
+    joint_weights : array (joints,), optional
+        Point weight of every joint (uniform if omitted), the same in every frame of the window.
+
+    Attributes
+    ----------
+    transitions_ : pandas.DataFrame
+        The transitions of the pruned graph, one row each: ``from_clip, from_frame`` (A, i: where the
+        blended window starts in A), ``to_clip, to_frame`` (B, j: where it ends in B; playback goes on at
+        j + 1), ``distance`` (m, RMS), ``theta`` (rad), ``x0``, ``z0`` (m): the floor transform moving B
+        onto A.
+    threshold_ : float
+        The threshold used (metres).
+    n_candidates_ : int
+        Candidate transitions (local minima, before the threshold).
+    n_below_threshold_ : int
+        Candidates at or below the threshold (before pruning).
+    n_nodes_ : int
+        Frames (nodes of the frame-level graph) in the largest strongly connected component.
+    largest_scc_share_ : float
+        ``n_nodes_`` / frames of the database.
+    in_graph_ : list of bool arrays (frames of each clip,)
+        Which frames of each clip are nodes of the pruned graph.
+    skeleton_, fps_ : the output skeleton (the first clip's) and frame rate.
+    window_, blend_ : int
+    clip_names_ : list of str
+    """
+
+    def __init__(self, window: int = 10, threshold: float | None = None, threshold_quantile: float = 0.5,
+                 blend: int | None = None, minima_radius: int = 1, joint_weights=None):
+        self.window = window
+        self.threshold = threshold
+        self.threshold_quantile = threshold_quantile
+        self.blend = blend
+        self.minima_radius = minima_radius
+        self.joint_weights = joint_weights
+
+    # ---------------------------------------------------------------- build
+    def _check_params(self):
+        k = self.window
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"window must be an integer >= 1 (frames), got {k!r}")
+        b = k if self.blend is None else self.blend
+        if isinstance(b, bool) or not isinstance(b, (int, np.integer)) or not 1 <= b <= k:
+            raise ValueError(f"blend must be an integer in [1, window={k}] (frames) or None, got {self.blend!r}")
+        r = self.minima_radius
+        if isinstance(r, bool) or not isinstance(r, (int, np.integer)) or r < 1:
+            raise ValueError(f"minima_radius must be an integer >= 1, got {r!r}")
+        if self.threshold is not None and not (np.isfinite(self.threshold) and self.threshold >= 0):
+            raise ValueError(f"threshold must be a finite distance >= 0 (metres) or None, got {self.threshold!r}")
+        if not 0.0 < float(self.threshold_quantile) <= 1.0:
+            raise ValueError(f"threshold_quantile must be in (0, 1], got {self.threshold_quantile!r}")
+        return int(k), int(b), int(r)
+
+    def fit(self, database) -> "MotionGraph":
+        """Build the graph on ``database`` (list of Motion: one DOF layout, one frame rate).
+
+        Every clip needs at least ``window + 2`` frames. Clips on skeletons with other bone lengths are
+        compared through their own forward kinematics; the output is on the first clip's skeleton: frames of
+        another subject's clip are played with that subject's joint rotations and root translation on the
+        first subject's bones (feet may then float or sink by the difference in leg length).
+        """
+        k, b, r = self._check_params()
+        clips = list(database)
+        if not clips:
+            raise ValueError("motion graph: the database is empty")
+        first = clips[0]
+        for c in clips:
+            if c.skeleton.columns() != first.skeleton.columns():
+                raise ValueError(f"motion graph: clip {c.name!r} has other DOF columns than {first.name!r}")
+            if not np.isclose(c.fps, first.fps):
+                raise ValueError(f"motion graph: clip {c.name!r} is at {c.fps:g} fps, {first.name!r} at "
+                                 f"{first.fps:g} fps (resample the database to one rate first)")
+            if c.n_frames < k + 2:
+                raise ValueError(f"motion graph: clip {c.name!r} has {c.n_frames} frames, fewer than "
+                                 f"window + 2 = {k + 2}")
+        pos = [_positions_m(c) for c in clips]
+        n_joints = pos[0].shape[1]
+        if any(p.shape[1] != n_joints for p in pos):
+            raise ValueError("motion graph: the clips' skeletons have different joint counts")
+        jw = _normalised_weights(self.joint_weights, n_joints)
+        w = np.tile(jw, k) / k
+
+        lengths = np.array([c.n_frames for c in clips])
+        offsets = np.concatenate([[0], np.cumsum(lengths)])
+        n_win = lengths - k + 1
+        win_off = np.concatenate([[0], np.cumsum(n_win)])
+        clouds = np.concatenate([_window_clouds(p, k) for p in pos])
+        d2, a, bb, cen, _ = _pair_terms(clouds, clouds, w)
+        dist = np.sqrt(d2)
+
+        # local minima inside each pair of clips, then the validity rules
+        rows, cols = [], []
+        for ca in range(len(clips)):
+            ra = slice(win_off[ca], win_off[ca + 1])
+            for cb in range(len(clips)):
+                rb = slice(win_off[cb], win_off[cb + 1])
+                block = dist[ra, rb]
+                is_min = block <= minimum_filter(block, size=2 * r + 1, mode="nearest")
+                i, s = np.nonzero(is_min)
+                ok = s <= lengths[cb] - k - 1  # the frame after the window's end, B_{j+1}, exists
+                if ca == cb:
+                    ok &= np.abs(i - s) >= k  # overlapping windows of one clip: the clip playing on
+                rows.append(i[ok] + win_off[ca])
+                cols.append(s[ok] + win_off[cb])
+        rows = np.concatenate(rows)
+        cols = np.concatenate(cols)
+        cand = dist[rows, cols]
+        self.n_candidates_ = int(cand.size)
+        if cand.size == 0:
+            raise ValueError("motion graph: no candidate transitions (local minima) in the database")
+        self.threshold_ = (float(self.threshold) if self.threshold is not None
+                           else float(np.quantile(cand, float(self.threshold_quantile))))
+        keep = cand <= self.threshold_
+        self.n_below_threshold_ = int(keep.sum())
+        rows, cols, cand = rows[keep], cols[keep], cand[keep]
+        theta, x0, z0 = _transform_from_terms(a[rows, cols], bb[rows, cols],
+                                              (cen[0][rows], cen[1][rows]), (cen[0][cols], cen[1][cols]))
+        del d2, a, bb, dist
+
+        win_clip = np.repeat(np.arange(len(clips)), n_win)
+        win_start = np.arange(win_off[-1]) - win_off[win_clip]
+        ca, i = win_clip[rows], win_start[rows]
+        cb, s = win_clip[cols], win_start[cols]
+        leave = offsets[ca] + i + (k - b)  # first blended frame of A
+        land = offsets[cb] + s + k  # B_{j+1}, j = s + k - 1
+
+        # frame-level graph: next frame of the same clip, and the transitions
+        n = int(offsets[-1])
+        clip_of = np.repeat(np.arange(len(clips)), lengths)
+        has_next = np.ones(n, bool)
+        has_next[offsets[1:] - 1] = False
+        nat_from = np.nonzero(has_next)[0]
+        src = np.concatenate([nat_from, leave])
+        dst = np.concatenate([nat_from + 1, land])
+        wts = np.concatenate([np.ones(nat_from.size), np.full(leave.size, float(b))])
+        g = csr_matrix((wts, (src, dst)), shape=(n, n))
+        _, labels = connected_components(g, directed=True, connection="strong")
+        counts = np.bincount(labels)
+        in_scc = labels == int(np.argmax(counts))
+        self.n_nodes_ = int(in_scc.sum())
+        if self.n_nodes_ < 2:
+            raise ValueError(f"motion graph: no cycle through the transitions at threshold {self.threshold_:.4g} m "
+                             f"({self.n_below_threshold_} transitions): raise the threshold or add clips")
+        self.largest_scc_share_ = self.n_nodes_ / n
+
+        tr = in_scc[leave] & in_scc[land]
+        order = np.lexsort((land[tr], leave[tr]))
+        sel = np.nonzero(tr)[0][order]
+        self._leave_ = leave[sel]
+        self._land_ = land[sel]
+        self._theta_, self._x0_, self._z0_ = theta[sel], x0[sel], z0[sel]
+        self._tr_dist_ = cand[sel]
+        self._tr_ptr_ = np.searchsorted(self._leave_, np.arange(n + 1))
+        self._has_next_ = has_next
+        self._nat_ok_ = has_next & in_scc & np.concatenate([in_scc[1:], [False]])
+        self._in_scc_ = in_scc
+        self.in_graph_ = [in_scc[offsets[c]:offsets[c + 1]].copy() for c in range(len(clips))]
+        self._clip_of_ = clip_of
+        self._frame_of_ = np.arange(n) - offsets[clip_of]
+        self._offsets_ = offsets
+        self.transitions_ = pd.DataFrame({
+            "from_clip": ca[sel], "from_frame": i[sel], "to_clip": cb[sel], "to_frame": s[sel] + k - 1,
+            "distance": self._tr_dist_, "theta": self._theta_, "x0": self._x0_, "z0": self._z0_})
+
+        keep_edges = np.concatenate([self._nat_ok_[nat_from], tr])
+        self._graph_ = csr_matrix((wts[keep_edges], (src[keep_edges], dst[keep_edges])), shape=(n, n))
+
+        # per-frame data for the output: local rotations, root translation (m), positions (m)
+        self._quat_ = np.concatenate([np.stack([r.as_quat() for r in local_rotations(c.skeleton, c.values)], 1)
+                                      for c in clips])
+        self._root_ = np.concatenate([root_translation(c.skeleton, c.values) * c.skeleton.length_to_m
+                                      for c in clips])
+        self._pos_ = np.concatenate(pos)
+        self._jw_ = jw
+        self.skeleton_ = first.skeleton
+        self.fps_ = float(first.fps)
+        self.window_, self.blend_ = k, b
+        self.clip_names_ = [c.name for c in clips]
+        return self
+
+    # ---------------------------------------------------------------- queries
+    def _check_fitted(self):
+        if not hasattr(self, "_graph_"):
+            raise RuntimeError("MotionGraph is not fitted: call fit(database) first")
+
+    def _check_length(self, length) -> int:
+        if isinstance(length, bool) or not isinstance(length, (int, np.integer)) or length < 1:
+            raise ValueError(f"length must be an integer >= 1 (frames), got {length!r}")
+        return int(length)
+
+    def _start_node(self, start: Motion):
+        """Graph node after the database frame nearest the end of ``start``, and the transform placing it."""
+        if not isinstance(start, Motion) or start.n_frames < 1:
+            raise ValueError("start must be a Motion with at least one frame")
+        if not np.isclose(start.fps, self.fps_):
+            raise ValueError(f"start {start.name!r} is at {start.fps:g} fps, the database at {self.fps_:g} fps")
+        q = _positions_m(start)
+        if q.shape[1] != self._pos_.shape[1]:
+            raise ValueError(f"start {start.name!r} has {q.shape[1]} joints, the database {self._pos_.shape[1]}")
+        m = min(self.window_, start.n_frames)
+        w = np.tile(self._jw_, m) / m
+        ends, clouds = [], []
+        for c in range(len(self._offsets_) - 1):
+            lo, hi = self._offsets_[c], self._offsets_[c + 1]
+            clouds.append(_window_clouds(self._pos_[lo:hi], m))
+            ends.append(np.arange(lo + m - 1, hi))
+        ends = np.concatenate(ends)
+        clouds = np.concatenate(clouds)
+        n = len(self._in_scc_)
+        ok = self._has_next_[ends] & self._in_scc_[np.minimum(ends + 1, n - 1)]
+        if not ok.any():
+            raise ValueError("motion graph: no graph node follows a database window")
+        d2, a, b, cp, cq = _pair_terms(_window_clouds(q[-m:], m), clouds[ok], w)
+        best = int(np.argmin(d2[0]))
+        theta, x0, z0 = _transform_from_terms(a[0, best], b[0, best], (cp[0][0], cp[1][0]),
+                                              (cq[0][best], cq[1][best]))
+        return int(ends[ok][best]) + 1, (float(theta), float(x0), float(z0))
+
+    def _out_transitions(self, g: int) -> np.ndarray:
+        return np.arange(self._tr_ptr_[g], self._tr_ptr_[g + 1])
+
+    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+        """A seeded random walk of ``length`` frames from the node nearest the end of ``start``.
+
+        At every node the walk picks uniformly among its out-edges (play on, or one of the transitions that
+        leave there).
+
+        Returns
+        -------
+        Motion (length, n_dof) on ``skeleton_`` at ``fps_``; ``meta``: ``seams`` (int array: output frames
+        where a transition's blend starts), ``source_frames`` ((length, 2) int: database clip and frame of
+        every output frame, -1 for blended frames), ``start_node`` (clip, frame), ``n_transitions``.
+        """
+        self._check_fitted()
+        length = self._check_length(length)
+        node, place = self._start_node(start)
+        rng = np.random.default_rng(seed)
+        steps, n_out, g = [], 0, node
+        while n_out < length:
+            trs = self._out_transitions(g)
+            nat = bool(self._nat_ok_[g])
+            pick = int(rng.integers(nat + trs.size))
+            if nat and pick == 0:
+                steps.append(g)
+                n_out += 1
+                g += 1
+            else:
+                t = int(trs[pick - nat])
+                steps.append(-1 - t)
+                n_out += self.blend_
+                g = int(self._land_[t])
+        return self._assemble(steps, place, length, f"motion_graph_walk_seed{seed}",
+                              {"start_node": self._source(node)})
+
+    def search(self, start: Motion, target, length: int) -> Motion:
+        """Shortest playback (Dijkstra over frames) from the start node to the node nearest ``target``.
+
+        Parameters
+        ----------
+        start : Motion
+            The context (as in :meth:`generate`).
+        target : array (n_dof,)
+            A pose on ``skeleton_`` (DOF values); the goal is the graph node whose pose is nearest after the
+            floor alignment (one-frame point clouds).
+        length : int
+            Frames of the output. After the goal the motion plays on deterministically (the next frame of
+            the clip, else the transition of smallest distance).
+
+        Returns
+        -------
+        Motion as :meth:`generate`, ``meta`` also: ``target_node`` (clip, frame), ``target_frame`` (output
+        frame that plays the goal frame, -1 if the path is longer than ``length``), ``path_frames`` (frames
+        of the shortest path up to and including the goal).
+        """
+        self._check_fitted()
+        length = self._check_length(length)
+        node, place = self._start_node(start)
+        tgt = np.asarray(target, float).reshape(-1)
+        if tgt.shape != (self.skeleton_.n_dof,):
+            raise ValueError(f"target must be one pose of {self.skeleton_.n_dof} DOF values, got shape "
+                             f"{np.shape(target)}")
+        tp = forward_kinematics(self.skeleton_, tgt[None], ends=True) * self.skeleton_.length_to_m
+        nodes = np.nonzero(self._in_scc_)[0]
+        d2, *_ = _pair_terms(tp, self._pos_[nodes], self._jw_)
+        goal = int(nodes[int(np.argmin(d2[0]))])
+        _, pred = dijkstra(self._graph_, indices=node, return_predecessors=True)
+        path = [goal]
+        while path[-1] != node:
+            p = int(pred[path[-1]])
+            if p < 0:  # cannot happen inside one strongly connected component
+                raise RuntimeError("motion graph: goal not reachable from the start node")
+            path.append(p)
+        path.reverse()
+        steps, n_out = [], 0
+        for u, v in zip(path[:-1], path[1:]):
+            if v == u + 1 and self._nat_ok_[u]:
+                steps.append(u)
+                n_out += 1
+            else:
+                trs = self._out_transitions(u)
+                trs = trs[self._land_[trs] == v]
+                t = int(trs[np.argmin(self._tr_dist_[trs])])
+                steps.append(-1 - t)
+                n_out += self.blend_
+        target_frame = n_out if n_out < length else -1
+        path_frames = n_out + 1
+        g = goal
+        while n_out < length:
+            if self._nat_ok_[g]:
+                steps.append(g)
+                n_out += 1
+                g += 1
+            else:
+                trs = self._out_transitions(g)
+                t = int(trs[np.argmin(self._tr_dist_[trs])])
+                steps.append(-1 - t)
+                n_out += self.blend_
+                g = int(self._land_[t])
+        return self._assemble(steps, place, length, "motion_graph_search",
+                              {"start_node": self._source(node), "target_node": self._source(goal),
+                               "target_frame": target_frame, "path_frames": path_frames})
+
+    def _source(self, g: int) -> tuple[int, int]:
+        return int(self._clip_of_[g]), int(self._frame_of_[g])
+
+    # ---------------------------------------------------------------- output
+    def _assemble(self, steps, place, length: int, name: str, meta: dict) -> Motion:
+        """Frames of a walk: ``steps`` are database frames (>= 0) or transitions (-1 - index)."""
+        b = self.blend_
+        alpha_tr = kovar_alpha(b)
+        ia, ib, alpha, ga, gb, blend_starts = [], [], [], [], [], []
+        cur = place
+        n_out = 0
+        for st in steps:
+            if st >= 0:
+                ia.append(st)
+                ib.append(st)
+                alpha.append(1.0)
+                ga.append(cur)
+                gb.append(cur)
+                n_out += 1
+            else:
+                t = -1 - st
+                nxt = compose_floor_transforms(cur, (self._theta_[t], self._x0_[t], self._z0_[t]))
+                lv, ld = int(self._leave_[t]), int(self._land_[t])
+                blend_starts.append(n_out)
+                ia.extend(range(lv, lv + b))
+                ib.extend(range(ld - b, ld))
+                alpha.extend(alpha_tr)
+                ga.extend([cur] * b)
+                gb.extend([nxt] * b)
+                cur = nxt
+                n_out += b
+        ia = np.asarray(ia[:length])
+        ib = np.asarray(ib[:length])
+        alpha = np.asarray(alpha[:length])
+        ga = np.asarray(ga[:length], float)
+        gb = np.asarray(gb[:length], float)
+        blend_starts = np.asarray([s for s in blend_starts if s < length], int)
+        seams = blend_starts[blend_starts > 0]
+
+        def placed(idx, tf):
+            rot = Rotation.from_euler("y", tf[:, :1]) * Rotation.from_quat(self._quat_[idx, 0])
+            root = apply_floor_transform(self._root_[idx][:, None, :], tf[:, 0], tf[:, 1], tf[:, 2])[:, 0]
+            return rot, root
+
+        rot_a, root_a = placed(ia, ga)
+        rot_b, root_b = placed(ib, gb)
+        u = 1.0 - alpha  # weight of the target clip
+        root = alpha[:, None] * root_a + u[:, None] * root_b
+        n_j = self._quat_.shape[1]
+        rots = [rot_a * Rotation.from_rotvec((rot_a.inv() * rot_b).as_rotvec() * u[:, None])]
+        for j in range(1, n_j):
+            ra = Rotation.from_quat(self._quat_[ia, j])
+            rb = Rotation.from_quat(self._quat_[ib, j])
+            rots.append(ra * Rotation.from_rotvec((ra.inv() * rb).as_rotvec() * u[:, None]))
+        values = dof_values_from_local(self.skeleton_, rots, root / self.skeleton_.length_to_m)
+        src = np.stack([self._clip_of_[ia], self._frame_of_[ia]], 1)
+        src[alpha < 1.0] = -1
+        meta = dict(meta, seams=seams, source_frames=src, n_transitions=int(blend_starts.size),
+                    generator="motion_graph")
+        return Motion(values, self.skeleton_, self.fps_, name, meta)

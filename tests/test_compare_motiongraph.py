@@ -1,0 +1,296 @@
+"""Kovar et al.'s motion graph (animsynth.compare.motiongraph): known answers on small synthetic clips."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from animsynth.compare.motiongraph import (MotionGraph, apply_floor_transform, floor_alignment, kovar_alpha,
+                                           _pair_terms, _window_clouds)
+from animsynth.kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation
+from animsynth.motion import Motion
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+FPS = 30.0
+
+
+def _positions(m: Motion) -> np.ndarray:
+    return forward_kinematics(m.skeleton, m.values) * m.skeleton.length_to_m
+
+
+def _periodic(sk, frames=120, period=30, amp=12.0, seed=0, name="periodic") -> Motion:
+    """Joint angles exactly periodic, the root walking straight at constant speed: windows one period
+    apart are identical up to a floor translation."""
+    base = generate_motion("walk_straight", 20, seed, sk, fps=FPS).values[0]
+    cols = sk.columns()
+    rot = [i for i, c in enumerate(cols) if not c.startswith("root.") and c.split(".")[1] in ("rx", "ry", "rz")]
+    rng = np.random.default_rng(seed)
+    t = np.arange(frames)[:, None]
+    v = np.tile(base, (frames, 1))
+    v[:, rot] += amp * np.sin(2 * np.pi * t / period + rng.uniform(0, 2 * np.pi, len(rot)))
+    v[:, cols.index("root.tz")] = base[cols.index("root.tz")] + 0.7 * t[:, 0]
+    return Motion(v, sk, FPS, name)
+
+
+def _moved(m: Motion, theta: float, x0: float, z0: float, name="moved") -> Motion:
+    """The same motion turned by ``theta`` about y and shifted on the floor (skeleton units)."""
+    rots = local_rotations(m.skeleton, m.values)
+    rots[0] = Rotation.from_euler("y", theta) * rots[0]
+    root = apply_floor_transform(root_translation(m.skeleton, m.values)[:, None], theta, x0, z0)[:, 0]
+    return Motion(dof_values_from_local(m.skeleton, rots, root), m.skeleton, m.fps, name)
+
+
+@pytest.fixture(scope="module")
+def sk():
+    return cmu_like_skeleton("mgtest", 1)
+
+
+# ---------------------------------------------------------------- the closed form
+@pytest.mark.parametrize("theta", [0.7, -2.9, 3.1])
+def test_floor_alignment_recovers_a_known_rotation_and_floor_translation(theta):
+    rng = np.random.default_rng(3)
+    q = rng.normal(size=(40, 3))
+    p = apply_floor_transform(q, theta, 1.3, -0.4)
+    th, x0, z0, d2 = floor_alignment(p, q, weights=rng.uniform(0.5, 2.0, 40))
+    assert np.isclose(th, theta, atol=1e-12) and np.isclose(x0, 1.3, atol=1e-12) and np.isclose(z0, -0.4, atol=1e-12)
+    assert d2 < 1e-24
+    # a vertical offset is not removed (translation in the floor plane only)
+    lifted = p + [0.0, 0.5, 0.0]
+    assert np.isclose(floor_alignment(lifted, q)[3], 0.25)
+
+
+def test_floor_alignment_is_the_minimum_over_rotations():
+    rng = np.random.default_rng(5)
+    q = rng.normal(size=(30, 3))
+    p = apply_floor_transform(q, 1.0, 0.2, 0.1) + rng.normal(scale=0.3, size=q.shape)
+    w = rng.uniform(0.1, 1.0, 30)
+    th, x0, z0, d2 = floor_alignment(p, q, w)
+    wn = w / w.sum()
+    grid = np.linspace(-np.pi, np.pi, 20001)
+    best = np.inf
+    for g in grid[::50]:  # coarse scan, optimal translation for each angle (the weighted centroid difference)
+        moved = apply_floor_transform(q, g, 0.0, 0.0)
+        shift = wn @ (p - moved)
+        shift[1] = 0.0
+        best = min(best, float(wn @ ((p - moved - shift) ** 2).sum(1)))
+    assert d2 <= best + 1e-12
+    assert d2 > best - 1e-3  # and the scan comes close to it
+
+
+def test_all_pairs_matrix_products_equal_the_closed_form_per_pair():
+    rng = np.random.default_rng(7)
+    P = rng.normal(size=(6, 25, 3)) + [3.0, 1.0, -2.0]
+    Q = rng.normal(size=(4, 25, 3))
+    w = rng.uniform(0.2, 1.0, 25)
+    w /= w.sum()
+    d2, a, b, cp, cq = _pair_terms(P, Q, w)
+    for i in range(6):
+        for j in range(4):
+            th, _, _, ref = floor_alignment(P[i], Q[j], w)
+            assert np.isclose(d2[i, j], ref, rtol=1e-10, atol=1e-12)
+            assert np.isclose(np.arctan2(b[i, j], a[i, j]), th, atol=1e-10)
+
+
+def test_window_clouds_are_frame_major():
+    pos = np.arange(5 * 2 * 3, dtype=float).reshape(5, 2, 3)
+    c = _window_clouds(pos, 3)
+    assert c.shape == (3, 6, 3)
+    assert np.array_equal(c[1], pos[1:4].reshape(6, 3))
+
+
+def test_kovar_alpha_goes_from_source_to_target():
+    a = kovar_alpha(10)
+    assert a[-1] == 0.0 and 0.95 < a[0] < 1.0 and np.all(np.diff(a) < 0)
+
+
+# ---------------------------------------------------------------- the graph
+def test_two_copies_of_one_clip_give_zero_distance_transitions(sk):
+    m = _periodic(sk)
+    copy = _moved(m, 0.9, 15.0, -4.0, "copy")
+    g = MotionGraph(window=8, threshold=1e-6).fit([m, copy])
+    tr = g.transitions_
+    cross = tr[tr.from_clip != tr.to_clip]
+    # the clip and its copy are joined at the same instant (the window ending at B_j starts at A_i),
+    # at zero distance, by the floor transform that undoes the move
+    same_instant = cross[cross.to_frame - cross.from_frame == 7]
+    assert len(same_instant) > 10 and set(same_instant.from_clip) == {0, 1}
+    assert tr.distance.max() < 1e-6
+    assert np.allclose(cross[cross.from_clip == 0].theta, -0.9, atol=1e-6)
+    assert np.allclose(cross[cross.from_clip == 1].theta, 0.9, atol=1e-6)
+    # (and within each clip one period apart: the loops that make the graph strongly connected)
+    within = tr[tr.from_clip == tr.to_clip]
+    assert len(within) > 0 and np.all((within.to_frame - 7 - within.from_frame) % 30 == 0)
+
+
+def test_threshold_none_keeps_the_quantile_of_the_candidates(sk):
+    m = generate_motion("walk_straight", 150, 4, sk, fps=FPS)
+    everything = MotionGraph(window=8, threshold_quantile=1.0).fit([m])
+    assert everything.n_below_threshold_ == everything.n_candidates_ > 10
+    half = MotionGraph(window=8, threshold_quantile=0.5).fit([m])
+    assert half.n_candidates_ == everything.n_candidates_
+    assert abs(half.n_below_threshold_ - half.n_candidates_ / 2) <= 1
+    assert half.threshold_ < everything.threshold_
+    assert MotionGraph(window=8, threshold=0.5).fit([m]).threshold_ == 0.5
+
+
+def test_scc_pruning_drops_a_dead_end(sk):
+    p = _periodic(sk, seed=0, name="loop")
+    other = _periodic(sk, amp=25.0, seed=9).values
+    q = Motion(np.vstack([p.values[:60], other[60:]]), sk, FPS, "dead_end")  # leaves the loop at frame 60
+    g = MotionGraph(window=8, threshold=1e-6).fit([p, q])
+    assert g.largest_scc_share_ < 1.0
+    assert g.in_graph_[1][:40].any()  # the shared part of the second clip is in the graph ...
+    assert not g.in_graph_[1][60:].any()  # ... its other part is a dead end, pruned
+    assert not (g.transitions_.to_clip == 1).values[g.transitions_.to_frame.values >= 59].any()
+    start = Motion(p.values[:12], sk, FPS, "start")
+    for seed in range(5):
+        src = g.generate(start, 300, seed).meta["source_frames"]
+        assert not np.any((src[:, 0] == 1) & (src[:, 1] >= 60))
+
+
+def test_transitions_between_moved_copies_are_continuous_and_root_aligned(sk):
+    p = _periodic(sk)
+    copy = _moved(p, -1.2, -30.0, 12.0, "copy")
+    g = MotionGraph(window=8, threshold=1e-6).fit([p, copy])
+    start = Motion(p.values[:10], sk, FPS, "start")
+    out = g.generate(start, 240, seed=4)
+    src = out.meta["source_frames"]
+    assert out.meta["seams"].size >= 3 and set(src[src[:, 0] >= 0, 0]) == {0, 1}
+    pos = _positions(out)
+    step = np.linalg.norm(np.diff(pos, axis=0), axis=-1).max(1)
+    db_step = max(np.linalg.norm(np.diff(_positions(c), axis=0), axis=-1).max() for c in (p, copy))
+    # the aligned copies are the same motion: across every transition it plays on without a jump,
+    # in place and heading (an unaligned cut into the copy would jump by metres)
+    assert step.max() <= db_step + 1e-6
+    # the first output frame continues the start context
+    first_gap = np.linalg.norm(pos[0] - _positions(start)[-1], axis=-1).max()
+    assert first_gap <= db_step + 1e-6
+
+
+def test_blended_transition_between_different_clips_has_no_jump_beyond_the_blend(sk):
+    a = generate_motion("walk_straight", 150, 1, sk, fps=FPS)
+    b = _moved(generate_motion("walk_straight", 150, 8, sk, fps=FPS), 2.0, 40.0, 10.0, "other_walk")
+    g = MotionGraph(window=10).fit([a, b])
+    start = Motion(a.values[:10], sk, FPS, "start")
+    out = g.generate(start, 300, seed=0)
+    seams = out.meta["seams"]
+    assert seams.size > 0
+    pos = _positions(out)
+    step = np.linalg.norm(np.diff(pos, axis=0), axis=-1).max(1)  # step[t-1]: frame t-1 -> t
+    db_step = max(np.linalg.norm(np.diff(_positions(c), axis=0), axis=-1).max() for c in (a, b))
+    assert step.max() <= 1.5 * db_step
+    # without the blend (one-frame transitions) the same graph jumps at its seams
+    hard = MotionGraph(window=10, blend=1).fit([a, b]).generate(start, 300, seed=0)
+    hard_step = np.linalg.norm(np.diff(_positions(hard), axis=0), axis=-1).max(1)
+    assert hard_step[hard.meta["seams"] - 1].max() > step[seams - 1].max()
+
+
+def test_blended_root_follows_kovar_weights(sk):
+    a = generate_motion("walk_straight", 150, 1, sk, fps=FPS)
+    b = generate_motion("walk_straight", 150, 8, sk, fps=FPS)
+    g = MotionGraph(window=10).fit([a, b])
+    out = g.generate(Motion(a.values[:10], sk, FPS, "start"), 200, seed=1)
+    s = int(out.meta["seams"][0])
+    src = out.meta["source_frames"]
+    assert np.all(src[s:s + 10] == -1) and np.all(src[s - 1] >= 0) and np.all(src[s + 10] >= 0)
+    # the root height (untouched by the floor alignment) is alpha(p) A + (1 - alpha(p)) B over the blend
+    root_y = root_translation(sk, out.values)[:, 1]
+    clips = [a, b]
+    ca, fa = src[s - 1]
+    cb, fb = src[s + 10]
+    ya = root_translation(sk, clips[ca].values)[fa + 1:fa + 11, 1]
+    yb = root_translation(sk, clips[cb].values)[fb - 10:fb, 1]
+    al = kovar_alpha(10)
+    assert np.allclose(root_y[s:s + 10], al * ya + (1 - al) * yb, atol=1e-9)
+
+
+def test_generate_length_and_seeds(sk):
+    a = generate_motion("walk_straight", 120, 1, sk, fps=FPS)
+    b = generate_motion("run_straight", 90, 2, sk, fps=FPS)
+    g = MotionGraph(window=8).fit([a, b])
+    start = Motion(a.values[30:40], sk, FPS, "start")
+    m1 = g.generate(start, 157, seed=11)
+    assert m1.values.shape == (157, sk.n_dof) and m1.fps == FPS and m1.skeleton is a.skeleton
+    assert m1.meta["source_frames"].shape == (157, 2)
+    assert np.array_equal(m1.values, g.generate(start, 157, seed=11).values)
+    assert not np.array_equal(m1.values, g.generate(start, 157, seed=12).values)
+
+
+def test_search_reaches_the_target_node(sk):
+    p = _periodic(sk)
+    copy = _moved(p, 0.5, 5.0, 5.0, "copy")
+    g = MotionGraph(window=8, threshold=1e-6).fit([p, copy])
+    start = Motion(p.values[:10], sk, FPS, "start")
+    target_frame = 75
+    out = g.search(start, p.values[target_frame], 150)
+    t = out.meta["target_frame"]
+    assert t >= 0 and out.n_frames == 150
+    assert out.meta["target_node"][1] % 30 == target_frame % 30  # the same phase of the periodic motion
+    assert tuple(out.meta["source_frames"][t]) == out.meta["target_node"]
+    # the played frame is the target pose (up to its place on the floor)
+    d2 = floor_alignment(_positions(Motion(p.values[[target_frame]], sk, FPS))[0], _positions(out)[t])[3]
+    assert d2 < 1e-10
+
+
+def test_bad_input_is_refused(sk):
+    a = generate_motion("walk_straight", 60, 1, sk, fps=FPS)
+    with pytest.raises(ValueError, match="fps"):
+        MotionGraph(window=8).fit([a, generate_motion("walk_straight", 60, 2, sk, fps=60.0)])
+    with pytest.raises(ValueError, match="blend"):
+        MotionGraph(window=8, blend=9).fit([a])
+    with pytest.raises(RuntimeError, match="not fitted"):
+        MotionGraph().generate(a, 10, 0)
+    g = MotionGraph(window=8).fit([a, generate_motion("walk_straight", 60, 3, sk, fps=FPS)])
+    with pytest.raises(ValueError, match="fps"):
+        g.generate(Motion(a.values[:5], sk, 120.0), 10, 0)
+
+
+# ---------------------------------------------------------------- the fairmotion peer
+def _fairmotion_reason() -> str:
+    from animsynth.compare.fairmotion_peer import FairmotionUnavailable, _fairmotion
+
+    try:
+        _fairmotion()
+    except FairmotionUnavailable as e:
+        return e.reason
+    return ""
+
+
+def test_missing_fairmotion_is_reported_with_the_install_command(sk, monkeypatch):
+    import importlib.metadata
+
+    from animsynth.compare.fairmotion_peer import INSTALL_COMMAND, FairmotionGraph, FairmotionUnavailable
+
+    def absent(name):
+        raise importlib.metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(importlib.metadata, "version", absent)
+    with pytest.raises(FairmotionUnavailable) as err:
+        FairmotionGraph().fit([generate_motion("walk_straight", 60, 1, sk, fps=FPS)])
+    assert "not installed" in err.value.reason and INSTALL_COMMAND in err.value.reason
+    assert INSTALL_COMMAND == "pip install --no-deps fairmotion==0.0.4 networkx==3.6.1 tqdm==4.70.1"
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_peer_walks_its_graph_on_our_clips(sk):
+    from animsynth.compare.fairmotion_peer import FairmotionGraph
+
+    a = generate_motion("walk_straight", 60, 1, sk, fps=FPS)
+    b = generate_motion("walk_straight", 60, 8, sk, fps=FPS)
+    g = FairmotionGraph(base=8, blend=4, compare=4).fit([a, b])
+    assert g.fairmotion_version_ == "0.0.4" and g.n_nodes_ >= 2 and len(g.transitions_) > 0
+    start = Motion(a.values[:10], sk, FPS, "start")
+    out = g.generate(start, 40, seed=3)
+    assert out.values.shape == (40, sk.n_dof) and out.fps == FPS
+    assert np.array_equal(out.values, g.generate(start, 40, seed=3).values)  # a walk leaves the graph as it was
+    assert not np.array_equal(out.values, g.generate(start, 40, seed=4).values)
+    # frames before the first seam are database frames, moved only on the floor; the source bookkeeping says which
+    src, seams = out.meta["source_frames"], out.meta["seams"]
+    assert seams.size > 0 and np.all((seams > 0) & (seams < 40))
+    pos = _positions(out)
+    clips = [a, b]
+    for t in range(int(seams[0])):
+        c, f = src[t]
+        assert floor_alignment(pos[t], _positions(clips[c])[f])[3] < 1e-8
+    assert np.all(src[seams[0]] == -1)  # a blended frame
