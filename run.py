@@ -24,6 +24,7 @@ import hashlib
 import os
 import subprocess
 import sys
+import tomllib
 import venv
 from pathlib import Path
 
@@ -59,6 +60,10 @@ def ensure_venv() -> None:
     print("[run.py] installing the pinned stack (pyproject.toml) ...", flush=True)
     subprocess.check_call([str(PY), "-m", "pip", "install", "--quiet", "--disable-pip-version-check",
                            "-e", f"{ROOT}[test]"])
+    no_deps = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["animsynth"]["no_deps"]
+    if no_deps:  # packages whose declared requirements cannot be installed (see pyproject.toml)
+        subprocess.check_call([str(PY), "-m", "pip", "install", "--quiet", "--disable-pip-version-check",
+                               "--no-deps", *no_deps])
     stamp.write_text(want + "\n")
 
 

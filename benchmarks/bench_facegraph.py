@@ -31,7 +31,7 @@ from threadpoolctl import threadpool_limits
 
 from animsynth.facegraph import FaceGraphBaseline, FaceGraphModel, FacePreprocessor, FaceSynthesizer
 from animsynth.facegraph.evaluate import evaluate_resynthesis
-from animsynth.facegraph.experiments import _subset_database, face_graph_nbytes
+from animsynth.facegraph.jobs import face_graph_nbytes, subset_database
 from animsynth.synth.faces import generate_sequences
 
 FAMILY = "facegraph"
@@ -101,7 +101,7 @@ def run(size: str = "full") -> list[dict]:
         rows.append(_row("facegraph_baseline_memory_mb_ckplus_scale", face_graph_nbytes(N, 1) / 1e6, "MB",
                          "region graphs at CK+ scale (same configuration)",
                          sum(g.nbytes() for g in big_model.graphs_.values()) / 1e6, "report only (computed from size)", True))
-        sub = _subset_database(big, 1500, 0)
+        sub = subset_database(big, 1500, 0)
         base = FaceGraphBaseline(power=1.0).fit(sub)
         so = sub.offsets
         t = [base.synthesize(int(so[k]), int(so[k + 1] - 1))[1] for k in range(0, sub.n_samples, 5)]

@@ -48,7 +48,7 @@ import numba  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
 from animsynth.config import derive_seed  # noqa: E402
-from animsynth.simplicial.experiment import fit_pca  # noqa: E402
+from animsynth.simplicial.folds import fit_pca  # noqa: E402
 from animsynth.simplicial.field import FieldStack, VectorField, training_vectors  # noqa: E402
 from animsynth.simplicial.path import follow_batch  # noqa: E402
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion  # noqa: E402

@@ -334,7 +334,7 @@ def test_config_path_symlink_leaving_data_dir_is_refused(tmp_path):
 def test_atomic_write_names_the_target_on_permission_error(tmp_path):
     import os
 
-    from animsynth.io.atomic import atomic_write_text
+    from animsynth.atomic import atomic_write_text
 
     ro = tmp_path / "ro"
     ro.mkdir()
@@ -350,7 +350,7 @@ def test_atomic_write_names_the_target_on_permission_error(tmp_path):
 
 
 def test_atomic_replace_failure_names_the_target(tmp_path):
-    from animsynth.io.atomic import atomic_write_text
+    from animsynth.atomic import atomic_write_text
 
     (tmp_path / "table.csv").mkdir()  # a folder where the file should go: rename fails
     with pytest.raises(OSError) as ei:
@@ -366,10 +366,10 @@ def test_stale_temporaries_of_a_jobs_outputs_are_removed(tmp_path):
     import subprocess
     import sys
 
-    from animsynth.io.atomic import clean_stale_temporaries
+    from animsynth.atomic import clean_stale_temporaries
 
     out = tmp_path / "big.csv"
-    code = ("import sys, time\nfrom animsynth.io.atomic import atomic_path\n"
+    code = ("import sys, time\nfrom animsynth.atomic import atomic_path\n"
             "with atomic_path(sys.argv[1]) as tmp:\n"
             "    open(tmp, 'w').write('partial')\n    print('ready', flush=True)\n    time.sleep(60)\n")
     proc = subprocess.Popen([sys.executable, "-c", code, str(out)], stdout=subprocess.PIPE, text=True)

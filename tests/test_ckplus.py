@@ -10,7 +10,7 @@ import pytest
 
 from animsynth.io.ckplus import (EMOTIONS, CKSequence, emotion_code, read_ckplus, read_emotion, read_landmarks,
                                  write_sequence)
-from animsynth.io.errors import MotionFormatError
+from animsynth.errors import MotionFormatError
 from animsynth.synth.faces import CKPLUS_COUNTS, au_field, generate_sequences, write_database
 
 

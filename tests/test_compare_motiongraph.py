@@ -244,3 +244,53 @@ def test_bad_input_is_refused(sk):
     g = MotionGraph(window=8).fit([a, generate_motion("walk_straight", 60, 3, sk, fps=FPS)])
     with pytest.raises(ValueError, match="fps"):
         g.generate(Motion(a.values[:5], sk, 120.0), 10, 0)
+
+
+# ---------------------------------------------------------------- the fairmotion peer
+def _fairmotion_reason() -> str:
+    from animsynth.compare.fairmotion_peer import FairmotionUnavailable, _fairmotion
+
+    try:
+        _fairmotion()
+    except FairmotionUnavailable as e:
+        return e.reason
+    return ""
+
+
+def test_missing_fairmotion_is_reported_with_the_install_command(sk, monkeypatch):
+    import importlib.metadata
+
+    from animsynth.compare.fairmotion_peer import INSTALL_COMMAND, FairmotionGraph, FairmotionUnavailable
+
+    def absent(name):
+        raise importlib.metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(importlib.metadata, "version", absent)
+    with pytest.raises(FairmotionUnavailable) as err:
+        FairmotionGraph().fit([generate_motion("walk_straight", 60, 1, sk, fps=FPS)])
+    assert "not installed" in err.value.reason and INSTALL_COMMAND in err.value.reason
+    assert INSTALL_COMMAND == "pip install --no-deps fairmotion==0.0.4 networkx==3.6.1 tqdm==4.70.1"
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_peer_walks_its_graph_on_our_clips(sk):
+    from animsynth.compare.fairmotion_peer import FairmotionGraph
+
+    a = generate_motion("walk_straight", 60, 1, sk, fps=FPS)
+    b = generate_motion("walk_straight", 60, 8, sk, fps=FPS)
+    g = FairmotionGraph(base=8, blend=4, compare=4).fit([a, b])
+    assert g.fairmotion_version_ == "0.0.4" and g.n_nodes_ >= 2 and len(g.transitions_) > 0
+    start = Motion(a.values[:10], sk, FPS, "start")
+    out = g.generate(start, 40, seed=3)
+    assert out.values.shape == (40, sk.n_dof) and out.fps == FPS
+    assert np.array_equal(out.values, g.generate(start, 40, seed=3).values)  # a walk leaves the graph as it was
+    assert not np.array_equal(out.values, g.generate(start, 40, seed=4).values)
+    # frames before the first seam are database frames, moved only on the floor; the source bookkeeping says which
+    src, seams = out.meta["source_frames"], out.meta["seams"]
+    assert seams.size > 0 and np.all((seams > 0) & (seams < 40))
+    pos = _positions(out)
+    clips = [a, b]
+    for t in range(int(seams[0])):
+        c, f = src[t]
+        assert floor_alignment(pos[t], _positions(clips[c])[f])[3] < 1e-8
+    assert np.all(src[seams[0]] == -1)  # a blended frame

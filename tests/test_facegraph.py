@@ -11,7 +11,7 @@ from animsynth.config import ConfigError
 from animsynth.facegraph import (FaceGraphBaseline, FaceGraphModel, FacePreprocessor, FaceSynthesizer,
                                  SynthesisError, load_graphs, node_similarity, pose_similarity, save_graphs, vinfl)
 from animsynth.facegraph.evaluate import compare, velocity_angle_difference
-from animsynth.facegraph.experiments import data_note, run_configuration, uniqueness_tables
+from animsynth.facegraph.jobs import data_note, run_configuration, uniqueness_tables
 from animsynth.facegraph.settings import config_name, configurations
 from animsynth.facegraph.geometry import apply_transform_2d, fit_transform_2d
 from animsynth.facegraph.merging import _rigid2d, merge_sample_graphs
@@ -23,6 +23,17 @@ from animsynth.facegraph.search import step_halving_search
 from animsynth.facegraph.synthesis import hop_neighbours, resample
 from animsynth.io.ckplus import EMOTIONS
 from animsynth.synth.faces import generate_sequences
+
+
+def default_config() -> dict:
+    """config/config.yaml validated against config/schema.yaml (every default filled), as the workflow sees it."""
+    import yaml
+
+    from animsynth.config import validate_config
+
+    cfg = yaml.safe_load(open("config/config.yaml"))
+    validate_config(cfg, "config/schema.yaml")
+    return cfg
 
 
 @pytest.fixture(scope="module")
@@ -477,19 +488,26 @@ def test_region_config_checks():
 
 
 def test_facegraph_config_checks():
-    import yaml
+    from animsynth.facegraph.settings import check
 
-    from animsynth.facegraph.settings import check_facegraph_config
+    config = default_config()
+    cfg = config["facegraph"]
+    check(config)
 
-    cfg = yaml.safe_load(open("config/config.yaml"))["facegraph"]
-    check_facegraph_config(cfg)
+    def with_fg(**change):
+        return dict(config, facegraph=dict(cfg, **change))
+
     with pytest.raises(ConfigError, match="duplicate configuration"):
-        check_facegraph_config(dict(cfg, configurations=[{"creation": 0.5, "creation_tolerance": 0.1, "merge": 0.5,
-                                                          "merge_tolerance": 0.1}] * 2))
+        check(with_fg(configurations=[{"creation": 0.5, "creation_tolerance": 0.1, "merge": 0.5,
+                                       "merge_tolerance": 0.1}] * 2))
     with pytest.raises(ConfigError, match="uniqueness.labels"):
-        check_facegraph_config(dict(cfg, uniqueness={"labels": ["joy"], "runs": 3}))
+        check(with_fg(uniqueness={"labels": ["joy"], "runs": 3}))
     with pytest.raises(ConfigError, match="ckplus_dir"):
-        check_facegraph_config(dict(cfg, ckplus_dir="/nonexistent/ck"))
+        check(with_fg(ckplus_dir="/nonexistent/ck"))
+    with pytest.raises(ConfigError, match="facegraph.synthesis.savgol_window"):
+        check(with_fg(synthesis=dict(cfg["synthesis"], savgol_window=6)))
+    with pytest.raises(ConfigError, match="facegraph.figures.trajectory_landmarks"):
+        check(with_fg(figures=dict(cfg["figures"], trajectory_landmarks=[70])))
     assert config_name(0.5, 0.125) == "c0.5_m0.125"
     assert config_name(0.2, 0.7, 0.1, 0.3) == "c0.2t0.1_m0.7t0.3"
     assert len({c["name"] for c in configurations(cfg)}) == 15
@@ -528,8 +546,10 @@ def test_face_graph_baseline_on_a_line():
 
 
 def test_table1_row_uniqueness_and_connectivity(db):
-    cfg = {"synthesis": {"noise_share": 0.3, "duration_noise": True},
-           "evaluation": {"noise": False}, "uniqueness": {"labels": ["happy", "surprise"], "runs": 4}}
+    fg = default_config()["facegraph"]
+    cfg = {"graph": fg["graph"], "synthesis": dict(fg["synthesis"], noise_share=0.3, duration_noise=True),
+           "evaluation": dict(fg["evaluation"], noise=False),
+           "uniqueness": dict(fg["uniqueness"], labels=["happy", "surprise"], runs=4)}
     conf = {"name": "c0.3t0.1_m0.5t0.2", "creation": 0.3, "creation_tolerance": 0.1, "merge": 0.5,
             "merge_tolerance": 0.2}
     row, timing, thr, model, per = run_configuration(db, conf, cfg, seed=4)
@@ -550,3 +570,52 @@ def test_table1_row_uniqueness_and_connectivity(db):
     assert summary["distinct"].iloc[0] == 1                        # fixed peaks, no noise: all runs equal
     assert summary["distinct"].iloc[2] == 4                        # node + duration noise: all runs differ
     assert len(pairs) == 4 * 6 and pairs[pairs.setting == summary.setting.iloc[0]].identical.all()
+    # the verdicts of these tables: the common format, words of the common vocabulary
+    from animsynth import verdicts as common
+    from animsynth.facegraph.jobs import assemble_table1, baseline_table
+    from animsynth.facegraph.verdicts import verdicts
+
+    table1 = assemble_table1([row], [row["config"]])
+    base, _ = baseline_table(db, model.graphs_, dict(cfg, baseline=dict(fg["baseline"], max_queries=3)), 4,
+                             row["config"])
+    v = verdicts(table1, base, summary, "synthetic test")
+    assert tuple(v.columns) == common.COLUMNS and len(v) >= 8
+    common.check(v)
+    assert set(v.verdict) <= set(common.VOCABULARY)
+    assert v.data.eq("synthetic CK+-layout, 1 configurations").all()
+    assert (v.loc[v.claim == "Landmark error rises with compression", "verdict"] == "not reproduced").all()
+
+
+# -- the published Table 1 (animsynth.published.read_table, mapped to configuration names) ---------------
+def test_published_table1_maps_rows_to_configuration_names(tmp_path, caplog):
+    from animsynth.facegraph.settings import PAPER_COLUMNS, published_table1
+    from animsynth.published import PublishedError
+    from conftest import PAPERS
+
+    fixture = PAPERS / "s4_table1.csv"
+    got = published_table1(fixture)
+    raw = pd.read_csv(fixture)
+    assert len(got) == len(raw)
+    first = raw.iloc[0]
+    name = config_name(first.creation_target, first.merge_target, first.creation_tolerance, first.merge_tolerance)
+    assert got[name]["row"] == int(first["row"])
+    assert got[name]["node_compression_pct"] == first["nodes_compression_pct"]
+    assert set(got[name]) == set(PAPER_COLUMNS) | {"row"}
+    # no file: {} and a WARNING naming the path
+    with caplog.at_level("WARNING", logger="animsynth.published"):
+        assert published_table1(tmp_path / "absent.csv") == {}
+    assert "absent.csv" in caplog.text and "published.facegraph.table1" in caplog.text
+    # malformed: the file and the line
+    bad = tmp_path / "bad.csv"
+    bad.write_text(fixture.read_text().replace("\n2,", "\nx,", 1))
+    with pytest.raises(PublishedError, match=r"bad\.csv, line 3: column 'row'"):
+        published_table1(bad)
+    lines = fixture.read_text().splitlines()
+    dup = tmp_path / "dup.csv"
+    dup.write_text("\n".join(lines + [lines[1]]) + "\n")
+    with pytest.raises(PublishedError, match=rf"dup\.csv, line {len(lines) + 1}: configuration {name} already"):
+        published_table1(dup)
+    no_col = tmp_path / "no_col.csv"
+    no_col.write_text(raw.drop(columns="landmark_diff_px").to_csv(index=False))
+    with pytest.raises(PublishedError, match=r"no_col\.csv, line 1: .*landmark_diff_px"):
+        published_table1(no_col)

@@ -1,6 +1,6 @@
 """The compiled (numba) graph creation of facegraph against a numpy route written here.
 
-``animsynth.facegraph._jit`` runs Algorithm 1, the merge loop (with its trial
+``animsynth.facegraph.kernels`` runs Algorithm 1, the merge loop (with its trial
 merges and undo), the edge weights and the nearest-node search compiled. This
 module writes each of them again in numpy, straight from the algorithm's
 definition (eq. 3 via :mod:`animsynth.facegraph.similarity`, no pruning, a full
@@ -24,7 +24,7 @@ import copy
 import numpy as np
 import pytest
 
-from animsynth.facegraph import FaceGraphModel, FacePreprocessor, _jit
+from animsynth.facegraph import FaceGraphModel, FacePreprocessor, kernels
 from animsynth.facegraph import merging, model as model_mod
 from animsynth.facegraph.merging import Merger, _finish_graph, _rigid2d
 from animsynth.facegraph.model import _nn_similarity
@@ -222,7 +222,7 @@ def numpy_route(monkeypatch):
         raise AssertionError("a compiled kernel ran on the numpy route")
 
     for name in KERNELS:
-        monkeypatch.setattr(_jit, name, compiled)
+        monkeypatch.setattr(kernels, name, compiled)
 
 
 # ----------------------------------------------------------------------------- data

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from animsynth.facegraph.experiments import TABLE1_COLUMNS
+from animsynth.facegraph.jobs import TABLE1_COLUMNS
 
 
 OUTPUTS = [

@@ -4,7 +4,7 @@ import gzip
 import numpy as np
 import pytest
 
-from animsynth.io.errors import MotionFormatError
+from animsynth.errors import MotionFormatError
 from animsynth.io.obj import MeshSequence, list_obj_frames, read_obj, read_obj_sequence, write_obj, write_obj_sequence
 
 QUAD = "# quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n"

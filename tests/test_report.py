@@ -3,13 +3,13 @@
 import pandas as pd
 import pytest
 
+from animsynth.verdicts import VerdictError
 from animsynth.report import (
     aggregate_rule_benchmarks,
     build_summary,
     claims_rst,
     claims_table,
     family_benchmark_summary,
-    read_verdicts,
     rule_benchmark_summary,
 )
 
@@ -41,17 +41,23 @@ def test_summary_renders_tables_and_verdicts(tmp_path):
     pd.DataFrame({"dataset": ["w1"], "error_a": [0.0123]}).to_csv(t, index=False)
     v = tmp_path / "simplicial" / "verdicts.csv"
     v.parent.mkdir()
-    pd.DataFrame({"claim": ["Delaunay beats k-NN"], "verdict": ["no"], "evidence": ["p=0.2"]}).to_csv(v, index=False)
+    row = {"claim": "Delaunay beats k-NN", "paper_value": "", "ours": "", "data": "", "verdict": "partly",
+           "evidence": "p=0.2", "source": ""}
+    pd.DataFrame([row]).to_csv(v, index=False)
     md = build_summary([{"title": "Table II", "csv": str(t), "note": "synthetic"}], [v], "Data: synthetic.",
-                       family_data={"simplicial": "synthetic mocap"})
+                       family_data={"simplicial": "synthetic mocap"}, family_real={"simplicial": False})
     assert md.index("## Claims of the four papers") < md.index("## Table II")
-    assert "| Gauch & Peters (simplicial complex) | Delaunay beats k-NN |  |  | synthetic mocap | **no** |" in md
+    assert "| Gauch & Peters (simplicial complex) | Delaunay beats k-NN |  |  | synthetic mocap | **partly** |" in md
     assert "## Table II" in md and "| w1 | 0.0123 |" in md
+    # a word outside the vocabulary is refused, naming the file and line
+    pd.DataFrame([{**row, "verdict": "no"}]).to_csv(v, index=False)
+    with pytest.raises(VerdictError, match=r"verdicts.csv, line 2: verdict 'no'"):
+        claims_table([v], family_real={"simplicial": False})
     bad = tmp_path / "x" / "verdicts.csv"
     bad.parent.mkdir()
     pd.DataFrame({"claim": ["c"]}).to_csv(bad, index=False)
-    with pytest.raises(ValueError, match="lacks columns"):
-        read_verdicts([bad])
+    with pytest.raises(VerdictError, match="missing"):
+        claims_table([bad], family_real={"x": True})
 
 
 def _verdicts(tmp_path, family, rows):
@@ -70,7 +76,8 @@ def test_claims_put_real_data_first_and_link_unique_report_files(tmp_path):
          "verdict": "not reproduced", "evidence": "e", "source": "simplicial/table2.csv"},
         {"claim": "overall median A", "paper_value": "0.068 vs 0.079", "ours": "0.05 vs 0.04", "data": "",
          "verdict": "contradicted", "evidence": "e", "source": "simplicial/verdicts.csv"}])
-    claims = claims_table([face, simp], {"simplicial": "CMU mocap from mirror"})
+    claims = claims_table([face, simp], {"simplicial": "CMU mocap from mirror"},
+                          family_real={"simplicial": True, "facegraph": False})
     assert list(claims["family"]) == ["simplicial", "simplicial", "facegraph"]
     assert list(claims["real"]) == [True, True, False]
     assert claims.loc[1, "data"] == "CMU mocap from mirror"  # empty data filled from the family's source

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 from scipy.spatial import QhullError
 
-from animsynth.simplicial import experiment as ex
+from animsynth.simplicial import folds as fl, stats as st, tables as tb
 from animsynth.simplicial import geometry
 from animsynth.simplicial.field import VectorField, idw_weights, training_vectors
 from animsynth.simplicial.geometry import SafeDelaunay, merge_duplicates
@@ -286,9 +286,9 @@ def test_bad_input_is_rejected_clearly():
     with pytest.raises(ValueError, match="non-empty"):
         SafeDelaunay().fit(np.zeros((0, 2)))
     with pytest.raises(ValueError, match="latent_dim"):
-        ex.fit_pca([np.zeros((3, 4))], 5)
+        fl.fit_pca([np.zeros((3, 4))], 5)
     with pytest.raises(ValueError, match="simplicial.steps"):
-        ex.steps_for(0, 10)
+        fl.steps_for(0, 10)
 
 
 # ----------------------------------------------------------------------------- planning, folds, tables
@@ -325,15 +325,15 @@ def _toy_trials(n_trials=3, n=60, seed=0):
 
 def test_run_fold_and_tables_on_toy_data():
     trials = _toy_trials()
-    df = ex.run_subset(trials, [ex.Variant("delaunay"), ex.Variant("knn", method="knn", k=4)], dataset="w1")
-    assert list(df.columns) == ex.FOLD_COLUMNS and len(df) == 6
+    df = fl.run_subset(trials, [fl.Variant("delaunay"), fl.Variant("knn", method="knn", k=4)], dataset="w1")
+    assert list(df.columns) == fl.FOLD_COLUMNS and len(df) == 6
     assert np.isfinite(df[["error_a", "error_f", "error_a_pose", "pose_floor"]].to_numpy(float)).all()
     assert (df["pose_floor"] >= 0).all()
     assert (df["steps"] == 60).all() and (df["latent_dim"] == 2).all()
     # a latent loop traversed with the printed 1/2 covers about half the arc
     assert df["length_ratio"].between(0.3, 0.7).all()
     paper = pd.DataFrame([{"metric": "error_a", "method": "delaunay", "w1": 1.5, "all": 2.0}])
-    t2 = ex.table2(df, ["w1"], paper=paper)
+    t2 = tb.table2(df, ["w1"], paper=paper)
     assert list(t2.columns) == ["metric", "method", "w1", "all", "paper_w1", "paper_all", "w1_minus_paper",
                                 "all_minus_paper"]
     assert t2[["metric", "method"]].values.tolist() == [["error_a", "delaunay"], ["error_a", "knn"],
@@ -343,25 +343,28 @@ def test_run_fold_and_tables_on_toy_data():
     assert np.isnan(t2.loc[1, "w1_minus_paper"])
     d = df[df["method"] == "knn"]
     assert t2.loc[3, "w1"] == pytest.approx(d["error_f_norm"].median())
-    pc = ex.paired_comparison(df, n_boot=200, seed=1)
+    pc = st.paired_comparison(df, n_boot=200, seed=1)
     assert set(pc["verdict"]) <= {"delaunay_better", "knn_better", "no_significant_difference"}
-    again = ex.paired_comparison(df, n_boot=200, seed=1)
+    again = st.paired_comparison(df, n_boot=200, seed=1)
     pd.testing.assert_frame_equal(pc, again)  # deterministic given the seed
 
 
 def test_target_variant_and_verdicts():
     trials = _toy_trials(3, 50, seed=2)
-    vs = ex.derivative_variants(["half", "forward"], ["delaunay", "knn"], 4, 2)
-    d = ex.run_subset(trials, vs, dataset="w1")
-    ds = ex.derivative_summary(d, claim="delaunay_better", n_boot=100)
+    vs = fl.derivative_variants(["half", "forward"], ["delaunay", "knn"], 4, 2)
+    d = fl.run_subset(trials, vs, dataset="w1")
+    ds = st.derivative_summary(d, claim="delaunay_better", n_boot=100)
     assert set(ds["derivative"]) == {"half", "forward"}
     half = ds.set_index("derivative").loc["half"]
     assert 0.3 < half["delaunay_length_ratio"] < 0.7
-    bv = ex.beyond_variants({"latent_dims": [2, 3], "k_values": [4]}, 4, "forward")
+    bv = fl.beyond_variants({"latent_dims": [2, 3], "k_values": [4], "barycentric": True, "kdelaunay": True,
+                             "target_directed": True}, 4, "forward")
     names = [v.name for v in bv]
     assert "target_delaunay_d2" in names and "delaunay_bary_d3" in names and len(names) == len(set(names))
-    b = ex.run_subset(trials, bv, dataset="w1")
+    b = fl.run_subset(trials, bv, dataset="w1")
     tgt = b[b["generation"] == "target"]
     assert (tgt["fallback_steps"] == 0).all() and tgt["target_reached"].isin([True, False]).all()
-    bs = ex.summarise_variants(b, "delaunay_idw_d2", ["w1"], n_boot=100)
+    bs = st.summarise_variants(b, "delaunay_idw_d2", ["w1"], n_boot=100)
+    assert sorted(bs["variant"]) == sorted(names) and bs["error_a_pose"].is_monotonic_increasing
+    assert bs.set_index("variant").loc["delaunay_idw_d2", "rel_change_vs_baseline"] == 0.0
     assert "half" in ds["derivative"].tolist()

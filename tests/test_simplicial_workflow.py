@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import json
+import re
+import shutil
+import subprocess
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from animsynth.simplicial import experiment as ex
-from animsynth.simplicial.verdicts import VERDICT_COLUMNS
+from animsynth.simplicial import folds as fl
+from animsynth.verdicts import COLUMNS
+from conftest import SAFETY_TIMEOUT, SNAKEMAKE, copy_workflow, place_papers
 
 OUTPUTS = [
     "results/simplicial/folds.csv", "results/simplicial/table2.csv", "results/simplicial/table2.md",
@@ -28,7 +32,7 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
     missing = [p for p in OUTPUTS if not (wd / p).exists()]
     assert not missing, missing
     folds = pd.read_csv(wd / "results/simplicial/folds.csv")
-    assert list(folds.columns) == ex.FOLD_COLUMNS
+    assert list(folds.columns) == fl.FOLD_COLUMNS
     # one JSON per dataset, holding every leave-one-out fold of its subset (3 trials each in the tiny config)
     jsons = sorted((wd / "results/simplicial/folds").glob("*.json"))
     assert [p.stem for p in jsons] == sorted(["w1", "w2", "r1", "r2"])
@@ -52,11 +56,11 @@ def test_tiny_workflow_simplicial_outputs(tiny_workflow):
         assert t2[f"{d}_minus_paper"].notna().all()
         np.testing.assert_allclose(t2[f"{d}_minus_paper"], t2[d] - t2[f"paper_{d}"], rtol=0, atol=1e-5)
     v = pd.read_csv(wd / "results/simplicial/verdicts.csv")
-    assert list(v.columns) == VERDICT_COLUMNS and len(v) >= 8
+    assert list(v.columns) == list(COLUMNS) and len(v) >= 8
     assert set(v["verdict"]) <= {"reproduced", "partly", "not reproduced", "contradicted", "within noise"}
     assert not v["evidence"].str.contains("not available").any()
     row = json.loads(next((wd / "results/simplicial/folds").glob("*.json")).read_text())
-    assert set(row["rows"][0]) == set(ex.FOLD_COLUMNS) and set(row["members"][0]) == set(ex.MEMBER_COLUMNS)
+    assert set(row["rows"][0]) == set(fl.FOLD_COLUMNS) and set(row["members"][0]) == set(fl.MEMBER_COLUMNS)
     assert (wd / "results/simplicial/figures/fig7_walk.bvh").read_text().startswith("HIERARCHY")
 
 
@@ -79,6 +83,39 @@ def test_without_published_table_the_paper_columns_are_empty(tiny_workflow, tiny
     assert extra and ds[extra].isna().all().all() and ds_paper[extra].notna().any().all()
 
 
+def _dry_run_inputs(project, workdir) -> dict:
+    """Rule name -> input line of each simplicial job that shows published values, from a dry run of
+    ``project``'s workflow in another working directory (``--directory``)."""
+    cfg = [str(project / "config" / "config.yaml"), str(project / "config" / "test.yaml")]
+    res = subprocess.run([SNAKEMAKE, "-n", "-s", str(project / "Snakefile"), "--directory", str(workdir),
+                          "results/data/datasets.csv", "results/simplicial/verdicts.csv", "--configfile", *cfg],
+                         cwd=workdir, capture_output=True, text=True, timeout=SAFETY_TIMEOUT)
+    assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
+    jobs = dict(re.findall(r"^rule (simplicial_table1|simplicial_table|simplicial_summary):\n\s+input: (.*)$",
+                           res.stdout, re.M))
+    assert sorted(jobs) == ["simplicial_summary", "simplicial_table", "simplicial_table1"], res.stdout[-3000:]
+    return jobs
+
+
+@pytest.mark.workflow
+def test_published_tables_are_found_from_another_working_directory(tmp_path):
+    """published.simplicial.table1/table2 are resolved against the workflow's own folder, not the working
+    directory: a run with --directory elsewhere still declares them as inputs of the jobs that fill the
+    paper_* columns; without the files the same jobs run with no such input (and empty columns)."""
+    project = copy_workflow(tmp_path / "project")
+    papers = place_papers(project)  # <project>/../shared/papers, as the default config names them
+    elsewhere = tmp_path / "other" / "run"
+    elsewhere.mkdir(parents=True)
+    assert not (elsewhere / "../shared/papers").exists()  # resolved against the working directory: nothing
+    jobs = _dry_run_inputs(project, elsewhere)
+    assert str(papers / "s1_table1.csv") in jobs["simplicial_table1"]
+    assert str(papers / "s1_table2.csv") in jobs["simplicial_table"]
+    assert str(papers / "s1_table2.csv") in jobs["simplicial_summary"]
+    shutil.rmtree(papers)
+    jobs = _dry_run_inputs(project, elsewhere)
+    assert not any("s1_table" in line for line in jobs.values()), jobs
+
+
 @pytest.mark.realdata
 def test_real_cmu_runs_fold(cmu_dir):
     """Subject 35 running (r1): real data has repeated frames (duplicate latent points) - handled, logged."""
@@ -88,7 +125,7 @@ def test_real_cmu_runs_fold(cmu_dir):
     ids = ["35_17", "35_22", "35_18", "35_19"]
     trials = {t: read_amc(cmu_dir / "35" / f"{t}.amc", sk).without_root() for t in ids}
     assert all(a.shape[1] == 56 for a in trials.values())
-    res = ex.run_fold([trials[t] for t in ids[1:]], trials[ids[0]], ex.Variant("delaunay"), dataset="r1",
+    res = fl.run_fold([trials[t] for t in ids[1:]], trials[ids[0]], fl.Variant("delaunay"), dataset="r1",
                       held_out=ids[0])
     r = res.row
     assert r["steps"] == trials[ids[0]].shape[0] and np.isfinite(r["error_a"]) and r["error_a"] > 0

@@ -4,6 +4,7 @@ a run with synthetic data opens its summary with the demo banner and the paper r
 from __future__ import annotations
 
 import pandas as pd
+import pytest
 
 from animsynth.report import PAPER_RUN_COMMAND, build_summary, claims_table, demo_banner
 
@@ -23,8 +24,9 @@ def test_synthetic_family_without_the_word_synthetic_is_not_real(tmp_path):
     mesh = _verdicts(tmp_path, "meshdetail", "mesh sequence samba")
     claims = claims_table([reseq, mesh], family_real={"resequencing": False, "meshdetail": True})
     assert dict(zip(claims["family"], claims["real"])) == {"meshdetail": True, "resequencing": False}
-    # without the record the old text rule would have called the re-sequencing rows real
-    assert bool(claims_table([reseq])["real"].iloc[0]) is True
+    # a family without a record is an error, never a guess from the text
+    with pytest.raises(ValueError, match="no provenance"):
+        claims_table([reseq])
 
 
 def test_summary_lists_synthetic_claims_apart_and_opens_with_the_demo_banner(tmp_path):

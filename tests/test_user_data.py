@@ -20,7 +20,7 @@ def test_user_example_config_runs_on_a_copy_of_cmu_trials(tmp_path, cmu_dir):
             dest.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(cmu_dir.parent / t[key], dest)
     wd = copy_workflow(tmp_path / "wf")
-    res = run_snakemake(wd, "--configfile", "config/user_example.yaml", "--until", "datasets_table",
+    res = run_snakemake(wd, "--configfile", "config/user_example.yaml", "--until", "simplicial_table1",
                         "--config", f"data_dir={data}")
     assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
     df = pd.read_csv(wd / "results" / "data" / "datasets.csv")
@@ -35,7 +35,7 @@ def test_user_example_config_runs_on_a_copy_of_cmu_trials(tmp_path, cmu_dir):
 def test_user_file_missing_is_a_clear_error(tmp_path, cmu_dir):
     wd = copy_workflow(tmp_path / "wf")
     (tmp_path / "empty").mkdir()
-    res = run_snakemake(wd, "--configfile", "config/user_example.yaml", "--until", "datasets_table",
+    res = run_snakemake(wd, "--configfile", "config/user_example.yaml", "--until", "simplicial_table1",
                         "--config", f"data_dir={tmp_path / 'empty'}")
     assert res.returncode != 0
     logs = "".join(p.read_text() for p in (wd / "logs").rglob("*.log"))

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from animsynth.simplicial import experiment as ex
+from animsynth.simplicial import folds as fl, stats as st, tables as tb
 from animsynth.simplicial.verdicts import build_verdicts
 
 from test_simplicial_ensemble import _trials
@@ -83,19 +83,19 @@ PAPER = pd.DataFrame([{"metric": m, "method": k, "w1": v, "all": v}
 def simplicial_runs():
     """Fold and ensemble-member rows of a small in-test fit: two methods and two derivative variants."""
     trials = _trials(4, 60)
-    folds, members = ex.run_subset(trials, [ex.Variant("delaunay"), ex.Variant("knn", method="knn", k=4)],
+    folds, members = fl.run_subset(trials, [fl.Variant("delaunay"), fl.Variant("knn", method="knn", k=4)],
                                    dataset="w1", ensemble={"n_starts": 3, "jitter": 1e-6}, seed=3)
-    vs = ex.derivative_variants(["half", "forward"], ["delaunay", "knn"], 4, 2)
-    dfold, dmem = ex.run_subset(trials, vs, dataset="w1", ensemble={"n_starts": 2, "jitter": 1e-6}, seed=3)
+    vs = fl.derivative_variants(["half", "forward"], ["delaunay", "knn"], 4, 2)
+    dfold, dmem = fl.run_subset(trials, vs, dataset="w1", ensemble={"n_starts": 2, "jitter": 1e-6}, seed=3)
     return dict(folds=folds, members=members, dfold=dfold, dmem=dmem)
 
 
 def _simplicial_verdicts(folds, members, dfold, dmem):
     """The tables the workflow builds from fold and member rows, and the verdicts read from them."""
-    return build_verdicts(table2=ex.table2(folds, ["w1"], paper=PAPER),
-                          table2_ens=ex.table2_ensemble(members, ["w1"], paper=PAPER), members=members,
-                          paired=ex.paired_comparison(folds, n_boot=100),
-                          deriv=ex.derivative_summary(dfold, members=dmem, n_boot=100), folds=folds,
+    return build_verdicts(table2=tb.table2(folds, ["w1"], paper=PAPER),
+                          table2_ens=tb.table2_ensemble(members, ["w1"], paper=PAPER), members=members,
+                          paired=st.paired_comparison(folds, n_boot=100),
+                          deriv=st.derivative_summary(dfold, members=dmem, n_boot=100), folds=folds,
                           claim="delaunay_better", main_derivative="half", baseline="delaunay_idw_d2",
                           datasets=["w1"], data="synthetic w1")
 
@@ -119,7 +119,7 @@ def test_simplicial_verdicts_survive_last_digit_noise(simplicial_runs, seed):
 @pytest.mark.parametrize("seed", [0, 1])
 def test_facegraph_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow, seed):
     """The tiny run's own tables (as its verdicts rule reads them), then the same with noise."""
-    from animsynth.facegraph.experiments import verdicts
+    from animsynth.facegraph.verdicts import verdicts
 
     out = tiny_workflow / "results" / "facegraph"
     read = lambda p: pd.read_csv(p, keep_default_na=False, na_values=[""])  # noqa: E731

@@ -86,6 +86,19 @@ def test_every_job_of_the_tiny_run_kept_a_log_and_a_benchmark_file(tiny_workflow
     assert not problems, "\n".join(problems[:40])
 
 
+def test_every_file_the_tiny_run_wrote_is_a_declared_output(tiny_workflow):
+    """No rule writes a file it does not declare (snakemake --list-untracked lists none under results/).
+
+    The one exception is the benchmark file of the job that aggregates the benchmark files (it is written
+    by Snakemake after that job, so no rule can take it as an input)."""
+    res = run_snakemake(tiny_workflow, "--configfile", "config/test.yaml", "--list-untracked")
+    assert res.returncode == 0, res.stderr[-2000:]
+    listed = [ln.strip() for ln in (res.stdout + res.stderr).splitlines() if ln.strip().startswith("results")]
+    own = "results/benchmarks/rules/report/rule_benchmarks.tsv"
+    untracked = [p for p in listed if p != own and "/logs/" not in p]
+    assert not untracked, "written but not declared:\n" + "\n".join(untracked[:40])
+
+
 #: Machine- and load-dependent outputs, the only ones allowed to differ between runs.
 # facegraph/table1.md is the rendered view that joins Table 1 with its timing table (as the paper's Table 1 does);
 # table1.csv itself is compared.

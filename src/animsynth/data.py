@@ -1,4 +1,5 @@
-"""Getting mocap trials: download/copy with checksums, parse, and Table I.
+"""Getting mocap trials: download/copy with checksums, and parse (Gauch & Peters Table I of the subsets:
+:mod:`animsynth.simplicial.table1`).
 
 Real CMU files are fetched per file from ``<mirror>/subjects/<SS>/<file>``
 where the mirror is ``http://mocap.cs.cmu.edu`` (the official site) or any URL
@@ -12,18 +13,14 @@ from __future__ import annotations
 
 import hashlib
 import logging
-import os
-import shutil
 import time
 import urllib.error
 import urllib.request
 
-import pandas as pd
-
 from .config import ConfigError, resolve_inside
 from .io.amc import read_amc
 from .io.asf import read_asf
-from .io.atomic import atomic_path
+from .atomic import atomic_path
 from .motion import Motion
 
 log = logging.getLogger("animsynth.data")
@@ -100,11 +97,6 @@ def fetch_file(source: str, rel: str, dest, sha256: str | None, attempts: int = 
     return got
 
 
-def copy_local(src, dest) -> None:
-    with atomic_path(dest) as tmp:
-        shutil.copyfile(src, tmp)
-
-
 def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
                bvh_length_to_m: float = 1.0) -> Motion:
     """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion`.
@@ -137,90 +129,3 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     m.skeleton.roles = dict(joint_roles or {})
     m.name = name or m.name
     return m
-
-
-def datasets_table(subsets: dict, motions: dict, source: str, paper: dict | None = None) -> pd.DataFrame:
-    """Gauch & Peters Table I for the selected data.
-
-    Parameters
-    ----------
-    subsets : name -> list of trial ids (in order)
-    motions : trial id -> Motion
-    source : ``synthetic``, ``cmu`` or ``user``
-    paper : name -> list of published lengths (see :func:`read_paper_table1`), optional
-        When given (even empty) the table gets ``paper_lengths``, ``paper_total_nodes``,
-        ``total_nodes_minus_paper`` (ours - paper)
-        and ``length_match`` (which trials match the paper's length at the same
-        position, and which stand in for another length); empty for subsets the
-        paper does not list.
-    """
-    rows = []
-    for name, ids in subsets.items():
-        lengths = [motions[t].n_frames for t in ids]
-        dims = {motions[t].without_root().shape[1] for t in ids}
-        if len(dims) != 1:
-            raise ValueError(f"subset {name!r} mixes trials with different DOF counts {sorted(dims)}")
-        rows.append(
-            {
-                "dataset": name,
-                "source": source,
-                "trials": " ".join(ids),
-                "dims": dims.pop(),
-                "n_sequences": len(ids),
-                "lengths": " ".join(str(n) for n in lengths),
-                "total_nodes": int(sum(lengths)),
-            }
-        )
-        if paper is not None:
-            pl = paper.get(name)
-            rows[-1]["paper_lengths"] = " ".join(map(str, pl)) if pl else ""
-            rows[-1]["paper_total_nodes"] = int(sum(pl)) if pl else None
-            rows[-1]["total_nodes_minus_paper"] = int(sum(lengths)) - int(sum(pl)) if pl else None
-            rows[-1]["length_match"] = length_match(ids, lengths, pl) if pl else ""
-    cols = ["dataset", "source", "trials", "dims", "n_sequences", "lengths", "total_nodes"]
-    if paper is not None:
-        cols += ["paper_lengths", "paper_total_nodes", "total_nodes_minus_paper", "length_match"]
-    return pd.DataFrame(rows, columns=cols)
-
-
-def length_match(ids, lengths, paper_lengths) -> str:
-    """``all N match`` or which trials match the published lengths (same position) and which stand in."""
-    same = [f"{t} ({n})" for t, n, p in zip(ids, lengths, paper_lengths) if n == p]
-    other = [f"{t} ({n}) for {p}" for t, n, p in zip(ids, lengths, paper_lengths) if n != p]
-    if len(paper_lengths) != len(ids):
-        other.append(f"paper lists {len(paper_lengths)} sequences, we use {len(ids)}")
-    if not other:
-        return f"all {len(ids)} match"
-    return ("match: " + ", ".join(same) + "; " if same else "") + "stand-ins: " + ", ".join(other)
-
-
-def read_paper_table1(path) -> dict:
-    """Published Table I lengths: ``{subset: [frames, ...]}``; empty when ``path`` is unset or absent.
-
-    The CSV has columns ``dataset`` and ``lengths`` (space-separated frame
-    counts). A malformed file raises ``ValueError`` naming the file and line.
-    """
-    if not path or not os.path.exists(path):
-        if path:
-            log.info("published Table I not found at %s: paper columns left empty", path)
-        return {}
-    df = pd.read_csv(path, dtype=str, keep_default_na=False)
-    for c in ("dataset", "lengths"):
-        if c not in df.columns:
-            raise ValueError(f"{path}: line 1: missing column {c!r}")
-    out = {}
-    for i, r in df.iterrows():
-        try:
-            out[r["dataset"].strip()] = [int(x) for x in r["lengths"].split()]
-        except ValueError:
-            raise ValueError(f"{path}: line {i + 2}: lengths must be integers, got {r['lengths']!r}") from None
-    return out
-
-
-#: Gauch & Peters Table I (frames per sequence), for the captions and tests.
-PAPER_TABLE_I = {
-    "w1": [443, 360, 455, 454],
-    "w2": [347, 520, 269, 282],
-    "r1": [167, 167, 175, 160],
-    "r2": [258, 139, 200, 163],
-}

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .atomic import atomic_path
+from .errors import MotionFormatError
 from .skeleton import Skeleton
 
 
@@ -49,10 +51,7 @@ class Motion:
         return self.values[:, n_root:]
 
     # -- .npz storage used between workflow rules -------------------------
-    # (io is imported inside the methods: io's readers import this module)
     def save_npz(self, path) -> None:
-        from .io.atomic import atomic_path
-
         with atomic_path(path, suffix=".npz") as tmp:
             np.savez_compressed(
                 tmp,
@@ -65,8 +64,6 @@ class Motion:
 
     @classmethod
     def load_npz(cls, path) -> "Motion":
-        from .io.errors import MotionFormatError
-
         with np.load(path, allow_pickle=False) as z:
             sk = Skeleton.from_json(str(z["skeleton"]))
             m = cls(np.array(z["values"], float), sk, float(z["fps"]), str(z["name"]))

@@ -11,14 +11,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from . import verdicts as verdict_format
 from .tables import to_markdown
 
 log = logging.getLogger("animsynth.report")
 
-VERDICT_COLUMNS = ["claim", "verdict", "evidence"]
-# The common verdict format of the families (optional beyond VERDICT_COLUMNS).
-CLAIM_COLUMNS = ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
-VERDICT_VOCABULARY = ("reproduced", "partly", "not reproduced", "contradicted", "within noise")
 # Which paper each family's verdicts speak for.
 FAMILY_PAPERS = {
     "simplicial": "Gauch & Peters (simplicial complex)",
@@ -135,24 +132,6 @@ def run_benchmarks(files, size: str = "full") -> pd.DataFrame:
     return df[cols + [c for c in df.columns if c not in cols]]
 
 
-def read_verdicts(paths) -> pd.DataFrame:
-    frames = []
-    for p in sorted(map(str, paths)):
-        df = pd.read_csv(p, keep_default_na=False)
-        missing = [c for c in VERDICT_COLUMNS if c not in df]
-        if missing:
-            raise ValueError(f"{p}: verdict table lacks columns {missing}")
-        df = df[VERDICT_COLUMNS].copy()
-        df.insert(0, "family", Path(p).parent.name)
-        frames.append(df)
-    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=["family"] + VERDICT_COLUMNS)
-
-
-def is_synthetic(data: str) -> bool:
-    """Does a verdict's ``data`` text name synthetic (generated) data?"""
-    return "synthetic" in str(data).lower()
-
-
 PAPER_RUN_COMMAND = ("python3 run.py paper --config cmu_mirror=../shared/data/cmu_mocap "
                      "mesh_dir=../shared/data/vlasic_mesh_animation/samba")
 
@@ -180,13 +159,13 @@ def claims_table(paths, family_data: dict[str, str] | None = None,
     Parameters
     ----------
     paths : iterable of path
-        ``<family>/verdicts.csv`` files (the family is the parent folder's name).
+        ``<family>/verdicts.csv`` files (the family is the parent folder's name), each in the common
+        format of :mod:`animsynth.verdicts` (checked: columns and vocabulary).
     family_data : dict, optional
         {family: what it ran on}; fills ``data`` where a verdict row leaves it empty.
-    family_real : dict, optional
-        {family: True if it ran on real data}, as the data layer recorded it. A
-        row's ``real`` comes from its family's entry; only a family missing here
-        falls back to the word "synthetic" in the row's ``data`` text.
+    family_real : dict
+        {family: True if it ran on real data}, as the data layer recorded it. Every row's ``real``
+        comes from its family's entry; a family missing here is an error (no word in a text decides it).
 
     Returns
     -------
@@ -196,29 +175,24 @@ def claims_table(paths, family_data: dict[str, str] | None = None,
         data first, then by family in the order given.
     """
     family_data = family_data or {}
+    family_real = family_real or {}
     frames = []
     for p in map(str, paths):
-        df = pd.read_csv(p, keep_default_na=False, dtype=str)
-        missing = [c for c in VERDICT_COLUMNS if c not in df]
-        if missing:
-            raise ValueError(f"{p}: verdict table lacks columns {missing}")
+        df = verdict_format.read(p).copy()
         fam = Path(p).parent.name
-        for c in CLAIM_COLUMNS:
-            if c not in df:
-                df[c] = ""
-        df = df[CLAIM_COLUMNS].copy()
+        if fam not in family_real:
+            raise ValueError(f"{p}: the data layer recorded no provenance (real or synthetic) for family {fam!r}; "
+                             f"recorded: {sorted(family_real)}")
         df.loc[df["data"].str.strip() == "", "data"] = family_data.get(fam, "")
         df.insert(0, "family", fam)
         df.insert(0, "paper", FAMILY_PAPERS.get(fam, fam))
+        df["real"] = bool(family_real[fam])
         df["order"] = len(frames)
         frames.append(df)
-    cols = ["paper", "family", *CLAIM_COLUMNS, "real"]
+    cols = ["paper", "family", *verdict_format.COLUMNS, "real"]
     if not frames:
         return pd.DataFrame(columns=cols)
     out = pd.concat(frames, ignore_index=True)
-    by_text = ~out["data"].map(is_synthetic)
-    recorded = out["family"].map(lambda f: (family_real or {}).get(f))
-    out["real"] = [bool(r) if r is not None else bool(t) for r, t in zip(recorded, by_text)]
     out = out.sort_values(["real", "order"], ascending=[False, True], kind="stable")
     return out[cols].reset_index(drop=True)
 

@@ -90,7 +90,7 @@ class Steps:
 STEP_FUNCTIONS = {
     "simplicial_steps": ("animsynth.simplicial.jobs", "scale_steps"),
     "resequencing_steps": ("animsynth.resequencing.study", "scale_steps"),
-    "facegraph_steps": ("animsynth.facegraph.experiments", "scale_steps"),
+    "facegraph_steps": ("animsynth.facegraph.jobs", "scale_steps"),
     "meshdetail_steps": ("animsynth.meshdetail.jobs", "scale_steps"),
 }
 

@@ -7,7 +7,7 @@ import os
 import numpy as np
 import pandas as pd
 
-from .io.atomic import atomic_path, atomic_write_text
+from .atomic import atomic_path, atomic_write_text
 
 
 def _fmt(v) -> str:
@@ -38,15 +38,20 @@ def to_markdown(df: pd.DataFrame, title: str | None = None, note: str | None = N
     return "\n".join(lines) + "\n"
 
 
-def write_table(df: pd.DataFrame, csv_path, md: bool = True, title: str | None = None,
+def write_table(df: pd.DataFrame, csv_path, md=True, title: str | None = None,
                 note: str | None = None, float_format: str = "%.6g") -> None:
-    """Write ``df`` to ``csv_path`` atomically and, if ``md``, a Markdown copy
-    rendered from the CSV just written (``.md`` beside it)."""
+    """Write ``df`` to ``csv_path`` atomically and a Markdown copy rendered from the CSV just written.
+
+    ``md``: the Markdown file's path (a workflow passes its declared output), True for the ``.md``
+    beside the CSV, False for none. Every file a rule writes is one of its declared outputs (the
+    workflow tests check that a run leaves no untracked file).
+    """
     with atomic_path(csv_path) as tmp:
         df.to_csv(tmp, index=False, float_format=float_format, lineterminator="\n")
     if md:
         back = pd.read_csv(csv_path, keep_default_na=False, na_values=[""])
-        atomic_write_text(os.path.splitext(os.fspath(csv_path))[0] + ".md", to_markdown(back, title, note))
+        md_path = os.path.splitext(os.fspath(csv_path))[0] + ".md" if md is True else os.fspath(md)
+        atomic_write_text(md_path, to_markdown(back, title, note))
 
 
 def add_paper_differences(df: pd.DataFrame, pairs: dict[str, str], suffix: str = "_minus_paper") -> pd.DataFrame:

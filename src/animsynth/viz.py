@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .io.atomic import atomic_path
+from .atomic import atomic_path
 
 
 def _bounds(positions_list):

@@ -26,7 +26,7 @@ def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None 
     Uncaught exceptions are logged too, so the log explains a failed job.
     Figures of the job are drawn with matplotlib's non-interactive Agg backend.
     Temporaries that an interrupted earlier run left for this job's outputs
-    are removed (:func:`animsynth.io.atomic.clean_stale_temporaries`).
+    are removed (:func:`animsynth.atomic.clean_stale_temporaries`).
     """
     # workflow jobs draw figures into files: matplotlib's non-interactive backend for them only (the library
     # itself forces no backend, so interactive use keeps the user's)
@@ -48,7 +48,7 @@ def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None 
     root.addHandler(handler)
     logger = logging.getLogger(name if name.startswith("animsynth") else f"animsynth.{name}")
     if snakemake is not None:
-        from .io.atomic import clean_stale_temporaries
+        from .atomic import clean_stale_temporaries
 
         clean_stale_temporaries(str(o) for o in snakemake.output)
         limit_compiled_threads(int(getattr(snakemake, "threads", 1) or 1))

@@ -1,6 +1,7 @@
 # Data layer: get every trial (generate synthetic ASF/AMC, or download real
-# CMU / copy user files with checksums), parse it with the real readers into
-# results/data/trials/{trial}.npz, and write Gauch & Peters Table I.
+# CMU / copy user files with checksums) and parse it with the real readers into
+# results/data/trials/{trial}.npz (Gauch & Peters Table I of the subsets,
+# results/data/datasets.csv, is the simplicial family's: simplicial.smk).
 # Downloads are not retried by Snakemake: animsynth.data retries network
 # failures itself, and a checksum mismatch is deterministic.
 # threads/resources (mem_mb in MB, runtime in minutes) are sized from the
@@ -19,8 +20,8 @@ if SOURCE == "synthetic":
             amc="resources/mocap/{trial}.amc",
             asf="resources/mocap/{trial}.asf",
         params:
-            spec=lambda wc: TRIALS[wc.trial],
-            seed=lambda wc: seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], wc.trial),
+            spec=trial_spec,
+            seed=synthetic_trial_seed,
             subject_seed=config["synthetic_mocap"]["seed"],
             fps=config["fps"],
         threads: 1
@@ -44,10 +45,10 @@ else:
             asf="resources/mocap/{trial}.asf",
         params:
             source=MOCAP_MIRROR,
-            amc=lambda wc: TRIALS[wc.trial]["amc"],
-            asf=lambda wc: TRIALS[wc.trial]["asf"],
-            sha256=lambda wc: TRIALS[wc.trial].get("sha256"),
-            asf_sha256=lambda wc: TRIALS[wc.trial].get("asf_sha256"),
+            amc=trial_field("amc"),
+            asf=trial_field("asf"),
+            sha256=trial_field("sha256", required=False),
+            asf_sha256=trial_field("asf_sha256", required=False),
         threads: 1
         resources:
             mem_mb=500,
@@ -66,8 +67,8 @@ else:
             bvh="resources/mocap/{trial}.bvh",
         params:
             source=MOCAP_MIRROR,
-            bvh=lambda wc: TRIALS[wc.trial]["bvh"],
-            sha256=lambda wc: TRIALS[wc.trial].get("sha256"),
+            bvh=trial_field("bvh"),
+            sha256=trial_field("sha256", required=False),
         threads: 1
         resources:
             mem_mb=500,
@@ -91,8 +92,8 @@ rule parse_trial:
         R("data/trials/{trial}.npz"),
     params:
         fps=config["fps"],
-        joint_roles=config.get("joint_roles") or {},
-        bvh_length_to_m=config.get("bvh_length_to_m", 1.0),
+        joint_roles=config["joint_roles"],
+        bvh_length_to_m=config["bvh_length_to_m"],
     threads: 1
     resources:
         mem_mb=500,
@@ -107,36 +108,7 @@ rule parse_trial:
         "../scripts/data_parse_trial.py"
 
 
-rule datasets_table:
-    input:
-        lambda wc: [trial_npz(t) for ids in SUBSETS.values() for t in ids],
-    output:
-        csv=report(
-            R("data/datasets.csv"),
-            caption="../report/data_datasets.rst",
-            category="1. Data",
-            labels={"table": "Gauch & Peters Table I"},
-        ),
-        md=R("data/datasets.md"),
-    params:
-        subsets=SUBSETS,
-        source=SOURCE,
-        paper_table1=config.get("simplicial", {}).get("paper_table1"),
-    threads: 1
-    resources:
-        mem_mb=500,
-        runtime=10,
-    log:
-        L("data/datasets_table.log"),
-    benchmark:
-        B("data/datasets_table.tsv")
-    conda:
-        "../envs/animsynth.yaml"
-    script:
-        "../scripts/data_datasets_table.py"
-
-
-DATA_TARGETS = [R("data/datasets.csv")] + [trial_npz(t) for t in USED_TRIALS]
+DATA_TARGETS = [trial_npz(t) for t in USED_TRIALS]
 
 
 # ---- mesh sequences of the hybrid mesh experiments -------------------------
@@ -165,12 +137,12 @@ if MESH_FETCH:
 
     rule mesh_fetch:
         input:
-            sums=lambda w: MESH_FETCH_SUMS[w.meshsrc],
+            sums=mesh_fetch_sums,
         output:
             directory("resources/mesh/{meshsrc}"),
         params:
-            source=lambda w: MESH_FETCH[w.meshsrc],
-            max_unpacked_mb=config.get("meshdetail", {}).get("max_unpacked_mb", 8000),
+            source=mesh_fetch_source,
+            max_unpacked_mb=config["meshdetail"]["max_unpacked_mb"],
         log:
             L("data/mesh_fetch/{meshsrc}.log"),
         benchmark:
@@ -191,8 +163,8 @@ if MESH_CHECK:
 
     rule mesh_checksums:
         input:
-            frames=lambda w: MD_FRAMES[w.mdseq],
-            sums=lambda w: MD_SEQS[w.mdseq]["mesh_sha256"],
+            frames=mesh_sequence_frames,
+            sums=mesh_sequence_sums,
         output:
             R("data/mesh_checksums/{mdseq}.csv"),
         log:

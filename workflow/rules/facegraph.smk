@@ -4,15 +4,15 @@
 # pre-processed once. Table 1: one job fits every compression configuration (the
 # paper's 15 targets with tolerances by default; per-sample threshold search,
 # graph build, re-synthesis of every sequence), aggregated by facegraph_table1
-# with the published values beside ours. The baseline, uniqueness study and
+# with the published values beside ours (published.facegraph.table1, a declared
+# input: a changed file reruns Table 1). The baseline, uniqueness study and
 # figures use the graphs of the showcase configuration. Every job gets only
 # the config keys it uses.
 
-from animsynth.facegraph.settings import (check_facegraph_config, configurations, showcase,
-                                          sweep_configurations)
+# Config checks: animsynth.facegraph.settings.check, called with the others from common.smk.
+from animsynth.facegraph.settings import configurations, showcase, sweep_configurations
 
 FG = config["facegraph"]
-check_facegraph_config(FG)
 FG_TABLE_CONFIGS = configurations(FG)
 FG_SWEEP_CONFIGS = sweep_configurations(FG)
 FG_SHOWCASE_CONF = showcase(FG)
@@ -27,7 +27,8 @@ FG_SHOWCASE_GRAPH = R(f"facegraph/graphs/{FG_SHOWCASE}.npz")
 # Resources sized from measured use with headroom (rule benchmarks, 70 sequences / CK+ scale): peak RSS
 # synth_db 107 / 115 MB, prepare 147 / 161 MB (13 / 66 s CPU), graph 230 / 475 MB (5-12 / 10-20 s CPU),
 # baseline 446 / 685 MB (face graphs capped at baseline.max_nodes poses), table1/verdicts/uniqueness ~160 MB. Runtimes (minutes)
-# allow for a machine shared by several jobs (wall up to 20x CPU seen) and scale with the database size.
+# allow for a machine shared by several jobs (wall up to 20x CPU seen) and scale with the database size
+# (fg_mem_mb / fg_runtime in common.smk's facegraph block: times the attempt; runtimes also times FG_SCALE).
 FG_SCALE = max(1.0, FG["synthetic"]["n_sequences"] / 70.0) if FG_SYNTHETIC else 5.0
 
 
@@ -41,8 +42,8 @@ if FG_SYNTHETIC:
             seed=seed_for("facegraph", FG["seed"], "synthetic"),
         threads: 1
         resources:
-            mem_mb=lambda wc, attempt: 500 * attempt,
-            runtime=lambda wc, attempt: int(10 * FG_SCALE * attempt),
+            mem_mb=fg_mem_mb(500),
+            runtime=fg_runtime(10),
         log:
             L("facegraph/synth_db.log"),
         benchmark:
@@ -70,8 +71,8 @@ rule facegraph_prepare:
         source=FG_SOURCE,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 1000 * attempt,
-        runtime=lambda wc, attempt: int(20 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(1000),
+        runtime=fg_runtime(20),
     log:
         L("facegraph/prepare.log"),
     benchmark:
@@ -100,8 +101,8 @@ rule facegraph_graphs:
         seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 1000 * attempt,
-        runtime=lambda wc, attempt: int(len(FG_MAIN_NAMES) * 5 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(1000),
+        runtime=fg_runtime(5 * len(FG_MAIN_NAMES)),
     log:
         L("facegraph/graphs.log"),
     benchmark:
@@ -125,8 +126,8 @@ if FG_SWEEP_NAMES:
             seed=FG_SEED_GRAPH,
         threads: 1
         resources:
-            mem_mb=lambda wc, attempt: 1000 * attempt,
-            runtime=lambda wc, attempt: int(len(FG_SWEEP_NAMES) * 5 * FG_SCALE * attempt),
+            mem_mb=fg_mem_mb(1000),
+            runtime=fg_runtime(5 * len(FG_SWEEP_NAMES)),
         log:
             L("facegraph/sweep_graphs.log"),
         benchmark:
@@ -141,6 +142,7 @@ rule facegraph_table1:
     input:
         runs=[R(f"facegraph/runs/{c['name']}.json") for c in FG_TABLE_CONFIGS],
         db=R("facegraph/preprocessed.npz"),
+        paper=published_input("facegraph", "table1"),
     output:
         csv=report(
             R("facegraph/table1.csv"),
@@ -159,7 +161,6 @@ rule facegraph_table1:
         thresholds_md=R("facegraph/thresholds.md"),
     params:
         order=[c["name"] for c in FG_TABLE_CONFIGS],
-        paper=FG["paper_table1"],
         title="Table 1: region motion graphs for the paper's 15 compression configurations",
     threads: 1
     resources:
@@ -194,7 +195,6 @@ if FG_SWEEP_CONFIGS:
             thresholds_md=R("facegraph/sweep_thresholds.md"),
         params:
             order=[c["name"] for c in FG_SWEEP_CONFIGS],
-            paper=None,
             title="Optional sweep: creation x merge targets (one tolerance)",
         threads: 1
         resources:
@@ -229,8 +229,8 @@ rule facegraph_baseline:
         seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 3000 * attempt,
-        runtime=lambda wc, attempt: int(30 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(3000),
+        runtime=fg_runtime(30),
     log:
         L("facegraph/baseline.log"),
     benchmark:
@@ -259,8 +259,8 @@ rule facegraph_uniqueness:
         seed=seed_for("facegraph", FG["seed"], "uniqueness"),
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 800 * attempt,
-        runtime=lambda wc, attempt: int(15 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(800),
+        runtime=fg_runtime(15),
     log:
         L("facegraph/uniqueness.log"),
     benchmark:
@@ -301,8 +301,8 @@ rule facegraph_figures:
         graph_seed=FG_SEED_GRAPH,
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 1000 * attempt,
-        runtime=lambda wc, attempt: int(15 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(1000),
+        runtime=fg_runtime(15),
     log:
         L("facegraph/figures.log"),
     benchmark:
@@ -332,8 +332,8 @@ rule facegraph_verdicts:
         order=[c["name"] for c in FG_TABLE_CONFIGS],
     threads: 1
     resources:
-        mem_mb=lambda wc, attempt: 500 * attempt,
-        runtime=lambda wc, attempt: int(5 * FG_SCALE * attempt),
+        mem_mb=fg_mem_mb(500),
+        runtime=fg_runtime(5),
     log:
         L("facegraph/verdicts.log"),
     benchmark:
@@ -362,7 +362,7 @@ FACEGRAPH_SUMMARY = [
     {
         "title": "Serra et al. 2018 Table 1: region motion graphs for the paper's 15 configurations",
         "csv": R("facegraph/table1.csv"),
-        "note": f"{_FG_DATA_NOTE} paper_* columns: the published values (facegraph.paper_table1), empty if that "
+        "note": f"{_FG_DATA_NOTE} paper_* columns: the published values (published.facegraph.table1), empty if that "
         "file is missing. Creation/synthesis times (CPU and wall) are in table1_timing.csv.",
     },
     {

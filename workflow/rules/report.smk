@@ -35,7 +35,7 @@ SUMMARY_TIMING = [s["csv"] for s in SUMMARY_SECTIONS if re.search(r"(^|_)timing\
 VERDICT_FILES = [v for fam, vs in FAMILY_VERDICTS.items() if FAMILY_RAN[fam] for v in vs]
 BENCH_SCRIPTS = sorted(glob_wildcards("benchmarks/bench_{name}.py").name)
 # With the scale study on, its 100,000-frame re-sequencing rows join benchmarks.csv.
-BENCH_EXTRA = [R("scale/benchmarks.csv")] if config.get("scale", {}).get("enabled", False) else []
+BENCH_EXTRA = [R("scale/benchmarks.csv")] if config["scale"]["enabled"] else []
 
 
 rule summary:
@@ -60,7 +60,7 @@ rule summary:
         timing=SUMMARY_TIMING,
         source=SOURCE,
         mesh_dir=config["mesh_dir"],
-        faces=config["facegraph"].get("ckplus_dir"),
+        faces=config["facegraph"]["ckplus_dir"],
         provenance=provenance_rows(),
         family_data={fam: label for fam, (label, _ok, _why) in FAMILY_STATUS.items()},
         family_real=FAMILY_REAL,
@@ -87,11 +87,12 @@ rule benchmarks:
         scripts=expand("benchmarks/bench_{name}.py", name=BENCH_SCRIPTS),
         extra=BENCH_EXTRA,
     output:
-        report(
+        csv=report(
             R("benchmarks.csv"),
             caption="../report/benchmarks.rst",
             category="0. Summary",
         ),
+        md=R("benchmarks.md"),
     params:
         size=config["benchmark_size"],
     # full size: ~160 s CPU, 254 MB peak; demo size: seconds
@@ -125,6 +126,8 @@ rule rule_benchmarks:
             caption="../report/rule_benchmarks_per_family.rst",
             category="0. Summary",
         ),
+        per_rule_md=R("rule_benchmarks_per_rule.md"),
+        per_family_md=R("rule_benchmarks_per_family.md"),
     params:
         root=BENCH_ROOT,
     threads: 1

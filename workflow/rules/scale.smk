@@ -41,14 +41,14 @@ rule scale_measure:
     params:
         cfg=SCALE,
         mirror=SCALE_MIRROR,
-        seed=lambda wc: seed_for("scale", wc.scfamily, wc.scpoint),
+        seed=scale_point_seed,
     log:
         L("scale/measure/{scfamily}_{scpoint}.log"),
     benchmark:
         B("scale/measure/{scfamily}_{scpoint}.tsv")
     threads: 1
     resources:
-        mem_mb=lambda wc: SCALE["resequencing"]["mem_mb"] if wc.scfamily == "resequencing" else 3000,
+        mem_mb=scale_point_mem_mb,
         runtime=60,
     conda:
         "../envs/animsynth.yaml"
@@ -92,7 +92,7 @@ rule scale_landmark_vs_exact:
     params:
         cfg=SCALE,
         mirror=SCALE_MIRROR,
-        seed=lambda wc: seed_for("scale", "landmark_vs_exact", wc.scn),
+        seed=landmark_vs_exact_seed,
     log:
         L("scale/landmark_vs_exact/n{scn}.log"),
     benchmark:

@@ -1,22 +1,25 @@
 # Simplicial-complex motion generation (Gauch & Peters).
+# Table I: the subsets' lengths beside the published ones (results/data/datasets.csv).
 # Main table: one job per dataset runs its leave-one-out folds (fold = held-out
 # trial id); each fold follows every method from the same ensemble of starts
 # together (one vectorised field step for all paths), aggregated into folds.csv /
 # table2*.csv / paired.csv. The derivative-variant grid and the
 # beyond-the-paper grid run one job per dataset. Figures 1-6 and the Fig 7
 # walk are one job each. Every job gets only the config keys it uses, so
-# changing a value reruns exactly the affected jobs.
-from animsynth.config import ConfigError
+# changing a value reruns exactly the affected jobs. The config checks of this
+# family (animsynth.simplicial.settings.check) run from common.smk; the input
+# functions are in common.smk ("simplicial input functions"). The published
+# tables (published.simplicial.table1/table2) are inputs of the jobs that show
+# them, declared only when the file exists; params.paper_label names the
+# configured path in the tables' notes.
 
 SIMP = config["simplicial"]
+SIMP_PUBLISHED = config["published"]["simplicial"]
 SIMP_DATASETS = list(SUBSETS)
 SIMP_METHODS = list(SIMP["methods"])
 SIMP_MAIN_KEYS = ("k", "latent_dim", "derivative", "weights", "steps", "dup_tol", "rank_tol")
-
-if SIMP["figures"]["dataset"] not in SUBSETS:
-    raise ConfigError(
-        f"config key 'simplicial.figures.dataset': {SIMP['figures']['dataset']!r} is not a subset ({SIMP_DATASETS})"
-    )
+# the parsed trials of the subset shown in Figs 1-7
+SIMP_FIGURE_TRIALS = [trial_npz(t) for t in SUBSETS[SIMP["figures"]["dataset"]]]
 
 
 wildcard_constraints:
@@ -35,6 +38,37 @@ SIMP_ENSEMBLE_SEED = seed_for("simplicial", SIMP["seed"], "ensemble")
 SIMP_FOLD_JSONS = [R(f"simplicial/folds/{d}.json") for d in SIMP_DATASETS]
 
 
+# Gauch & Peters Table I for the run's subsets, beside the published lengths.
+rule simplicial_table1:
+    input:
+        trials=[trial_npz(t) for ids in SUBSETS.values() for t in ids],
+        paper_table1=published_input("simplicial", "table1"),
+    output:
+        csv=report(
+            R("data/datasets.csv"),
+            caption="../report/data_datasets.rst",
+            category="1. Data",
+            labels={"table": "Gauch & Peters Table I"},
+        ),
+        md=R("data/datasets.md"),
+    params:
+        subsets=SUBSETS,
+        source=SOURCE,
+        paper_label=SIMP_PUBLISHED["table1"],
+    log:
+        L("simplicial/table1.log"),
+    benchmark:
+        B("simplicial/table1.tsv")
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=10,
+    conda:
+        "../envs/animsynth.yaml"
+    script:
+        "../scripts/simplicial_table1.py"
+
+
 # One job per dataset runs its leave-one-out folds one after the other (a fold
 # takes about a second, less than a job's start-up).
 rule simplicial_fold:
@@ -43,7 +77,7 @@ rule simplicial_fold:
     output:
         R("simplicial/folds/{dataset}.json"),
     params:
-        ids=lambda wc: SUBSETS[wc.dataset],
+        ids=simplicial_subset_ids,
         cfg=SIMP_ENSEMBLE_CFG,
         seed=SIMP_ENSEMBLE_SEED,
     log:
@@ -62,7 +96,8 @@ rule simplicial_fold:
 
 rule simplicial_table:
     input:
-        SIMP_FOLD_JSONS,
+        folds=SIMP_FOLD_JSONS,
+        paper_table2=published_input("simplicial", "table2"),
     output:
         folds=report(
             R("simplicial/folds.csv"),
@@ -102,8 +137,9 @@ rule simplicial_table:
     params:
         datasets=SIMP_DATASETS,
         methods=SIMP_METHODS,
-        cfg={k: SIMP[k] for k in ("paper_table2", "bootstrap", "alpha", "ensemble")},
+        cfg={k: SIMP[k] for k in ("bootstrap", "alpha", "ensemble")},
         seed=seed_for("simplicial", SIMP["seed"], "bootstrap"),
+        paper_label=SIMP_PUBLISHED["table2"],
     log:
         L("simplicial/table.log"),
     benchmark:
@@ -125,8 +161,8 @@ rule simplicial_grid:
         folds=R("simplicial/{grid}/{dataset}.csv"),
         members=R("simplicial/{grid}/{dataset}_members.csv"),
     params:
-        ids=lambda wc: SUBSETS[wc.dataset],
-        cfg=lambda wc: SIMP_GRID_CFG[wc.grid],
+        ids=simplicial_subset_ids,
+        cfg=simplicial_grid_cfg,
         seed=SIMP_ENSEMBLE_SEED,
     log:
         L("simplicial/{grid}/{dataset}.log"),
@@ -153,6 +189,7 @@ rule simplicial_summary:
         paired=R("simplicial/paired.csv"),
         table2=R("simplicial/table2.csv"),
         table2_ensemble=R("simplicial/table2_ensemble.csv"),
+        paper_table2=published_input("simplicial", "table2"),
     output:
         derivative=report(
             R("simplicial/derivative.csv"),
@@ -193,7 +230,6 @@ rule simplicial_summary:
         cfg={
             "methods": SIMP["methods"],
             "paper_claim": SIMP["paper_claim"],
-            "paper_table2": SIMP["paper_table2"],
             "magnitude_factor": SIMP["magnitude_factor"],
             "derivative": SIMP["derivative"],
             "bootstrap": SIMP["bootstrap"],
@@ -219,7 +255,7 @@ rule simplicial_summary:
 
 rule simplicial_figures:
     input:
-        lambda wc: [trial_npz(t) for t in SUBSETS[SIMP["figures"]["dataset"]]],
+        SIMP_FIGURE_TRIALS,
     output:
         **{
             f"fig{n}": report(
@@ -257,7 +293,7 @@ rule simplicial_figures:
 
 rule simplicial_walk:
     input:
-        lambda wc: [trial_npz(t) for t in SUBSETS[SIMP["figures"]["dataset"]]],
+        SIMP_FIGURE_TRIALS,
     output:
         png=report(
             R("simplicial/figures/fig7_walk.png"),
@@ -291,6 +327,7 @@ rule simplicial_walk:
 
 
 SIMPLICIAL_TARGETS = [
+    R("data/datasets.csv"),
     R("simplicial/folds.csv"),
     R("simplicial/table2.csv"),
     R("simplicial/table2.md"),
@@ -318,7 +355,7 @@ SIMPLICIAL_SUMMARY = [
         "title": "Gauch & Peters Table II: median Error A / Error F per subset (Delaunay vs k-NN)",
         "csv": R("simplicial/table2.csv"),
         "note": "Ours normalised by the fold's latent bounding-box diagonal, from the held-out start; paper_* = the "
-        "published Table II (simplicial.paper_table2; empty when the file is absent).",
+        "published Table II (published.simplicial.table2; empty when the file is absent).",
     },
     {
         "title": "Simplicial: Table II over the ensemble of jittered starts",

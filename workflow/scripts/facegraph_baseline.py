@@ -1,5 +1,5 @@
 """Face graph (Zhang et al. 2004) vs region graphs on the same re-synthesis queries."""
-from animsynth.facegraph.experiments import baseline_table, data_note
+from animsynth.facegraph.jobs import baseline_table, data_note
 from animsynth.facegraph.preprocess import FaceDatabase
 from animsynth.facegraph.regiongraph import load_graphs
 from animsynth.tables import write_table

@@ -1,11 +1,11 @@
 """Region graph drawing, original vs synthesised trajectories, animated GIF."""
 import numpy as np
 
-from animsynth.facegraph.experiments import synth_kwargs
+from animsynth.facegraph.jobs import synth_kwargs
 from animsynth.facegraph.regiongraph import load_graphs
 from animsynth.facegraph.preprocess import FaceDatabase
 from animsynth.facegraph.synthesis import FaceSynthesizer
-from animsynth.facegraph.viz import draw_region_graphs, draw_trajectories, face_gif
+from animsynth.facegraph.plots import draw_region_graphs, draw_trajectories, face_gif
 from animsynth.io.ckplus import EMOTIONS
 from animsynth.workflow_utils import setup_logging
 

@@ -3,10 +3,10 @@ every sequence. An untimed warm-up fit first, so that every configuration's crea
 compile or cache load."""
 import json
 
-from animsynth.facegraph.experiments import run_configuration, warm_up
+from animsynth.facegraph.jobs import run_configuration, warm_up
 from animsynth.facegraph.preprocess import FaceDatabase
 from animsynth.facegraph.regiongraph import save_graphs
-from animsynth.io.atomic import atomic_path, atomic_write_text
+from animsynth.atomic import atomic_path, atomic_write_text
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821

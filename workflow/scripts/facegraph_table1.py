@@ -1,24 +1,31 @@
 """Aggregate the per-configuration runs into Table 1 (or the sweep), its timing table and the thresholds."""
 import json
+import os
 
 import pandas as pd
 
-from animsynth.facegraph.experiments import assemble_table1, assemble_timing, data_note
+from animsynth.facegraph.jobs import assemble_table1, assemble_timing, data_note
 from animsynth.facegraph.preprocess import FaceDatabase
-from animsynth.facegraph.settings import read_paper_table1
-from animsynth.io.atomic import atomic_write_text
+from animsynth.facegraph.settings import published_table1
+from animsynth.atomic import atomic_write_text
 from animsynth.tables import to_markdown, write_table
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
 runs = [json.load(open(p)) for p in snakemake.input.runs]  # noqa: F821
 db = FaceDatabase.load_npz(snakemake.input.db)  # noqa: F821
-paper = read_paper_table1(snakemake.params.paper) if snakemake.params.paper else {}  # noqa: F821
+# Table 1 declares the published table as input "paper" (empty when the file is absent: read_table(None)
+# then logs the WARNING); the sweep has no published counterpart and declares none.
+published = None
+paper = {}
+if "paper" in snakemake.input.keys():  # noqa: F821
+    published = snakemake.input.paper[0] if snakemake.input.paper else None  # noqa: F821
+    paper = published_table1(published)
 order = snakemake.params.order  # noqa: F821
 table = assemble_table1([r["row"] for r in runs], order, paper)
 timing = assemble_timing([r["timing"] for r in runs], order, paper)
 thr = pd.DataFrame([t for r in runs for t in r["thresholds"]])
-src = (f"published values from {snakemake.params.paper}" if paper else  # noqa: F821
+src = (f"published values from {os.path.relpath(published)}" if paper else
        "no published values available (paper_* columns empty)")
 note = (f"{data_note(db.source)} {db.n_samples} sequences, {int(db.lengths.sum())} poses. paper_*: {src}. "
         "Node compression = 1 - region-graph nodes / poses (negative when the five region graphs hold more nodes "

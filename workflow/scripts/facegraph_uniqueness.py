@@ -1,8 +1,8 @@
 """Distinct animations from one label sequence over N seeded runs."""
-from animsynth.facegraph.experiments import data_note, uniqueness_tables
+from animsynth.facegraph.jobs import data_note, uniqueness_tables
 from animsynth.facegraph.regiongraph import load_graphs
 from animsynth.facegraph.preprocess import FaceDatabase
-from animsynth.io.atomic import atomic_path
+from animsynth.atomic import atomic_path
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 

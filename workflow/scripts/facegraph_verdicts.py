@@ -1,7 +1,8 @@
 """Claims of the paper checked against the facegraph tables -> verdicts.csv."""
 import pandas as pd
 
-from animsynth.facegraph.experiments import data_note, verdicts
+from animsynth.facegraph.jobs import data_note
+from animsynth.facegraph.verdicts import verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 

@@ -1,7 +1,7 @@
 """Fig. 5a (full deformation vs detail), Fig. 5c and generalisation under blocked CV, held-out predictions."""
 import numpy as np
 
-from animsynth.io.atomic import atomic_path
+from animsynth.atomic import atomic_path
 from animsynth.meshdetail.experiments import run_main
 from animsynth.meshdetail.jobs import fold_rig_fitter, load_prepared
 from animsynth.tables import write_table

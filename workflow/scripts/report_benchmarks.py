@@ -20,5 +20,5 @@ df = run_benchmarks(snakemake.input.scripts, size=snakemake.params.size)  # noqa
 extra = [pd.read_csv(p) for p in snakemake.input.extra]  # noqa: F821
 if extra:
     df = pd.concat([df, *extra], ignore_index=True)[list(df.columns)]
-write_table(df, snakemake.output[0], md=True, title="Benchmarks (machine-dependent)")  # noqa: F821
+write_table(df, snakemake.output.csv, md=snakemake.output.md, title="Benchmarks (machine-dependent)")  # noqa: F821
 log.info("%d benchmark rows", len(df))

@@ -8,8 +8,8 @@ out = snakemake.output  # noqa: F821
 root = snakemake.params.root  # noqa: F821
 jobs = aggregate_rule_benchmarks(list(snakemake.input), root=root)  # noqa: F821
 write_table(jobs, out.jobs, md=False)
-write_table(rule_benchmark_summary(jobs), out.per_rule, md=True,
+write_table(rule_benchmark_summary(jobs), out.per_rule, md=out.per_rule_md,
             title="Runtime and peak memory per rule (this machine)")
-write_table(family_benchmark_summary(jobs), out.per_family, md=True,
+write_table(family_benchmark_summary(jobs), out.per_family, md=out.per_family_md,
             title="Wall time, CPU time and peak memory per family (this machine)")
 log.info("%d job benchmark files below %s", len(jobs), root)

@@ -1,7 +1,7 @@
 """summary.md (claims first, then every table), claims.csv and the report's home page (claims.rst)."""
 import pandas as pd
 
-from animsynth.io.atomic import atomic_write_text
+from animsynth.atomic import atomic_write_text
 from animsynth.report import build_summary, claims_rst, claims_table
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging

@@ -2,7 +2,7 @@
 import numpy as np
 
 from animsynth.motion import Motion
-from animsynth.io.atomic import atomic_path
+from animsynth.atomic import atomic_path
 from animsynth.resequencing.study import analyse, gdof_flag, prepare_motion
 from animsynth.workflow_utils import setup_logging
 

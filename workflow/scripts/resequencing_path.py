@@ -2,7 +2,7 @@
 import pandas as pd
 
 from animsynth.motion import Motion
-from animsynth.io.atomic import atomic_path
+from animsynth.atomic import atomic_path
 from animsynth.resequencing.study import gdof_flag, prepare_motion, resequence
 from animsynth.viz import motion_previews
 from animsynth.workflow_utils import setup_logging

@@ -1,7 +1,7 @@
 """Aggregate: Table 2 beside the paper, explanations, sign flips, residual variance, smoothness, verdicts, timings."""
 import pandas as pd
 
-from animsynth.io.atomic import atomic_path
+from animsynth.atomic import atomic_path
 from animsynth.resequencing.study import (check_lee_weights, min_k_table, read_published, summarise_paths,
                                           with_defaults)
 from animsynth.resequencing.verdicts import all_verdicts

@@ -12,27 +12,27 @@ Dijkstra (``scipy.sparse.csgraph``), rotations and their interpolation (``scipy.
 Written here, each in a few lines: the paper's closed-form alignment, the graph bookkeeping, the walk and the
 transition blend.
 
-The method (sections of the paper)
-----------------------------------
-3.1 Frame distance. Frame ``i`` of clip A and frame ``j`` of clip B are compared through point clouds over
-    windows of ``k`` frames: ``A_i .. A_{i+k-1}`` (the window that *starts* at A_i) and
+The method (the paper's steps)
+------------------------------
+Candidate transitions. Frame ``i`` of clip A and frame ``j`` of clip B are compared through point clouds
+    over windows of ``k`` frames: ``A_i .. A_{i+k-1}`` (the window that *starts* at A_i) and
     ``B_{j-k+1} .. B_j`` (the window that *ends* at B_j). The points are the joint positions of every frame
     of the window (forward kinematics, metres). ``D(A_i, B_j) = min_{theta, x0, z0} sum_n w_n
     |p_n - T(theta, x0, z0) p'_n|^2``, ``T`` a rotation by ``theta`` about the vertical (y) axis followed by
     the floor translation ``(x0, 0, z0)``, solved in closed form (:func:`floor_alignment`). With
     ``sum w_n = 1`` D is a weighted mean squared distance (m^2); we report and threshold ``sqrt(D)``, the
-    RMS point distance in metres (monotone in D: the same minima). Candidate transitions are the local
-    minima of D over ``(i, j)`` below a threshold.
-3.2 Transitions. A transition from A_i to B_j blends the ``k`` frame pairs of the two windows after B has
-    been moved by the aligning transform: for ``p = 0 .. k-1`` the root position is interpolated linearly
-    and every joint rotation spherically, with A's weight
+    RMS point distance in metres (monotone in D: the same minima).
+Transition points: the local minima of D over ``(i, j)`` below a threshold.
+Creating transitions. A transition from A_i to B_j blends the ``k`` frame pairs of the two windows after
+    B has been moved by the aligning transform: for ``p = 0 .. k-1`` the root position is interpolated
+    linearly and every joint rotation spherically, with A's weight
     ``alpha(p) = 2((p+1)/k)^3 - 3((p+1)/k)^2 + 1`` (``alpha(k-1) = 0``: the last blended frame is B_j).
     Playback then continues at ``B_{j+1}``.
-4   Pruning: only the largest strongly connected component is kept (no dead ends; every node reaches every
+Pruning: only the largest strongly connected component is kept (no dead ends; every node reaches every
     other).
-5   Search: random walks (:meth:`MotionGraph.generate`) and a shortest path to the node nearest a target
-    pose (:meth:`MotionGraph.search`; the paper's branch-and-bound over a user error function is replaced by
-    Dijkstra on the playback time, the plainest well-defined graph search).
+Extracting motion: random walks (:meth:`MotionGraph.generate`) and a shortest path to the node nearest a
+    target pose (:meth:`MotionGraph.search`; the paper's branch-and-bound over a user error function is
+    replaced by Dijkstra on the playback time, the plainest well-defined graph search).
 
 Choices the paper leaves open (ours)
 ------------------------------------
@@ -49,7 +49,7 @@ Choices the paper leaves open (ours)
 * Threshold (``threshold``, metres RMS): ``None`` resolves it from the data as the ``threshold_quantile``
   quantile of the candidate local minima (default the median: half the candidates become transitions).
   This default was chosen so that it means the same for any skeleton, unit and database; it is not tuned
-  to any published number (Kovar et al. set the threshold by hand for each database).
+  to any published number (the paper leaves the threshold to the user and names none).
 * ``blend`` b <= k blends only the last b frame pairs of the two windows (b = k is the paper's transition).
 * Start of generation: the walk starts at the database frame that follows the frame whose preceding window
   is nearest (the same aligned distance) to the last frames of ``start``, and the whole output is moved by
@@ -75,7 +75,7 @@ __all__ = ["MotionGraph", "apply_floor_transform", "floor_alignment", "kovar_alp
 
 
 # --------------------------------------------------------------------------------------------------
-# the closed-form alignment (paper, section 3.1)
+# the closed-form alignment
 # --------------------------------------------------------------------------------------------------
 def _normalised_weights(weights, n: int) -> np.ndarray:
     w = np.ones(n) if weights is None else np.asarray(weights, float).reshape(-1)
@@ -113,7 +113,7 @@ def floor_alignment(p, q, weights=None):
     """The rotation about y and floor translation that best map point cloud ``q`` onto ``p`` (closed form).
 
     Minimises ``sum_n w_n |p_n - T q_n|^2`` over ``T`` = rotation by ``theta`` about the vertical y axis
-    followed by ``(x0, 0, z0)`` (Kovar, Gleicher & Pighin 2002, section 3.1). With ``xb = sum w x`` etc.
+    followed by ``(x0, 0, z0)`` (the closed form of Kovar, Gleicher & Pighin 2002). With ``xb = sum w x`` etc.
     (weights normalised to sum 1)::
 
         theta = atan2(sum w (x z' - x' z) - (xb zb' - xb' zb), sum w (x x' + z z') - (xb xb' + zb zb'))
@@ -220,7 +220,8 @@ class MotionGraph:
     Parameters
     ----------
     window : int
-        ``k``: frames (at the database's frame rate) of the point-cloud windows and of a transition.
+        ``k``: frames (at the database's frame rate) of the point-cloud windows and of a transition
+        (10: 1/3 s at 30 fps).
     threshold : float or None
         Largest RMS aligned point distance (metres) of a transition; ``None``: resolved from the data as
         the ``threshold_quantile`` quantile of the candidate local minima.
@@ -287,7 +288,9 @@ class MotionGraph:
         """Build the graph on ``database`` (list of Motion: one DOF layout, one frame rate).
 
         Every clip needs at least ``window + 2`` frames. Clips on skeletons with other bone lengths are
-        compared through their own forward kinematics; the output is on the first clip's skeleton.
+        compared through their own forward kinematics; the output is on the first clip's skeleton: frames of
+        another subject's clip are played with that subject's joint rotations and root translation on the
+        first subject's bones (feet may then float or sink by the difference in leg length).
         """
         k, b, r = self._check_params()
         clips = list(database)

@@ -5,8 +5,11 @@ Pipeline: :class:`FacePreprocessor` (sigmoid fit, two-stage Procrustes,
 neutral-peak-neutral samples) -> :class:`FaceGraphModel` (Algorithm 1 sample
 graphs, merging, compression-driven thresholds, one graph per region) ->
 :class:`FaceSynthesizer` (labels -> peak nodes -> Dijkstra -> motion
-recovery, coherent noise). :mod:`.experiments` holds Table 1, the baseline
-comparison and the uniqueness study.
+recovery, coherent noise). The family's rooms: :mod:`.settings` (config checks,
+configurations, the published Table 1), :mod:`.jobs` (the workflow steps: Table 1,
+the baseline comparison, the uniqueness study), :mod:`.verdicts` (the paper's
+claims decided), :mod:`.plots` (figures) and :mod:`.kernels` (the compiled loops of
+graph creation).
 """
 
 from .._lazy import lazy_exports

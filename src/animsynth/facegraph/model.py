@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from . import _jit
+from . import kernels
 from .merging import Merger, merge_sample_graphs
 from .preprocess import FaceDatabase
 from .samplegraphs import (PoseStack, RegionData, SampleNodes, create_sample_graphs, creation_compression,
@@ -43,7 +43,7 @@ def _consecutive_similarity(rd: RegionData, lam, eps) -> np.ndarray:
 def _nn_similarity(nodes: SampleNodes, red, rng, k: int = 256) -> np.ndarray:
     """Plain distance sum from up to k random sample nodes to their nearest node of another sample.
 
-    Exact, compiled (:func:`._jit.nearest_other_sample`; written by hand: the
+    Exact, compiled (:func:`.kernels.nearest_other_sample`; written by hand: the
     distance is a sum of per-landmark Euclidean norms, which no
     scipy/scikit-learn neighbour search offers). The sum runs landmark by
     landmark (the order of a reduction over the strided landmark axis of
@@ -57,7 +57,7 @@ def _nn_similarity(nodes: SampleNodes, red, rng, k: int = 256) -> np.ndarray:
     if len(q) == 0:
         return np.zeros(0)
     D = np.ascontiguousarray(nodes.disp[:, red], float)
-    out = _jit.nearest_other_sample(D, np.ascontiguousarray(nodes.sample, np.int64), np.asarray(q, np.int64))
+    out = kernels.nearest_other_sample(D, np.ascontiguousarray(nodes.sample, np.int64), np.asarray(q, np.int64))
     return out[np.isfinite(out)]
 
 
@@ -248,9 +248,9 @@ class FaceGraphModel:
         if bad or not np.all(np.isfinite(db.mean_neutral)):
             raise ValueError(f"pre-processed database holds non-finite coordinates (samples {bad[:10]}); "
                              "refusing to build graphs")
-        too_big = {r: len(ix) for r, ix in db.regions.items() if len(ix) > _jit.MAX_REGION_LANDMARKS}
+        too_big = {r: len(ix) for r, ix in db.regions.items() if len(ix) > kernels.MAX_REGION_LANDMARKS}
         if too_big:
-            raise ValueError(f"regions with more than {_jit.MAX_REGION_LANDMARKS} landmarks ({too_big}): the compiled "
+            raise ValueError(f"regions with more than {kernels.MAX_REGION_LANDMARKS} landmarks ({too_big}): the compiled "
                              "graph code sums at most that many per region in numpy's order; split the region")
         cpu0, wall0 = time.process_time(), time.perf_counter()
         lam, eps = float(self.lam), float(self.velocity_eps)

@@ -46,7 +46,7 @@ import numpy as np
 from scipy.optimize import OptimizeWarning, curve_fit
 from scipy.special import expit
 
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 from ..io.ckplus import EMOTIONS, CKSequence
 from .geometry import apply_transform_2d, fit_transform_2d
 from .regions import REGION_NAMES, check_regions

@@ -10,7 +10,6 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..io.ckplus import EMOTIONS, emotion_code, read_ckplus
-from .experiments import graph_kwargs, synth_kwargs
 from .model import FaceGraphModel
 from .preprocess import FacePreprocessor
 from .synthesis import FaceSynthesizer
@@ -47,21 +46,21 @@ def synthesise_from_labels(labels, out: str, ckplus_dir: str | None = None, seed
         db = FacePreprocessor().fit_transform(seqs, source=str(ckplus_dir or "synthetic CK+-layout data"))
     with threadpool_limits(1):
         model = FaceGraphModel(creation, merge, seed=seed, creation_tolerance=creation_tolerance,
-                               merge_tolerance=merge_tolerance, **graph_kwargs({})).fit(db)
-        synth = FaceSynthesizer(model.graphs_, **synth_kwargs({"noise_share": 0.2, "duration_noise": True}))
+                               merge_tolerance=merge_tolerance).fit(db)
+        synth = FaceSynthesizer(model.graphs_, noise_share=0.2, duration_noise=True)
         anim = synth.synthesize(list(labels), rng=np.random.default_rng(seed))
     pos = anim.positions(db.mean_neutral)
     if out.endswith(".csv"):
         import pandas as pd
 
-        from ..io.atomic import atomic_path
+        from ..atomic import atomic_path
 
         f, k = np.meshgrid(np.arange(pos.shape[0]), np.arange(pos.shape[1]), indexing="ij")
         df = pd.DataFrame({"frame": f.ravel(), "landmark": k.ravel(), "x": pos[..., 0].ravel(), "y": pos[..., 1].ravel()})
         with atomic_path(out) as t:
             df.to_csv(t, index=False, float_format="%.3f")
     elif out.endswith(".gif"):
-        from .viz import face_gif
+        from .plots import face_gif
 
         face_gif(out, pos, anim.segments)
     else:

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.sparse import csr_matrix
 
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 
 #: Added to every edge weight so that ``scipy.sparse.csgraph`` keeps zero-similarity edges.
 EDGE_EPS = 1e-9

@@ -8,7 +8,7 @@ was entered (its incoming edges). The next pose is compared with the nodes of
 its sample graph by eq. 3 (reduced landmarks, :mod:`.similarity`); if the
 similarity is at most the creation threshold the pose is merged into the most
 similar node, otherwise it opens a new node linked from the current one. The
-walks are compiled (numba, :mod:`._jit`), which is what makes the threshold
+walks are compiled (numba, :mod:`.kernels`), which is what makes the threshold
 searches cheap; the threshold may differ per region and per sample
 (per-sample thresholds, :mod:`.model`).
 """
@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _jit
+from . import kernels
 from .preprocess import FaceDatabase
 from .regions import REGION_NAMES
 from .similarity import pose_similarity
@@ -121,7 +121,7 @@ def create_sample_graphs(stack: PoseStack, thresholds, lam: float = 1.0, max_ent
     most the threshold, otherwise it opens a new node; a change of node is an
     edge. The time-reversed half thus folds back onto the forward nodes.
 
-    The walks run compiled, one sample at a time (:func:`._jit.alg1_all`), with
+    The walks run compiled, one sample at a time (:func:`.kernels.alg1_all`), with
     the arithmetic of eq. 3 over the zero-padded landmark axis of the stack.
 
     Parameters
@@ -142,7 +142,7 @@ def create_sample_graphs(stack: PoseStack, thresholds, lam: float = 1.0, max_ent
         thr = np.atleast_2d(thr)[..., None]
     thr = np.ascontiguousarray(np.broadcast_to(thr, (thr.shape[0], R, S0)))
     out = np.empty(thr.shape + (T,), np.int64)
-    _jit.alg1_all(np.ascontiguousarray(stack.X, float), np.ascontiguousarray(stack.U, float),
+    kernels.alg1_all(np.ascontiguousarray(stack.X, float), np.ascontiguousarray(stack.U, float),
                   np.ascontiguousarray(stack.ok, float), np.ascontiguousarray(stack.lengths, np.int64), thr,
                   float(lam), int(max_entries), out)
     return out

@@ -1,4 +1,8 @@
-"""Cross-key checks of the ``facegraph`` config block (beyond the JSON Schema)."""
+"""Settings of the facegraph family: its config checks beyond the JSON Schema (:func:`check`), the
+configurations named by the config, and the published Table 1 mapped to them.
+
+Defaults live only in ``config/schema.yaml`` (the validator fills them); nothing here supplies one.
+"""
 
 from __future__ import annotations
 
@@ -19,33 +23,40 @@ def config_name(creation: float, merge: float, creation_tolerance: float | None 
     return f"{c}_{m}"
 
 
-def _entry(c: dict, tolerance: float | None = None) -> dict:
-    ct = c.get("creation_tolerance", tolerance)
-    mt = c.get("merge_tolerance", tolerance)
-    return {"name": config_name(c["creation"], c["merge"], ct, mt), "creation": float(c["creation"]),
-            "creation_tolerance": float(ct), "merge": float(c["merge"]), "merge_tolerance": float(mt)}
+def _entry(creation: float, creation_tolerance: float, merge: float, merge_tolerance: float) -> dict:
+    return {"name": config_name(creation, merge, creation_tolerance, merge_tolerance), "creation": float(creation),
+            "creation_tolerance": float(creation_tolerance), "merge": float(merge),
+            "merge_tolerance": float(merge_tolerance)}
+
+
+def _config_entry(c: dict) -> dict:
+    return _entry(c["creation"], c["creation_tolerance"], c["merge"], c["merge_tolerance"])
 
 
 def configurations(fg: dict) -> list[dict]:
     """Table 1 configurations in config order: dicts with ``name``, ``creation``,
     ``creation_tolerance``, ``merge``, ``merge_tolerance`` (fractions)."""
-    return [_entry(c) for c in fg["configurations"]]
+    return [_config_entry(c) for c in fg["configurations"]]
 
 
 def sweep_configurations(fg: dict) -> list[dict]:
     """The optional creation x merge grid (``facegraph.sweep``); empty unless enabled."""
-    sw = fg.get("sweep", {})
-    if not sw.get("enabled", False):
+    sw = fg["sweep"]
+    if not sw["enabled"]:
         return []
     tol = float(sw["tolerance"])
-    return [_entry({"creation": c, "merge": m}, tol) for c in sw["creation"] for m in sw["merge"]]
+    return [_entry(c, tol, m, tol) for c in sw["creation"] for m in sw["merge"]]
 
 
 def showcase(fg: dict) -> dict:
     """The configuration whose graphs feed the baseline, uniqueness study and figures."""
-    return _entry(fg["showcase"])
+    return _config_entry(fg["showcase"])
 
 
+#: Config key naming the published Table 1 (Serra et al. 2018).
+PUBLISHED_KEY = "published.facegraph.table1"
+#: Columns of the published Table 1 that name a configuration (fractions).
+PAPER_KEYS = ("creation_target", "creation_tolerance", "merge_target", "merge_tolerance")
 PAPER_COLUMNS = {  # our column -> column of the published table (s4_table1.csv)
     "node_compression_pct": "nodes_compression_pct", "data_compression_pct": "data_compression_pct",
     "duration_diff": "duration_diff", "duration_diff_sd": "duration_diff_sd",
@@ -56,37 +67,55 @@ PAPER_COLUMNS = {  # our column -> column of the published table (s4_table1.csv)
 }
 
 
-def read_paper_table1(path) -> dict[str, dict]:
-    """Published Table 1 values keyed by configuration name ({} if the file is missing).
+def published_table1(path) -> dict[str, dict]:
+    """Published Table 1 values keyed by configuration name ({} when there is no file).
 
-    The file (``facegraph.paper_table1``) has one row per configuration with
-    ``creation_target, creation_tolerance, merge_target, merge_tolerance`` as
-    fractions and the published columns named in :data:`PAPER_COLUMNS`.
+    Read with :func:`animsynth.published.read_table` (a missing file or ``None`` logs a WARNING naming
+    the path and gives {}). The file (config key ``published.facegraph.table1``) has one row per
+    configuration: ``row``, the targets and tolerances :data:`PAPER_KEYS` as fractions, and the published
+    columns named in :data:`PAPER_COLUMNS`.
+
+    Returns
+    -------
+    dict
+        ``{config name: {our column: value, ..., "row": published row number}}``.
+
+    Raises
+    ------
+    animsynth.published.PublishedError
+        A column missing, a non-number, an empty target cell or two rows naming one configuration
+        (the message names the file and the line).
     """
-    import logging
+    import numpy as np
 
-    import pandas as pd
+    from ..published import PublishedError, read_table
 
-    if not path or not os.path.isfile(path):
-        logging.getLogger("animsynth.facegraph.settings").info(
-            "no published Table 1 at %r: paper_* columns left empty", path)
+    cols = ("row", *PAPER_KEYS, *PAPER_COLUMNS.values())
+    df = read_table(path, cols, cols, what="Serra et al. 2018 Table 1", config_key=PUBLISHED_KEY)
+    if df is None:
         return {}
-    df = pd.read_csv(path)
-    need = {"creation_target", "creation_tolerance", "merge_target", "merge_tolerance"}
-    missing = need - set(df.columns)
-    if missing:
-        raise ConfigError(f"config key 'facegraph.paper_table1': {path} lacks column(s) {sorted(missing)}")
-    out = {}
-    for _, r in df.iterrows():
-        name = config_name(r.creation_target, r.merge_target, r.creation_tolerance, r.merge_tolerance)
-        out[name] = {ours: float(r[theirs]) for ours, theirs in PAPER_COLUMNS.items() if theirs in df.columns}
-        if "row" in df.columns:
-            out[name]["row"] = int(r["row"])
+    out, line_of = {}, {}
+    for i, r in enumerate(df.to_dict("records")):
+        line = i + 2  # header = line 1
+        if not all(np.isfinite(r[k]) for k in ("row", *PAPER_KEYS)):
+            raise PublishedError(f"{path}, line {line}: empty row number or target ({PUBLISHED_KEY})")
+        name = config_name(r["creation_target"], r["merge_target"], r["creation_tolerance"], r["merge_tolerance"])
+        if name in out:
+            raise PublishedError(f"{path}, line {line}: configuration {name} already on line {line_of[name]} "
+                                 f"({PUBLISHED_KEY})")
+        out[name] = {ours: float(r[theirs]) for ours, theirs in PAPER_COLUMNS.items()}
+        out[name]["row"] = int(r["row"])
+        line_of[name] = line
     return out
 
 
-def check_facegraph_config(fg: dict) -> None:
-    """Raise :class:`ConfigError` naming the key for values the schema cannot check."""
+def check(config: dict) -> None:
+    """Every check of the ``facegraph`` config block the schema cannot express.
+
+    ``config``: the whole workflow config (validated against ``config/schema.yaml``, defaults filled).
+    Raises :class:`ConfigError` naming the key.
+    """
+    fg = config["facegraph"]
     key = "facegraph"
     pre = fg["preprocess"]
     check_regions(pre["regions"], pre["reduced_landmarks"], pre["rigid_landmarks"], key=f"{key}.preprocess")
@@ -115,7 +144,7 @@ def check_facegraph_config(fg: dict) -> None:
                           f"into {s['n_sequences']} sequences of {s['min_frames']}-{s['max_frames']} frames")
     if s["min_frames"] > s["max_frames"]:
         raise ConfigError(f"config key '{key}.synthetic.min_frames': larger than max_frames")
-    d = fg.get("ckplus_dir")
+    d = fg["ckplus_dir"]
     if d is not None and not os.path.isdir(d):
         raise ConfigError(f"config key '{key}.ckplus_dir': {d!r} is not a folder (point it at your CK+ copy "
                           "holding Landmarks/ and Emotion/, or use null for the synthetic database)")

@@ -15,8 +15,8 @@ import numpy as np
 
 from ..motion import Motion
 from ..skeleton import Skeleton
-from .atomic import atomic_write_text
-from .errors import MotionFormatError, parse_float, read_text_lines
+from ..atomic import atomic_write_text
+from ..errors import MotionFormatError, parse_float, read_text_lines
 
 log = logging.getLogger("animsynth.io")
 

@@ -18,8 +18,8 @@ import os
 import numpy as np
 
 from ..skeleton import CMU_BONE_ORDER, Joint, Skeleton
-from .atomic import atomic_write_text
-from .errors import MotionFormatError, parse_float, read_text_lines
+from ..atomic import atomic_write_text
+from ..errors import MotionFormatError, parse_float, read_text_lines
 
 _AXES = {"X", "Y", "Z"}
 

@@ -4,7 +4,7 @@ Reading (:func:`read_bvh`) accepts BVH as it exists in the wild: any root name
 (``ROOT Hips``, ``ROOT root``, ``ROOT mixamorig:Hips``), any rotation-channel
 order per joint, lengths in whatever unit the file uses. It is strict where a
 silent misreading would follow; each of these is a
-:class:`~animsynth.io.errors.MotionFormatError` naming file and line:
+:class:`~animsynth.errors.MotionFormatError` naming file and line:
 
 * a joint's rotation (or position) channels must name distinct axes
   (``Xrotation Xrotation Xrotation`` is refused);
@@ -71,8 +71,8 @@ from scipy.spatial.transform import Rotation
 from ..kinematics import dof_values_from_local, local_rotations, root_translation
 from ..motion import Motion
 from ..skeleton import ROT_DOFS, TRANS_DOFS, Joint, Skeleton
-from .atomic import atomic_write_text
-from .errors import MotionFormatError, parse_float, read_text_lines
+from ..atomic import atomic_write_text
+from ..errors import MotionFormatError, parse_float, read_text_lines
 
 _CH = {"Xposition": "tx", "Yposition": "ty", "Zposition": "tz",
        "Xrotation": "rx", "Yrotation": "ry", "Zrotation": "rz"}

@@ -29,7 +29,7 @@ The official layout (Lucey et al. 2010), which :func:`read_ckplus` reads as is::
   a margin of 150 px; a UTF-8 byte-order mark is stripped; undecodable bytes
   are reported with their line.
 
-Every problem raises :class:`~animsynth.io.errors.MotionFormatError` with the
+Every problem raises :class:`~animsynth.errors.MotionFormatError` with the
 file (and the 1-based line for content errors).
 """
 
@@ -42,8 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .atomic import atomic_write_text
-from .errors import MotionFormatError, parse_float
+from ..atomic import atomic_write_text
+from ..errors import MotionFormatError, parse_float
 
 log = logging.getLogger("animsynth.io.ckplus")
 

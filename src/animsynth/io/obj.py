@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .atomic import atomic_path, atomic_write_bytes
-from .errors import MotionFormatError, parse_float
+from ..atomic import atomic_path, atomic_write_bytes
+from ..errors import MotionFormatError, parse_float
 
 __all__ = ["MeshSequence", "read_obj", "write_obj", "read_obj_sequence", "write_obj_sequence", "list_obj_frames",
            "is_frame_name", "frame_stem"]

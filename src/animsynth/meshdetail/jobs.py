@@ -19,7 +19,7 @@ import os
 import numpy as np
 
 from ..io import read_amc, read_asf
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 from ..io.obj import MeshSequence, read_obj_sequence, write_obj_sequence
 from ..skinning import Rig, cmu_motion_to_rig, default_rig, rebase, rebase_pose
 from ..synth.character import SkirtParams, build_character, edit_motion, procedural_motion, simulate

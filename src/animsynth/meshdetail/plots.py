@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.collections import PolyCollection
 
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 
 
 def _shade_split(ax, df):

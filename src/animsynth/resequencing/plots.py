@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.collections import LineCollection
 
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 
 __all__ = ["embedding_figure", "residual_variance_figure"]
 

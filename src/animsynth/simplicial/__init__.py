@@ -7,8 +7,11 @@ graph       the motion graph G', edge orientation, connectivity (SCC, H)
 field       training vectors (half / forward / central) and the interpolated vector field
 path        field following (one path, or many together) and target-directed shortest paths in G'
 metrics     Error A / Error F and point-to-polyline distances
-experiment  leave-one-sequence-out folds, ensembles of starts, Table II, paired tests, variant grids
-settings    the published values (paper Table II) and the paper's conclusion
+folds       leave-one-sequence-out folds, ensembles of starts, variant grids (the fold and member rows)
+tables      Table II in the paper's layout, in every unit, over the ensemble of starts, per fold
+stats       stability over the ensemble, paired tests, bootstrap CIs, derivative and variant summaries
+table1      Gauch & Peters Table I of the run's data (results/data/datasets.csv)
+settings    config checks, the published values (paper Tables I and II) and the paper's conclusion
 verdicts    the claims checked, decided from the tables
 plots       the paper's figures and the beyond-the-paper figure
 jobs        one function per workflow job (the Snakemake scripts stay thin)
@@ -18,23 +21,25 @@ from .._lazy import lazy_exports
 
 # name -> module; imported on first use (the family's heavy libraries load only when needed)
 _EXPORTS = {
-    "FOLD_COLUMNS": ".experiment",
+    "FOLD_COLUMNS": ".folds",
     "FieldStack": ".field",
-    "MEMBER_COLUMNS": ".experiment",
+    "MEMBER_COLUMNS": ".folds",
     "MotionGraph": ".graph",
     "SafeDelaunay": ".geometry",
     "TargetPlanner": ".path",
-    "Variant": ".experiment",
+    "Variant": ".folds",
     "VectorField": ".field",
+    "datasets_table": ".table1",
     "error_a": ".metrics",
     "error_f": ".metrics",
     "follow_batch": ".path",
     "follow_field": ".path",
     "generate_from_trials": ".generate",
     "point_polyline_distance": ".metrics",
-    "run_fold": ".experiment",
-    "run_fold_ensemble": ".experiment",
-    "run_subset": ".experiment",
+    "run_fold": ".folds",
+    "run_fold_ensemble": ".folds",
+    "run_subset": ".folds",
+    "table2": ".tables",
     "training_vectors": ".field",
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

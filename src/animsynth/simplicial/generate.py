@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .experiment import fit_pca
+from .folds import fit_pca
 from .field import VectorField, training_vectors
 from .path import follow_field
 

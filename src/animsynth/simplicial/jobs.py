@@ -15,10 +15,14 @@ import pandas as pd
 
 from ..config import derive_seed
 from ..motion import Motion
-from ..io.atomic import atomic_write_text
+from ..atomic import atomic_write_text
 from ..tables import write_table
-from . import experiment as ex
-from .settings import paper_claim_from, read_paper_table2
+from .folds import (FOLD_COLUMNS, MEMBER_COLUMNS, Variant, beyond_variants, derivative_variants, order_folds,
+                    run_fold, run_fold_ensemble, run_subset, to_jsonable)
+from .settings import check_figure_folds, paper_claim_from, read_paper_table1, read_paper_table2
+from .stats import derivative_summary, paired_comparison, summarise_variants
+from .table1 import datasets_table
+from .tables import fold_ensemble, table2, table2_ensemble, table2_units
 
 log = logging.getLogger("animsynth.simplicial.jobs")
 
@@ -40,10 +44,36 @@ def load_trials(paths, ids) -> tuple[dict, dict]:
     return angles, motions
 
 
-def main_variant(cfg: dict, method: str) -> ex.Variant:
+def table1_job(trial_paths, subsets: dict, source: str, out: dict, paper_table1=None, paper_label=None) -> None:
+    """Gauch & Peters Table I of the run's subsets, the published lengths beside ours (``out["csv"]`` + ``.md``).
+
+    Parameters
+    ----------
+    trial_paths : parsed trials (``<trial id>.npz``) of every subset
+    subsets : subset name -> trial ids, in order
+    source : ``synthetic``, ``cmu`` or ``user``
+    paper_table1 : the published Table I file, or None (no published lengths: the ``paper_*`` columns stay
+        empty); ``paper_label`` names it in the note (the configured path).
+    """
+    motions = {os.path.splitext(os.path.basename(os.fspath(p)))[0]: Motion.load_npz(p) for p in trial_paths}
+    paper = read_paper_table1(paper_table1)
+    df = datasets_table(subsets, motions, source, paper if paper is not None else {})
+    if paper:
+        diff = [f"{r.dataset}: {r.length_match}" for r in df.itertuples()
+                if r.length_match and not r.length_match.startswith("all")]
+        note = (f"`paper_*`: Gauch & Peters Table I, read from {paper_label}. "
+                + ("Subsets whose lengths differ from the paper's (same position): " + "; ".join(diff) + "."
+                   if diff else "Every trial has the paper's length."))
+    else:
+        note = f"No published Table I at {paper_label!r}: paper columns left empty."
+    write_table(df, out["csv"], md=True, title=f"Table I: datasets ({source} data)", note=note)
+    log.info("wrote Table I with %d subsets", len(df))
+
+
+def main_variant(cfg: dict, method: str) -> Variant:
     """The paper's configuration for ``method`` (config keys of the main table)."""
-    return ex.Variant(method, method=method, k=int(cfg["k"]), latent_dim=int(cfg["latent_dim"]),
-                      derivative=cfg["derivative"], weights=cfg["weights"] if method == "delaunay" else "idw").check()
+    return Variant(method, method=method, k=int(cfg["k"]), latent_dim=int(cfg["latent_dim"]),
+                   derivative=cfg["derivative"], weights=cfg["weights"] if method == "delaunay" else "idw").check()
 
 
 def run_main_fold(paths, ids, dataset: str, fold: str, cfg: dict, seed: int):
@@ -63,7 +93,7 @@ def run_main_fold(paths, ids, dataset: str, fold: str, cfg: dict, seed: int):
                          f"of fold {dataset}/{fold}")
     ens = cfg["ensemble"]
     variants = [main_variant(cfg, m) for m in cfg["methods"]]
-    rows, members = ex.run_fold_ensemble(
+    rows, members = run_fold_ensemble(
         train, angles[fold], variants, n_starts=int(ens["n_starts"]), jitter=float(ens["jitter"]),
         seed=derive_seed(seed, dataset, fold), dataset=dataset, held_out=fold, fold=ids.index(fold),
         steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]), rank_tol=float(cfg["rank_tol"]))
@@ -80,8 +110,8 @@ def write_fold_json(path, rows: list, members) -> None:
     """Fold rows and ensemble members (one DataFrame, or a list of them, one per fold) -> one JSON file."""
     if isinstance(members, pd.DataFrame):
         members = [members]
-    payload = {"rows": [ex.to_jsonable(r) for r in rows],
-               "members": [ex.to_jsonable(r) for m in members for r in m.to_dict("records")]}
+    payload = {"rows": [to_jsonable(r) for r in rows],
+               "members": [to_jsonable(r) for m in members for r in m.to_dict("records")]}
     atomic_write_text(path, json.dumps(payload, indent=0) + "\n")
 
 
@@ -92,7 +122,7 @@ def read_fold_jsons(paths) -> tuple[pd.DataFrame, pd.DataFrame]:
             d = json.load(f)
         rows += d["rows"]
         members += d["members"]
-    return pd.DataFrame(rows, columns=ex.FOLD_COLUMNS), pd.DataFrame(members, columns=ex.MEMBER_COLUMNS)
+    return pd.DataFrame(rows, columns=FOLD_COLUMNS), pd.DataFrame(members, columns=MEMBER_COLUMNS)
 
 
 def _fallback_note(folds: pd.DataFrame, method: str = "delaunay") -> str:
@@ -103,19 +133,24 @@ def _fallback_note(folds: pd.DataFrame, method: str = "delaunay") -> str:
     return f"Share of {method} steps outside the hull (k-NN fallback), held-out start, per fold: " + ", ".join(parts) + "."
 
 
-def table_job(fold_paths, datasets, methods, cfg: dict, out: dict) -> None:
-    """folds.csv, members.csv, table2 (paper layout), table2_units, table2_ensemble, fold_ensemble, paired."""
+def table_job(fold_paths, datasets, methods, cfg: dict, out: dict, paper_table2=None, paper_label=None) -> None:
+    """folds.csv, members.csv, table2 (paper layout), table2_units, table2_ensemble, fold_ensemble, paired.
+
+    ``paper_table2`` is the published Table II file (None: none; see
+    :func:`~animsynth.simplicial.settings.read_paper_table2`), ``paper_label`` how the notes name it
+    (the configured path).
+    """
     folds, members = read_fold_jsons(fold_paths)
-    folds = ex.order_folds(folds, datasets)
-    members = ex.order_folds(members, datasets)
+    folds = order_folds(folds, datasets)
+    members = order_folds(members, datasets)
     write_table(folds, out["folds"], md=False)
     write_table(members, out["members"], md=False)
-    paper = read_paper_table2(cfg.get("paper_table2"))
-    src = (f"`paper_*`: the paper's Table II, read from {cfg.get('paper_table2')} (its `knn16` row is our `knn`)"
-           if paper is not None else f"`paper_*` empty: no published values file at {cfg.get('paper_table2')!r}")
+    paper = read_paper_table2(paper_table2)
+    src = (f"`paper_*`: the paper's Table II, read from {paper_label} (its `knn16` row is our `knn`)"
+           if paper is not None else f"`paper_*` empty: no published values file at {paper_label!r}")
     ens = cfg["ensemble"]
     fb = _fallback_note(folds, methods[0])
-    t2 = ex.table2(folds, datasets, methods, paper)
+    t2 = table2(folds, datasets, methods, paper)
     write_table(t2, out["table2"], md=True, title="Gauch & Peters Table II (reproduction)", note=(
         "Medians over the leave-one-sequence-out folds (one per trial of a subset; `all` = all folds), from the held-out "
         "trial's first latent frame as in the paper. Error A: mean closest-point distance between held-out and "
@@ -123,18 +158,18 @@ def table_job(fold_paths, datasets, methods, cfg: dict, out: dict) -> None:
         "the held-out final point; both divided by the diagonal of the fold's latent bounding box (the paper does "
         f"not state its unit). {src}. Spread over {int(ens['n_starts'])} jittered starts: table2_ensemble.csv. "
         f"Other units: table2_units.csv. {fb}"))
-    write_table(ex.table2_units(folds, datasets, methods), out["table2_units"], md=False)
-    t2e = ex.table2_ensemble(members, datasets, methods, paper)
+    write_table(table2_units(folds, datasets, methods), out["table2_units"], md=False)
+    t2e = table2_ensemble(members, datasets, methods, paper)
     write_table(t2e, out["table2_ensemble"], md=True, title="Table II over the ensemble of starts", note=(
         f"Every cell of Table II recomputed for each of {int(ens['n_starts']) + 1} starts per fold (the held-out "
         f"start and {int(ens['n_starts'])} copies moved by {float(ens['jitter']):g} of the latent diagonal): median "
         f"and IQR over members, `a_lower_share` = share of members in which {methods[0]} has the lower cell, "
         f"`stability` = stable only when that holds in every member, `agree_share` = share agreeing with the "
         f"paper's ordering. {fb}"))
-    fe = ex.fold_ensemble(members, datasets, methods)
+    fe = fold_ensemble(members, datasets, methods)
     write_table(fe, out["fold_ensemble"], md=False)
-    pc = ex.paired_comparison(folds, methods[0], methods[1], n_boot=int(cfg["bootstrap"]), seed=int(cfg["seed_value"]),
-                              alpha=float(cfg["alpha"]))
+    pc = paired_comparison(folds, methods[0], methods[1], n_boot=int(cfg["bootstrap"]), seed=int(cfg["seed_value"]),
+                           alpha=float(cfg["alpha"]))
     write_table(pc, out["paired"], md=True, title=f"Paired comparison {methods[0]} vs {methods[1]} over folds",
                 note="Wilcoxon signed-rank test (two-sided) on per-fold differences (held-out start); bootstrap "
                      "percentile CI of the median difference (a - b < 0: a has the lower error). `_pose` metrics "
@@ -143,10 +178,10 @@ def table_job(fold_paths, datasets, methods, cfg: dict, out: dict) -> None:
 
 def grid_variants(grid: str, cfg: dict) -> list:
     if grid == "derivative":
-        return ex.derivative_variants(cfg["derivatives"], cfg["methods"], int(cfg["k"]), int(cfg["latent_dim"]),
-                                      cfg["weights"])
+        return derivative_variants(cfg["derivatives"], cfg["methods"], int(cfg["k"]), int(cfg["latent_dim"]),
+                                   cfg["weights"])
     if grid == "beyond":
-        return ex.beyond_variants(cfg["beyond"], int(cfg["k"]), cfg["beyond"]["derivative"])
+        return beyond_variants(cfg["beyond"], int(cfg["k"]), cfg["beyond"]["derivative"])
     raise ValueError(f"unknown grid {grid!r}")
 
 
@@ -158,18 +193,23 @@ def grid_job(paths, ids, dataset: str, grid: str, cfg: dict, seed: int, out: dic
     d0 = min(v.latent_dim for v in variants)
     pose = [v.name for v in variants if v.latent_dim != d0 or (v.method == "delaunay" and v.weights == "idw"
                                                                 and v.generation == "field")]
-    df, members = ex.run_subset(angles, variants, dataset=dataset, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]),
-                                rank_tol=float(cfg["rank_tol"]),
-                                max_all_pairs=int(cfg.get("beyond", {}).get("max_all_pairs", 4000)),
-                                ensemble=cfg["ensemble"], seed=seed, member_pose=pose if grid == "beyond" else False)
+    # target-directed variants (shortest paths in G') are only in the beyond grid
+    plan = {"max_all_pairs": int(cfg["beyond"]["max_all_pairs"])} if grid == "beyond" else {}
+    df, members = run_subset(angles, variants, dataset=dataset, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]),
+                             rank_tol=float(cfg["rank_tol"]), ensemble=cfg["ensemble"], seed=seed,
+                             member_pose=pose if grid == "beyond" else False, **plan)
     log.info("%s grid on %s: %d variants x %d folds x %d starts", grid, dataset, len(variants), len(ids),
              int(cfg["ensemble"]["n_starts"]) + 1)
     write_table(df, out["folds"], md=False)
     write_table(members, out["members"], md=False)
 
 
-def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out: dict) -> None:
-    """derivative.csv, beyond.csv, beyond_folds.csv, verdicts.csv and their figures."""
+def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out: dict, paper_table2=None) -> None:
+    """derivative.csv, beyond.csv, beyond_folds.csv, verdicts.csv and their figures.
+
+    ``paper_table2``: the published Table II file (None: none); its overall medians give the paper's
+    ordering, else config ``simplicial.paper_claim``.
+    """
     from .plots import plot_beyond, plot_derivative
     from .verdicts import build_verdicts
 
@@ -179,16 +219,16 @@ def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out:
     def read(p):
         return pd.read_csv(p, keep_default_na=False, na_values=[""])
 
-    dfold = ex.order_folds(cat(deriv_paths["folds"]), datasets)
-    dmem = ex.order_folds(cat(deriv_paths["members"]), datasets)
-    bfold = ex.order_folds(cat(beyond_paths["folds"]), datasets)
-    bmem = ex.order_folds(cat(beyond_paths["members"]), datasets)
+    dfold = order_folds(cat(deriv_paths["folds"]), datasets)
+    dmem = order_folds(cat(deriv_paths["members"]), datasets)
+    bfold = order_folds(cat(beyond_paths["folds"]), datasets)
+    bmem = order_folds(cat(beyond_paths["members"]), datasets)
     seed, n_boot, alpha = int(cfg["seed_value"]), int(cfg["bootstrap"]), float(cfg["alpha"])
     methods = tuple(cfg["methods"])
-    paper = read_paper_table2(cfg.get("paper_table2"))
+    paper = read_paper_table2(paper_table2)
     claim = paper_claim_from(paper, cfg["paper_claim"], methods)
     ens = cfg["ensemble"]
-    dsum = ex.derivative_summary(dfold, methods, claim, n_boot=n_boot, seed=seed, members=dmem)
+    dsum = derivative_summary(dfold, methods, claim, n_boot=n_boot, seed=seed, members=dmem)
     write_table(dsum, out["derivative"], md=True, title="Training-vector derivative variants",
                 note="Medians over all folds (held-out start). `half` = (x[i+1]-x[i])/2 as printed in the paper; "
                      "`forward` = x[i+1]-x[i]; `central` = (x[i+1]-x[i-1])/2. `reproduces_claim` compares the "
@@ -200,7 +240,7 @@ def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out:
                      "`*_sep_final_rel` = median final separation / latent diagonal.")
     d0 = int(cfg["beyond"]["latent_dims"][0])
     baseline = f"delaunay_idw_d{d0}"
-    bsum = ex.summarise_variants(bfold, baseline, datasets, n_boot=n_boot, seed=seed, members=bmem)
+    bsum = summarise_variants(bfold, baseline, datasets, n_boot=n_boot, seed=seed, members=bmem)
     write_table(bfold, out["beyond_folds"], md=False)
     best = bsum.iloc[0]
     write_table(bsum, out["beyond"], md=True, title="Beyond the paper: variants ranked by median pose-space Error A",
@@ -216,7 +256,7 @@ def summary_job(deriv_paths, beyond_paths, main: dict, datasets, cfg: dict, out:
     t2 = read(main["table2"])
     t2e = read(main["table2_ensemble"])
     n_folds = int(folds.groupby("method").size().max()) if len(folds) else 0
-    data = f"{cfg.get('data_label', '')} {' '.join(datasets)} ({n_folds} folds x {int(ens['n_starts']) + 1} starts)".strip()
+    data = f"{cfg['data_label']} {' '.join(datasets)} ({n_folds} folds x {int(ens['n_starts']) + 1} starts)".strip()
     verdicts = build_verdicts(table2=t2, table2_ens=t2e, members=members, paired=paired, deriv=dsum, folds=folds,
                               beyond=bsum, beyond_folds=bfold, beyond_members=bmem, claim=claim,
                               main_derivative=cfg["derivative"], baseline=baseline, datasets=datasets, data=data,
@@ -232,15 +272,13 @@ def figures_job(paths, ids, dataset: str, cfg: dict, out: dict) -> None:
 
     angles, _ = load_trials(paths, ids)
     fig = cfg["figures"]
+    check_figure_folds(fig, len(ids), dataset)
     graph_folds = [int(i) for i in fig["folds"]]
-    for i in graph_folds + [int(fig["field_fold"])]:
-        if not 0 <= i < len(ids):
-            raise ValueError(f"config key 'simplicial.figures': fold index {i} outside 0..{len(ids) - 1}")
     results = {}
     for m in ("knn", "delaunay"):
         v = main_variant(cfg, m)
-        results[m] = [ex.run_fold([angles[t] for t in ids if t != tid], angles[tid], v, dataset=dataset, held_out=tid,
-                                  fold=i, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]), rank_tol=float(cfg["rank_tol"]))
+        results[m] = [run_fold([angles[t] for t in ids if t != tid], angles[tid], v, dataset=dataset, held_out=tid,
+                               fold=i, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]), rank_tol=float(cfg["rank_tol"]))
                       for i, tid in enumerate(ids)]
     lab = {"knn": f"k-NN (k={cfg['k']})", "delaunay": "Delaunay"}
     for n, m in ((1, "knn"), (2, "delaunay")):
@@ -260,13 +298,12 @@ def walk_job(paths, ids, dataset: str, cfg: dict, out: dict) -> None:
 
     angles, motions = load_trials(paths, ids)
     fig = cfg["figures"]
+    check_figure_folds(fig, len(ids), dataset)
     i = int(fig["walk_fold"])
-    if not 0 <= i < len(ids):
-        raise ValueError(f"config key 'simplicial.figures.walk_fold': {i} outside 0..{len(ids) - 1}")
     tid = ids[i]
-    res = ex.run_fold([angles[t] for t in ids if t != tid], angles[tid], main_variant(cfg, fig["walk_method"]),
-                      dataset=dataset, held_out=tid, fold=i, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]),
-                      rank_tol=float(cfg["rank_tol"]))
+    res = run_fold([angles[t] for t in ids if t != tid], angles[tid], main_variant(cfg, fig["walk_method"]),
+                   dataset=dataset, held_out=tid, fold=i, steps=cfg["steps"], dup_tol=float(cfg["dup_tol"]),
+                   rank_tol=float(cfg["rank_tol"]))
     motion = walk_motion(res, motions[tid], name=f"simplicial {fig['walk_method']} walk, {dataset} held out {tid}")
     held = motions[tid]
     held_in_place = Motion(held.values.copy(), held.skeleton, held.fps, tid)
@@ -280,7 +317,7 @@ def walk_job(paths, ids, dataset: str, cfg: dict, out: dict) -> None:
 
 
 def scale_steps(recorder, n: int, seed: int = 0, steps: int = 1000, trial_frames: int = 200, method: str = "delaunay",
-                     k: int = 8, latent_dim: int = 3):
+                k: int = 8, latent_dim: int = 3):
     """One simplicial fold on ``n`` synthetic training frames plus a ``steps``-step path."""
     from ..synth.mocap import synthetic_motions
 
@@ -288,8 +325,8 @@ def scale_steps(recorder, n: int, seed: int = 0, steps: int = 1000, trial_frames
     angles = [np.asarray(m.without_root(), float) for m in motions]
     test, train = angles[0], angles[1:]
     S = recorder("simplicial", sum(len(a) for a in train), method=method)
-    var = ex.Variant(method, method=method, k=k, latent_dim=latent_dim, derivative="forward",
-                     weights="idw" if method != "delaunay" else "barycentric").check()
+    var = Variant(method, method=method, k=k, latent_dim=latent_dim, derivative="forward",
+                  weights="idw" if method != "delaunay" else "barycentric").check()
     with S.step("fold_build_and_path", path_steps=steps):
-        ex.run_fold(train, test, var, steps=int(steps))
+        run_fold(train, test, var, steps=int(steps))
     return S.rows

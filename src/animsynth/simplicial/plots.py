@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.collections import LineCollection
 
 from ..motion import Motion
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 
 _CLIP_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink")
 

@@ -1,70 +1,125 @@
 """Config checks of the simplicial family and the published values it shows beside ours.
 
-The paper's Table II is read from a CSV (config key ``simplicial.paper_table2``,
-default ``../shared/papers/s1_table2.csv`` relative to the working directory)
-with columns ``metric, method, <subsets...>, all``. The paper calls its k-NN
-method ``knn16`` (k = 16); any ``knn<k>`` is shown as our ``knn`` row. A
-missing file means "no published values": the ``paper_*`` columns stay empty
-and the verdicts fall back to ``simplicial.paper_claim`` for the ordering.
-A file that exists but is malformed is an error naming the file and line.
+:func:`check` holds every check of the ``simplicial`` config block beyond the schema (the workflow calls
+it once, from ``workflow/rules/common.smk``); every default comes from ``config/schema.yaml``.
+
+The published tables are named by config ``published.simplicial.table1`` and ``.table2`` and read only
+through :func:`animsynth.published.read_table` (a missing file: ``None`` and a WARNING, the ``paper_*``
+columns stay empty and the verdicts fall back to ``simplicial.paper_claim`` for the ordering; a
+malformed file: :class:`~animsynth.published.PublishedError` naming the file and line). This module maps
+them to the shapes the tables use:
+
+* Table II (:func:`read_paper_table2`): columns ``metric, method, w1, w2, r1, r2, all``. The paper calls
+  its k-NN method ``knn16`` (k = 16); any ``knn<k>`` is shown as our ``knn`` row.
+* Table I (:func:`read_paper_table1`): columns ``dataset`` and ``lengths`` (space-separated frame counts).
 """
 
 from __future__ import annotations
 
-import logging
-import os
 import re
 
-import numpy as np
 import pandas as pd
 
-log = logging.getLogger("animsynth.simplicial.settings")
+from ..config import ConfigError
+from ..published import PublishedError, read_table
 
-PAPER_SUBSETS = ("w1", "w2", "r1", "r2", "all")
+#: Subset columns of the published Table II (the paper's w1 w2 r1 r2 and all folds).
+TABLE2_SUBSETS = ("w1", "w2", "r1", "r2", "all")
+TABLE2_METRICS = ("error_a", "error_f")
+
+
+def check_figure_folds(figures: dict, n_trials: int, dataset: str) -> None:
+    """Fold indices of ``simplicial.figures`` (``folds``, ``field_fold``, ``walk_fold``) inside the subset.
+
+    Raises
+    ------
+    ConfigError
+        naming the key, when an index is not in ``0 .. n_trials - 1``.
+    """
+    named = [("folds", i) for i in figures["folds"]] + [("field_fold", figures["field_fold"]),
+                                                        ("walk_fold", figures["walk_fold"])]
+    for key, i in named:
+        if not 0 <= int(i) < n_trials:
+            raise ConfigError(f"config key 'simplicial.figures.{key}': fold index {i} outside 0..{n_trials - 1} "
+                              f"(subset {dataset!r} has {n_trials} trials)")
+
+
+def check(config: dict) -> None:
+    """Checks of the ``simplicial`` block beyond the schema, on a schema-validated config.
+
+    Raises
+    ------
+    ConfigError
+        naming the key: ``simplicial.figures.dataset`` not one of the subsets in use (a subset set to
+        null is not in use), or a figure fold index outside that subset.
+    """
+    fig = config["simplicial"]["figures"]
+    subsets = {k: v for k, v in config["subsets"].items() if v}
+    if fig["dataset"] not in subsets:
+        raise ConfigError(f"config key 'simplicial.figures.dataset': {fig['dataset']!r} is not a subset "
+                          f"({list(subsets)})")
+    check_figure_folds(fig, len(subsets[fig["dataset"]]), fig["dataset"])
 
 
 def read_paper_table2(path) -> pd.DataFrame | None:
-    """The paper's Table II as ``metric, method, w1, w2, r1, r2, all`` (float), or None when absent.
+    """The paper's Table II as ``metric, method, paper_method, w1, w2, r1, r2, all`` (floats), or None.
 
     Parameters
     ----------
-    path : str or None
-        CSV path; None, "" or a missing file -> None (logged).
+    path : str, path or None
+        The published table (config ``published.simplicial.table2``, resolved by the workflow); None or a
+        missing file -> None (a WARNING names the path).
+
+    Raises
+    ------
+    PublishedError
+        a missing column, a non-number in a subset column, or a metric other than ``error_a``/``error_f``
+        (the message names the file and line).
     """
-    if not path:
+    df = read_table(path, ("metric", "method") + TABLE2_SUBSETS, numeric=TABLE2_SUBSETS,
+                    what="Gauch & Peters Table II", config_key="published.simplicial.table2")
+    if df is None:
         return None
-    path = os.fspath(path)
-    if not os.path.exists(path):
-        log.info("published Table II not found at %s: paper columns left empty", path)
-        return None
-    try:
-        df = pd.read_csv(path, dtype=str, keep_default_na=False)
-    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path}: cannot parse the published Table II ({exc})") from None
-    missing = [c for c in ("metric", "method") if c not in df.columns]
-    if missing:
-        raise ValueError(f"{path}: line 1: missing column(s) {missing} (config key 'simplicial.paper_table2')")
-    subsets = [c for c in df.columns if c not in ("metric", "method")]
     rows = []
-    for i, r in df.iterrows():
-        line = i + 2
-        metric = r["metric"].strip()
-        if metric not in ("error_a", "error_f"):
-            raise ValueError(f"{path}: line {line}: metric must be error_a or error_f, got {metric!r}")
-        method = r["method"].strip()
-        m = re.fullmatch(r"knn(\d*)", method)
-        out = {"metric": metric, "method": "knn" if m else method, "paper_method": method}
-        for c in subsets:
-            txt = r[c].strip()
-            if txt == "":
-                out[c] = np.nan
-                continue
-            try:
-                out[c] = float(txt)
-            except ValueError:
-                raise ValueError(f"{path}: line {line}: column {c!r} is not a number: {txt!r}") from None
-        rows.append(out)
-    return pd.DataFrame(rows, columns=["metric", "method", "paper_method"] + subsets)
+    for i, r in enumerate(df.itertuples(index=False)):
+        metric, method = r.metric.strip(), r.method.strip()
+        if metric not in TABLE2_METRICS:
+            raise PublishedError(f"{path}, line {i + 2}: metric must be one of {list(TABLE2_METRICS)}, "
+                                 f"got {metric!r}")
+        rows.append({"metric": metric, "method": "knn" if re.fullmatch(r"knn(\d*)", method) else method,
+                     "paper_method": method})
+    out = pd.DataFrame(rows, columns=["metric", "method", "paper_method"])
+    for c in TABLE2_SUBSETS:
+        out[c] = df[c].to_numpy(float)
+    return out
+
+
+def read_paper_table1(path) -> dict[str, list[int]] | None:
+    """The paper's Table I lengths as ``{subset: [frames, ...]}``, or None when there is no file.
+
+    Parameters
+    ----------
+    path : str, path or None
+        The published table (config ``published.simplicial.table1``); None or a missing file -> None
+        (a WARNING names the path).
+
+    Raises
+    ------
+    PublishedError
+        a missing ``dataset`` or ``lengths`` column, or lengths that are not integers (file and line).
+    """
+    df = read_table(path, ("dataset", "lengths"), what="Gauch & Peters Table I",
+                    config_key="published.simplicial.table1")
+    if df is None:
+        return None
+    out = {}
+    for i, (name, lengths) in enumerate(zip(df["dataset"], df["lengths"])):
+        try:
+            out[name.strip()] = [int(x) for x in lengths.split()]
+        except ValueError:
+            raise PublishedError(f"{path}, line {i + 2}: lengths must be integers separated by spaces, "
+                                 f"got {lengths!r}") from None
+    return out
 
 
 def paper_claim_from(paper: pd.DataFrame | None, fallback: str, methods=("delaunay", "knn")) -> str:
@@ -87,3 +142,7 @@ def paper_claim_from(paper: pd.DataFrame | None, fallback: str, methods=("delaun
     if all(higher):
         return f"{b}_better"
     return fallback
+
+
+__all__ = ["TABLE2_SUBSETS", "check", "check_figure_folds", "paper_claim_from", "read_paper_table1",
+           "read_paper_table2"]

@@ -1,13 +1,14 @@
 """The claims this family checks, each decided from the result tables.
 
-Rows use the common verdict format ``claim, paper_value, ours, data, verdict,
-evidence, source`` with ``verdict`` one of ``reproduced``, ``partly``,
-``not reproduced``, ``contradicted``, ``within noise``.
+Rows are built with :func:`animsynth.verdicts.row` and gathered with :func:`animsynth.verdicts.table`
+(the common columns ``claim, paper_value, ours, data, verdict, evidence, source``; a verdict word outside
+:data:`animsynth.verdicts.VOCABULARY` is refused).
 
 An ordering (method a has the lower error than b) is judged over the ensemble
-of starts (:mod:`animsynth.simplicial.experiment`): it is *stable* only when it
+of starts (:mod:`animsynth.simplicial.folds`): it is *stable* only when it
 holds in every member; it is ``reproduced`` (or ``contradicted``) only when
-stable, and otherwise ``within noise`` with the share of members that agree.
+stable, and otherwise ``within noise`` with the share of members that agree
+(:func:`animsynth.verdicts.agreement_verdict`).
 """
 
 from __future__ import annotations
@@ -15,25 +16,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .experiment import stability
+from ..verdicts import agreement_verdict, row, table
+from ..verdicts import fmt as _fmt
+from .stats import member_share, paired_comparison, stability
 
-VERDICT_COLUMNS = ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
 LABEL = {"error_a": "Error A", "error_f": "Error F"}
-
-
-def _fmt(x, nd=3):
-    return "nan" if x is None or not np.isfinite(x) else f"{x:.{nd}g}"
-
-
-def ordering_verdict(agree_share: float) -> str:
-    """``reproduced`` when every member agrees, ``contradicted`` when none does, else ``within noise``."""
-    if agree_share is None or not np.isfinite(agree_share):
-        return "not reproduced"
-    if agree_share == 1.0:
-        return "reproduced"
-    if agree_share == 0.0:
-        return "contradicted"
-    return "within noise"
 
 
 def _share_text(share: float, what: str) -> str:
@@ -50,10 +37,10 @@ def build_verdicts(*, table2: pd.DataFrame, table2_ens: pd.DataFrame, members: p
 
     Parameters
     ----------
-    table2, table2_ens : :func:`~animsynth.simplicial.experiment.table2` and ``table2_ensemble`` outputs
+    table2, table2_ens : :func:`~animsynth.simplicial.tables.table2` and ``table2_ensemble`` outputs
     members : ensemble member rows of the main table (both methods)
     paired : paired Wilcoxon comparison of the main folds (held-out start)
-    deriv : :func:`~animsynth.simplicial.experiment.derivative_summary` (with ensemble shares)
+    deriv : :func:`~animsynth.simplicial.stats.derivative_summary` (with ensemble shares)
     folds : main fold rows
     beyond, beyond_folds, beyond_members : beyond-the-paper summary, fold rows and member rows (optional)
     claim : ``delaunay_better``, ``knn_better`` or ``unknown`` (the paper's conclusion)
@@ -65,8 +52,8 @@ def build_verdicts(*, table2: pd.DataFrame, table2_ens: pd.DataFrame, members: p
     rows = []
 
     def add(claim_txt, paper_value, ours, verdict, evidence, source, data_txt=None):
-        rows.append({"claim": claim_txt, "paper_value": paper_value, "ours": ours, "data": data_txt or data,
-                     "verdict": verdict, "evidence": evidence, "source": source})
+        rows.append(row(claim_txt, verdict, evidence, paper_value=paper_value, ours=ours, data=data_txt or data,
+                        source=source))
 
     want_a_lower = True if claim == f"{a}_better" else False if claim == f"{b}_better" else None
     t2 = table2.set_index(["metric", "method"])
@@ -91,7 +78,7 @@ def build_verdicts(*, table2: pd.DataFrame, table2_ens: pd.DataFrame, members: p
             f"{a} {_fmt(t2.loc[(met, a), 'all'])} vs {b} {_fmt(t2.loc[(met, b), 'all'])} (held-out start); "
             f"ensemble median {_fmt(e[f'{a}_median'])} [IQR {_fmt(e[f'{a}_q25'])}-{_fmt(e[f'{a}_q75'])}] vs "
             f"{_fmt(e[f'{b}_median'])} [{_fmt(e[f'{b}_q25'])}-{_fmt(e[f'{b}_q75'])}]",
-            ordering_verdict(agree),
+            agreement_verdict(agree),
             _share_text(share, f"{a} has the lower all-fold median") + ptxt
             + f". Ours: {LABEL[met]} / latent bounding-box diagonal (the paper states no unit).",
             "simplicial/table2_ensemble.csv")
@@ -239,25 +226,20 @@ def build_verdicts(*, table2: pd.DataFrame, table2_ens: pd.DataFrame, members: p
 
     if beyond is not None and len(beyond):
         _beyond_rows(add, beyond, beyond_folds, beyond_members, baseline)
-    return pd.DataFrame(rows, columns=VERDICT_COLUMNS)
+    return table(rows)
 
 
 def _beyond_rows(add, beyond: pd.DataFrame, beyond_folds, beyond_members, baseline: str) -> None:
-    from .experiment import paired_comparison
-
     b = beyond.set_index("variant")
     metric = "error_a_pose"
     base = float(b.loc[baseline, metric]) if baseline in b.index else np.nan
     best = beyond.iloc[0]
 
-    def share_v(share):
-        return ordering_verdict(share) if np.isfinite(share) else "not reproduced"
-
     if best["variant"] != baseline:
         sh = float(best.get("lower_share_vs_baseline", np.nan))
         add(f"Beyond the paper: {best['variant']} has a lower median pose-space Error A than the paper's method "
             f"({baseline})", "", f"{_fmt(best[metric])} vs {_fmt(base)} deg",
-            share_v(sh),
+            agreement_verdict(sh),
             f"{_fmt(100 * best['rel_change_vs_baseline'])} % change, Wilcoxon p={_fmt(best['p_vs_baseline'])} "
             f"(held-out start, lower in {int(best['better_folds_vs_baseline'])}/{int(best['folds'])} folds); "
             + (f"lower in {100 * sh:.0f} % of the ensemble members ({stability(sh)}, on "
@@ -281,7 +263,7 @@ def _beyond_rows(add, beyond: pd.DataFrame, beyond_folds, beyond_members, baseli
             sh = member_share(beyond_members, var, ref, "error_a_norm")
             add(f"Beyond the paper: {lab} (Error A, latent dim {d0})", "",
                 f"{_fmt(pc['median_a'])} vs {_fmt(pc['median_b'])} (Error A / diagonal)",
-                share_v(sh),
+                agreement_verdict(sh),
                 f"held-out-start Wilcoxon p={_fmt(pc['p_value'])}; "
                 + (f"lower in {100 * sh:.0f} % of the ensemble members ({stability(sh)})" if np.isfinite(sh)
                    else "no ensemble"), "simplicial/beyond.csv", data_txt=None)
@@ -296,22 +278,8 @@ def _beyond_rows(add, beyond: pd.DataFrame, beyond_folds, beyond_members, baseli
             sh = member_share(beyond_members, name_best, f"delaunay_idw_d{dims[0]}", metric)
         add("Beyond the paper: a higher latent dimension lowers pose-space Error A (Delaunay 1/D^2)", "",
             "; ".join(f"d={int(d)}: {_fmt(r[metric])} deg (floor {_fmt(r['pose_floor'])})" for d, r in per.iterrows()),
-            share_v(sh) if best_d != dims[0] else "not reproduced",
+            agreement_verdict(sh) if best_d != dims[0] else "not reproduced",
             (f"d={int(best_d)} lower than d={dims[0]} in {100 * sh:.0f} % of the members ({stability(sh)}); "
              if np.isfinite(sh) else "")
             + "the floor is the error of a perfect latent path (PCA reconstruction loss), so part of a gain from a "
             "higher dimension is reconstruction, not generation", "simplicial/beyond.csv", data_txt=None)
-
-
-def member_share(members: pd.DataFrame | None, var: str, ref: str, metric: str) -> float:
-    """Share of ensemble members in which ``var``'s all-fold median ``metric`` is below ``ref``'s (NaN if unknown)."""
-    if members is None or not len(members):
-        return np.nan
-    med = {}
-    for v in (var, ref):
-        s = members[members["variant"] == v]
-        if not len(s) or s[metric].isna().any():
-            return np.nan
-        med[v] = s.groupby("member")[metric].median().sort_index().to_numpy(float)
-    n = min(len(med[var]), len(med[ref]))
-    return float(np.mean(med[var][:n] < med[ref][:n])) if n else np.nan

@@ -52,7 +52,7 @@ import os
 import numpy as np
 import pandas as pd
 
-from ..io.atomic import atomic_write_text
+from ..atomic import atomic_write_text
 from ..io.ckplus import EMOTIONS, CKSequence, write_sequence
 
 # Unit mean face (x right, y down), iBUG 68-point order, hand-made after the
@@ -143,12 +143,6 @@ def au_field(au) -> np.ndarray:
         for i in _CENTRE:  # centre points move half as much in a one-sided action
             field[i] *= 0.5
     return field
-
-
-def mean_face_px() -> np.ndarray:
-    """The mean face in pixels, centred in a 640 x 490 image."""
-    u = MEAN_FACE_UNIT - MEAN_FACE_UNIT.mean(0)
-    return u * FACE_SCALE_PX + np.array([IMAGE_SIZE[0] / 2, IMAGE_SIZE[1] / 2 + 25])
 
 
 def _rot(theta):

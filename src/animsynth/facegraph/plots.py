@@ -1,4 +1,4 @@
-"""Figures of the facegraph experiments (matplotlib)."""
+"""Figures of the facegraph family (matplotlib): region graphs, trajectories, animated GIF."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.collections import LineCollection
 
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 from ..io.ckplus import EMOTIONS
 
 #: Polylines of the 68-point face (closed ones repeat their first point).

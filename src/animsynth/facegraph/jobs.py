@@ -1,9 +1,10 @@
-"""The facegraph experiments: Table 1 rows, face-graph baseline, uniqueness.
+"""Workflow steps of the facegraph family (the scripts in workflow/scripts only call these): Table 1 rows
+and their assembly, the face-graph baseline, the uniqueness study, table notes, and the family's scale steps.
 
-Each function takes plain config dicts (the ``facegraph`` block of the
-workflow config) and returns deterministic tables (numbers rounded so that the
-same config gives byte-identical CSV files) and, separately, timing tables
-(machine-dependent: CPU and wall time).
+Each function takes plain config dicts (sub-blocks of the ``facegraph`` block of the workflow config,
+validated against ``config/schema.yaml``, which fills every default) and returns deterministic tables
+(numbers rounded so that the same config gives byte-identical CSV files) and, separately, timing tables
+(machine-dependent: CPU and wall time). The claims checked against these tables are in :mod:`.verdicts`.
 """
 
 from __future__ import annotations
@@ -23,46 +24,49 @@ from ..tables import add_paper_differences
 from .baseline import FaceGraphBaseline
 from .evaluate import compare, evaluate_resynthesis, summarise
 from .model import FaceGraphModel
+from .preprocess import FaceDatabase, FacePreprocessor
 from .regiongraph import RegionGraph
-from .preprocess import FaceDatabase
-from .settings import config_name
 from .synthesis import FaceSynthesizer, resample
 
-log = logging.getLogger("animsynth.facegraph.experiments")
+log = logging.getLogger("animsynth.facegraph.jobs")
 
 #: Rounding of reported (non-timing) numbers.
 DECIMALS = 4
 
 
 def graph_kwargs(graph_cfg: dict) -> dict:
+    """:class:`FaceGraphModel` keyword arguments from the ``facegraph.graph`` config block."""
     return {
-        "tolerance": float(graph_cfg.get("tolerance", 1.0)),
-        "lam": float(graph_cfg.get("lambda", 1.0)),
-        "velocity_eps": float(graph_cfg.get("velocity_eps", 1e-2)),
-        "max_iterations": int(graph_cfg.get("max_iterations", 40)),
-        "procrustes": bool(graph_cfg.get("procrustes", True)),
-        "thresholds": str(graph_cfg.get("thresholds", "per_sample")),
-        "min_step_fraction": float(graph_cfg.get("min_step_fraction", 1e-3)),
+        "tolerance": float(graph_cfg["tolerance"]),
+        "lam": float(graph_cfg["lambda"]),
+        "velocity_eps": float(graph_cfg["velocity_eps"]),
+        "max_iterations": int(graph_cfg["max_iterations"]),
+        "procrustes": bool(graph_cfg["procrustes"]),
+        "thresholds": str(graph_cfg["thresholds"]),
+        "min_step_fraction": float(graph_cfg["min_step_fraction"]),
     }
 
 
 def synth_kwargs(synth_cfg: dict, noise: bool = True) -> dict:
+    """:class:`FaceSynthesizer` keyword arguments from the ``facegraph.synthesis`` config block;
+    ``noise=False`` switches the coherent node noise and the duration noise off."""
     return {
-        "savgol_window": int(synth_cfg.get("savgol_window", 7)),
-        "savgol_order": int(synth_cfg.get("savgol_order", 2)),
-        "sigmoid_weight": float(synth_cfg.get("sigmoid_weight", 1.0)),
-        "noise_share": float(synth_cfg.get("noise_share", 0.0)) if noise else 0.0,
-        "noise_hops": int(synth_cfg.get("noise_hops", 2)),
-        "duration_noise": bool(synth_cfg.get("duration_noise", False)) if noise else False,
-        "peak_weights": tuple(synth_cfg.get("peak_weights", (0.3, 0.7))),
+        "savgol_window": int(synth_cfg["savgol_window"]),
+        "savgol_order": int(synth_cfg["savgol_order"]),
+        "sigmoid_weight": float(synth_cfg["sigmoid_weight"]),
+        "noise_share": float(synth_cfg["noise_share"]) if noise else 0.0,
+        "noise_hops": int(synth_cfg["noise_hops"]),
+        "duration_noise": bool(synth_cfg["duration_noise"]) if noise else False,
+        "peak_weights": tuple(synth_cfg["peak_weights"]),
     }
 
 
 def model_for(conf: dict, cfg: dict, seed: int) -> FaceGraphModel:
-    """The estimator of one configuration (``conf`` from :func:`.settings.configurations`, fractions)."""
+    """The estimator of one configuration (``conf`` from :func:`.settings.configurations`, fractions;
+    ``cfg`` holds the ``graph`` block)."""
     return FaceGraphModel(100.0 * conf["creation"], 100.0 * conf["merge"], seed=seed,
                           creation_tolerance=100.0 * conf["creation_tolerance"],
-                          merge_tolerance=100.0 * conf["merge_tolerance"], **graph_kwargs(cfg.get("graph", {})))
+                          merge_tolerance=100.0 * conf["merge_tolerance"], **graph_kwargs(cfg["graph"]))
 
 
 def _r(x):
@@ -95,21 +99,22 @@ def warm_up(db: FaceDatabase, conf: dict, cfg: dict, seed: int, max_poses: int =
     configurations that follow in the same process comparable with one another.
     """
     with threadpool_limits(1):
-        model_for(conf, cfg, seed).fit(_subset_database(db, max_poses, seed))
+        model_for(conf, cfg, seed).fit(subset_database(db, max_poses, seed))
 
 
 def run_configuration(db: FaceDatabase, conf: dict, cfg: dict, seed: int):
     """Build the region graphs for one compression configuration and evaluate them.
 
-    ``conf``: a dict of :func:`.settings.configurations` (fractions). Returns
+    ``conf``: a dict of :func:`.settings.configurations` (fractions); ``cfg``: the
+    ``graph``, ``synthesis`` and ``evaluation`` blocks of the facegraph config. Returns
     (Table 1 row, timing row, per-region threshold table, fitted model,
     per-sample table). Only the timing row holds machine-dependent numbers.
     """
-    ev = cfg.get("evaluation", {})
+    ev = cfg["evaluation"]
     with threadpool_limits(1):
         model = model_for(conf, cfg, seed).fit(db)
-        synth = FaceSynthesizer(model.graphs_, **synth_kwargs(cfg.get("synthesis", {}), noise=bool(ev.get("noise", False))))
-        per = evaluate_resynthesis(db, synth, seed=seed, min_speed=float(ev.get("min_speed", 0.05)))
+        synth = FaceSynthesizer(model.graphs_, **synth_kwargs(cfg["synthesis"], noise=bool(ev["noise"])))
+        per = evaluate_resynthesis(db, synth, seed=seed, min_speed=float(ev["min_speed"]))
     sm = summarise(per)
     frames = int(db.lengths.sum())
     graphs = model.graphs_
@@ -188,7 +193,7 @@ TIMING_COLUMNS = ["config", "creation_cpu_s", "creation_wall_s", "paper_creation
 
 
 def assemble_table1(rows: list[dict], order: list[str], paper: dict | None = None) -> pd.DataFrame:
-    """Rows in config order; ``paper``: config name -> published values (:func:`.settings.read_paper_table1`)."""
+    """Rows in config order; ``paper``: config name -> published values (:func:`.settings.published_table1`)."""
     by = {r["config"]: dict(r) for r in rows}
     out = []
     for name in order:
@@ -203,6 +208,7 @@ def assemble_table1(rows: list[dict], order: list[str], paper: dict | None = Non
 
 
 def assemble_timing(rows: list[dict], order: list[str], paper: dict | None = None) -> pd.DataFrame:
+    """Timing rows in config order with the published times beside ours and ours / paper ratios."""
     by = {r["config"]: dict(r) for r in rows}
     out = []
     for name in order:
@@ -241,16 +247,17 @@ def baseline_table(db: FaceDatabase, graphs: dict[str, RegionGraph], cfg: dict, 
     ``baseline.max_nodes`` is not built: its memory is computed from its size
     and its path time extrapolated (Dijkstra on a complete graph is O(N^2)) from
     a complete graph on a seeded subset of ``max_nodes`` poses; the ``built``
-    column says which. Returns (deterministic table, timing table).
+    column says which. ``cfg``: the ``baseline``, ``synthesis`` and ``evaluation`` blocks of the
+    facegraph config. Returns (deterministic table, timing table).
     """
-    bcfg = cfg.get("baseline", {})
-    ev = cfg.get("evaluation", {})
-    min_speed = float(ev.get("min_speed", 0.05))
-    max_nodes = bcfg.get("max_nodes")
-    queries = _query_samples(db, bcfg.get("max_queries"), seed)
+    bcfg = cfg["baseline"]
+    ev = cfg["evaluation"]
+    min_speed = float(ev["min_speed"])
+    max_nodes = bcfg["max_nodes"]  # None: always build
+    queries = _query_samples(db, bcfg["max_queries"], seed)
     rows, trows = [], []
     with threadpool_limits(1):
-        synth = FaceSynthesizer(graphs, **synth_kwargs(cfg.get("synthesis", {}), noise=bool(ev.get("noise", False))))
+        synth = FaceSynthesizer(graphs, **synth_kwargs(cfg["synthesis"], noise=bool(ev["noise"])))
         per = evaluate_resynthesis(db, synth, seed=seed, min_speed=min_speed, samples=queries, extras=False)
         pf = []
         for s in queries:
@@ -270,11 +277,11 @@ def baseline_table(db: FaceDatabase, graphs: dict[str, RegionGraph], cfg: dict, 
         for per_region in (False, True):
             kind = "per region (5 graphs)" if per_region else "holistic (1 graph)"
             parts = 5 if per_region else 1
-            for power in bcfg.get("weight_powers", [1, 2]):
+            for power in bcfg["weight_powers"]:
                 wname = "L2" if float(power) == 1.0 else f"L2^{float(power):g}"
                 name = f"face graph, Zhang et al. 2004 ({wname})"
                 if max_nodes is not None and N > int(max_nodes):
-                    sub = _subset_database(db, int(max_nodes), seed)
+                    sub = subset_database(db, int(max_nodes), seed)
                     base = FaceGraphBaseline(power=float(power), per_region=per_region).fit(sub)
                     so = sub.offsets
                     times = [base.synthesize(int(so[k]), int(so[k + 1] - 1))[1]
@@ -298,7 +305,7 @@ def baseline_table(db: FaceDatabase, graphs: dict[str, RegionGraph], cfg: dict, 
     return pd.DataFrame(rows), pd.DataFrame(trows)
 
 
-def _subset_database(db: FaceDatabase, max_poses: int, seed: int) -> FaceDatabase:
+def subset_database(db: FaceDatabase, max_poses: int, seed: int) -> FaceDatabase:
     """Whole samples (seeded order) holding at most ``max_poses`` poses."""
     order = np.random.default_rng(seed).permutation(db.n_samples)
     keep = order[np.cumsum(db.lengths[order]) <= max_poses]
@@ -345,12 +352,13 @@ def uniqueness_tables(graphs: dict[str, RegionGraph], cfg: dict, seed: int):
     4. random peak nodes + node noise + duration noise (the full synthesis).
 
     Distances: mean landmark distance (px) after resampling both animations to
-    100 frames over the same time span. Returns (summary table, pairwise table).
+    100 frames over the same time span. ``cfg``: the ``uniqueness`` and ``synthesis``
+    blocks of the facegraph config. Returns (summary table, pairwise table).
     """
-    ucfg = cfg.get("uniqueness", {})
-    labels = [EMOTIONS[emotion_code(x)] for x in ucfg.get("labels", ["fear", "surprise", "happy"])]
-    runs = int(ucfg.get("runs", 20))
-    scfg = cfg.get("synthesis", {})
+    ucfg = cfg["uniqueness"]
+    labels = [EMOTIONS[emotion_code(x)] for x in ucfg["labels"]]
+    runs = int(ucfg["runs"])
+    scfg = cfg["synthesis"]
     full = synth_kwargs(scfg, noise=True)
     settings = [
         ("fixed peaks, no noise", dict(synth_kwargs(scfg, noise=False)), True),
@@ -394,177 +402,10 @@ def data_note(source: str) -> str:
     return f"Data: {source} (real CK+ landmarks; the paper's exact sequence selection may differ)."
 
 
-# ---------------------------------------------------------------------------
-def _fmt(v) -> str:
-    return f"{float(v):.3g}"
-
-
-VERDICT_COLUMNS = ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
-
-
-def _rank_trend(x, y, samples: dict | None, order: list[str], n_boot: int = 200, seed: int = 0):
-    """Spearman rho of y over x (configurations) and the share of bootstrap
-    resamples of the database samples (same resample in every configuration)
-    in which rho stays > 0."""
-    from scipy.stats import spearmanr
-
-    rho, p = spearmanr(x, y)
-    share = np.nan
-    if samples and all(n in samples for n in order):
-        M = np.stack([samples[n]["landmark_diff_px"].to_numpy(float) for n in order])  # (configs, S)
-        rng = np.random.default_rng(seed)
-        pos = 0
-        for _ in range(n_boot):
-            idx = rng.integers(M.shape[1], size=M.shape[1])
-            r, _ = spearmanr(x, np.nanmean(M[:, idx], 1))
-            pos += bool(r > 0)
-        share = pos / n_boot
-    return float(rho), float(p), share
-
-
-def verdicts(table1: pd.DataFrame, baseline: pd.DataFrame, uniqueness: pd.DataFrame, source: str,
-             samples: dict | None = None) -> pd.DataFrame:
-    """The paper's claims checked against our deterministic tables (common verdict columns).
-
-    ``samples``: configuration name -> per-sample table (for the bootstrap of the trend verdict).
-    """
-    rows = []
-    t = table1
-    data = f"{'synthetic CK+-layout' if source.startswith('synthetic') else source}, {len(t)} configurations"
-
-    def add(claim, paper_value, ours, verdict, evidence, src):
-        rows.append({"claim": claim, "paper_value": paper_value, "ours": ours, "data": data, "verdict": verdict,
-                     "evidence": evidence, "source": src})
-
-    cb = t["creation_in_band_pct"].astype(float)
-    mb = t["merge_in_band_pct"].astype(float)
-    ok = (cb >= 95) & (mb >= 95)
-    add("Thresholds optimised per sample reach the target compression band",
-        "targets with tolerances, e.g. creation 0.2 +/- 0.1, merge 0.7 +/- 0.3",
-        f"samples in band: creation {_fmt(cb.min())}-{_fmt(cb.max())} %, merge {_fmt(mb.min())}-{_fmt(mb.max())} %",
-        "reproduced" if ok.all() else ("partly" if ok.any() else "not reproduced"),
-        f"{int(ok.sum())}/{len(t)} configurations have >= 95 % of the samples of every region inside both bands "
-        "(step-halving search per sample; a sample whose compression jumps over a narrow band cannot hit it).",
-        "facegraph/thresholds.csv")
-    dd = t["duration_diff"].astype(float)
-    pd_ = t["paper_duration_diff"].astype(float)
-    rd = t["random_duration_diff"].astype(float)
-    near = dd <= 0.25  # the paper's largest mean difference is 0.11 frames
-    verdict = "reproduced" if near.all() else ("partly" if near.any() else "not reproduced")
-    add("Synthesised sequences keep the original durations (duration difference near 0)",
-        f"{_fmt(pd_.min())}-{_fmt(pd_.max())} frames" if pd_.notna().any() else "",
-        f"{_fmt(dd.min())}-{_fmt(dd.max())} frames", verdict,
-        f"{int(near.sum())}/{len(t)} configurations within 0.25 frames. "
-        f"Counterpart re-synthesis (own neutral and peak node) stretched to the peak nodes' stored duration: "
-        f"mean |difference| {_fmt(dd.min())}-{_fmt(dd.max())} frames (sd up to {_fmt(t.duration_diff_sd.max())}); "
-        f"a peak node that merged several samples' peaks stores their mean ({_fmt(t.shared_peak_pct.min())}-"
-        f"{_fmt(t.shared_peak_pct.max())} % of sample-region peaks are shared, rising with compression). "
-        f"A random same-label peak gives {_fmt(rd.min())}-{_fmt(rd.max())} frames.", "facegraph/table1.csv")
-    lm = t["landmark_diff_px"].astype(float)
-    inside = (lm >= 1.4) & (lm <= 2.5)
-    pl = t["paper_landmark_diff_px"].astype(float)
-    add("Landmark difference of re-synthesised sequences lies in the paper's 1.4-2.5 px band",
-        f"{_fmt(pl.min())}-{_fmt(pl.max())} px" if pl.notna().any() else "1.4-2.5 px",
-        f"{_fmt(lm.min())}-{_fmt(lm.max())} px",
-        "reproduced" if inside.all() else ("partly" if inside.any() else "not reproduced"),
-        f"{int(inside.sum())}/{len(t)} configurations inside 1.4-2.5 px; ours "
-        f"{'below' if lm.max() < 1.4 else 'above' if lm.min() > 2.5 else 'around'} the band on these data "
-        f"(linear neutral-to-peak interpolation: {_fmt(t.linear_landmark_diff_px.min())}-"
-        f"{_fmt(t.linear_landmark_diff_px.max())} px).", "facegraph/table1.csv")
-    order = t["config"].tolist()
-    rho, p, share = (_rank_trend(t["node_compression_pct"].astype(float), lm, samples, order)
-                     if len(t) > 2 else (np.nan, np.nan, np.nan))
-    prho = np.nan
-    if pl.notna().sum() > 2:
-        from scipy.stats import spearmanr
-
-        prho = float(spearmanr(t["paper_node_compression_pct"].astype(float), pl)[0])
-    if not np.isfinite(rho):
-        verdict = "not reproduced"
-    elif rho > 0 and p < 0.05 and (np.isnan(share) or share >= 0.95):
-        verdict = "reproduced"
-    elif rho > 0:
-        verdict = "within noise"
-    else:
-        verdict = "contradicted" if p < 0.05 else "not reproduced"
-    add("Landmark error rises with compression",
-        f"Spearman rho {_fmt(prho)} over the published rows" if np.isfinite(prho) else "",
-        f"Spearman rho {_fmt(rho)} (p={_fmt(p)})", verdict,
-        f"Rank correlation of landmark difference with node compression over {len(t)} configurations; "
-        f"rho > 0 in {_fmt(100 * share) if np.isfinite(share) else 'n/a'} % of 200 bootstrap resamples of the "
-        "database samples.", "facegraph/table1.csv")
-    nc = t["node_compression_pct"].astype(float)
-    pn = t["paper_node_compression_pct"].astype(float)
-    if pn.notna().any():
-        diff = (nc - pn).abs()
-        add("Node compression for the published targets (may be negative: more nodes than poses)",
-            f"{_fmt(pn.min())} to {_fmt(pn.max())} %", f"{_fmt(nc.min())} to {_fmt(nc.max())} %",
-            "reproduced" if (diff <= 10).all() else ("partly" if (diff <= 10).any() else "not reproduced"),
-            f"|ours - paper| <= 10 points in {int((diff <= 10).sum())}/{len(t)} configurations (median "
-            f"{_fmt(diff.median())} points). With node compression = 1 - nodes / poses and stage compressions "
-            "1 - nodes / poses (creation) and 1 - final / sample nodes (merge), five region graphs hold at least "
-            "5 (1 - c_max)(1 - m_max) nodes per pose (c_max, m_max: upper band ends), e.g. >= 2.4 poses for "
-            "0.1 +/- 0.1, 0.2 +/- 0.2, where the paper prints -54 % (1.54); its stage compressions must be measured "
-            "differently, which the text does not let us determine. Where in a wide band a sample lands depends on "
-            "the search start.", "facegraph/table1.csv")
-    region = baseline[baseline.method.str.startswith("region graphs")].iloc[0]
-    face = baseline[baseline.method.str.startswith("face graph")]
-    smaller = face.memory_mb > region.memory_mb
-    add("Region graphs need less memory than the face graph (Zhang et al. 2004)", "",
-        f"{_fmt(region.memory_mb)} MB vs {_fmt(face.memory_mb.min())}-{_fmt(face.memory_mb.max())} MB",
-        "reproduced" if smaller.all() else ("partly" if smaller.any() else "not reproduced"),
-        "float32 storage of what synthesis needs; complete face graphs hold N^2 weights"
-        + ("" if face.built.all() else " (graphs too large to build: memory computed from their size)") + ".",
-        "facegraph/baseline.csv")
-    work_region = float(region.edges + region.nodes * np.log2(max(region.nodes, 2)))
-    work_face = (face.edges + face.nodes * np.log2(face.nodes.clip(lower=2))).astype(float)
-    add("Path finding on region graphs is faster than on the face graph", "face graph ~1.9 s per path",
-        f"Dijkstra work (E + N log N) {_fmt(work_region)} vs {_fmt(work_face.min())}-{_fmt(work_face.max())}",
-        "reproduced" if (work_face > 10 * work_region).all() else "partly",
-        "Compared on graph size (deterministic); measured path times are in facegraph/baseline_timing.csv.",
-        "facegraph/baseline.csv")
-    built = face[face.built]
-    if len(built):
-        better = built.landmark_diff_px > region.landmark_diff_px
-        add("Region graphs reproduce database sequences more accurately than the face graph", "",
-            f"region graphs {_fmt(region.landmark_diff_px)} px vs face graph {_fmt(built.landmark_diff_px.min())}-"
-            f"{_fmt(built.landmark_diff_px.max())} px",
-            "reproduced" if better.all() else ("partly" if better.any() else "contradicted"),
-            "Same queries (neutral to own peak); the face graph's shortest path on the database poses can follow "
-            "the sample itself, so it is a strong baseline for re-synthesis.", "facegraph/baseline.csv")
-    lin = t["linear_landmark_diff_px"].astype(float)
-    add("The graph adds over straight neutral-to-peak interpolation (landmark difference)", "",
-        f"graph {_fmt(lm.median())} px vs linear {_fmt(lin.median())} px (medians)",
-        "reproduced" if (lm < lin).all() else ("partly" if (lm < lin).any() else "not reproduced"),
-        f"Graph counterpart below the linear baseline in {int((lm < lin).sum())}/{len(t)} configurations; "
-        f"velocity angle {_fmt(t.velocity_angle_diff_pct.median())} % vs {_fmt(t.linear_velocity_angle_diff_pct.median())} %. "
-        "The reference is the pre-processed sequence, whose eq.-1 fit (one timing for x and y) moves every landmark "
-        "on a straight line, so straight interpolation to the true peak pose has no direction error by construction; "
-        "it also knows the peak pose, which the graph must find.",
-        "facegraph/table1.csv")
-    u = uniqueness.reset_index(drop=True)
-    plain, noisy, full = u.iloc[0], u.iloc[2], u.iloc[3]
-    add("Coherent (node and duration) noise makes repeated runs of one label sequence distinct", "",
-        f"{int(noisy.distinct)}/{int(noisy.runs)} distinct",
-        "reproduced" if noisy.distinct == noisy.runs and noisy.distinct > plain.distinct else
-        ("partly" if noisy.distinct > plain.distinct else "not reproduced"),
-        f"{plain.labels}, same peak nodes: {int(plain.distinct)}/{int(plain.runs)} distinct without noise, "
-        f"{int(noisy.distinct)}/{int(noisy.runs)} with node + duration noise (mean pairwise distance "
-        f"{_fmt(noisy.distance_mean_px)} px); random peaks too: {int(full.distinct)}/{int(full.runs)}.",
-        "facegraph/uniqueness.csv")
-    return pd.DataFrame(rows)[VERDICT_COLUMNS]
-
-
 # ----------------------------------------------------------------------------- cost curves (animsynth.scale)
-
-
 def scale_steps(recorder, n: int, seed: int = 0, creation: float = 50.0, merge: float = 30.0, frames_per_sequence: int = 26):
     """Facial motion graphs of ``n`` synthetic sequences: pre-processing, then creation + merging
     including both threshold searches."""
-    from threadpoolctl import threadpool_limits
-
-    from .model import FaceGraphModel
-    from .preprocess import FacePreprocessor
     from ..synth.faces import generate_sequences
 
     seqs = generate_sequences(n_subjects=max(1, n // 4), n_sequences=n, total_frames=n * frames_per_sequence,

@@ -1,4 +1,4 @@
-"""Leave-one-sequence-out experiments of Gauch & Peters and their extensions.
+"""Fold running: the leave-one-sequence-out folds of Gauch & Peters, ensembles of starts, variant grids.
 
 One *fold* holds one trial of a subset out, fits PCA on the other trials'
 joint angles (56 columns, root removed), builds the vector field and the
@@ -34,11 +34,13 @@ space are followed together (:func:`~animsynth.simplicial.path.follow_batch`).
 Member 0 gives the fold row; the members give the spread (IQR), the share of
 members in which one method beats another, and the separation growth
 ``|x_j(T) - x_0(T)| / |x_j(0) - x_0(0)|`` (how fast nearby paths separate).
+
+The tables built from these rows are in :mod:`~animsynth.simplicial.tables`, the statistics over them
+(paired tests, shares over the ensemble, variant summaries) in :mod:`~animsynth.simplicial.stats`.
 """
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -50,8 +52,6 @@ from .geometry import SafeDelaunay, bbox_diagonal
 from .graph import MotionGraph
 from .metrics import error_a, error_f
 from .path import GeneratedPath, TargetPlanner, follow_batch, follow_field
-
-log = logging.getLogger("animsynth.simplicial.experiment")
 
 GENERATIONS = ("field", "target")
 
@@ -74,9 +74,6 @@ MEMBER_COLUMNS = [
     "member", "steps", "fallback_steps", "error_a_norm", "error_f_norm", "error_a_pose", "error_f_pose",
     "sep_initial_rel", "sep_final_rel", "sep_max_rel",
 ]
-
-#: Columns of the wide all-units table (per method).
-TABLE2_METRICS = ("error_a", "error_f", "error_a_norm", "error_f_norm", "error_a_pose", "error_f_pose")
 
 
 @dataclass(frozen=True)
@@ -430,222 +427,6 @@ def order_folds(df: pd.DataFrame, datasets) -> pd.DataFrame:
 
 
 # ----------------------------------------------------------------------------
-# Table II (the paper's layout), its ensemble spread, and the paired comparison
-# ----------------------------------------------------------------------------
-#: Table II metrics: the paper's Error A and Error F (ours: normalised by the latent bbox diagonal).
-PAPER_METRICS = ("error_a", "error_f")
-
-
-def stability(share: float) -> str:
-    """``stable`` when an ordering holds in every ensemble member (share 0 or 1), else the share."""
-    if share is None or not np.isfinite(share):
-        return "no ensemble"
-    if share in (0.0, 1.0):
-        return "stable"
-    return f"within start-noise (share {100 * share:.0f} %)"
-
-
-def table2(folds: pd.DataFrame, datasets, methods=("delaunay", "knn"), paper: pd.DataFrame | None = None,
-           col: str = "{metric}_norm") -> pd.DataFrame:
-    """Medians over the folds laid out as the paper's Table II.
-
-    One row per metric (``error_a``, ``error_f``) x method; columns the
-    subsets and ``all`` with our medians (``col``: bounding-box-normalised by
-    default), then ``paper_<subset>`` with the published value (empty when
-    ``paper`` is None or lacks the cell), then ``<subset>_minus_paper``
-    (ours - paper, empty without the published value).
-
-    Parameters
-    ----------
-    folds : fold rows (member 0 = the held-out start)
-    paper : DataFrame with ``metric, method`` and one column per subset, optional
-    """
-    cols = list(datasets) + ["all"]
-    pap = None
-    if paper is not None and len(paper):
-        pap = paper.set_index(["metric", "method"])
-    rows = []
-    for met in PAPER_METRICS:
-        c = col.format(metric=met)
-        for m in methods:
-            r = {"metric": met, "method": m}
-            fm = folds[folds["method"] == m]
-            for d in cols:
-                s = fm if d == "all" else fm[fm["dataset"] == d]
-                r[d] = float(s[c].median()) if len(s) else np.nan
-            for d in cols:
-                val = np.nan
-                if pap is not None and (met, m) in pap.index and d in pap.columns:
-                    val = float(pap.loc[(met, m), d])
-                r[f"paper_{d}"] = val
-            for d in cols:
-                r[f"{d}_minus_paper"] = r[d] - r[f"paper_{d}"]
-            rows.append(r)
-    return pd.DataFrame(rows, columns=["metric", "method"] + cols + [f"paper_{d}" for d in cols]
-                        + [f"{d}_minus_paper" for d in cols])
-
-
-def table2_units(folds: pd.DataFrame, datasets, methods=("delaunay", "knn")) -> pd.DataFrame:
-    """Table II in every unit: one row per subset (+ ``all``), per method the median of each metric."""
-    rows = []
-    for name in list(datasets) + ["all"]:
-        sub = folds if name == "all" else folds[folds["dataset"] == name]
-        r = {"dataset": name, "folds": int(sub["fold"].count() // max(len(methods), 1))}
-        for m in methods:
-            s = sub[sub["method"] == m]
-            for met in TABLE2_METRICS:
-                r[f"{m}_{met}"] = float(s[met].median()) if len(s) else np.nan
-            r[f"{m}_fallback_share"] = float(s["fallback_steps"].sum() / s["steps"].sum()) if len(s) else np.nan
-        rows.append(r)
-    return pd.DataFrame(rows)
-
-
-def member_medians(members: pd.DataFrame, datasets, key: str, values, metric: str) -> dict:
-    """Per ensemble member: the median over folds of ``metric`` per (value of ``key``, subset or ``all``).
-
-    Returns
-    -------
-    dict (value, subset) -> ndarray (n_members,)
-    """
-    out = {}
-    for v in values:
-        mv = members[members[key] == v]
-        for d in list(datasets) + ["all"]:
-            s = mv if d == "all" else mv[mv["dataset"] == d]
-            out[(v, d)] = s.groupby("member")[metric].median().sort_index().to_numpy(float)
-    return out
-
-
-def _spread(x):
-    if len(x) == 0:
-        return np.nan, np.nan, np.nan
-    q25, q50, q75 = np.quantile(x, [0.25, 0.5, 0.75])
-    return float(q50), float(q25), float(q75)
-
-
-def table2_ensemble(members: pd.DataFrame, datasets, methods=("delaunay", "knn"),
-                    paper: pd.DataFrame | None = None) -> pd.DataFrame:
-    """Table II over the ensemble of starts: per metric x subset, each member's Table II cell.
-
-    For every member j the cell is the median over the subset's folds (as in
-    the paper); the row gives the median and IQR of that cell over members for
-    both methods, the share of members in which the first method is lower
-    (``a_lower_share``), whether that ordering is stable, the paper's ordering
-    and the share of members that agree with it, and the fallback share of the
-    first method (steps outside the hull, all members).
-    """
-    a, b = methods
-    pap = paper.set_index(["metric", "method"]) if paper is not None and len(paper) else None
-    rows = []
-    for met in PAPER_METRICS:
-        mm = member_medians(members, datasets, "method", methods, f"{met}_norm")
-        for d in list(datasets) + ["all"]:
-            xa, xb = mm[(a, d)], mm[(b, d)]
-            r = {"metric": met, "dataset": d, "n_members": int(min(len(xa), len(xb)))}
-            for m, x in ((a, xa), (b, xb)):
-                r[f"{m}_median"], r[f"{m}_q25"], r[f"{m}_q75"] = _spread(x)
-            n = r["n_members"]
-            share = float(np.mean(xa[:n] < xb[:n])) if n else np.nan
-            r["a_lower_share"] = share
-            r["ordering"] = (f"{a}<{b}" if share > 0.5 else f"{b}<{a}" if share < 0.5 else "tie") if n else ""
-            r["stability"] = stability(share)
-            pa = pb = np.nan
-            if pap is not None and (met, a) in pap.index and (met, b) in pap.index and d in pap.columns:
-                pa, pb = float(pap.loc[(met, a), d]), float(pap.loc[(met, b), d])
-            r[f"paper_{a}"], r[f"paper_{b}"] = pa, pb
-            r[f"{a}_median_minus_paper"] = r[f"{a}_median"] - pa
-            r[f"{b}_median_minus_paper"] = r[f"{b}_median"] - pb
-            if np.isfinite(pa) and np.isfinite(pb) and n:
-                r["paper_ordering"] = f"{a}<{b}" if pa < pb else f"{b}<{a}" if pb < pa else "tie"
-                r["agree_share"] = share if pa < pb else (1.0 - share if pb < pa else np.nan)
-            else:
-                r["paper_ordering"], r["agree_share"] = "", np.nan
-            s = members[(members["method"] == a) & ((members["dataset"] == d) | (d == "all"))]
-            r[f"{a}_fallback_share"] = float(s["fallback_steps"].sum() / s["steps"].sum()) if len(s) else np.nan
-            rows.append(r)
-    return pd.DataFrame(rows)
-
-
-def fold_ensemble(members: pd.DataFrame, datasets, methods=("delaunay", "knn")) -> pd.DataFrame:
-    """Per fold and metric: median and IQR over members per method, share of members with the first method lower,
-    and each method's fallback share (held-out start, and over all members)."""
-    a, b = methods
-    rows = []
-    for (d, fold), s in members.groupby(["dataset", "fold"], sort=False):
-        for met in PAPER_METRICS:
-            c = f"{met}_norm"
-            r = {"dataset": d, "fold": int(fold), "held_out": s["held_out"].iloc[0], "metric": met}
-            xs = {}
-            for m in methods:
-                sm = s[s["method"] == m].sort_values("member")
-                xs[m] = sm[c].to_numpy(float)
-                r[f"{m}_start"] = float(sm.loc[sm["member"] == 0, c].iloc[0]) if (sm["member"] == 0).any() else np.nan
-                r[f"{m}_median"], r[f"{m}_q25"], r[f"{m}_q75"] = _spread(xs[m])
-            n = min(len(xs[a]), len(xs[b]))
-            share = float(np.mean(xs[a][:n] < xs[b][:n])) if n else np.nan
-            r["a_lower_share"], r["stability"] = share, stability(share)
-            for m in methods:
-                sm = s[s["method"] == m]
-                z = sm[sm["member"] == 0]
-                r[f"{m}_fallback_share_start"] = float(z["fallback_steps"].sum() / max(z["steps"].sum(), 1))
-                r[f"{m}_fallback_share_members"] = float(sm["fallback_steps"].sum() / max(sm["steps"].sum(), 1))
-            rows.append(r)
-    out = pd.DataFrame(rows)
-    order = {d: i for i, d in enumerate(datasets)}
-    return out.assign(_d=out["dataset"].map(order)).sort_values(["_d", "fold", "metric"], kind="stable").drop(
-        columns="_d").reset_index(drop=True)
-
-
-def paired_comparison(folds: pd.DataFrame, a: str = "delaunay", b: str = "knn",
-                      metrics=("error_a_norm", "error_f_norm", "error_a_pose", "error_f_pose"),
-                      n_boot: int = 2000, seed: int = 0, alpha: float = 0.05, key: str = "method") -> pd.DataFrame:
-    """Paired Wilcoxon signed-rank test and bootstrap CI of ``a - b`` over folds.
-
-    Folds are paired on (dataset, held_out). ``median_diff`` < 0 means ``a``
-    has the lower error. The bootstrap resamples folds (paired) and reports
-    the percentile CI of the median difference.
-    """
-    rng = np.random.default_rng(seed)
-    A = folds[folds[key] == a].set_index(["dataset", "held_out"])
-    B = folds[folds[key] == b].set_index(["dataset", "held_out"])
-    common = A.index.intersection(B.index)
-    rows = []
-    for met in metrics:
-        x = A.loc[common, met].to_numpy(float)
-        y = B.loc[common, met].to_numpy(float)
-        d = x - y
-        n = int(d.size)
-        r = {"metric": met, "a": a, "b": b, "n_pairs": n,
-             "median_a": float(np.median(x)) if n else np.nan, "median_b": float(np.median(y)) if n else np.nan,
-             "median_diff": float(np.median(d)) if n else np.nan, "a_better_folds": int(np.sum(d < 0)),
-             "b_better_folds": int(np.sum(d > 0))}
-        if n >= 2 and np.any(d != 0):
-            from scipy import stats  # here, not at import: scipy.stats costs a fold job a third of a second
-
-            w = stats.wilcoxon(x, y, zero_method="wilcox", alternative="two-sided")
-            r["wilcoxon_stat"], r["p_value"] = float(w.statistic), float(w.pvalue)
-        else:
-            r["wilcoxon_stat"], r["p_value"] = np.nan, np.nan
-        if n >= 2:
-            idx = rng.integers(0, n, size=(n_boot, n))
-            meds = np.median(d[idx], axis=1)
-            r["ci_low"], r["ci_high"] = (float(v) for v in np.quantile(meds, [alpha / 2, 1 - alpha / 2]))
-        else:
-            r["ci_low"] = r["ci_high"] = np.nan
-        r["verdict"] = comparison_verdict(r, alpha)
-        rows.append(r)
-    return pd.DataFrame(rows)
-
-
-def comparison_verdict(r: dict, alpha: float = 0.05) -> str:
-    """``a_better``/``b_better`` when Wilcoxon p < alpha, else ``no_significant_difference``."""
-    p = r.get("p_value")
-    if p is None or not np.isfinite(p) or p >= alpha:
-        return "no_significant_difference"
-    return f"{r['a']}_better" if r["median_diff"] < 0 else f"{r['b']}_better"
-
-
-# ----------------------------------------------------------------------------
 # Variant grids
 # ----------------------------------------------------------------------------
 def derivative_variants(derivatives, methods, k: int, latent_dim: int, weights: str = "idw") -> list[Variant]:
@@ -655,6 +436,9 @@ def derivative_variants(derivatives, methods, k: int, latent_dim: int, weights: 
 
 def beyond_variants(cfg: dict, base_k: int, derivative: str) -> list[Variant]:
     """The beyond-the-paper grid (see ``docs/config_simplicial.md``).
+
+    ``cfg`` holds the keys of config ``simplicial.beyond`` used here: ``latent_dims``, ``k_values``,
+    ``barycentric``, ``kdelaunay`` and ``target_directed`` (all required; the schema fills them).
 
     * latent dimension in ``latent_dims`` for Delaunay (1/D^2), Delaunay
       (barycentric), k-NN and k-Delaunay (k = ``base_k``);
@@ -671,121 +455,19 @@ def beyond_variants(cfg: dict, base_k: int, derivative: str) -> list[Variant]:
 
     for d in dims:
         add(Variant(f"delaunay_idw_d{d}", "delaunay", base_k, d, derivative, "idw"))
-        if cfg.get("barycentric", True):
+        if cfg["barycentric"]:
             add(Variant(f"delaunay_bary_d{d}", "delaunay", base_k, d, derivative, "barycentric"))
         add(Variant(f"knn{base_k}_d{d}", "knn", base_k, d, derivative))
-        if cfg.get("kdelaunay", True):
+        if cfg["kdelaunay"]:
             add(Variant(f"kdelaunay{base_k}_d{d}", "kdelaunay", base_k, d, derivative))
     for k in cfg["k_values"]:
         add(Variant(f"knn{k}_d{d0}", "knn", int(k), d0, derivative))
-        if cfg.get("kdelaunay", True):
+        if cfg["kdelaunay"]:
             add(Variant(f"kdelaunay{k}_d{d0}", "kdelaunay", int(k), d0, derivative))
-    if cfg.get("target_directed", True):
+    if cfg["target_directed"]:
         add(Variant(f"target_delaunay_d{d0}", "delaunay", base_k, d0, derivative, "idw", "target"))
         add(Variant(f"target_knn{base_k}_d{d0}", "knn", base_k, d0, derivative, "idw", "target"))
     return list(out.values())
-
-
-def summarise_variants(folds: pd.DataFrame, baseline: str, datasets,
-                       metrics=("error_a_pose", "error_f_pose", "error_a_norm", "error_f_norm"),
-                       n_boot: int = 2000, seed: int = 0, members: pd.DataFrame | None = None) -> pd.DataFrame:
-    """One row per variant: medians over all folds (held-out start), per-subset median of the first metric,
-    the paired comparison with ``baseline`` on the first metric, and with ``members`` the share of ensemble
-    members in which the variant's all-fold median is below the baseline's (``lower_share_vs_baseline``)."""
-    first = metrics[0]
-    mm = members if members is not None and len(members) else None
-    rows = []
-    for name, s in folds.groupby("variant", sort=False):
-        r = {"variant": name}
-        for c in ("method", "k", "latent_dim", "derivative", "weights", "generation"):
-            r[c] = s[c].iloc[0]
-        r["folds"] = int(len(s))
-        for met in metrics:
-            r[met] = float(s[met].median())
-        for d in datasets:
-            r[f"{first}_{d}"] = float(s.loc[s["dataset"] == d, first].median()) if (s["dataset"] == d).any() else np.nan
-        r["pose_floor"] = float(s["pose_floor"].median())
-        r["fallback_steps"] = float(s["fallback_steps"].median())
-        r["fallback_share"] = float(s["fallback_steps"].sum() / max(s["steps"].sum(), 1))
-        r["length_ratio"] = float(s["length_ratio"].median())
-        r["sep_growth_log10"] = float(s["sep_growth_log10"].median())
-        if name != baseline:
-            pc = paired_comparison(folds, name, baseline, metrics=(first,), n_boot=n_boot, seed=seed, key="variant")
-            pr = pc.iloc[0]
-            r["rel_change_vs_baseline"] = (r[first] / float(folds.loc[folds["variant"] == baseline, first].median())) - 1.0
-            r["p_vs_baseline"] = pr["p_value"]
-            r["better_folds_vs_baseline"] = int(pr["a_better_folds"])
-        else:
-            r["rel_change_vs_baseline"] = 0.0
-            r["p_vs_baseline"] = np.nan
-            r["better_folds_vs_baseline"] = 0
-        r["lower_share_vs_baseline"] = np.nan
-        r["share_metric"] = ""
-        r["members"] = int(members[members["variant"] == name]["member"].nunique()) if mm is not None else 0
-        if mm is not None and name != baseline:
-            from .verdicts import member_share
-
-            same_dim = int(r["latent_dim"]) == int(folds.loc[folds["variant"] == baseline, "latent_dim"].iloc[0])
-            for met in (first, "error_a_norm") if same_dim else (first,):
-                sh = member_share(members, name, baseline, met)
-                if np.isfinite(sh):
-                    r["lower_share_vs_baseline"], r["share_metric"] = sh, met
-                    break
-        rows.append(r)
-    out = pd.DataFrame(rows)
-    return out.sort_values([first, "variant"], kind="stable").reset_index(drop=True)
-
-
-def derivative_summary(folds: pd.DataFrame, methods=("delaunay", "knn"), claim: str = "delaunay_better",
-                       n_boot: int = 2000, seed: int = 0, members: pd.DataFrame | None = None) -> pd.DataFrame:
-    """Per derivative: medians per method (held-out start), the Delaunay-vs-k-NN ordering, whether it matches
-    ``claim``, and with ``members`` its share over the ensemble of starts and each method's separation growth."""
-    a, b = methods
-    rows = []
-    for d, s in folds.groupby("derivative", sort=False):
-        r = {"derivative": d, "folds": int(len(s) // 2)}
-        for m in methods:
-            sm = s[s["method"] == m]
-            for met in ("error_a_norm", "error_f_norm", "error_a_pose", "length_ratio", "fallback_steps",
-                        "sep_growth_log10", "sep_final_rel"):
-                r[f"{m}_{met}"] = float(sm[met].median())
-        pc = paired_comparison(s, a, b, metrics=("error_a_norm", "error_f_norm"), n_boot=n_boot, seed=seed)
-        for _, p in pc.iterrows():
-            tag = "a" if p["metric"] == "error_a_norm" else "f"
-            r[f"p_value_{tag}"] = p["p_value"]
-            r[f"{a}_lower_{tag}"] = bool(p["median_a"] < p["median_b"])
-        r["ordering"] = ordering(r[f"{a}_lower_a"], r[f"{a}_lower_f"], a, b)
-        r["reproduces_claim"] = claim_matches(claim, r[f"{a}_lower_a"], r[f"{a}_lower_f"])
-        for tag, met in (("a", "error_a_norm"), ("f", "error_f_norm")):
-            share = np.nan
-            if members is not None and len(members):
-                md = members[members["derivative"] == d]
-                mm = member_medians(md, [], "method", methods, met)
-                x, y = mm[(a, "all")], mm[(b, "all")]
-                n = min(len(x), len(y))
-                share = float(np.mean(x[:n] < y[:n])) if n else np.nan
-            r[f"{a}_lower_share_{tag}"] = share
-            r[f"stability_{tag}"] = stability(share)
-        rows.append(r)
-    return pd.DataFrame(rows)
-
-
-def ordering(a_lower_a: bool, a_lower_f: bool, a: str, b: str) -> str:
-    if a_lower_a and a_lower_f:
-        return f"{a}<{b} (A and F)"
-    if not a_lower_a and not a_lower_f:
-        return f"{b}<{a} (A and F)"
-    return "mixed: " + (f"{a}<{b} on A" if a_lower_a else f"{b}<{a} on A") + (
-        f", {a}<{b} on F" if a_lower_f else f", {b}<{a} on F")
-
-
-def claim_matches(claim: str, a_lower_a: bool, a_lower_f: bool) -> str:
-    """``yes``/``no``/``partly``/``unknown`` against the configured paper claim."""
-    if claim == "unknown":
-        return "unknown"
-    want = claim == "delaunay_better"
-    hits = [a_lower_a == want, a_lower_f == want]
-    return "yes" if all(hits) else ("no" if not any(hits) else "partly")
 
 
 def to_jsonable(row: dict) -> dict:
@@ -803,11 +485,8 @@ def to_jsonable(row: dict) -> dict:
     return out
 
 
-
-
 __all__ = [
-    "FOLD_COLUMNS", "MEMBER_COLUMNS", "FoldResult", "Variant", "beyond_variants", "derivative_summary",
-    "derivative_variants", "fit_pca", "fold_ensemble", "jittered_starts", "member_medians", "order_folds",
-    "paired_comparison", "prepare_fold", "run_fold", "run_fold_ensemble", "run_subset", "stability", "steps_for",
-    "summarise_variants", "table2", "table2_ensemble", "table2_units", "to_jsonable",
+    "FOLD_COLUMNS", "GENERATIONS", "MEMBER_COLUMNS", "FoldContext", "FoldResult", "Variant", "arc_length",
+    "beyond_variants", "derivative_variants", "fit_pca", "jittered_starts", "order_folds", "prepare_fold",
+    "run_fold", "run_fold_ensemble", "run_subset", "steps_for", "to_jsonable",
 ]

@@ -16,8 +16,9 @@ operations of the numpy code they replace, in the same order:
 * a ``(n, 2) @ (2, 2)`` product (BLAS ``gemm``, OpenBLAS Haswell kernel) is
   ``fma(a1, b1, a0 * b0)``; a ``(2, 2) @ (2,)`` product (``gemv``) is
   ``fma(a0, b0, a1 * b1)`` (:func:`fma`, the LLVM intrinsic); these were
-  checked against numpy's results on this build and are covered by the
-  reference-digest test (another BLAS kernel could round differently);
+  checked against numpy's results on this build and are covered by
+  ``tests/test_facegraph_compiled.py`` (compiled kernels against a numpy
+  route in the same process; another BLAS kernel could round differently);
 * ``math.hypot`` is CPython's correctly rounded algorithm (:func:`py_hypot`),
   not the C library's.
 
@@ -338,7 +339,6 @@ def merge_sample(s, T, trial, lam, eps, procrustes, st,
     qv = np.empty((Lr, 2))
     qvt = np.empty((Lr, 2))
     qdr = np.empty((Lr, 2))
-    dist = np.empty(Lr)
     cdist = np.empty(Lr)
     qn = np.empty(Lr)
     prod = np.empty(Lr)

@@ -1,0 +1,126 @@
+"""The package's import graph: no cycle, no import from a lower layer up to a higher one, families apart.
+
+Every ``import`` statement of every module counts, also those inside functions (a lazy import is still a
+dependency). Layers, bottom to top:
+
+0. plain helpers with no animsynth import: atomic writes, file-format errors, limits, the verdict format,
+   the published-table reader, joint roles, the skeleton;
+1. config checks, tables, the Motion container, kinematics;
+2. io (file formats; knows no method);
+3. shared machinery on top of io: synthetic data, skinning, drawing, data sources, the data layer,
+   workflow logging;
+4. the four families (simplicial, resequencing, facegraph, meshdetail), which never import each other;
+5. compare, which scores the families' generators side by side (the one package that imports them);
+6. report, scale (the measuring harness) and the command line.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "animsynth"
+PKG = "animsynth"
+FAMILIES = ("simplicial", "resequencing", "facegraph", "meshdetail")
+LAYERS = {
+    0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton"],
+    1: ["config", "tables", "motion", "kinematics"],
+    2: ["io"],
+    3: ["synth", "skinning", "viz", "sources", "data", "workflow_utils"],
+    4: list(FAMILIES),
+    5: ["compare"],
+    6: ["report", "scale", "cli"],
+}
+TOP = {name: layer for layer, names in LAYERS.items() for name in names}
+
+
+def modules() -> dict[str, Path]:
+    out = {}
+    for p in sorted(SRC.rglob("*.py")):
+        parts = p.relative_to(SRC.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        out[name] = p
+    return out
+
+
+def import_graph() -> dict[str, set[str]]:
+    mods = modules()
+    graph = {}
+    for name, path in mods.items():
+        is_pkg = path.name == "__init__.py"
+        deps = set()
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.Import):
+                targets = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = name.split(".") if is_pkg else name.split(".")[:-1]
+                    base = base[: len(base) - (node.level - 1)]
+                    mod = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    mod = node.module or ""
+                targets = [f"{mod}.{a.name}" if f"{mod}.{a.name}" in mods else mod for a in node.names]
+            else:
+                continue
+            for t in targets:
+                if t.split(".")[0] != PKG:
+                    continue
+                while t not in mods and "." in t:
+                    t = t.rsplit(".", 1)[0]
+                if t in mods and t != name:
+                    deps.add(t)
+        graph[name] = deps
+    return graph
+
+
+def top_name(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else None
+
+
+def test_every_module_has_a_layer():
+    missing = sorted({top_name(m) for m in modules() if top_name(m) and top_name(m) not in TOP})
+    assert not missing, f"modules without a layer in {__file__}: {missing}"
+
+
+def test_no_import_cycle():
+    graph = import_graph()
+    names = sorted(graph)
+    index = {n: i for i, n in enumerate(names)}
+    rows = [index[a] for a in names for b in graph[a]]
+    cols = [index[b] for a in names for b in graph[a]]
+    adj = csr_matrix(([1] * len(rows), (rows, cols)), shape=(len(names), len(names)))
+    _, labels = connected_components(adj, directed=True, connection="strong")
+    cycles = [sorted(n for n in names if labels[index[n]] == lab)
+              for lab in set(labels) if list(labels).count(lab) > 1]
+    assert not cycles, f"import cycles: {cycles}"
+
+
+def test_no_import_from_a_lower_layer_up():
+    bad = []
+    for mod, deps in import_graph().items():
+        src = top_name(mod)
+        if src is None:  # the package's own __init__ exports lazily
+            continue
+        for d in deps:
+            dst = top_name(d)
+            if dst is not None and TOP[dst] > TOP[src]:
+                bad.append(f"{mod} (layer {TOP[src]}) imports {d} (layer {TOP[dst]})")
+    assert not bad, "\n".join(sorted(bad))
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_families_never_import_each_other(family):
+    bad = [f"{m} imports {d}" for m, deps in import_graph().items() if top_name(m) == family
+           for d in deps if top_name(d) in FAMILIES and top_name(d) != family]
+    assert not bad, "\n".join(bad)
+
+
+def test_the_walk_sees_lazy_imports():
+    # motion.py imports its atomic writer inside a method: the walk must count it
+    assert "animsynth.atomic" in import_graph()["animsynth.motion"] or \
+        "animsynth.atomic" in import_graph()["animsynth.motion"]
