@@ -47,17 +47,23 @@ def _start(m: Motion, n: int = 8) -> Motion:
     return Motion(m.values[:n].copy(), m.skeleton, m.fps, "start")
 
 
+NAMES = ["delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "replay", "concat"]
+
+
 @pytest.fixture(scope="module")
 def fitted(walks, cfg):
     out = {}
-    for name in ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "replay", "concat"):
-        out[name] = G.make_generator(name, cfg, held_out=walks[0]).fit(walks[1:])
+    for name in NAMES:
+        if not settings.unavailable(name):
+            out[name] = G.make_generator(name, cfg, held_out=walks[0]).fit(walks[1:])
     return out
 
 
-@pytest.mark.parametrize("name", ["delaunay", "knn", "isomap", "stisomap", "motion_graph", "replay", "concat"])
+@pytest.mark.parametrize("name", NAMES)
 def test_generator_returns_length_frames_on_the_skeleton_and_is_seeded(fitted, walks, name):
-    gen, start, length = fitted[name], _start(walks[0]), 20
+    if name not in fitted:
+        pytest.skip(f"{name}: {settings.unavailable(name)}")
+    gen, start, length = fitted[name], _start(walks[0]), 40
     a = gen.generate(start, length, 5)
     assert a.values.shape == (length, walks[0].skeleton.n_dof)
     assert a.skeleton.columns() == walks[0].skeleton.columns() and a.fps == 30.0
@@ -297,6 +303,9 @@ def test_summary_and_winners_tables():
     (lambda c: c["compare"]["concat"].update(min_segment_s=2.0), "compare.concat.min_segment_s"),
     (lambda c: c["compare"]["motion_graph"].update(blend=20), "compare.motion_graph.blend"),
     (lambda c: c["compare"]["metrics"].update(window=50), "compare.metrics.window"),
+    (lambda c: c["compare"]["fairmotion"].update(blend=15), "compare.fairmotion.blend"),
+    (lambda c: c["compare"]["fairmotion"].update(compare=5), "compare.fairmotion.compare"),
+    (lambda c: c["compare"]["fairmotion"].update(stride=20), "compare.fairmotion.stride"),
     (lambda c: c["compare"].update(subsets=[], resequencing=[]), "compare.subsets"),
 ])
 def test_settings_check_names_the_key(mutate, key):

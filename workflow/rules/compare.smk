@@ -42,6 +42,7 @@ rule compare_clips:
             caption="../report/compare_clips.rst",
             category="The generators side by side",
         ),
+        table_md=R("compare/clips.md"),
     params:
         trials=CMP_TRIALS,
         subsets=CMP_SUBSETS,
@@ -110,16 +111,19 @@ rule compare_tables:
             caption="../report/compare_winners.rst",
             category="The generators side by side",
         ),
+        winners_md=R("compare/winners.md"),
         cost=report(
             R("compare/cost_timing.csv"),
             caption="../report/compare_cost.rst",
             category="The generators side by side",
         ),
+        cost_md=R("compare/cost_timing.md"),
         verdicts=report(
             R("compare/verdicts.csv"),
             caption="../report/compare_verdicts.rst",
             category="The generators side by side",
         ),
+        verdicts_md=R("compare/verdicts.md"),
         summary_md=report(
             R("compare/summary.md"),
             caption="../report/compare_summary_md.rst",

@@ -11,5 +11,5 @@ for t, m in trials.items():
     m.name = t
 clips = prepare_clips(trials, dict(p.subsets), dict(p.resequencing), dict(p.cfg))
 save_clips(snakemake.output.clips, clips)  # noqa: F821
-write_table(clips_table(clips), snakemake.output.table)  # noqa: F821
+write_table(clips_table(clips), snakemake.output.table, md=snakemake.output.table_md)  # noqa: F821
 log.info("%d held-out clips", len(clips))

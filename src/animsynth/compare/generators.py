@@ -31,8 +31,8 @@ Generators (``GENERATORS``):
 ``motion_graph``
     the classic motion graph of Kovar, Gleicher & Pighin 2002 (:mod:`animsynth.compare.motiongraph`).
 ``fairmotion``
-    fairmotion's motion graph on the same clips (:mod:`animsynth.compare.fairmotion_peer`), when it
-    can be imported; :func:`unavailable` gives the reason when not.
+    fairmotion's motion graph on the same clips (:mod:`animsynth.compare.fairmotion_peer`), when its
+    package is installed (:func:`animsynth.compare.settings.unavailable` gives the reason when not).
 ``replay``
     the held-out capture itself (upper bound for realism; the same for every seed).
 ``concat``
@@ -55,7 +55,7 @@ from ..skeleton import ROT_DOFS, TRANS_DOFS
 log = logging.getLogger("animsynth.compare.generators")
 
 __all__ = ["GENERATORS", "REFERENCES", "Database", "FieldFollower", "Resequencer", "Replay", "Concat",
-           "make_generator", "unavailable", "heading", "align_root", "check_generated"]
+           "make_generator", "heading", "align_root", "check_generated"]
 
 #: every generator name, in the order of the tables
 GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "replay", "concat")
@@ -507,25 +507,6 @@ class Concat(Generator):
 
 
 # ----------------------------------------------------------------------------- the factory
-
-
-def unavailable(name: str) -> str:
-    """Why generator ``name`` cannot run here ('' when it can): fairmotion needs its package
-    (:func:`animsynth.compare.fairmotion_peer.check_available` says why not)."""
-    if name != "fairmotion":
-        return ""
-    try:
-        from . import fairmotion_peer
-    except ImportError as exc:  # the adapter itself is missing
-        return f"the fairmotion adapter cannot be imported ({exc})"
-    check = getattr(fairmotion_peer, "check_available", None)
-    if check is None:
-        return "the fairmotion adapter has no check_available()"
-    try:
-        check()
-    except fairmotion_peer.FairmotionUnavailable as exc:
-        return str(exc)
-    return ""
 
 
 def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Generator:

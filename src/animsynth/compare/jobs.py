@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import derive_seed
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 from ..motion import Motion
 from ..skeleton import Skeleton
 from .generators import REFERENCES, make_generator
@@ -586,9 +586,9 @@ def _num(x) -> str:
 
 def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str) -> None:
     """Assemble the family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``,
-    ``timing`` lists) into ``out``: ``metrics``, ``metrics_timing``, ``summary``, ``winners``, ``cost``,
-    ``verdicts``, ``summary_md``."""
-    from ..io.atomic import atomic_write_text
+    ``timing`` lists) into ``out``: ``metrics``, ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``),
+    ``cost`` (+ ``cost_md``), ``verdicts`` (+ ``verdicts_md``), ``summary_md`` (the family's page)."""
+    from ..atomic import atomic_write_text
     from ..tables import write_table
     from .verdicts import build
 
@@ -603,10 +603,10 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     winners = winners_table(metrics, summary, order)
     data = data_label(source, clips, cfg["seeds"])
     verdicts = build(metrics, cfg["verdicts"], data, left_out)
-    write_table(metrics, out["metrics"])
-    write_table(timing, out["metrics_timing"])
-    write_table(summary, out["summary"])
-    write_table(winners, out["winners"])
-    write_table(cost_table(timing, order), out["cost"])
-    write_table(verdicts, out["verdicts"])
+    write_table(metrics, out["metrics"], md=False)
+    write_table(timing, out["metrics_timing"], md=False)
+    write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below
+    write_table(winners, out["winners"], md=out["winners_md"])
+    write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
+    write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
     atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io.atomic import atomic_path
+from ..atomic import atomic_path
 from .generators import REFERENCES
 from .jobs import METRICS
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ..config import ConfigError
 
-__all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "generator_cfg"]
+__all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "generator_cfg", "unavailable"]
 
 
 def groups(config: dict) -> tuple[dict, dict]:
@@ -35,11 +35,25 @@ def showcase(config: dict) -> tuple[str, int]:
     return (sc["clip"] or clip_ids(config)[0], int(sc["seed"]))
 
 
-def run_generators(config: dict) -> tuple[list[str], dict]:
-    """``(generators that run, {generator left out: reason})``: fairmotion is left out when its package
-    cannot be imported here (:func:`animsynth.compare.generators.unavailable`)."""
-    from .generators import unavailable
+def unavailable(name: str) -> str:
+    """Why generator ``name`` cannot run here ('' when it can).
 
+    Only fairmotion can be missing: its package is installed apart from the stack (``python3 run.py``
+    installs it with ``--no-deps``; docs/compare.md). Checked without importing it (the workflow parses
+    this in every job): a package that is installed but whose motion graph cannot be imported stops
+    the fairmotion job with :class:`animsynth.compare.fairmotion_peer.FairmotionUnavailable`.
+    """
+    import importlib.util
+
+    if name == "fairmotion" and importlib.util.find_spec("fairmotion") is None:
+        return ("fairmotion is not installed (python3 run.py installs fairmotion 0.0.4 with --no-deps; "
+                "animsynth.compare.fairmotion_peer.INSTALL_COMMAND)")
+    return ""
+
+
+def run_generators(config: dict) -> tuple[list[str], dict]:
+    """``(generators that run, {generator left out: reason})``: fairmotion is left out when its package is
+    not installed here (:func:`unavailable`)."""
     run, left = [], {}
     for g in config["compare"]["generators"]:
         why = unavailable(g)
@@ -90,6 +104,14 @@ def check(config: dict) -> None:
     if mg["blend"] is not None and mg["blend"] > mg["window"]:
         raise ConfigError(f"config key 'compare.motion_graph.blend': {mg['blend']} exceeds the window "
                           f"({mg['window']} frames)")
+    fm = cmp["fairmotion"]
+    if not fm["blend"] < fm["base"]:
+        raise ConfigError(f"config key 'compare.fairmotion.blend': {fm['blend']} must be below base ({fm['base']})")
+    if fm["compare"] < fm["blend"]:
+        raise ConfigError(f"config key 'compare.fairmotion.compare': {fm['compare']} must be at least blend "
+                          f"({fm['blend']})")
+    if fm["stride"] is not None and fm["stride"] > fm["base"]:
+        raise ConfigError(f"config key 'compare.fairmotion.stride': {fm['stride']} exceeds base ({fm['base']})")
     sc = cmp["showcase"]
     if sc["clip"] is not None and sc["clip"] not in clip_ids(config):
         raise ConfigError(f"config key 'compare.showcase.clip': {sc['clip']!r} is not a clip of this run "
