@@ -205,7 +205,7 @@ def test_run_generator_scores_every_clip_and_seed_and_writes_a_bvh_our_reader_re
            (("metrics", ".csv"), ("timing", "_timing.csv"), ("shown", ".npz"), ("bvh", ".bvh"))}
     jobs.run_job(tmp_path / "clips.npz", "stisomap", cfg, 7, None, ("w1/t1", 1), out)
     m = pd.read_csv(out["metrics"])
-    assert len(m) == 3 * cfg["seeds"] and list(m.columns) == jobs.KEY_COLUMNS + jobs.METRIC_NAMES
+    assert len(m) == 3 * cfg["seeds"] and list(m.columns) == jobs.KEY_COLUMNS + jobs.METRIC_NAMES + ["note"]
     assert (m["n_seams"] >= 1).all()  # the entry is a seam
     assert m["copy_share"].between(0.99, 1).all()  # a re-sequencer copies database poses
     t = pd.read_csv(out["timing"])
@@ -325,3 +325,19 @@ def test_settings_lists_clips_and_showcase():
     run, left = settings.run_generators(cfg)
     assert set(run) | set(left) == set(cfg["compare"]["generators"]) and "motion_graph" in run
     assert all(why for why in left.values())
+
+
+def test_a_generator_not_built_on_a_clip_keeps_its_rows_with_the_reason(walks, cfg):
+    trials = {"a": walks[0], "b": walks[1], "c": Motion(walks[2].values[:18], walks[2].skeleton, 30.0, "c")}
+    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
+    clips = jobs.prepare_clips(trials, {"w1": ["a", "b"], "w2": ["b", "c"]}, {}, dict(cc, length=10))
+    # the w2/b clip's database is c alone: 18 frames, too short for windows of 20 frames
+    mg = dict(cfg, motion_graph=dict(cfg["motion_graph"], window=20))
+    metrics, timing, _ = jobs.run_generator(clips, "motion_graph", mg, 7)
+    bad = metrics[metrics["clip"] == "w2/b"]
+    assert len(bad) == cfg["seeds"] and bad["note"].str.startswith("not built: ").all()
+    assert bad[jobs.METRIC_NAMES].isna().all().all()
+    assert (metrics.loc[metrics["clip"] != "w2/b", "note"] == "").all()
+    assert timing.set_index("clip").loc["w2/b", "frames_generated"] == 0
+    with pytest.raises(ValueError, match="compare.showcase.clip"):
+        jobs.run_generator(clips, "motion_graph", mg, 7, showcase=("w2/b", 0))

@@ -14,7 +14,7 @@ def test_compare_outputs(tiny_workflow):
     clips = pd.read_csv(r / "clips.csv")
     assert set(clips["protocol"]) == {"leave one out", "temporal split"}
     m = pd.read_csv(r / "metrics.csv")
-    assert list(m.columns) == KEY_COLUMNS + METRIC_NAMES
+    assert list(m.columns) == KEY_COLUMNS + METRIC_NAMES + ["note"]
     gens = list(dict.fromkeys(m["generator"]))
     assert {"delaunay", "knn", "isomap", "stisomap", "motion_graph", "replay", "concat"} <= set(gens)
     assert len(m) == len(clips) * len(gens) * m["seed"].nunique() and m["seed"].nunique() == 2

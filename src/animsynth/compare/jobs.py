@@ -344,7 +344,9 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
 
     Returns
     -------
-    metrics : DataFrame, one row per clip x seed (:data:`KEY_COLUMNS` + :data:`METRIC_NAMES`)
+    metrics : DataFrame, one row per clip x seed (:data:`KEY_COLUMNS` + :data:`METRIC_NAMES` + ``note``):
+        a clip whose database the generator cannot be built on (its ``fit`` raises ValueError, e.g. a
+        motion graph without transitions) keeps its rows with no values and ``note`` = "not built: <why>"
     timing : DataFrame, one row per clip (:data:`TIMING_COLUMNS`): CPU and wall seconds of the build
         and of the generation, the Python heap's peak (tracemalloc) of a second, traced build and
         generation of the first clip
@@ -352,12 +354,26 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
         (``meta["context"]``: start frames)
     """
     mcfg = cfg["metrics"]
-    rows, trows, shown = [], [], None
-    for k, clip in enumerate(clips):
+    rows, trows, shown, traced = [], [], None, False
+    for clip in clips:
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
+        key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
+        db_frames = int(sum(d.n_frames for d in clip.database))
         gen = make_generator(generator, cfg, held_out=clip.held_out)
         c0, w0 = time.process_time(), time.perf_counter()
-        gen.fit(clip.database)
+        try:
+            gen.fit(clip.database)
+        except ValueError as exc:  # e.g. a motion graph without transitions on a short database
+            if showcase is not None and clip.clip == showcase[0]:
+                raise ValueError(f"{generator} cannot be built on the showcase clip {clip.clip} ({exc}); choose "
+                                 "another with config key 'compare.showcase.clip'") from exc
+            log.warning("%s cannot be built on %s: %s", generator, clip.clip, exc)
+            rows += [{**key, "seed": i, **{m: np.nan for m in METRIC_NAMES}, "note": f"not built: {exc}"}
+                     for i in range(len(seeds))]
+            trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
+                          "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan,
+                          "generate_wall_s": np.nan, "frames_generated": 0, "peak_mb": np.nan})
+            continue
         build_cpu, build_wall = time.process_time() - c0, time.perf_counter() - w0
         start = clip.start
         ref = reference(clip, mcfg, roles)
@@ -370,8 +386,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
             gen_wall += time.perf_counter() - w0
             row, f = score(clip, ref, m, generator, mcfg, roles)
             feats.append(f)
-            rows.append({"clip": clip.clip, "group": clip.group, "protocol": clip.protocol,
-                         "generator": generator, "seed": i, **row})
+            rows.append({**key, "seed": i, **row, "note": ""})
             if showcase is not None and (clip.clip, i) == tuple(showcase):
                 seams = np.asarray(m.meta["seams"], np.int64)
                 if generator != "replay":  # the entry is a seam, as scored
@@ -384,7 +399,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
         for r in rows[-len(seeds):]:
             r["seed_diversity_m"] = div
         peak = np.nan
-        if k == 0:  # the Python heap's peak of a build and one generation, traced apart from the timed runs
+        if not traced:  # the Python heap's peak of a build and one generation, traced apart from the timed runs
             g2 = make_generator(generator, cfg, held_out=clip.held_out)
             tracemalloc.start()
             try:
@@ -393,21 +408,14 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
                 peak = tracemalloc.get_traced_memory()[1] / 2**20
             finally:
                 tracemalloc.stop()
-        trows.append({"generator": generator, "clip": clip.clip,
-                      "database_frames": int(sum(d.n_frames for d in clip.database)),
+            traced = True
+        trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
                       "build_cpu_s": build_cpu, "build_wall_s": build_wall, "generate_cpu_s": gen_cpu,
                       "generate_wall_s": gen_wall, "frames_generated": clip.length * len(seeds), "peak_mb": peak})
         log.info("%s on %s: build %.3f s CPU, %d seeds x %d frames in %.3f s CPU", generator, clip.clip, build_cpu,
                  len(seeds), clip.length, gen_cpu)
-    metrics = pd.DataFrame(rows)
-    metrics = metrics[KEY_COLUMNS + METRIC_NAMES]
+    metrics = pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"])
     return metrics, pd.DataFrame(trows, columns=TIMING_COLUMNS), shown
-
-
-def skipped_run(generator: str, reason: str) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The tables of a generator that cannot run here: no rows (the reason is logged and documented)."""
-    log.warning("generator %s left out: %s", generator, reason)
-    return pd.DataFrame(columns=KEY_COLUMNS + METRIC_NAMES), pd.DataFrame(columns=TIMING_COLUMNS)
 
 
 # ----------------------------------------------------------------------------- tables
@@ -550,7 +558,7 @@ def data_label(source: str, clips: pd.DataFrame, seeds: int) -> str:
 
 
 def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.DataFrame, generators, left_out: dict,
-                     data: str, cfg: dict) -> str:
+                     data: str, cfg: dict, not_built: pd.DataFrame | None = None) -> str:
     """``compare/summary.md``: the protocol in numbers, which generator wins which metric, the verdicts.
     Generated from the tables (no timing: cost is in ``cost_timing.csv``)."""
     from ..tables import to_markdown
@@ -561,6 +569,10 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
            + ", ".join(generators) + ".", ""]
     if left_out:
         out += ["Left out: " + "; ".join(f"**{g}**: {why}" for g, why in left_out.items()) + ".", ""]
+    if not_built is not None and len(not_built):
+        out += ["Not built (no values for these clips): " + "; ".join(
+            f"**{r.generator}** on {r.clip} ({r.note.removeprefix('not built: ')})"
+            for r in not_built.itertuples()) + ".", ""]
     out += ["## Which generator wins which metric", "",
             "Best and second-best by median over clips x seeds (the reference rows replay and concat aside); "
             "`beyond_spread`: the two IQRs do not overlap; `best_wins_share`: share of clip x seed pairs in "
@@ -593,7 +605,9 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     from .verdicts import build
 
     order = list(cfg["generators"])
-    metrics = pd.concat([pd.read_csv(p) for p in inp["metrics"]], ignore_index=True)
+    metrics = pd.concat([pd.read_csv(p, dtype={"note": str}, keep_default_na=False, na_values=[""])
+                         for p in inp["metrics"]], ignore_index=True)
+    metrics["note"] = metrics["note"].fillna("")
     metrics["_g"] = metrics["generator"].map({g: i for i, g in enumerate(order)})
     clips = pd.read_csv(inp["clips"], dtype={"held_out": str})
     metrics["_c"] = metrics["clip"].map({c: i for i, c in enumerate(clips["clip"])})
@@ -609,4 +623,6 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     write_table(winners, out["winners"], md=out["winners_md"])
     write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
     write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
-    atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg))
+    not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
+    atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg,
+                                                          not_built))
