@@ -341,3 +341,12 @@ def test_a_generator_not_built_on_a_clip_keeps_its_rows_with_the_reason(walks, c
     assert timing.set_index("clip").loc["w2/b", "frames_generated"] == 0
     with pytest.raises(ValueError, match="compare.showcase.clip"):
         jobs.run_generator(clips, "motion_graph", mg, 7, showcase=("w2/b", 0))
+
+
+def test_root_rotation_is_the_root_of_local_rotations(walks):
+    from animsynth.kinematics import local_rotations
+
+    sk, v = walks[0].skeleton, walks[0].values[:10]
+    a = G.root_rotation(sk, v).as_quat()
+    b = local_rotations(sk, v)[0].as_quat()
+    assert np.allclose(np.abs(np.sum(a * b, axis=1)), 1.0)

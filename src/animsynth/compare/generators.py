@@ -48,14 +48,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import local_rotations, root_translation
+from ..kinematics import root_translation
 from ..motion import Motion
 from ..skeleton import ROT_DOFS, TRANS_DOFS
 
 log = logging.getLogger("animsynth.compare.generators")
 
 __all__ = ["GENERATORS", "REFERENCES", "Database", "FieldFollower", "Resequencer", "Replay", "Concat",
-           "make_generator", "heading", "align_root", "check_generated"]
+           "make_generator", "root_rotation", "heading", "align_root", "check_generated"]
 
 #: every generator name, in the order of the tables
 GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "replay", "concat")
@@ -66,9 +66,23 @@ REFERENCES = ("replay", "concat")
 # ----------------------------------------------------------------------------- root helpers
 
 
+def root_rotation(skeleton, values) -> Rotation:
+    """The root joint's rotation per frame (:func:`animsynth.kinematics.local_rotations` of the root alone)."""
+    values = np.atleast_2d(np.asarray(values, float))
+    root = skeleton.joints[0]
+    cols = values[:, skeleton.dof_slices()[root.name]]
+    rd = [(k, d) for k, d in enumerate(root.dofs) if d in ROT_DOFS]
+    if rd:
+        M = Rotation.from_euler("".join(d[1] for _, d in rd), cols[:, [k for k, _ in rd]], degrees=True)
+    else:
+        M = Rotation.identity(values.shape[0])
+    C = root.axis_rotation()
+    return C * M * C.inv()
+
+
 def heading(skeleton, values) -> np.ndarray:
     """Heading (radians about +Y) of the root's local +Z axis, per frame: shape ``(frames,)``."""
-    f = local_rotations(skeleton, values)[0].apply(np.array([0.0, 0.0, 1.0]))
+    f = root_rotation(skeleton, values).apply(np.array([0.0, 0.0, 1.0]))
     return np.arctan2(f[:, 0], f[:, 2])
 
 
@@ -101,7 +115,7 @@ def align_root(skeleton, values, anchor, index: int = 0) -> np.ndarray:
     """
     values = np.asarray(values, float)
     anchor = np.asarray(anchor, float)[None, :]
-    R = local_rotations(skeleton, values)[0]
+    R = root_rotation(skeleton, values)
     p = root_translation(skeleton, values)
     turn = float(heading(skeleton, anchor)[0] - heading(skeleton, values[index:index + 1])[0])
     Ry = Rotation.from_euler("y", turn)
@@ -496,7 +510,7 @@ class Concat(Generator):
             p = root_translation(sk, seg)
             target = root_translation(sk, last[None, :])[0]
             shift = np.array([target[0] - p[0, 0], 0.0, target[2] - p[0, 2]])
-            seg = _set_root(sk, seg, local_rotations(sk, seg)[0], p + shift)
+            seg = _set_root(sk, seg, root_rotation(sk, seg), p + shift)
             parts.append(seg)
             seams.append(t)
             sources.append(np.stack([np.full(size, c), np.arange(f0, f0 + size)], 1))

@@ -324,6 +324,15 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
 # ----------------------------------------------------------------------------- one generator over every clip
 
 
+def cpu_seconds() -> float:
+    """CPU seconds (user + system) of this process and of its finished child processes (fairmotion builds
+    its graph in a multiprocessing pool)."""
+    import resource
+
+    c = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + c.ru_utime + c.ru_stime
+
+
 def clip_seeds(master: int, family_seed: int, clip: str, n: int) -> list[int]:
     """The seeds of one clip: the same for every generator."""
     return [derive_seed(master, "compare", family_seed, clip, i) for i in range(int(n))]
@@ -347,8 +356,8 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     metrics : DataFrame, one row per clip x seed (:data:`KEY_COLUMNS` + :data:`METRIC_NAMES` + ``note``):
         a clip whose database the generator cannot be built on (its ``fit`` raises ValueError, e.g. a
         motion graph without transitions) keeps its rows with no values and ``note`` = "not built: <why>"
-    timing : DataFrame, one row per clip (:data:`TIMING_COLUMNS`): CPU and wall seconds of the build
-        and of the generation, the Python heap's peak (tracemalloc) of a second, traced build and
+    timing : DataFrame, one row per clip (:data:`TIMING_COLUMNS`): CPU (:func:`cpu_seconds`, child
+        processes included) and wall seconds of the build and of the generation, the Python heap's peak (tracemalloc) of a second, traced build and
         generation of the first clip
     shown : Motion or None, the showcase clip's start and generated frames joined
         (``meta["context"]``: start frames)
@@ -360,7 +369,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
         db_frames = int(sum(d.n_frames for d in clip.database))
         gen = make_generator(generator, cfg, held_out=clip.held_out)
-        c0, w0 = time.process_time(), time.perf_counter()
+        c0, w0 = cpu_seconds(), time.perf_counter()
         try:
             gen.fit(clip.database)
         except ValueError as exc:  # e.g. a motion graph without transitions on a short database
@@ -374,15 +383,15 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
                           "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan,
                           "generate_wall_s": np.nan, "frames_generated": 0, "peak_mb": np.nan})
             continue
-        build_cpu, build_wall = time.process_time() - c0, time.perf_counter() - w0
+        build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
         start = clip.start
         ref = reference(clip, mcfg, roles)
         gen_cpu = gen_wall = 0.0
         feats = []
         for i, s in enumerate(seeds):
-            c0, w0 = time.process_time(), time.perf_counter()
+            c0, w0 = cpu_seconds(), time.perf_counter()
             m = gen.generate(start, clip.length, s)
-            gen_cpu += time.process_time() - c0
+            gen_cpu += cpu_seconds() - c0
             gen_wall += time.perf_counter() - w0
             row, f = score(clip, ref, m, generator, mcfg, roles)
             feats.append(f)
