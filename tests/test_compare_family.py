@@ -320,7 +320,10 @@ def test_settings_check_names_the_key(mutate, key):
 def test_settings_lists_clips_and_showcase():
     cfg = _config()
     ids = settings.clip_ids(cfg)
-    assert ids[0] == f"w1/{cfg['subsets']['w1'][0]}" and ids[-1] == f"dance/{cfg['resequencing_trials']['dance']}"
+    first = cfg["compare"]["subsets"][0] if cfg["compare"]["subsets"] else "w1"
+    assert ids[0] == f"{first}/{cfg['subsets'][first][0]}" and ids[-1] == f"dance/{cfg['resequencing_trials']['dance']}"
+    every = dict(cfg, compare=dict(cfg["compare"], subsets=None))
+    assert len(settings.clip_ids(every)) == sum(len(v) for v in cfg["subsets"].values() if v) + 3
     assert settings.showcase(cfg) == (ids[0], 0)
     run, left = settings.run_generators(cfg)
     assert set(run) | set(left) == set(cfg["compare"]["generators"]) and "motion_graph" in run
@@ -344,9 +347,9 @@ def test_a_generator_not_built_on_a_clip_keeps_its_rows_with_the_reason(walks, c
 
 
 def test_root_rotation_is_the_root_of_local_rotations(walks):
-    from animsynth.kinematics import local_rotations
+    from animsynth.kinematics import local_rotations, root_rotation
 
     sk, v = walks[0].skeleton, walks[0].values[:10]
-    a = G.root_rotation(sk, v).as_quat()
+    a = root_rotation(sk, v).as_quat()
     b = local_rotations(sk, v)[0].as_quat()
     assert np.allclose(np.abs(np.sum(a * b, axis=1)), 1.0)

@@ -45,6 +45,21 @@ def local_rotations(skeleton: Skeleton, values) -> list[Rotation]:
     return out
 
 
+def root_rotation(skeleton: Skeleton, values) -> Rotation:
+    """The root joint's local rotation per frame: ``local_rotations(skeleton, values)[0]`` without the others
+    (placing and turning a motion on the floor needs only the root)."""
+    values = _check_values(skeleton, values)
+    root = skeleton.joints[0]
+    cols = values[:, skeleton.dof_slices()[root.name]]
+    rdofs = [(k, d) for k, d in enumerate(root.dofs) if d in ROT_DOFS]
+    if rdofs:
+        M = Rotation.from_euler("".join(d[1] for _, d in rdofs), cols[:, [k for k, _ in rdofs]], degrees=True)
+    else:
+        M = Rotation.identity(values.shape[0])
+    C = root.axis_rotation()
+    return C * M * C.inv()
+
+
 def root_translation(skeleton: Skeleton, values) -> np.ndarray:
     """Root translation per frame (frames, 3), skeleton length units."""
     values = _check_values(skeleton, values)

@@ -48,14 +48,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import root_translation
+from ..kinematics import root_rotation, root_translation
 from ..motion import Motion
 from ..skeleton import ROT_DOFS, TRANS_DOFS
 
 log = logging.getLogger("animsynth.compare.generators")
 
 __all__ = ["GENERATORS", "REFERENCES", "Database", "FieldFollower", "Resequencer", "Replay", "Concat",
-           "make_generator", "root_rotation", "heading", "align_root", "check_generated"]
+           "make_generator", "heading", "align_root", "check_generated"]
 
 #: every generator name, in the order of the tables
 GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "replay", "concat")
@@ -64,20 +64,6 @@ REFERENCES = ("replay", "concat")
 
 
 # ----------------------------------------------------------------------------- root helpers
-
-
-def root_rotation(skeleton, values) -> Rotation:
-    """The root joint's rotation per frame (:func:`animsynth.kinematics.local_rotations` of the root alone)."""
-    values = np.atleast_2d(np.asarray(values, float))
-    root = skeleton.joints[0]
-    cols = values[:, skeleton.dof_slices()[root.name]]
-    rd = [(k, d) for k, d in enumerate(root.dofs) if d in ROT_DOFS]
-    if rd:
-        M = Rotation.from_euler("".join(d[1] for _, d in rd), cols[:, [k for k, _ in rd]], degrees=True)
-    else:
-        M = Rotation.identity(values.shape[0])
-    C = root.axis_rotation()
-    return C * M * C.inv()
 
 
 def heading(skeleton, values) -> np.ndarray:

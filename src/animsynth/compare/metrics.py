@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..joints import resolve_roles
-from ..kinematics import forward_kinematics, local_rotations
+from ..kinematics import forward_kinematics, root_rotation
 
 __all__ = [
     "UP", "FOOT_ROLES", "positions", "foot_indices", "facing", "body_frame", "pose_features",
@@ -119,7 +119,7 @@ def facing(motion, overrides: dict | None = None) -> np.ndarray:
     if np.linalg.norm(f0) < 1e-9 * max(np.linalg.norm(across), 1e-300):
         raise ValueError(f"skeleton {sk.name!r}: the hips ({lh}, {rh}) are vertically aligned in the zero pose; "
                          "no facing direction")
-    f = local_rotations(sk, motion.values)[0].apply(f0 / np.linalg.norm(f0))[:, _HORIZONTAL]
+    f = root_rotation(sk, motion.values).apply(f0 / np.linalg.norm(f0))[:, _HORIZONTAL]
     n = np.linalg.norm(f, axis=1)
     ok = n > 1e-6
     if not ok.any():
