@@ -209,7 +209,7 @@ def test_run_generator_scores_every_clip_and_seed_and_writes_a_bvh_our_reader_re
     assert (m["n_seams"] >= 1).all()  # the entry is a seam
     assert m["copy_share"].between(0.99, 1).all()  # a re-sequencer copies database poses
     t = pd.read_csv(out["timing"])
-    assert len(t) == 3 and np.isfinite(t.loc[0, "peak_mb"]) and t["peak_mb"].iloc[1:].isna().all()
+    assert len(t) == 3 and (t["peak_rss_mb"] > 10).all() and t["peak_rss_mb"].is_monotonic_increasing
     shown = jobs.load_shown(out["shown"])
     assert shown.n_frames == clips[1].context + clips[1].length and shown.meta["context"] == clips[1].context
     back = read_bvh(out["bvh"])

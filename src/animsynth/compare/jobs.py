@@ -27,7 +27,6 @@ from __future__ import annotations
 import json
 import logging
 import time
-import tracemalloc
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -70,7 +69,7 @@ METRICS = (
 METRIC_NAMES = [m for m, _u, _b in METRICS]
 KEY_COLUMNS = ["clip", "group", "protocol", "generator", "seed"]
 TIMING_COLUMNS = ["generator", "clip", "database_frames", "build_cpu_s", "build_wall_s", "generate_cpu_s",
-                  "generate_wall_s", "frames_generated", "peak_mb"]
+                  "generate_wall_s", "frames_generated", "peak_rss_mb"]
 
 
 # ----------------------------------------------------------------------------- clips
@@ -333,6 +332,15 @@ def cpu_seconds() -> float:
     return time.process_time() + c.ru_utime + c.ru_stime
 
 
+def peak_rss_mb() -> float:
+    """The largest resident memory (MB) so far of this process and of its largest finished child process
+    (``getrusage``): a generator job's peak, fairmotion's pool included."""
+    import resource
+
+    return max(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss,
+               resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss) / 1024.0
+
+
 def clip_seeds(master: int, family_seed: int, clip: str, n: int) -> list[int]:
     """The seeds of one clip: the same for every generator."""
     return [derive_seed(master, "compare", family_seed, clip, i) for i in range(int(n))]
@@ -357,13 +365,13 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
         a clip whose database the generator cannot be built on (its ``fit`` raises ValueError, e.g. a
         motion graph without transitions) keeps its rows with no values and ``note`` = "not built: <why>"
     timing : DataFrame, one row per clip (:data:`TIMING_COLUMNS`): CPU (:func:`cpu_seconds`, child
-        processes included) and wall seconds of the build and of the generation, the Python heap's peak (tracemalloc) of a second, traced build and
-        generation of the first clip
+        processes included) and wall seconds of the build and of the generation, the job's peak resident
+        memory so far (:func:`peak_rss_mb`)
     shown : Motion or None, the showcase clip's start and generated frames joined
         (``meta["context"]``: start frames)
     """
     mcfg = cfg["metrics"]
-    rows, trows, shown, traced = [], [], None, False
+    rows, trows, shown = [], [], None
     for clip in clips:
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
@@ -381,7 +389,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
                      for i in range(len(seeds))]
             trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
                           "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan,
-                          "generate_wall_s": np.nan, "frames_generated": 0, "peak_mb": np.nan})
+                          "generate_wall_s": np.nan, "frames_generated": 0, "peak_rss_mb": peak_rss_mb()})
             continue
         build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
         start = clip.start
@@ -407,20 +415,10 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
         div = seed_diversity(feats)
         for r in rows[-len(seeds):]:
             r["seed_diversity_m"] = div
-        peak = np.nan
-        if not traced:  # the Python heap's peak of a build and one generation, traced apart from the timed runs
-            g2 = make_generator(generator, cfg, held_out=clip.held_out)
-            tracemalloc.start()
-            try:
-                g2.fit(clip.database)
-                g2.generate(start, clip.length, seeds[0])
-                peak = tracemalloc.get_traced_memory()[1] / 2**20
-            finally:
-                tracemalloc.stop()
-            traced = True
         trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
                       "build_cpu_s": build_cpu, "build_wall_s": build_wall, "generate_cpu_s": gen_cpu,
-                      "generate_wall_s": gen_wall, "frames_generated": clip.length * len(seeds), "peak_mb": peak})
+                      "generate_wall_s": gen_wall, "frames_generated": clip.length * len(seeds),
+                      "peak_rss_mb": peak_rss_mb()})
         log.info("%s on %s: build %.3f s CPU, %d seeds x %d frames in %.3f s CPU", generator, clip.clip, build_cpu,
                  len(seeds), clip.length, gen_cpu)
     metrics = pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"])
@@ -501,7 +499,8 @@ def winners_table(metrics: pd.DataFrame, summary: pd.DataFrame, order) -> pd.Dat
 
 def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
     """Per generator: builds (clips it was built on), median and total build CPU and wall seconds, generation
-    frames per CPU and wall second, the traced peak of the Python heap (MB). Machine-dependent (a timing table)."""
+    frames per CPU and wall second, the generator job's peak resident memory (MB: the whole job, Python and
+    scoring included; fairmotion's pool counted by its largest child). Machine-dependent (a timing table)."""
     rows = []
     for g in order_generators(timing["generator"].unique(), order):
         t = timing[timing["generator"] == g]
@@ -515,7 +514,7 @@ def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
                      else np.nan,
                      "generate_fps_wall": frames / float(t["generate_wall_s"].sum())
                      if t["generate_wall_s"].sum() > 0 else np.nan,
-                     "peak_mb": float(pd.to_numeric(t["peak_mb"], errors="coerce").max())})
+                     "peak_rss_mb": float(pd.to_numeric(t["peak_rss_mb"], errors="coerce").max())})
     return pd.DataFrame(rows)
 
 
