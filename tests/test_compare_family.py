@@ -353,3 +353,13 @@ def test_root_rotation_is_the_root_of_local_rotations(walks):
     a = root_rotation(sk, v).as_quat()
     b = local_rotations(sk, v)[0].as_quat()
     assert np.allclose(np.abs(np.sum(a * b, axis=1)), 1.0)
+
+
+def test_partly_when_groups_hold_stably_in_opposite_directions():
+    groups = pd.Series(["a"] * 20 + ["b"] * 20)
+    outcome = pd.Series([1] * 20 + [-1] * 20)
+    verdict, per = CV.by_group(groups, outcome, "within noise", 0.75, 0.05)
+    assert verdict == "partly" and per == {"a": "reproduced", "b": "contradicted"}
+    outcome = pd.Series([1] * 20 + [1, -1] * 10)
+    assert CV.by_group(groups, outcome, "within noise", 0.75, 0.05)[0] == "within noise"
+    assert CV.by_group(groups, pd.Series([1] * 40), "reproduced", 0.75, 0.05)[0] == "reproduced"

@@ -8,6 +8,8 @@ neither. The verdict:
 * ``reproduced`` -- at least ``compare.verdicts.share`` of the untied pairs agree and a two-sided
   sign test gives p below ``compare.verdicts.alpha``;
 * ``contradicted`` -- the same for the opposite;
+* ``partly`` -- anything between overall, but the claim holds (as above) within some groups (subsets or
+  re-sequencing clips) and its opposite within others;
 * ``within noise`` -- anything between (the evidence gives the share and p);
 * ``not reproduced`` -- no pair can be compared (a generator did not run: the evidence says why).
 
@@ -24,7 +26,7 @@ from .. import verdicts as V
 from .generators import REFERENCES
 from .jobs import METRICS
 
-__all__ = ["decide", "pair_outcomes", "build"]
+__all__ = ["decide", "by_group", "pair_outcomes", "build"]
 
 _UNITS = {m: u for m, u, _b in METRICS}
 
@@ -43,6 +45,20 @@ def decide(holds: int, fails: int, share: float, alpha: float) -> tuple[str, flo
     if s <= 1.0 - share and p < alpha:
         return "contradicted", s, p
     return "within noise", s, p
+
+
+def by_group(groups: pd.Series, outcome: pd.Series, verdict: str, share: float, alpha: float, order=None):
+    """``partly`` instead of ``within noise`` when the claim holds stably in some groups (subsets or clips)
+    and its opposite holds stably in others (each group decided as a whole claim); else ``verdict``.
+    Returns ``(verdict, {group: its verdict})``."""
+    per = {}
+    for g in (order if order is not None else dict.fromkeys(groups)):
+        o = outcome[groups == g]
+        per[g] = decide(int((o > 0).sum()), int((o < 0).sum()), share, alpha)[0]
+    words = set(per.values())
+    if verdict == "within noise" and {"reproduced", "contradicted"} <= words:
+        return "partly", per
+    return verdict, per
 
 
 def pair_outcomes(metrics: pd.DataFrame, a: str, b: str, metric: str, better: str = "lower") -> pd.DataFrame:
@@ -67,6 +83,14 @@ def _per_group(groups: pd.Series, outcome: pd.Series, order=None) -> str:
         n = int((o != 0).sum())
         parts.append(f"{g} {int((o > 0).sum())}/{n}" if n else f"{g} no pair")
     return "per group (holds/untied): " + ", ".join(parts)
+
+
+def _partly(verdict: str, per: dict) -> str:
+    if verdict != "partly":
+        return ""
+    holds = [g for g, v in per.items() if v == "reproduced"]
+    opposite = [g for g, v in per.items() if v == "contradicted"]
+    return f"; holds in {' '.join(holds)}, the opposite holds in {' '.join(opposite)}"
 
 
 def _median(metrics: pd.DataFrame, g: str, metric: str) -> float:
@@ -94,11 +118,13 @@ def _pair_row(metrics, claim, a, b, metric, better, vc, data, paper_value="", le
     j = pair_outcomes(metrics, a, b, metric, better)
     holds, fails, ties = int((j["outcome"] > 0).sum()), int((j["outcome"] < 0).sum()), int((j["outcome"] == 0).sum())
     verdict, share, p = decide(holds, fails, float(vc["share"]), float(vc["alpha"]))
+    order = dict.fromkeys(metrics["group"])
+    verdict, per = by_group(j["group"], j["outcome"], verdict, float(vc["share"]), float(vc["alpha"]), order)
     unit = _UNITS[metric]
     ours = f"{metric} ({unit}) median {a} {_spread(metrics, a, metric)} vs {b} {_spread(metrics, b, metric)}"
     evidence = (f"{a} {'lower' if better == 'lower' else 'higher'} in {holds} of {holds + fails} untied clip x seed "
                 f"pairs (share {V.fmt(share)}, {ties} ties), sign test p = {V.fmt(p, 2)}; "
-                + _per_group(j["group"], j["outcome"], dict.fromkeys(metrics["group"])))
+                + _per_group(j["group"], j["outcome"], order) + _partly(verdict, per))
     return V.row(claim, verdict, evidence, paper_value=paper_value, ours=ours, data=data, source="compare/metrics.csv")
 
 
@@ -118,10 +144,13 @@ def _copy_row(metrics, vc, data, left_out=None):
     ok = (wide[copiers].max(axis=1) <= tol) & (wide[makers].min(axis=1) > tol)
     holds, fails = int(ok.sum()), int((~ok).sum())
     verdict, share, p = decide(holds, fails, float(vc["share"]), float(vc["alpha"]))
+    order = dict.fromkeys(metrics["group"])
+    outcome = pd.Series(np.where(ok, 1, -1), index=ok.index)
+    verdict, per = by_group(groups, outcome, verdict, float(vc["share"]), float(vc["alpha"]), order)
     ours = "; ".join(f"{g} novelty median {_spread(metrics, g, 'novelty_median_m')} m" for g in copiers + makers)
     evidence = (f"every re-sequencer at most {V.fmt(tol)} m from the database and every field follower farther in "
                 f"{holds} of {holds + fails} clip x seed pairs (share {V.fmt(share)}), sign test p = {V.fmt(p, 2)}; "
-                + _per_group(groups, pd.Series(np.where(ok, 1, -1), index=ok.index), dict.fromkeys(metrics["group"])))
+                + _per_group(groups, outcome, order) + _partly(verdict, per))
     return V.row(claim, verdict, evidence, ours=ours, data=data, source="compare/metrics.csv")
 
 
