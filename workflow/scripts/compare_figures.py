@@ -15,3 +15,4 @@ metrics_figure(out.metrics, metrics, list(p.generators), f"Generators side by si
 shown = {g: load_shown(f) for g, f in zip(p.generators, snakemake.input.shown)}  # noqa: F821
 strips_figure(out.strips, shown, title=f"From the same start: clip {p.showcase[0]}, seed {p.showcase[1]} ({data}); "
               "grey: last start frame, red: frames at a seam")
+log.info("metrics.png: %d rows; strips.png: %s", len(metrics), ", ".join(shown))

@@ -633,5 +633,8 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
     write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
     not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
+    log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
+             metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
+             len(verdicts), ", ".join(verdicts["verdict"]))
     atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg,
                                                           not_built))
