@@ -11,6 +11,7 @@ import yaml
 
 from animsynth.compare import generators as G
 from animsynth.compare import jobs
+from animsynth.compare import tables
 from animsynth.compare import settings
 from animsynth.compare import verdicts as CV
 from animsynth.config import ConfigError, validate_config
@@ -279,11 +280,11 @@ def test_summary_and_winners_tables():
     metrics = _metrics({"motion_graph": [0.1] * n, "stisomap": [0.2] * n, "isomap": [0.3] * n,
                         "replay": [0.0] * n, "concat": [0.5] * n})
     order = list(G.GENERATORS)
-    s = jobs.summary_table(metrics, order)
+    s = tables.summary_table(metrics, order)
     row = s[(s["generator"] == "stisomap") & (s["metric"] == "skate_share")].iloc[0]
     assert row["n"] == n and row["median"] == pytest.approx(0.2) and row["better"] == "lower"
     assert list(dict.fromkeys(s["generator"])) == ["isomap", "stisomap", "motion_graph", "replay", "concat"]
-    w = jobs.winners_table(metrics, s, order).set_index("metric")
+    w = tables.winners_table(metrics, s, order).set_index("metric")
     r = w.loc["skate_share"]
     assert (r["best"], r["second"], bool(r["beyond_spread"])) == ("motion_graph", "stisomap", True)
     assert r["best_wins_share"] == 1.0 and r["replay_median"] == 0.0 and r["concat_median"] == 0.5

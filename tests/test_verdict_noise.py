@@ -195,7 +195,7 @@ def test_resequencing_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_wor
 @pytest.mark.workflow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_compare_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow, seed):
-    from animsynth.compare.jobs import data_label
+    from animsynth.compare.tables import data_label
     from animsynth.compare.verdicts import build
 
     out = tiny_workflow / "results" / "compare"

@@ -12,7 +12,8 @@ generators      the one interface (``fit(database)``, ``generate(start, length, 
 motiongraph     the classic motion graph (Kovar, Gleicher & Pighin 2002)
 fairmotion_peer fairmotion's motion graph on the same clips (the peer row), when it can be imported
 metrics         the metrics (pure numpy; metres, m/s)
-jobs            the protocol (held-out clips, starts, seeds), one generator over every clip, the tables
+jobs            the protocol (held-out clips, starts, seeds), one generator over every clip, scored
+tables          medians and spreads, which generator wins which metric, cost, the family's summary page
 verdicts        the side-by-side claims, decided over clips x seeds
 plots           metrics per generator with spreads, one skeleton strip per generator
 settings        config checks and what the workflow reads of the ``compare`` block

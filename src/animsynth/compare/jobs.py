@@ -16,6 +16,8 @@ Protocol (docs/compare.md, "Protocol"):
   ``compare.seed``, ``c`` and ``i`` (the same for every generator, so generators are compared
   seed by seed).
 
+The tables of the family are assembled by :mod:`animsynth.compare.tables`.
+
 Files between steps: ``compare/clips.npz`` (every clip's database, held-out clip and length:
 :func:`save_clips` / :func:`load_clips`), per generator ``compare/runs/<generator>.csv`` (metrics,
 one row per clip x seed), ``<generator>_timing.csv`` (build and generation cost, one row per clip)
@@ -32,11 +34,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..config import derive_seed
 from ..atomic import atomic_path
+from ..config import derive_seed
 from ..motion import Motion
 from ..skeleton import Skeleton
-from .generators import REFERENCES, make_generator
+from .generators import make_generator
 
 log = logging.getLogger("animsynth.compare.jobs")
 
@@ -425,99 +427,6 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     return metrics, pd.DataFrame(trows, columns=TIMING_COLUMNS), shown
 
 
-# ----------------------------------------------------------------------------- tables
-
-
-def _better(metric: str) -> str:
-    return {m: b for m, _u, b in METRICS}[metric]
-
-
-def _unit(metric: str) -> str:
-    return {m: u for m, u, _b in METRICS}[metric]
-
-
-def order_generators(names, order) -> list[str]:
-    """``names`` in the order of ``order`` (the config's generator list)."""
-    return [g for g in order if g in set(names)]
-
-
-def summary_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
-    """Per generator and metric: n (clip x seed rows with a value), median, IQR and 5-95 % range."""
-    out = []
-    for g in order_generators(metrics["generator"].unique(), order):
-        sub = metrics[metrics["generator"] == g]
-        for m in METRIC_NAMES:
-            x = pd.to_numeric(sub[m], errors="coerce").to_numpy(float)
-            x = x[np.isfinite(x)]
-            q = np.percentile(x, [5, 25, 50, 75, 95]) if x.size else np.full(5, np.nan)
-            out.append({"generator": g, "metric": m, "unit": _unit(m), "better": _better(m), "n": int(x.size),
-                        "median": q[2], "q25": q[1], "q75": q[3], "p05": q[0], "p95": q[4]})
-    return pd.DataFrame(out, columns=["generator", "metric", "unit", "better", "n", "median", "q25", "q75", "p05",
-                                      "p95"])
-
-
-def paired_share(metrics: pd.DataFrame, a: str, b: str, metric: str, better: str = "lower"):
-    """Over the clip x seed pairs where both generators have a value: (a better, b better, ties)."""
-    key = ["clip", "seed"]
-    A = metrics[metrics["generator"] == a].set_index(key)[metric]
-    B = metrics[metrics["generator"] == b].set_index(key)[metric]
-    j = pd.concat([A.rename("a"), B.rename("b")], axis=1, join="inner").apply(pd.to_numeric, errors="coerce")
-    j = j[np.isfinite(j["a"]) & np.isfinite(j["b"])]
-    d = (j["a"] - j["b"]).to_numpy(float)
-    if better == "higher":
-        d = -d
-    return int(np.sum(d < 0)), int(np.sum(d > 0)), int(np.sum(d == 0))
-
-
-def winners_table(metrics: pd.DataFrame, summary: pd.DataFrame, order) -> pd.DataFrame:
-    """Per metric with a direction: the best and the second-best generator (reference rows aside) by
-    median, the margin, whether the IQRs are apart ("beyond the spread"), the share of clip x seed pairs
-    in which the best beats the second, and the two reference rows' medians."""
-    rows = []
-    for m in METRIC_NAMES:
-        better = _better(m)
-        if not better:
-            continue
-        s = summary[(summary["metric"] == m) & ~summary["generator"].isin(REFERENCES) & (summary["n"] > 0)]
-        if len(s) < 2:
-            continue
-        s = s.sort_values("median", ascending=(better == "lower"), kind="stable")
-        a, b = s.iloc[0], s.iloc[1]
-        apart = (a["q75"] < b["q25"]) if better == "lower" else (a["q25"] > b["q75"])
-        wins, losses, ties = paired_share(metrics, a["generator"], b["generator"], m, better)
-        ref = {g: summary[(summary["metric"] == m) & (summary["generator"] == g)]["median"] for g in REFERENCES}
-        rows.append({"metric": m, "unit": _unit(m), "better": better, "best": a["generator"],
-                     "best_median": a["median"], "best_q25": a["q25"], "best_q75": a["q75"],
-                     "second": b["generator"], "second_median": b["median"], "second_q25": b["q25"],
-                     "second_q75": b["q75"], "margin": abs(a["median"] - b["median"]),
-                     "beyond_spread": bool(apart),
-                     "best_wins_share": wins / (wins + losses) if wins + losses else np.nan,
-                     "pairs": wins + losses + ties,
-                     **{f"{g}_median": (float(v.iloc[0]) if len(v) else np.nan) for g, v in ref.items()}})
-    return pd.DataFrame(rows)
-
-
-def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
-    """Per generator: builds (clips it was built on), median and total build CPU and wall seconds, generation
-    frames per CPU and wall second, the generator job's peak resident memory (MB: the whole job, Python and
-    scoring included; fairmotion's pool counted by its largest child). Machine-dependent (a timing table)."""
-    rows = []
-    for g in order_generators(timing["generator"].unique(), order):
-        t = timing[timing["generator"] == g]
-        frames = float(t["frames_generated"].sum())
-        rows.append({"generator": g, "builds": int(t["build_cpu_s"].notna().sum()),
-                     "build_cpu_s_median": float(t["build_cpu_s"].median()),
-                     "build_wall_s_median": float(t["build_wall_s"].median()),
-                     "build_cpu_s_total": float(t["build_cpu_s"].sum()),
-                     "build_wall_s_total": float(t["build_wall_s"].sum()),
-                     "generate_fps_cpu": frames / float(t["generate_cpu_s"].sum()) if t["generate_cpu_s"].sum() > 0
-                     else np.nan,
-                     "generate_fps_wall": frames / float(t["generate_wall_s"].sum())
-                     if t["generate_wall_s"].sum() > 0 else np.nan,
-                     "peak_rss_mb": float(pd.to_numeric(t["peak_rss_mb"], errors="coerce").max())})
-    return pd.DataFrame(rows)
-
-
 # ----------------------------------------------------------------------------- files of one generator job
 
 
@@ -555,86 +464,3 @@ def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict
     write_table(timing, out["timing"], md=False)
     save_shown(out["shown"], shown)
     write_bvh(out["bvh"], shown)
-
-
-# ----------------------------------------------------------------------------- the family's summary
-
-
-def data_label(source: str, clips: pd.DataFrame, seeds: int) -> str:
-    """What the comparison ran on, e.g. ``CMU mocap: 19 held-out clips x 5 seeds``."""
-    kind = {"cmu": "CMU mocap", "synthetic": "synthetic mocap", "user": "user mocap"}.get(source, source)
-    return f"{kind}: {len(clips)} held-out clips x {int(seeds)} seeds"
-
-
-def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.DataFrame, generators, left_out: dict,
-                     data: str, cfg: dict, not_built: pd.DataFrame | None = None) -> str:
-    """``compare/summary.md``: the protocol in numbers, which generator wins which metric, the verdicts.
-    Generated from the tables (no timing: cost is in ``cost_timing.csv``)."""
-    from ..tables import to_markdown
-
-    out = ["# The generators side by side", "",
-           f"Data: {data}. Working rate {_num(cfg['fps'])} fps; start = the held-out clip's first "
-           f"{cfg['context']} frames; up to {cfg['length']} frames generated from it; generators: "
-           + ", ".join(generators) + ".", ""]
-    if left_out:
-        out += ["Left out: " + "; ".join(f"**{g}**: {why}" for g, why in left_out.items()) + ".", ""]
-    if not_built is not None and len(not_built):
-        out += ["Not built (no values for these clips): " + "; ".join(
-            f"**{r.generator}** on {r.clip} ({r.note.removeprefix('not built: ')})"
-            for r in not_built.itertuples()) + ".", ""]
-    out += ["## Which generator wins which metric", "",
-            "Best and second-best by median over clips x seeds (the reference rows replay and concat aside); "
-            "`beyond_spread`: the two IQRs do not overlap; `best_wins_share`: share of clip x seed pairs in "
-            "which the best beats the second.", ""]
-    if winners.empty:
-        out += ["(no metric with two generators)", ""]
-    else:
-        cols = ["metric", "better", "best", "best_median", "second", "second_median", "margin", "beyond_spread",
-                "best_wins_share", "replay_median", "concat_median"]
-        out += [to_markdown(winners[[c for c in cols if c in winners]]), ""]
-    out += ["## Verdicts", "", to_markdown(verdicts[["claim", "ours", "verdict", "evidence"]]), "",
-            "## Clips", "", to_markdown(clips), "",
-            "Per clip x seed values: `metrics.csv`; medians and spreads: `summary.csv`; build time, generation "
-            "speed and memory: `cost_timing.csv` (machine-dependent, not shown here).", ""]
-    return "\n".join(out)
-
-
-def _num(x) -> str:
-    from ..verdicts import fmt
-
-    return fmt(x, 4)
-
-
-def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str) -> None:
-    """Assemble the family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``,
-    ``timing`` lists) into ``out``: ``metrics``, ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``),
-    ``cost`` (+ ``cost_md``), ``verdicts`` (+ ``verdicts_md``), ``summary_md`` (the family's page)."""
-    from ..atomic import atomic_write_text
-    from ..tables import write_table
-    from .verdicts import build
-
-    order = list(cfg["generators"])
-    metrics = pd.concat([pd.read_csv(p, dtype={"note": str}, keep_default_na=False, na_values=[""])
-                         for p in inp["metrics"]], ignore_index=True)
-    metrics["note"] = metrics["note"].fillna("")
-    metrics["_g"] = metrics["generator"].map({g: i for i, g in enumerate(order)})
-    clips = pd.read_csv(inp["clips"], dtype={"held_out": str})
-    metrics["_c"] = metrics["clip"].map({c: i for i, c in enumerate(clips["clip"])})
-    metrics = metrics.sort_values(["_c", "_g", "seed"], kind="stable").drop(columns=["_g", "_c"])
-    timing = pd.concat([pd.read_csv(p) for p in inp["timing"]], ignore_index=True)
-    summary = summary_table(metrics, order)
-    winners = winners_table(metrics, summary, order)
-    data = data_label(source, clips, cfg["seeds"])
-    verdicts = build(metrics, cfg["verdicts"], data, left_out)
-    write_table(metrics, out["metrics"], md=False)
-    write_table(timing, out["metrics_timing"], md=False)
-    write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below
-    write_table(winners, out["winners"], md=out["winners_md"])
-    write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
-    write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
-    not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
-    log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
-             metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
-             len(verdicts), ", ".join(verdicts["verdict"]))
-    atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg,
-                                                          not_built))
