@@ -9,9 +9,10 @@ from scipy.sparse.csgraph import connected_components
 from sklearn.neighbors import kneighbors_graph
 
 from animsynth.io import read_amc, read_asf
-from animsynth.resequencing.study import base_distances, method_distances, prepare_motion, with_defaults
+from animsynth.resequencing.jobs import base_distances, method_distances, prepare_motion
 from animsynth.resequencing.embedding import min_connected_k
 from animsynth.resequencing.features import motion_features
+from conftest import config_block
 
 
 @pytest.mark.workflow
@@ -73,7 +74,7 @@ def test_exact_min_k_on_real_cmu_trials(cmu_dir, trial):
     subject, name = trial.split("/")
     m = read_amc(cmu_dir / subject / f"{name}.amc", read_asf(cmu_dir / subject / f"{subject}.asf"))
     m = prepare_motion(m, 400, 2)
-    cfg = with_defaults({})
+    cfg = config_block("resequencing", files=("config.yaml", "cmu.yaml"))
     f = motion_features(m)
     for metric in ("l2", "lee"):
         for g in (False, True):
@@ -86,8 +87,9 @@ def test_exact_min_k_on_real_cmu_trials(cmu_dir, trial):
 @pytest.mark.realdata
 def test_matrix_naive_flips_the_humerus_and_raises_l2_min_k_on_cmu_walk(cmu_dir):
     m = read_amc(cmu_dir / "35" / "35_01.amc", read_asf(cmu_dir / "35" / "35.asf"))
-    cfg = with_defaults({"metrics": ["l2"], "explanations": {"frame_steps": [1], "global_dof": [False]}})
-    from animsynth.resequencing.study import explain
+    cfg = config_block("resequencing", {"metrics": ["l2"], "explanations": {"frame_steps": [1], "global_dof": [False]}},
+                       ("config.yaml", "cmu.yaml"))
+    from animsynth.resequencing.jobs import explain
 
     grid, flips = explain(m, "walk", "35_01", cfg)
     f = flips.set_index("joint")["flips_matrix_naive"]

@@ -238,6 +238,22 @@ def simplicial_benchmarks():
     )
 
 
+# ---- resequencing input functions ----
+def reseq_trial(wildcards):
+    """The trial id of a re-sequencing dataset (params of the analyse and explain jobs)."""
+    return RESEQ_TRIALS[wildcards.rsdata]
+
+
+def reseq_trial_npz(wildcards):
+    """The parsed trial of a re-sequencing dataset (input of its analyse, explain and path jobs)."""
+    return trial_npz(RESEQ_TRIALS[wildcards.rsdata])
+
+
+def reseq_pairs_seed(wildcards):
+    """Seed of a dataset's measured start/end pairs (the same for every method, metric and global flag)."""
+    return seed_for("resequencing", "pairs", wildcards.rsdata)
+
+
 def reseq_path_outputs(pattern):
     """One output per method x metric x global flag of a dataset (the order of RESEQ_PATH_CONFIGS)."""
     return [pattern.format(rsmethod=m, rsmetric=x, rsgdof=g) for m, x, g in RESEQ_PATH_CONFIGS]

@@ -1,7 +1,7 @@
 """Min k over the candidate explanations of the paper's Table 2 (sign mode x frame rate x global DOF) and sign flips."""
 from animsynth.motion import Motion
 from animsynth.atomic import atomic_path
-from animsynth.resequencing.study import explain
+from animsynth.resequencing.jobs import explain
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)  # noqa: F821
