@@ -312,6 +312,46 @@ def facegraph_benchmarks():
 # ---- end facegraph input functions ----
 
 
+# ---- meshdetail input functions ----
+def md_frames(wildcards):
+    """The frames of a mesh sequence: its folder (or the synthetic character's main clip)."""
+    return MD_FRAMES[wildcards.mdseq]
+
+
+def md_edit_dirs(wildcards):
+    """The synthetic character's edited clips (none for real meshes)."""
+    if MD_SEQS[wildcards.mdseq]["mesh_dir"]:
+        return []
+    return [R(f"meshdetail/character/edit_{e}") for e in config["meshdetail"]["character"]["edits"]]
+
+
+def md_checked(wildcards):
+    """The checksum table of a real sequence with a SHA-256 list (none otherwise)."""
+    return MESH_CHECK.get(wildcards.mdseq, [])
+
+
+def md_fps(wildcards):
+    return MD_SEQS[wildcards.mdseq]["mesh_fps"]
+
+
+def md_rig(wildcards):
+    """The sequence's rig block (meshdetail.rig with its own embedding)."""
+    return MD_SEQS[wildcards.mdseq]["rig"]
+
+
+def md_render_frames(wildcards):
+    return MD_SEQS[wildcards.mdseq]["render_frames"]
+
+
+def md_name(wildcards):
+    return wildcards.mdseq
+
+
+def md_data_source(wildcards):
+    """What the job's sequence is, for its tables (params)."""
+    return md_source(wildcards.mdseq)
+
+
 def md_truth(wildcards):
     """The synthetic character's ground truth (none for real meshes)."""
     return [] if MD_SEQS[wildcards.mdseq]["mesh_dir"] else [R("meshdetail/character/truth.npz")]

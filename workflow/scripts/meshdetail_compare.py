@@ -2,6 +2,7 @@
 row per claim saying on which sequences it holds."""
 import pandas as pd
 
+from animsynth import verdicts as common
 from animsynth.meshdetail.verdicts import combine_verdicts, side_by_side
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
@@ -15,7 +16,7 @@ write_table(table, o.table, title="Hybrid mesh animation: sequences side by side
             note="Mean vertex error (mm) over the folds and the SD of the fold means, per sequence ("
                  + ", ".join(names) + "). Dem Bones rows are a floor (best LBS with SSDR weights from the training "
                  "blocks when the bone transforms are solved from the held-out meshes), not a skeleton-driven model.")
-verdicts = combine_verdicts({n: read(f) for n, f in zip(names, i.verdicts)})
+verdicts = combine_verdicts({n: common.read(f) for n, f in zip(names, i.verdicts)})
 write_table(verdicts, o.verdicts, title="Meshdetail verdicts (every sequence, and across sequences)",
             note="Per sequence: model comparisons on held-out frames of the blocked cross-validation; 'within noise' "
                  "where the margin does not exceed the per-block spread or the blocks disagree. [all sequences]: a "

@@ -2,7 +2,7 @@
 import numpy as np
 
 from animsynth.atomic import atomic_path
-from animsynth.meshdetail.experiments import run_main
+from animsynth.meshdetail.evaluation import run_main
 from animsynth.meshdetail.jobs import fold_rig_fitter, load_prepared
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging

@@ -1,5 +1,5 @@
 """Joint parameterisation x detail encoding study."""
-from animsynth.meshdetail.experiments import run_representations
+from animsynth.meshdetail.evaluation import run_representations
 from animsynth.meshdetail.jobs import load_prepared
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging

@@ -1,5 +1,5 @@
 """Fig. 5b (error and stored size per control-mesh level, two decimations) and its timing table."""
-from animsynth.meshdetail.experiments import run_resolution
+from animsynth.meshdetail.evaluation import run_resolution
 from animsynth.meshdetail.jobs import load_prepared
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
