@@ -15,9 +15,7 @@ from animsynth.sources import is_archive, is_url, mesh_source_name, probe_source
 # settings.check(config) (which names the offending config key).
 check_config(config)
 for _family in ("simplicial", "resequencing", "facegraph", "meshdetail"):
-    _settings = importlib.import_module(f"animsynth.{_family}.settings")
-    if hasattr(_settings, "check"):
-        _settings.check(config)
+    importlib.import_module(f"animsynth.{_family}.settings").check(config)
 
 TRIALS = {t["id"]: t for t in config["trials"]}
 SUBSETS = {k: v for k, v in config["subsets"].items() if v}  # null drops a subset
