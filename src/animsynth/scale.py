@@ -29,7 +29,6 @@ Each family owns the steps it measures (``scale_steps`` in its workflow-step mod
 from __future__ import annotations
 
 import logging
-import os
 import resource
 import time
 from contextlib import contextmanager

@@ -7,8 +7,8 @@ from animsynth.meshdetail.verdicts import combine_verdicts, side_by_side
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-i, o, p = snakemake.input, snakemake.output, snakemake.params  # noqa: F821
+log = setup_logging(snakemake)
+i, o, p = snakemake.input, snakemake.output, snakemake.params
 read = lambda path: pd.read_csv(path, keep_default_na=False, na_values=[""])  # noqa: E731
 names = list(p.names)
 table = side_by_side({n: read(f) for n, f in zip(names, i.gen)}, {n: read(f) for n, f in zip(names, i.dembones)})

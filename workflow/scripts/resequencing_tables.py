@@ -7,10 +7,10 @@ from animsynth.resequencing.verdicts import all_verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-inp, out = snakemake.input, snakemake.output  # noqa: F821
-cfg = snakemake.params.cfg  # noqa: F821
-trials = snakemake.params.trials  # noqa: F821
+log = setup_logging(snakemake)
+inp, out = snakemake.input, snakemake.output
+cfg = snakemake.params.cfg
+trials = snakemake.params.trials
 
 
 def cat(paths):
