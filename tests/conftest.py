@@ -139,3 +139,21 @@ def write_small_trial(folder: Path, frames: int) -> Path:
     write_asf(folder / "c.asf", sk, length_unit=0.45)
     write_amc(folder / "c.amc", generate_motion("walk_straight", frames, 0, sk))
     return folder
+
+
+def config_block(family: str, overrides: dict | None = None, files=("config.yaml",)) -> dict:
+    """The ``family`` block of ``config/<files>`` merged in order (as snakemake merges ``--configfile``s), with
+    ``overrides`` merged over it, validated by config/schema.yaml (which fills every default, as in a run)."""
+    import copy
+
+    import yaml
+    from snakemake.utils import update_config
+
+    from animsynth.config import validate_config
+
+    cfg = {}
+    for name in files:
+        update_config(cfg, yaml.safe_load((REPO / "config" / name).read_text()))
+    update_config(cfg, {family: copy.deepcopy(overrides or {})})
+    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
+    return cfg[family]

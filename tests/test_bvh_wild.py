@@ -353,7 +353,7 @@ def test_asf_in_radians_with_an_amc_without_unit_flag(asf_amc, tmp_path, caplog)
     vals = deg.values.copy()
     rot = [k for k, c in enumerate(sk.columns()) if c.split(".")[1].startswith("r")]
     vals[:, rot] = np.radians(vals[:, rot])
-    lines, f = [], -1
+    lines = []
     body = iter(vals)
     for ln in amc.split("\n"):
         tok = ln.split()

@@ -65,7 +65,8 @@ def test_errors_are_clear(trial_files, tmp_path, capsys):
     assert "argument --end: 999 is outside" in capsys.readouterr().err
     assert main(["face", "--labels", "fear,bored", str(tmp_path / "f.gif")]) == 2
     assert "unknown CK+ emotion 'bored'" in capsys.readouterr().err
-    assert main(["generate", str(trial_files / "c_0.amc"), "--asf", str(trial_files / "c.asf"), "--out", str(tmp_path / "g.txt")]) == 2
+    assert main(["generate", str(trial_files / "c_0.amc"), "--asf", str(trial_files / "c.asf"),
+                 "--out", str(tmp_path / "g.txt")]) == 2
     assert "use a .bvh, .amc or .gif" in capsys.readouterr().err
     assert not (tmp_path / "x.bvh").exists() and not (tmp_path / "f.gif").exists()
 

@@ -196,20 +196,22 @@ def walk():
 
 def test_resequencing_over_the_memory_budget_is_refused_before_the_distances(walk, monkeypatch):
     from animsynth.limits import BudgetError
-    from animsynth.resequencing import study
+    from animsynth.resequencing import jobs
+    from conftest import config_block
 
     def no_distances(*a, **k):
         raise AssertionError("distance matrices built before the budget check")
 
-    monkeypatch.setattr(study, "base_distances", no_distances)
-    monkeypatch.setattr(study, "config_graph", no_distances)
+    monkeypatch.setattr(jobs, "base_distances", no_distances)
+    monkeypatch.setattr(jobs, "config_graph", no_distances)
+    cfg = config_block("resequencing", {"explanations": {"frame_steps": [4, 1]}})
     n = walk.n_frames
     msg = rf"re-sequencing trial 'syn_walk': {n} frames .*{n} x {n}.*needs about .* GiB.*memory budget of 1e-05 GiB"
     with pytest.raises(BudgetError, match=msg):
-        study.analyse(walk, "walk", "syn_walk", False, {}, budget_gib=1e-5)
+        jobs.analyse(walk, "walk", "syn_walk", False, cfg, budget_gib=1e-5)
     with pytest.raises(BudgetError, match=msg):
-        study.explain(walk, "walk", "syn_walk", {"explanations": {"frame_steps": [4, 1]}}, budget_gib=1e-5)
+        jobs.explain(walk, "walk", "syn_walk", cfg, budget_gib=1e-5)
     walk = walk.__class__(walk.values, walk.skeleton, walk.fps, "syn_walk")
     with pytest.raises(BudgetError, match=msg):
-        study.resequence(walk, False, "isomap", "l2", 5, {}, budget_gib=1e-5)
-    study.check_distance_budget(n, "syn_walk", 8.0 * 4 * n * n / 2**30 * 1.01)  # fits: no error
+        jobs.resequence(walk, False, "isomap", "l2", 5, cfg, budget_gib=1e-5)
+    jobs.check_distance_budget(n, "syn_walk", 8.0 * 4 * n * n / 2**30 * 1.01)  # fits: no error

@@ -9,7 +9,7 @@ from animsynth.meshdetail.detail import LaplacianCoder, farthest_point_order, le
 from animsynth.meshdetail.fit import PoseFitter, refine_joints_from_motion
 from animsynth.meshdetail.gp import GPRegression, SharedGPDM
 from animsynth.meshdetail.models import HybridModel, MeshContext, mean_vertex_error, pose_features
-from animsynth.skinning import (Rig, default_rig, forward, joint_transforms, lbs, pose_vertices, rebase,
+from animsynth.skinning import (Rig, default_rig, forward, pose_vertices, rebase,
                                       rebase_pose, skinning_weights)
 
 

@@ -7,7 +7,7 @@ import yaml
 
 from animsynth.io.obj import read_obj_sequence
 from animsynth.kinematics import forward_kinematics
-from animsynth.meshdetail.experiments import fit_skeleton, rig_from_joints
+from animsynth.meshdetail.rigfit import fit_skeleton, rig_from_joints
 from animsynth.skinning import JOINTS, cmu_motion_to_rig, forward
 
 REPO = Path(__file__).resolve().parents[1]
@@ -78,26 +78,64 @@ def test_samba_skeleton_fits_the_whole_sequence(vlasic_dir):
     assert fit.residual_.max() < 0.03 and np.all(np.isfinite(fit.angles_))
 
 
-def test_config_checks_name_the_key():
-    from animsynth.config import ConfigError
-    from animsynth.meshdetail.settings import check_meshdetail_config
+def _validated(**top):
+    from animsynth.config import validate_config
 
-    md = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["meshdetail"]
-    check_meshdetail_config(md, None)
+    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    cfg.update(top)
+    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
+    return cfg
+
+
+def test_config_checks_name_the_key():
+    import copy
+
+    from animsynth.config import ConfigError
+    from animsynth.meshdetail.settings import check
+
+    base = _validated()
+    check(base)
+
+    def with_md(**md):
+        cfg = copy.deepcopy(base)
+        cfg["meshdetail"].update(md)
+        return cfg
+
+    # the synthetic character: frames for training and for the blocked cross-validation, its driver
     with pytest.raises(ConfigError, match="meshdetail.cv_folds"):
-        check_meshdetail_config({**md, "cv_folds": 100}, None)
+        check(with_md(cv_folds=100))
+    with pytest.raises(ConfigError, match="meshdetail.train_fraction"):
+        check(with_md(train_fraction=0.05))
+    with pytest.raises(ConfigError, match="meshdetail.levels"):
+        check(with_md(levels=[50, 5, 50]))
+    with pytest.raises(ConfigError, match=r"meshdetail.character.fps': must divide 120"):
+        check(with_md(character={**base["meshdetail"]["character"], "fps": 25}))
+    with pytest.raises(ConfigError, match=r"meshdetail.character.asf' and 'meshdetail.character.amc'"):
+        check(with_md(character={**base["meshdetail"]["character"], "driver": "amc"}))
+    # real meshes: the 18-joint embedding, checked for every sequence with the sequence's key
     samba = yaml.safe_load((REPO / "config" / "samba.yaml").read_text())["meshdetail"]["rig"]
     joints = dict(samba["joints"])
-    check_meshdetail_config({**md, "rig": {**md["rig"], "joints": joints}}, "samba")
-    joints.pop("l_shin")
+    real = _validated(mesh_dir="../data/samba")
+    real["meshdetail"]["rig"]["joints"] = joints
+    check(real)
+    short = dict(joints)
+    short.pop("l_shin")
+    real["meshdetail"]["rig"]["joints"] = short
     with pytest.raises(ConfigError, match=r"meshdetail.rig.joints' misses \['l_shin'\]"):
-        check_meshdetail_config({**md, "rig": {**md["rig"], "joints": joints}}, "samba")
+        check(real)
+    real["meshdetail"]["rig"]["joints"] = joints
+    real["meshdetail"]["sequences"] = {"crane": {"mesh_dir": "../data/crane", "rig": {"joints": short}}}
+    with pytest.raises(ConfigError, match=r"meshdetail.sequences.crane.rig.joints' misses \['l_shin'\]"):
+        check(real)
+    real["meshdetail"]["sequences"] = {"crane": {"mesh_dir": "../data/crane", "rig": {"joints": joints, "skining": "heat"}}}
+    with pytest.raises(ConfigError, match=r"meshdetail.sequences.crane.rig': unknown key\(s\) \['skining'\]"):
+        check(real)
 
 
 def test_fold_rig_fitter_sees_only_the_fold_training_frames(tmp_path):
     import yaml
 
-    from animsynth.meshdetail.experiments import run_main
+    from animsynth.meshdetail.evaluation import run_main
     from animsynth.meshdetail.jobs import fit_pose, fold_rig_fitter, load_prepared, load_sequences, make_character
     from animsynth.io.obj import MeshSequence
 

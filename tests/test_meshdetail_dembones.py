@@ -6,7 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from animsynth.config import ConfigError
 from animsynth.meshdetail import dembones as D
-from animsynth.meshdetail.settings import mesh_sequences
+from animsynth.meshdetail.settings import check, mesh_sequences
 from animsynth.meshdetail.verdicts import combine_verdicts, holds_on, side_by_side
 from test_meshdetail_skinning import closed_cylinder
 
@@ -123,4 +123,4 @@ def test_mesh_sequences_names_and_own_rig():
     with pytest.raises(ConfigError, match="already taken"):
         mesh_sequences(_config(sequences={"samba": {"mesh_dir": "x", "rig": {"joints": joints}}}))
     with pytest.raises(ConfigError, match="crane.rig.joints"):
-        mesh_sequences(_config(sequences={"crane": {"mesh_dir": "x", "rig": {"joints": {"hips": [0, 0, 0]}}}}))
+        check(_config(sequences={"crane": {"mesh_dir": "x", "rig": {"joints": {"hips": [0, 0, 0]}}}}))

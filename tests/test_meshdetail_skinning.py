@@ -1,6 +1,5 @@
 """Skinning core: bone heat, weight refit, inside test, joint placement; control meshes and RBF reconstruction."""
 import numpy as np
-import pytest
 from scipy import sparse
 
 from animsynth.meshdetail.detail import ControlMesh, LaplacianCoder, RBFUpsampler

@@ -22,7 +22,7 @@ def test_fixture_holds_every_table_the_default_config_reads():
 
     cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
     paths = [*cfg["published"]["simplicial"].values(), cfg["published"]["facegraph"]["table1"],
-             *cfg["resequencing"]["published"].values()]
+             *cfg["published"]["resequencing"].values()]
     assert len(paths) == 5 and all(p.startswith("../shared/papers/") for p in paths), paths
     assert sorted(p.rsplit("/", 1)[1] for p in paths) == sorted(KEYS)
     for p in paths:

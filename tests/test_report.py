@@ -13,7 +13,8 @@ from animsynth.report import (
     rule_benchmark_summary,
 )
 
-TSV = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n{s}\t0:00:01\t{m}\t200\t1\t1\t0\t0\t50\t{s}\n"
+TSV = ("s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+       "{s}\t0:00:01\t{m}\t200\t1\t1\t0\t0\t50\t{s}\n")
 
 
 def test_rule_benchmarks(tmp_path):

@@ -24,11 +24,17 @@ from animsynth.resequencing.metrics import (Reference, TransitionReference, clas
                                             jerk_magnitude, pose_steps, root_reversals, smoothness,
                                             transition_measures, transitions)
 from animsynth.resequencing.paths import pad_path, play_path, resolve_frame, shortest_path_frames
-from animsynth.resequencing.study import (analyse, explain, min_k_table, path_pairs, prepare_motion, read_published,
-                                          resequence, splice, summarise_paths, with_defaults)
+from animsynth.resequencing.jobs import (analyse, explain, min_k_table, path_pairs, prepare_motion, published_table2,
+                                         resequence, splice, summarise_paths)
 from animsynth.resequencing.verdicts import (explanation_verdicts, global_dof_verdict, lee_vs_l2_verdict,
                                              st_smoother_verdict)
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+from conftest import config_block
+
+
+def full_cfg(overrides=None):
+    """The resequencing block at full size (config.yaml with cmu.yaml's sizes; schema defaults filled in)."""
+    return config_block("resequencing", overrides, ("config.yaml", "cmu.yaml"))
 
 
 def rot(axis, deg):
@@ -391,9 +397,9 @@ def test_smoothness_of_the_original_path_is_one(walk):
     assert s2["jumps"] == 1 and s2["jump_max_ratio"] > 1.0 and s2["jerk_events"] >= 1
 
 
-# ------------------------------------------------------------------ study
+# ------------------------------------------------------------------ workflow steps (jobs)
 def test_study_end_to_end_small(walk):
-    cfg = with_defaults({"fixed_k_sweep": [6], "max_dim": 3, "path": {"random_pairs": 3}})
+    cfg = full_cfg({"fixed_k_sweep": [6], "max_dim": 3, "path": {"random_pairs": 3}})
     m = prepare_motion(walk, 150, 2)
     assert m.n_frames == 75 and m.fps == walk.fps / 2
     mk, rv, emb, timing = analyse(m, "walk", "t35", False, cfg)
@@ -428,9 +434,9 @@ def test_analyse_switches_to_landmark_isomap_above_the_size_threshold(walk):
 
     m = prepare_motion(walk, 150, 2)  # 75 frames
     base = {"fixed_k_sweep": [], "max_dim": 3, "metrics": ["l2"]}
-    exact = analyse(m, "walk", "t", False, with_defaults(base))
+    exact = analyse(m, "walk", "t", False, full_cfg(base))
     # threshold below the frame count -> landmark; with every frame a landmark it is exact Isomap again
-    lm_cfg = with_defaults({**base, "embedding": {"exact_max_frames": 74, "n_landmarks": 75}})
+    lm_cfg = full_cfg({**base, "embedding": {"exact_max_frames": 74, "n_landmarks": 75}})
     lm = analyse(m, "walk", "t", False, lm_cfg)
     assert set(exact[0]["embedding_method"]) == {"exact"} and set(lm[0]["embedding_method"]) == {"landmark"}
     assert set(lm[1]["embedding_method"]) == {"landmark"}
@@ -439,15 +445,15 @@ def test_analyse_switches_to_landmark_isomap_above_the_size_threshold(walk):
         assert procrustes(exact[2][key], lm[2][key])[2] < 1e-6
     np.testing.assert_allclose(exact[1]["residual_variance"], lm[1]["residual_variance"], atol=1e-5)
     # 20 landmarks: an approximation that still follows the exact embedding
-    few = analyse(m, "walk", "t", False, with_defaults({**base, "embedding": {"method": "landmark", "n_landmarks": 20}}))
+    few = analyse(m, "walk", "t", False, full_cfg({**base, "embedding": {"method": "landmark", "n_landmarks": 20}}))
     assert set(few[0]["embedding_method"]) == {"landmark"}
     assert procrustes(exact[2]["isomap_l2_xy"], few[2]["isomap_l2_xy"])[2] < 0.1
     with pytest.raises(ValueError, match="resequencing.embedding.method"):
-        analyse(m, "walk", "t", False, with_defaults({**base, "embedding": {"method": "fast"}}))
+        analyse(m, "walk", "t", False, full_cfg({**base, "embedding": {"method": "fast"}}))
 
 
 def test_analyse_is_deterministic(walk):
-    cfg = with_defaults({"fixed_k_sweep": [5], "max_dim": 3, "metrics": ["lee"]})
+    cfg = full_cfg({"fixed_k_sweep": [5], "max_dim": 3, "metrics": ["lee"]})
     m = prepare_motion(walk, 120, 2)
     a = analyse(m, "walk", "t", True, cfg)
     b = analyse(m, "walk", "t", True, cfg)
@@ -469,8 +475,8 @@ def test_min_k_table_fills_published_values(tmp_path):
                          for st in (1, 4) for g in (True, False) for mode in ("matrix_naive", "continuous")])
     f = tmp_path / "t2.csv"
     _published().to_csv(f, index=False)
-    pub = read_published(f)
-    assert read_published(tmp_path / "absent.csv") is None  # missing file: no published values, no error
+    pub = published_table2(f)
+    assert published_table2(tmp_path / "absent.csv") is None  # missing file: no published values, no error
     t = min_k_table(grid, pub, 1)
     assert len(t) == 4 and (t["fps"] == 120).all()
     assert t["global_dof"].tolist() == [False, False, True, True]
@@ -487,7 +493,27 @@ def test_min_k_table_fills_published_values(tmp_path):
     bad.loc[1, "method"] = "lle"
     bad.to_csv(f, index=False)
     with pytest.raises(ValueError, match="line 3"):
-        read_published(f)
+        published_table2(f)
+
+
+def test_lee_weights_beside_the_paper_and_malformed_published_files(tmp_path):
+    from animsynth.published import PublishedError
+    from animsynth.resequencing.jobs import lee_weights_table
+
+    f = tmp_path / "lee.csv"
+    f.write_text("joint_pair,weight\nhips,1.0000\nknees,0.0900\n")
+    t = lee_weights_table(f, dict(PAPER_WEIGHTS)).set_index("group")
+    assert list(t.columns) == ["weight_paper", "weight_ours", "weight_minus_paper", "match"]
+    assert bool(t.loc["hips", "match"]) and not bool(t.loc["knees", "match"])
+    assert t.loc["knees", "weight_minus_paper"] == pytest.approx(0.0001)
+    assert lee_weights_table(tmp_path / "absent.csv", dict(PAPER_WEIGHTS)) is None
+    f.write_text("joint_pair,weight\nhips,one\n")
+    with pytest.raises(PublishedError, match="lee.csv, line 2.*'weight'"):
+        lee_weights_table(f, dict(PAPER_WEIGHTS))
+    g = tmp_path / "t2.csv"
+    _published().drop(columns="min_k").to_csv(g, index=False)
+    with pytest.raises(PublishedError, match="line 1.*min_k"):
+        published_table2(g)
 
 
 def test_explanation_verdict_names_the_matching_candidate(tmp_path):
@@ -501,7 +527,7 @@ def test_explanation_verdict_names_the_matching_candidate(tmp_path):
     grid = pd.DataFrame(rows)
     f = tmp_path / "t2.csv"
     _published().to_csv(f, index=False)
-    v = pd.DataFrame(explanation_verdicts(grid, read_published(f), 1))
+    v = pd.DataFrame(explanation_verdicts(grid, published_table2(f), 1))
     summary = v.iloc[0]
     assert "matrix_naive" in summary["evidence"] and summary["verdict"] == "reproduced"
     naive = v[v["claim"].str.contains(r"matrix_naive, 120")].iloc[0]
@@ -586,21 +612,29 @@ def test_global_dof_verdict_per_dataset():
     assert v["verdict"] == "reproduced" and "walk: re-sequencing paths 10/10 without vs 0/10 with" in v["ours"]
 
 
-def test_library_defaults_match_the_full_size_config():
-    """The library's defaults are the study at full size: the embedded (demo-sized) config with the real-data
-    config's full sizes merged over it, as the workflow merges them."""
+def test_the_full_size_config_is_the_schema_defaults():
+    """Defaults live in config/schema.yaml only: the demo config with the real-data config's full sizes merged
+    over it, as the workflow merges them, is exactly the schema's resequencing block."""
     import yaml
-    from pathlib import Path
 
-    from snakemake.utils import update_config
+    from animsynth.config import validate_config
 
-    from animsynth.resequencing.study import DEFAULTS
+    from conftest import REPO
 
-    root = Path(__file__).resolve().parents[1] / "config"
-    cfg = yaml.safe_load((root / "config.yaml").read_text())
-    assert cfg["resequencing"] != DEFAULTS  # the embedded default is the demo
-    update_config(cfg, {"resequencing": yaml.safe_load((root / "cmu.yaml").read_text())["resequencing"]})
-    assert cfg["resequencing"] == DEFAULTS
+    cfg = full_cfg()
+    assert config_block("resequencing") != cfg  # the embedded default is the demo
+    schema_only = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    del schema_only["resequencing"]  # every resequencing value from the schema
+    validate_config(schema_only, str(REPO / "config" / "schema.yaml"))
+    assert schema_only["resequencing"] == cfg
+
+
+def test_no_defaults_dict_in_the_workflow_steps():
+    from animsynth.resequencing import jobs
+
+    assert not hasattr(jobs, "DEFAULTS") and not hasattr(jobs, "with_defaults")
+    with pytest.raises(KeyError):  # a step needs the whole (validated) block; nothing fills it in behind the config
+        explain(generate_motion("walk_straight", 60, 0, cmu_like_skeleton("t", 1)), "walk", "t", {})
 
 
 # ------------------------------------------------------- sign modes (Table 2 explanation)
@@ -639,7 +673,7 @@ def test_explain_counts_flips_and_raises_l2_min_k_only():
     vals[:, sl] = 0.0
     vals[:, sl.start] = ang
     m = Motion(vals, sk, m.fps, "flip", {})
-    cfg = with_defaults({"explanations": {"frame_steps": [1], "global_dof": [False]}})
+    cfg = full_cfg({"explanations": {"frame_steps": [1], "global_dof": [False]}})
     grid, flips = explain(m, "dance", "flip", cfg)
     f = flips.set_index("joint")
     assert f.loc["lhumerus", "flips_matrix_naive"] >= 3 and (flips["flips_continuous"] == 0).all()
@@ -720,20 +754,37 @@ def test_transition_measures_on_the_original_and_on_a_jump(walk):
 
 
 def test_config_cross_checks_name_the_key():
-    from animsynth.config import ConfigError
-    from animsynth.resequencing.settings import check_resequencing_config
+    import copy
 
-    rs = with_defaults({})
-    trials = {"walk": "35_01", "run": "35_17", "dance": "05_02"}
-    check_resequencing_config(rs, trials)
+    import yaml
+
+    from animsynth.config import ConfigError, validate_config
+    from animsynth.resequencing.settings import check
+
+    from conftest import REPO
+
+    base = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    validate_config(base, str(REPO / "config" / "schema.yaml"))
+    check(base)
+
+    def bad(**change):
+        cfg = copy.deepcopy(base)
+        for key, value in change.items():
+            *path, last = key.split("__")
+            d = cfg
+            for k in path:
+                d = d[k]
+            d[last] = value
+        return cfg
+
     with pytest.raises(ConfigError, match="resequencing.datasets"):
-        check_resequencing_config(rs, {"walk": "35_01"})
-    bad = with_defaults({"frame_step": 2})
+        check(bad(resequencing_trials={"walk": base["resequencing_trials"]["walk"]}))
+    with pytest.raises(ConfigError, match="resequencing.methods.*duplicate"):
+        check(bad(resequencing__methods=["isomap", "isomap"]))
     with pytest.raises(ConfigError, match="explanations.frame_steps"):
-        check_resequencing_config(bad, trials)
-    bad = with_defaults({"explanations": {"sign_modes": ["matrix_naive"]}})
+        check(bad(resequencing__frame_step=2))
     with pytest.raises(ConfigError, match="explanations.sign_modes"):
-        check_resequencing_config(bad, trials)
+        check(bad(resequencing__explanations__sign_modes=["matrix_naive"]))
 
 
 def test_smoothness_decision_separates_clear_wins_leans_and_noise():

@@ -9,9 +9,10 @@ from scipy.sparse.csgraph import connected_components
 from sklearn.neighbors import kneighbors_graph
 
 from animsynth.io import read_amc, read_asf
-from animsynth.resequencing.study import base_distances, method_distances, prepare_motion, with_defaults
+from animsynth.resequencing.jobs import base_distances, method_distances, prepare_motion
 from animsynth.resequencing.embedding import min_connected_k
 from animsynth.resequencing.features import motion_features
+from conftest import config_block
 
 
 @pytest.mark.workflow
@@ -73,7 +74,7 @@ def test_exact_min_k_on_real_cmu_trials(cmu_dir, trial):
     subject, name = trial.split("/")
     m = read_amc(cmu_dir / subject / f"{name}.amc", read_asf(cmu_dir / subject / f"{subject}.asf"))
     m = prepare_motion(m, 400, 2)
-    cfg = with_defaults({})
+    cfg = config_block("resequencing", files=("config.yaml", "cmu.yaml"))
     f = motion_features(m)
     for metric in ("l2", "lee"):
         for g in (False, True):
@@ -86,11 +87,32 @@ def test_exact_min_k_on_real_cmu_trials(cmu_dir, trial):
 @pytest.mark.realdata
 def test_matrix_naive_flips_the_humerus_and_raises_l2_min_k_on_cmu_walk(cmu_dir):
     m = read_amc(cmu_dir / "35" / "35_01.amc", read_asf(cmu_dir / "35" / "35.asf"))
-    cfg = with_defaults({"metrics": ["l2"], "explanations": {"frame_steps": [1], "global_dof": [False]}})
-    from animsynth.resequencing.study import explain
+    cfg = config_block("resequencing", {"metrics": ["l2"], "explanations": {"frame_steps": [1], "global_dof": [False]}},
+                       ("config.yaml", "cmu.yaml"))
+    from animsynth.resequencing.jobs import explain
 
     grid, flips = explain(m, "walk", "35_01", cfg)
     f = flips.set_index("joint")["flips_matrix_naive"]
     assert f["lhumerus"] > 0 and f.drop("lhumerus").sum() == 0
     g = grid[grid["method"] == "isomap"].set_index("sign_mode")["min_k"]
     assert g["continuous"] < 10 <= g["matrix_naive"]
+
+
+@pytest.mark.workflow
+def test_paper_columns_with_and_without_the_published_tables(tiny_workflow, tiny_without_papers):
+    """Table 2 and the Lee weights read the published tables as declared inputs: beside the tiny run (made-up
+    values in their layout) the paper columns hold numbers; without them they are empty, with a WARNING naming
+    the config key, and our columns do not change."""
+    rel = "results/resequencing/table2_min_k.csv"
+    with_papers, without = pd.read_csv(tiny_workflow / rel), pd.read_csv(tiny_without_papers / rel)
+    paper_cols = ["min_k_paper", "paper_frames", "min_k_minus_paper", "frames_minus_paper"]
+    assert with_papers["min_k_paper"].notna().any() and with_papers["min_k_minus_paper"].notna().any()
+    assert without[paper_cols].isna().all().all()
+    ours = [c for c in with_papers.columns if c not in paper_cols]
+    pd.testing.assert_frame_equal(with_papers[ours], without[ours])
+    lee = "results/resequencing/lee_weights.csv"
+    assert pd.read_csv(tiny_workflow / lee)["weight_paper"].notna().all()
+    assert pd.read_csv(tiny_without_papers / lee).empty
+    log = (tiny_without_papers / "logs" / "resequencing" / "tables.log").read_text()
+    for key in ("published.resequencing.table2", "published.resequencing.lee_weights"):
+        assert any("WARNING" in line and key in line for line in log.splitlines()), log

@@ -16,7 +16,7 @@ from animsynth.resequencing.embedding import (DisconnectedGraphError, knn_graph,
                                               spatio_temporal_distances, temporal_adjacency)
 from animsynth.resequencing.features import motion_features
 from animsynth.resequencing.paths import shortest_path_frames
-from animsynth.synth.mocap import KINDS, cmu_like_skeleton, generate_motion
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 
 @pytest.fixture(scope="module")
@@ -125,7 +125,9 @@ def test_st_lists_give_the_dense_st_isomap_graph(database):
               ctn_reach=6)
     Dst, _, ctn = spatio_temporal_distances(D, **kw)
     dist, idx = sparse.l2_neighbours(X, n - 1)  # all frames: the candidate search cannot miss a CTN
-    pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)
+    def pair(i, j):
+        return np.linalg.norm(X[i] - X[j], axis=1)
+
     sd, si, n_ctn = sparse.st_neighbours(dist, idx, np.zeros(n, int), pair_distance=pair, **kw)
     assert n_ctn == int(np.count_nonzero(np.triu(ctn)))
     assert sparse.sparse_min_connected_k(si) == min_connected_k(Dst)
@@ -142,7 +144,9 @@ def test_sparse_st_isomap_keeps_the_adjacent_temporal_edges_like_the_dense_one(d
               ctn_reach=6)
     Dst = spatio_temporal_distances(l2_distances(X), **kw)[0]
     dist, idx = sparse.l2_neighbours(X, n - 1)
-    pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)
+    def pair(i, j):
+        return np.linalg.norm(X[i] - X[j], axis=1)
+
     sd, si, _ = sparse.st_neighbours(dist, idx, np.zeros(n, int), pair_distance=pair, **kw)
     pairs, w = sparse.st_always_edges(np.zeros(n, int), 1, 10.0, pair)
     assert pairs.shape == (n - 1, 2) and np.all(pairs[:, 1] - pairs[:, 0] == 1)
@@ -174,7 +178,9 @@ def test_st_temporal_neighbours_stay_inside_each_sequence(database):
     X = np.vstack([f.linearised(False) for f in database])
     seq = np.concatenate([np.full(f.n_frames, s) for s, f in enumerate(database)])
     dist, idx = sparse.l2_neighbours(X, 20)
-    pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)
+    def pair(i, j):
+        return np.linalg.norm(X[i] - X[j], axis=1)
+
     sd, si, _ = sparse.st_neighbours(dist, idx, seq, c_atn=1e6, c_ctn=10.0, pair_distance=pair)
     # with a huge c_atn the nearest is a temporal neighbour, never across a boundary (except
     # for exact copies at distance 0: every linearised trial starts at the zero vector)

@@ -11,7 +11,7 @@ import pytest
 from animsynth.config import ConfigError
 from animsynth.published import PublishedError
 from animsynth.simplicial.jobs import table1_job
-from animsynth.simplicial.settings import check, read_paper_table1
+from animsynth.simplicial.settings import check, check_figure_folds, read_paper_table1
 from animsynth.simplicial.table1 import datasets_table, length_match
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
@@ -100,15 +100,27 @@ def test_check_accepts_the_default_config(simplicial_config):
 @pytest.mark.parametrize("change,key", [
     (lambda c: c["simplicial"]["figures"].update(dataset="w9"), "simplicial.figures.dataset"),
     (lambda c: c["subsets"].update(w1=None), "simplicial.figures.dataset"),  # a null subset is not in use
-    (lambda c: c["simplicial"]["figures"].update(folds=[0, 4]), "simplicial.figures.folds"),
-    (lambda c: c["simplicial"]["figures"].update(field_fold=9), "simplicial.figures.field_fold"),
-    (lambda c: c["simplicial"]["figures"].update(walk_fold=4), "simplicial.figures.walk_fold"),
 ])
 def test_check_names_the_config_key(simplicial_config, change, key):
     cfg = copy.deepcopy(simplicial_config)
     change(cfg)
     with pytest.raises(ConfigError, match=rf"config key '{key}'"):
         check(cfg)
+
+
+@pytest.mark.parametrize("fig, key", [({"folds": [0, 4]}, "folds"), ({"field_fold": 9}, "field_fold"),
+                                      ({"walk_fold": 4}, "walk_fold")])
+def test_figure_folds_outside_the_subset_name_the_key(simplicial_config, fig, key):
+    figures = {**simplicial_config["simplicial"]["figures"], **fig}
+    with pytest.raises(ConfigError, match=rf"config key 'simplicial.figures.{key}'"):
+        check_figure_folds(figures, 4, "w1")
+
+
+def test_short_subsets_pass_the_parse_time_check(simplicial_config):
+    # a user's two-trial subset must not stop the run's other jobs because of the figures' default folds
+    cfg = copy.deepcopy(simplicial_config)
+    cfg["subsets"]["w1"] = cfg["subsets"]["w1"][:2]
+    check(cfg)
 
 
 def test_figure_fold_outside_the_subset_is_refused_by_the_job_too(tmp_path):

@@ -168,7 +168,9 @@ def _assert_same_tables(local: Path, remote: Path):
     for rel in a:
         pd.testing.assert_frame_equal(a[rel], b[rel], check_exact=True, obj=rel)
     # every results file the local run made exists on the SLURM side too
-    files = lambda root: {str(p.relative_to(root)) for p in (root / "results").rglob("*") if p.is_file()}
+    def files(root):
+        return {str(p.relative_to(root)) for p in (root / "results").rglob("*") if p.is_file()}
+
     assert files(local) == files(remote), sorted(files(local) ^ files(remote))
 
 
@@ -228,7 +230,8 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
                           text=True, timeout=RUN_TIMEOUT + 60)
     out = proc.stdout
     if proc.returncode != 0:
-        logs = "\n".join(f"--- {p}\n{p.read_text()[-3000:]}" for p in sorted((remote / ".snakemake" / "slurm_logs").rglob("*.log")))
+        slurm_logs = sorted((remote / ".snakemake" / "slurm_logs").rglob("*.log"))
+        logs = "\n".join(f"--- {p}\n{p.read_text()[-3000:]}" for p in slurm_logs)
         pytest.fail(f"snakemake on SLURM failed (rc {proc.returncode}; 124 = timed out):\n{out[-6000:]}\n{logs[-8000:]}")
 
     # Every job went through sbatch: snakemake reports a SLURM job id for each...

@@ -171,13 +171,13 @@ def _tiny_config(wd) -> dict:
 @pytest.mark.workflow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_resequencing_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow, seed):
-    from animsynth.resequencing.study import read_published, with_defaults
+    from animsynth.resequencing.jobs import published_table2
     from animsynth.resequencing.verdicts import all_verdicts
 
     out = tiny_workflow / "results" / "resequencing"
-    rs = _tiny_config(tiny_workflow)["resequencing"]
-    cfg = with_defaults({k: rs[k] for k in ("frame_step", "explanations", "verdict_share", "verdict_alpha", "lee")})
-    published = read_published(str(tiny_workflow / rs["published"]["table2"]))
+    tiny = _tiny_config(tiny_workflow)
+    cfg = tiny["resequencing"]
+    published = published_table2(str(tiny_workflow / tiny["published"]["resequencing"]["table2"]))
     tables = [pd.read_csv(out / f"{k}.csv") for k in ("table2_min_k", "min_k_explanations", "smoothness_paths")]
 
     def build(table2, grid, per_path):

@@ -198,7 +198,7 @@ def cmd_generate(a) -> None:
 
 
 def cmd_resequence(a) -> None:
-    from .resequencing.study import resequence_motion
+    from .resequencing.jobs import resequence_motion
 
     m = _load(a.asf, a.amc, a.fps)
     if a.length is not None:

@@ -247,7 +247,8 @@ def explain_schema_error(config: dict, schema: dict) -> str | None:
         lines.append("  (keys and their meaning: config/README.md and config/schema.yaml)")
         return "\n".join(lines)
     message = error.message if len(error.message) <= 300 else error.message[:300] + " ..."
-    return f"config key '{where or '<top level>'}': {message}\n  (keys and their meaning: config/README.md and config/schema.yaml)"
+    return (f"config key '{where or '<top level>'}': {message}\n"
+            "  (keys and their meaning: config/README.md and config/schema.yaml)")
 
 
 def validate_config(config: dict, schema_path: str) -> None:

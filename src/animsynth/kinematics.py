@@ -177,7 +177,9 @@ def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t:
         if rd:
             axes = [d[1] for d in rd]
             full = axes + [a for a in "xyz" if a not in axes]
-            ang = _continuous_euler(M.as_euler("".join(full), degrees=True)) if len(axes) == 3 else M.as_euler("".join(full), degrees=True)
+            ang = M.as_euler("".join(full), degrees=True)
+            if len(axes) == 3:
+                ang = _continuous_euler(ang)
             for k, d in enumerate(j.dofs):
                 if d in ROT_DOFS:
                     block[:, k] = ang[:, axes.index(d[1])]

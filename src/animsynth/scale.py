@@ -29,7 +29,6 @@ Each family owns the steps it measures (``scale_steps`` in its workflow-step mod
 from __future__ import annotations
 
 import logging
-import os
 import resource
 import time
 from contextlib import contextmanager
@@ -89,7 +88,7 @@ class Steps:
 #: a :class:`Steps`); this module only measures.
 STEP_FUNCTIONS = {
     "simplicial_steps": ("animsynth.simplicial.jobs", "scale_steps"),
-    "resequencing_steps": ("animsynth.resequencing.study", "scale_steps"),
+    "resequencing_steps": ("animsynth.resequencing.jobs", "scale_steps"),
     "facegraph_steps": ("animsynth.facegraph.jobs", "scale_steps"),
     "meshdetail_steps": ("animsynth.meshdetail.jobs", "scale_steps"),
 }

@@ -46,7 +46,6 @@ CMU_MAP = {
     "l_thigh": "lfemur", "l_shin": "ltibia", "l_foot": "lfoot",
     "r_thigh": "rfemur", "r_shin": "rtibia", "r_foot": "rfoot",
 }
-N_JOINTS = len(JOINTS)
 
 
 @dataclass

@@ -33,9 +33,9 @@ from pathlib import Path
 
 import pandas as pd
 
-log = logging.getLogger("animsynth.sources")
-
 from .io.obj import frame_stem, is_frame_name
+
+log = logging.getLogger("animsynth.sources")
 
 ARCHIVE_SUFFIXES = (".zip", ".tar.gz", ".tgz", ".tar")
 #: Default cap (MB, 10**6 bytes) on the total unpacked size of a mesh archive.

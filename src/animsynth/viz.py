@@ -160,7 +160,8 @@ def motion_previews(motion, gif_path=None, bvh_path=None, png_path=None, origina
         plist = [pos]
         if original is not None:
             plist = [forward_kinematics(original.skeleton, original.values) * original.skeleton.length_to_m, pos]
-        skeleton_gif(gif_path, plist, sk.parents(), titles or (["original", "generated"] if original is not None else ["generated"]), fps=fps,
+        default_titles = ["original", "generated"] if original is not None else ["generated"]
+        skeleton_gif(gif_path, plist, sk.parents(), titles or default_titles, fps=fps,
                      source_fps=motion.fps)
     if png_path:
         filmstrip(png_path, pos, sk.parents(), title=motion.name)

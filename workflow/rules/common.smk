@@ -15,9 +15,7 @@ from animsynth.sources import is_archive, is_url, mesh_source_name, probe_source
 # settings.check(config) (which names the offending config key).
 check_config(config)
 for _family in ("simplicial", "resequencing", "facegraph", "meshdetail", "compare"):
-    _settings = importlib.import_module(f"animsynth.{_family}.settings")
-    if hasattr(_settings, "check"):
-        _settings.check(config)
+    importlib.import_module(f"animsynth.{_family}.settings").check(config)
 
 TRIALS = {t["id"]: t for t in config["trials"]}
 SUBSETS = {k: v for k, v in config["subsets"].items() if v}  # null drops a subset
@@ -241,6 +239,22 @@ def simplicial_benchmarks():
     )
 
 
+# ---- resequencing input functions ----
+def reseq_trial(wildcards):
+    """The trial id of a re-sequencing dataset (params of the analyse and explain jobs)."""
+    return RESEQ_TRIALS[wildcards.rsdata]
+
+
+def reseq_trial_npz(wildcards):
+    """The parsed trial of a re-sequencing dataset (input of its analyse, explain and path jobs)."""
+    return trial_npz(RESEQ_TRIALS[wildcards.rsdata])
+
+
+def reseq_pairs_seed(wildcards):
+    """Seed of a dataset's measured start/end pairs (the same for every method, metric and global flag)."""
+    return seed_for("resequencing", "pairs", wildcards.rsdata)
+
+
 def reseq_path_outputs(pattern):
     """One output per method x metric x global flag of a dataset (the order of RESEQ_PATH_CONFIGS)."""
     return [pattern.format(rsmethod=m, rsmetric=x, rsgdof=g) for m, x, g in RESEQ_PATH_CONFIGS]
@@ -297,6 +311,46 @@ def facegraph_benchmarks():
         "facegraph_baseline", "facegraph_uniqueness", "facegraph_figures", "facegraph_verdicts"]
     return [f for r in rules_run for f in job_benchmarks(r)]
 # ---- end facegraph input functions ----
+
+
+# ---- meshdetail input functions ----
+def md_frames(wildcards):
+    """The frames of a mesh sequence: its folder (or the synthetic character's main clip)."""
+    return MD_FRAMES[wildcards.mdseq]
+
+
+def md_edit_dirs(wildcards):
+    """The synthetic character's edited clips (none for real meshes)."""
+    if MD_SEQS[wildcards.mdseq]["mesh_dir"]:
+        return []
+    return [R(f"meshdetail/character/edit_{e}") for e in config["meshdetail"]["character"]["edits"]]
+
+
+def md_checked(wildcards):
+    """The checksum table of a real sequence with a SHA-256 list (none otherwise)."""
+    return MESH_CHECK.get(wildcards.mdseq, [])
+
+
+def md_fps(wildcards):
+    return MD_SEQS[wildcards.mdseq]["mesh_fps"]
+
+
+def md_rig(wildcards):
+    """The sequence's rig block (meshdetail.rig with its own embedding)."""
+    return MD_SEQS[wildcards.mdseq]["rig"]
+
+
+def md_render_frames(wildcards):
+    return MD_SEQS[wildcards.mdseq]["render_frames"]
+
+
+def md_name(wildcards):
+    return wildcards.mdseq
+
+
+def md_data_source(wildcards):
+    """What the job's sequence is, for its tables (params)."""
+    return md_source(wildcards.mdseq)
 
 
 def md_truth(wildcards):

@@ -6,7 +6,8 @@
 # (meshdetail.sequences, e.g. crane in config/paper.yaml). Every job runs on one
 # sequence ({mdseq}: results/meshdetail/<sequence>/...); meshdetail_compare puts the
 # sequences side by side. Every job gets only the config keys it uses, so a changed
-# value reruns exactly the affected jobs.
+# value reruns exactly the affected jobs. Input functions: common.smk ("meshdetail input
+# functions"); config checks: animsynth.meshdetail.settings.check (called from common.smk).
 MD = config["meshdetail"]
 MD_MODEL_KEYS = (
     "level", "latent_dim", "iterations", "dynamics_weight", "ridge_alphas", "joint_param", "detail", "decimation",
@@ -39,6 +40,7 @@ MESHDETAIL_TARGETS = [R(f"meshdetail/{n}/{f}") for n in MD_NAMES for f in MD_PER
 rule meshdetail_character:
     output:
         main=directory(R("meshdetail/character/main")),
+        edits=[directory(R(f"meshdetail/character/edit_{e}")) for e in MD["character"]["edits"]],
         truth=R("meshdetail/character/truth.npz"),
     params:
         cfg=MD["character"],
@@ -59,14 +61,15 @@ rule meshdetail_character:
 
 rule meshdetail_load:
     input:
-        main=lambda w: MD_FRAMES[w.mdseq],
+        main=md_frames,
         truth=md_truth,
-        checked=lambda w: MESH_CHECK.get(w.mdseq, []),
+        edits=md_edit_dirs,
+        checked=md_checked,
     output:
         seq=MD_DATA["seq"],
         edits=MD_DATA["edits"],
     params:
-        fps=lambda w: MD_SEQS[w.mdseq]["mesh_fps"],
+        fps=md_fps,
         max_frames=MD["max_frames"],
     threads: 1
     resources:
@@ -106,8 +109,11 @@ rule meshdetail_rig:
             category="Meshdetail",
             subcategory="Skeleton fit",
         ),
+        table_md=R("meshdetail/{mdseq}/rig_fit.md"),
+        joints_md=R("meshdetail/{mdseq}/joints.md"),
+        skinning_md=R("meshdetail/{mdseq}/skinning.md"),
     params:
-        rig=lambda w: MD_SEQS[w.mdseq]["rig"],
+        rig=md_rig,
         train_fraction=MD["train_fraction"],
     threads: 1
     resources:
@@ -146,12 +152,15 @@ rule meshdetail_main:
             category="Meshdetail",
             subcategory="Generalisation",
         ),
+        fig5a_md=R("meshdetail/{mdseq}/fig5a.md"),
+        fig5c_md=R("meshdetail/{mdseq}/fig5c.md"),
+        gen_md=R("meshdetail/{mdseq}/generalisation.md"),
         preds=R("meshdetail/{mdseq}/data/predictions.npz"),
     params:
         cfg=MD_MODEL_CFG,
-        rig=lambda w: MD_SEQS[w.mdseq]["rig"],
+        rig=md_rig,
         train_fraction=MD["train_fraction"],
-        render_frames=lambda w: MD_SEQS[w.mdseq]["render_frames"],
+        render_frames=md_render_frames,
     threads: 1
     resources:
         mem_mb=2000,
@@ -182,6 +191,8 @@ rule meshdetail_resolution:
             category="Meshdetail",
             subcategory="Performance",
         ),
+        fig5b_md=R("meshdetail/{mdseq}/fig5b.md"),
+        timing_md=R("meshdetail/{mdseq}/fig5b_timing.md"),
     params:
         cfg=dict(MD_MODEL_CFG, levels=MD["levels"]),
         train_fraction=MD["train_fraction"],
@@ -209,6 +220,7 @@ rule meshdetail_representations:
             category="Meshdetail",
             subcategory="Representations",
         ),
+        table_md=R("meshdetail/{mdseq}/representations.md"),
     params:
         cfg=MD_MODEL_CFG,
         train_fraction=MD["train_fraction"],
@@ -266,7 +278,7 @@ rule meshdetail_figures:
             subcategory="Rendered frames",
         ),
     params:
-        name=lambda w: w.mdseq,
+        name=md_name,
     threads: 1
     resources:
         mem_mb=1000,
@@ -294,8 +306,9 @@ rule meshdetail_verdicts:
             category="Meshdetail",
             subcategory="Verdicts",
         ),
+        md=R("meshdetail/{mdseq}/verdicts.md"),
     params:
-        source=lambda w: md_source(w.mdseq),
+        source=md_data_source,
         cv_rig=MD["cv_rig"],
     threads: 1
     resources:
@@ -327,11 +340,13 @@ rule meshdetail_dembones:
             category="Meshdetail",
             subcategory="Performance",
         ),
+        table_md=R("meshdetail/{mdseq}/dembones.md"),
+        timing_md=R("meshdetail/{mdseq}/dembones_timing.md"),
         preds=R("meshdetail/{mdseq}/data/dembones_predictions.npz"),
     params:
         cfg=MD["dembones"],
         cv_folds=MD["cv_folds"],
-        render_frames=lambda w: MD_SEQS[w.mdseq]["render_frames"],
+        render_frames=md_render_frames,
     # samba (9,971 vertices, 175 frames), bones [18, 40]: SSDR fit 7 + 11 s, held-out solve 3.5 + 7.5 s CPU per fold
     threads: 1
     resources:
@@ -365,6 +380,8 @@ rule meshdetail_compare:
             category="Meshdetail",
             subcategory="Verdicts",
         ),
+        table_md=R("meshdetail/sequences.md"),
+        verdicts_md=R("meshdetail/verdicts.md"),
     params:
         names=MD_NAMES,
     threads: 1

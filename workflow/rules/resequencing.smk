@@ -11,16 +11,13 @@
 # explain, figures), 275 MB (path), 170 MB (tables); wall time at most 70 s (analyse, explain), 285 s
 # (path; 24 s of CPU), 55 s (figures), 21 s (tables). Memory about 3x and runtime (minutes) about 4x that.
 # Wildcards are prefixed rs* because `dataset` and `method` are constrained
-# globally by other families.
-from animsynth.resequencing.settings import check_resequencing_config
-
+# globally by other families. Input functions: common.smk ("resequencing input functions");
+# config checks: animsynth.resequencing.settings.check (called from common.smk).
 RESEQ = config["resequencing"]
 RESEQ_DATASETS = list(RESEQ["datasets"])
 RESEQ_METHODS = list(RESEQ["methods"])
 RESEQ_METRICS = list(RESEQ["metrics"])
 RESEQ_GDOF = ["global" if g else "noglobal" for g in RESEQ["global_dof"]]
-
-check_resequencing_config(RESEQ, RESEQ_TRIALS)
 
 
 wildcard_constraints:
@@ -33,8 +30,8 @@ wildcard_constraints:
 # The config keys each job depends on (passed as params, so a change reruns exactly those jobs).
 RESEQ_ANALYSE_CFG = {
     k: RESEQ[k]
-    for k in ("methods", "metrics", "max_frames", "frame_step", "linearisation", "fixed_k_sweep", "max_dim", "lee",
-              "stisomap")
+    for k in ("methods", "metrics", "max_frames", "frame_step", "linearisation", "fixed_k_sweep", "max_dim",
+              "embedding", "lee", "stisomap")
 }
 RESEQ_EXPLAIN_CFG = {
     k: RESEQ[k] for k in ("methods", "metrics", "max_frames", "linearisation", "lee", "stisomap", "explanations")
@@ -54,14 +51,14 @@ RESEQ_CONFIGS = [
 
 rule resequencing_analyse:
     input:
-        lambda wc: trial_npz(RESEQ_TRIALS[wc.rsdata]),
+        reseq_trial_npz,
     output:
         min_k=f"{RESEQ_WORK}/{{rsdata}}_{{rsgdof}}_min_k.csv",
         rv=f"{RESEQ_WORK}/{{rsdata}}_{{rsgdof}}_residual_variance.csv",
         emb=f"{RESEQ_WORK}/{{rsdata}}_{{rsgdof}}_embedding.npz",
         timing=f"{RESEQ_WORK}/{{rsdata}}_{{rsgdof}}_timing.csv",
     params:
-        trial=lambda wc: RESEQ_TRIALS[wc.rsdata],
+        trial=reseq_trial,
         cfg=RESEQ_ANALYSE_CFG,
     log:
         L("resequencing/analyse/{rsdata}_{rsgdof}.log"),
@@ -79,12 +76,12 @@ rule resequencing_analyse:
 
 rule resequencing_explain:
     input:
-        lambda wc: trial_npz(RESEQ_TRIALS[wc.rsdata]),
+        reseq_trial_npz,
     output:
         grid=f"{RESEQ_WORK}/{{rsdata}}_explain_min_k.csv",
         flips=f"{RESEQ_WORK}/{{rsdata}}_sign_flips.csv",
     params:
-        trial=lambda wc: RESEQ_TRIALS[wc.rsdata],
+        trial=reseq_trial,
         cfg=RESEQ_EXPLAIN_CFG,
     log:
         L("resequencing/explain/{rsdata}.log"),
@@ -107,7 +104,7 @@ RESEQ_PATH_CONFIGS = [(m, x, g) for m in RESEQ_METHODS for x in RESEQ_METRICS fo
 # about a second, less than a job's own start-up.
 rule resequencing_path:
     input:
-        npz=lambda wc: trial_npz(RESEQ_TRIALS[wc.rsdata]),
+        npz=reseq_trial_npz,
         min_k=expand(f"{RESEQ_WORK}/{{{{rsdata}}}}_{{g}}_min_k.csv", g=RESEQ_GDOF),
     output:
         csv=reseq_path_outputs(R("resequencing/paths/{{rsdata}}_{rsmethod}_{rsmetric}_{rsgdof}.csv")),
@@ -119,7 +116,7 @@ rule resequencing_path:
         cfg=RESEQ_PATH_CFG,
         configs=RESEQ_PATH_CONFIGS,
         gdof=RESEQ_GDOF,
-        seed=lambda wc: seed_for("resequencing", "pairs", wc.rsdata),
+        seed=reseq_pairs_seed,
     log:
         L("resequencing/path/{rsdata}.log"),
     benchmark:
@@ -182,6 +179,8 @@ rule resequencing_tables:
         timing=expand(f"{RESEQ_WORK}/{{d}}_{{g}}_timing.csv", d=RESEQ_DATASETS, g=RESEQ_GDOF),
         smooth=[f"{RESEQ_WORK}/{d}_{m}_{x}_{g}_smoothness.csv" for d, m, x, g in RESEQ_CONFIGS],
         transitions=[f"{RESEQ_WORK}/{d}_{m}_{x}_{g}_transitions.csv" for d, m, x, g in RESEQ_CONFIGS],
+        published_table2=published_input("resequencing", "table2"),
+        published_lee_weights=published_input("resequencing", "lee_weights"),
     output:
         table2=report(
             R("resequencing/table2_min_k.csv"),
@@ -229,7 +228,6 @@ rule resequencing_tables:
         timing=R("resequencing/resequencing_timing.csv"),
     params:
         cfg=RESEQ_TABLES_CFG,
-        published=RESEQ["published"],
         trials={d: RESEQ_TRIALS[d] for d in RESEQ_DATASETS},
     log:
         L("resequencing/tables.log"),
@@ -271,7 +269,7 @@ RESEQUENCING_SUMMARY = [
         "csv": R("resequencing/table2_min_k.csv"),
         "note": "Exact (MST bottleneck over neighbour ranks), cross-checked with connected_components, in both "
         "linearisation sign modes (continuous = our method; matrix_naive = reproduction of a probable artefact); "
-        "min_k_paper from resequencing.published.table2 (empty when the file is absent).",
+        "min_k_paper from published.resequencing.table2 (empty when the file is absent).",
     },
     {
         "title": "Re-sequencing: smoothness of the re-sequenced motions",

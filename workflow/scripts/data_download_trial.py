@@ -4,9 +4,9 @@ import sys
 from animsynth.data import DownloadError, fetch_file
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-p = snakemake.params  # noqa: F821
-out = snakemake.output  # noqa: F821
+log = setup_logging(snakemake)
+p = snakemake.params
+out = snakemake.output
 try:
     if "bvh" in out.keys():
         fetch_file(p.source, p.bvh, out.bvh, p.sha256)

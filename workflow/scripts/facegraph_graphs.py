@@ -9,11 +9,11 @@ from animsynth.facegraph.regiongraph import save_graphs
 from animsynth.atomic import atomic_path, atomic_write_text
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-out = snakemake.output  # noqa: F821
-cfg, seed = snakemake.params.cfg, snakemake.params.seed  # noqa: F821
-db = FaceDatabase.load_npz(snakemake.input[0])  # noqa: F821
-confs = snakemake.params.confs  # noqa: F821
+log = setup_logging(snakemake)
+out = snakemake.output
+cfg, seed = snakemake.params.cfg, snakemake.params.seed
+db = FaceDatabase.load_npz(snakemake.input[0])
+confs = snakemake.params.confs
 warm_up(db, confs[0], cfg, seed)
 for i, conf in enumerate(confs):
     row, timing, thr, model, per = run_configuration(db, conf, cfg, seed)

@@ -4,7 +4,7 @@ import os
 from animsynth.meshdetail.jobs import make_character
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-out = snakemake.output  # noqa: F821
-info = make_character(dict(snakemake.params.cfg), int(snakemake.params.seed), os.path.dirname(out.truth))  # noqa: F821
+log = setup_logging(snakemake)
+out = snakemake.output
+info = make_character(dict(snakemake.params.cfg), int(snakemake.params.seed), os.path.dirname(out.truth))
 log.info("wrote %s", info)

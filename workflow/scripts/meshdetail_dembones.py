@@ -3,10 +3,11 @@ from animsynth.meshdetail.jobs import dembones_floor
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-i, o, p = snakemake.input, snakemake.output, snakemake.params  # noqa: F821
+log = setup_logging(snakemake)
+i, o, p = snakemake.input, snakemake.output, snakemake.params
 table, summary = dembones_floor(i.seq, dict(p.cfg), p.cv_folds, p.render_frames, o.preds)
-write_table(table.drop(columns=[c for c in table.columns if c.endswith("_s")]), o.table, title="LBS floor with Dem Bones (SSDR), per fold and bone count",
+write_table(table.drop(columns=[c for c in table.columns if c.endswith("_s")]), o.table,
+            title="LBS floor with Dem Bones (SSDR), per fold and bone count",
             note=f"Blocked CV with {p.cv_folds} contiguous blocks (the folds of Fig. 5c). Dem Bones fits weights "
                  f"(<= {p.cfg['max_influences']} bones per vertex, {p.cfg['iterations']} iterations) on the training "
                  "blocks; on the held-out blocks the weights stay fixed and the rigid bone transforms are solved from "

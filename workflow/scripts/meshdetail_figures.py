@@ -1,4 +1,5 @@
-"""The three Fig. 5 panels and rendered frames (original, LBS, hybrid, CV ridge; held-out predictions) with an error colour map."""
+"""The three Fig. 5 panels and rendered frames (original, LBS, hybrid, CV ridge; held-out predictions)
+with an error colour map."""
 import numpy as np
 import pandas as pd
 
@@ -6,8 +7,8 @@ from animsynth.io.obj import MeshSequence
 from animsynth.meshdetail import plots
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-i, o = snakemake.input, snakemake.output  # noqa: F821
+log = setup_logging(snakemake)
+i, o = snakemake.input, snakemake.output
 plots.plot_fig5a(pd.read_csv(i.fig5a), o.fig5a)
 plots.plot_fig5b(pd.read_csv(i.fig5b), o.fig5b)
 plots.plot_fig5c(pd.read_csv(i.fig5c), o.fig5c)
@@ -24,5 +25,5 @@ with np.load(i.dembones) as z:
 j = frames.index(f)
 plots.error_map(o.error_map, truth[j], seq.faces,
                 {"our skin (LBS)": preds["lbs"][j], f"Dem Bones floor ({bones} bones)": floor, "hybrid": preds["hybrid"][j]},
-                title=f"{snakemake.params.name}, frame {f}: held-out per-vertex error (blocked CV)")  # noqa: F821
-log.info("wrote %s", ", ".join(map(str, snakemake.output)))  # noqa: F821
+                title=f"{snakemake.params.name}, frame {f}: held-out per-vertex error (blocked CV)")
+log.info("wrote %s", ", ".join(map(str, snakemake.output)))

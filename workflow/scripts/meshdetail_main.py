@@ -2,13 +2,13 @@
 import numpy as np
 
 from animsynth.atomic import atomic_path
-from animsynth.meshdetail.experiments import run_main
+from animsynth.meshdetail.evaluation import run_main
 from animsynth.meshdetail.jobs import fold_rig_fitter, load_prepared
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-i, o, p = snakemake.input, snakemake.output, snakemake.params  # noqa: F821
+log = setup_logging(snakemake)
+i, o, p = snakemake.input, snakemake.output, snakemake.params
 d = load_prepared(i.seq, i.pose, i.edits, p.train_fraction)
 refit = None
 if p.cfg["cv_rig"] == "per_fold":

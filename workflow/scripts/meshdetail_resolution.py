@@ -1,11 +1,11 @@
 """Fig. 5b (error and stored size per control-mesh level, two decimations) and its timing table."""
-from animsynth.meshdetail.experiments import run_resolution
+from animsynth.meshdetail.evaluation import run_resolution
 from animsynth.meshdetail.jobs import load_prepared
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-i, o, p = snakemake.input, snakemake.output, snakemake.params  # noqa: F821
+log = setup_logging(snakemake)
+i, o, p = snakemake.input, snakemake.output, snakemake.params
 d = load_prepared(i.seq, i.pose, i.edits, p.train_fraction)
 fig5b, timing = run_resolution(d, dict(p.cfg))
 write_table(fig5b, o.fig5b, title="Fig. 5b: error vs control-mesh resolution",

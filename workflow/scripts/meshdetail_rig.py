@@ -5,8 +5,8 @@ from animsynth.meshdetail.jobs import fit_pose
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-i, o, p = snakemake.input, snakemake.output, snakemake.params  # noqa: F821
+log = setup_logging(snakemake)
+i, o, p = snakemake.input, snakemake.output, snakemake.params
 table, joints, comparison, method = fit_pose(i.seq, i.truth[0] if len(i.truth) else None, dict(p.rig),
                                              float(p.train_fraction), o.pose)
 write_table(table, o.table, title="Skeleton fit (18 joints, LBS): residual per bone, training and held-out frames",

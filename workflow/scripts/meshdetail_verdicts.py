@@ -5,8 +5,8 @@ from animsynth.meshdetail.verdicts import verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-i, o, p = snakemake.input, snakemake.output, snakemake.params  # noqa: F821
+log = setup_logging(snakemake)
+i, o, p = snakemake.input, snakemake.output, snakemake.params
 read = lambda path: pd.read_csv(path, keep_default_na=False, na_values=[""])  # noqa: E731
 table = verdicts(read(i.fig5a), read(i.fig5b), read(i.fig5c), read(i.gen), p.source, p.cv_rig)
 write_table(table, o.csv, title="Meshdetail verdicts", note=f"Data: {p.source}. Model comparisons on held-out frames "

@@ -15,10 +15,10 @@ from animsynth.report import run_benchmarks  # noqa: E402
 from animsynth.tables import write_table  # noqa: E402
 from animsynth.workflow_utils import setup_logging  # noqa: E402
 
-log = setup_logging(snakemake)  # noqa: F821
-df = run_benchmarks(snakemake.input.scripts, size=snakemake.params.size)  # noqa: F821
-extra = [pd.read_csv(p) for p in snakemake.input.extra]  # noqa: F821
+log = setup_logging(snakemake)
+df = run_benchmarks(snakemake.input.scripts, size=snakemake.params.size)
+extra = [pd.read_csv(p) for p in snakemake.input.extra]
 if extra:
     df = pd.concat([df, *extra], ignore_index=True)[list(df.columns)]
-write_table(df, snakemake.output.csv, md=snakemake.output.md, title="Benchmarks (machine-dependent)")  # noqa: F821
+write_table(df, snakemake.output.csv, md=snakemake.output.md, title="Benchmarks (machine-dependent)")
 log.info("%d benchmark rows", len(df))

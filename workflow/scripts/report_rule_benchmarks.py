@@ -3,10 +3,10 @@ from animsynth.report import aggregate_rule_benchmarks, family_benchmark_summary
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-out = snakemake.output  # noqa: F821
-root = snakemake.params.root  # noqa: F821
-jobs = aggregate_rule_benchmarks(list(snakemake.input), root=root)  # noqa: F821
+log = setup_logging(snakemake)
+out = snakemake.output
+root = snakemake.params.root
+jobs = aggregate_rule_benchmarks(list(snakemake.input), root=root)
 write_table(jobs, out.jobs, md=False)
 write_table(rule_benchmark_summary(jobs), out.per_rule, md=out.per_rule_md,
             title="Runtime and peak memory per rule (this machine)")

@@ -6,10 +6,10 @@ from animsynth.report import build_summary, claims_rst, claims_table
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-p = snakemake.params  # noqa: F821
-out = snakemake.output  # noqa: F821
-verdicts = list(snakemake.input.verdicts)  # noqa: F821
+log = setup_logging(snakemake)
+p = snakemake.params
+out = snakemake.output
+verdicts = list(snakemake.input.verdicts)
 provenance = pd.DataFrame(p.provenance, columns=["family", "data", "status"])
 note = ("What each part ran on: " + "; ".join(f"**{r.family}**: {r.data} ({r.status})" for r in provenance.itertuples())
         + ". Every number below is computed by the workflow on that data; paper values are quoted beside ours"

@@ -3,17 +3,17 @@ import numpy as np
 
 from animsynth.motion import Motion
 from animsynth.atomic import atomic_path
-from animsynth.resequencing.study import analyse, gdof_flag, prepare_motion
+from animsynth.resequencing.jobs import analyse, gdof_flag, prepare_motion
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-cfg = snakemake.params.cfg  # noqa: F821
-wc = snakemake.wildcards  # noqa: F821
-motion = prepare_motion(Motion.load_npz(snakemake.input[0]), cfg["max_frames"], cfg["frame_step"])  # noqa: F821
-log.info("%s (%s): %d frames at %.4g fps", wc.rsdata, snakemake.params.trial, motion.n_frames, motion.fps)  # noqa: F821
-min_k, rv, emb, timing = analyse(motion, wc.rsdata, snakemake.params.trial, gdof_flag(wc.rsgdof), cfg,  # noqa: F821
-                                  budget_gib=snakemake.config.get("memory_budget_gib"))  # noqa: F821
-out = snakemake.output  # noqa: F821
+log = setup_logging(snakemake)
+cfg = snakemake.params.cfg
+wc = snakemake.wildcards
+motion = prepare_motion(Motion.load_npz(snakemake.input[0]), cfg["max_frames"], cfg["frame_step"])
+log.info("%s (%s): %d frames at %.4g fps", wc.rsdata, snakemake.params.trial, motion.n_frames, motion.fps)
+min_k, rv, emb, timing = analyse(motion, wc.rsdata, snakemake.params.trial, gdof_flag(wc.rsgdof), cfg,
+                                  budget_gib=snakemake.config.get("memory_budget_gib"))
+out = snakemake.output
 with atomic_path(out.min_k) as tmp:
     min_k.to_csv(tmp, index=False, lineterminator="\n")
 with atomic_path(out.rv) as tmp:

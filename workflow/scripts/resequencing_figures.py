@@ -4,18 +4,18 @@ import numpy as np
 import pandas as pd
 
 from animsynth.resequencing.plots import embedding_figure, residual_variance_figure
-from animsynth.resequencing.study import METHOD_LABEL, METRIC_LABEL
+from animsynth.resequencing.jobs import METHOD_LABEL, METRIC_LABEL
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-dataset = snakemake.wildcards.rsdata  # noqa: F821
-inp = snakemake.input  # noqa: F821
+log = setup_logging(snakemake)
+dataset = snakemake.wildcards.rsdata
+inp = snakemake.input
 min_k = [pd.read_csv(p) for p in inp.min_k]
-for method, out in zip(snakemake.params.methods, snakemake.output.fig2):  # noqa: F821
+for method, out in zip(snakemake.params.methods, snakemake.output.fig2):
     panels = []
     for emb_path, mk in zip(inp.emb, min_k):
         with np.load(emb_path) as z:
-            for metric in snakemake.params.metrics:  # noqa: F821
+            for metric in snakemake.params.metrics:
                 key = f"{method}_{metric}"
                 row = mk[(mk["method"] == method) & (mk["metric"] == metric)].iloc[0]
                 panels.append({"xy": z[f"{key}_xy"], "edges": z[f"{key}_edges"],
@@ -25,5 +25,5 @@ for method, out in zip(snakemake.params.methods, snakemake.output.fig2):  # noqa
     embedding_figure(out, panels, title)
     log.info("Fig 2 %s: %d panels", method, len(panels))
 rv = pd.concat([pd.read_csv(p) for p in inp.rv], ignore_index=True)
-residual_variance_figure(snakemake.output.fig3, rv, f"Residual variance, {dataset}")  # noqa: F821
+residual_variance_figure(snakemake.output.fig3, rv, f"Residual variance, {dataset}")
 log.info("Fig 3: %d residual-variance values plotted", len(rv))

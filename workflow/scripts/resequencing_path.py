@@ -3,25 +3,25 @@ import pandas as pd
 
 from animsynth.motion import Motion
 from animsynth.atomic import atomic_path
-from animsynth.resequencing.study import gdof_flag, prepare_motion, resequence
+from animsynth.resequencing.jobs import gdof_flag, prepare_motion, resequence
 from animsynth.viz import motion_previews
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-cfg = snakemake.params.cfg  # noqa: F821
-out = snakemake.output  # noqa: F821
-dataset = snakemake.wildcards.rsdata  # noqa: F821
-motion = prepare_motion(Motion.load_npz(snakemake.input.npz), cfg["max_frames"], cfg["frame_step"])  # noqa: F821
+log = setup_logging(snakemake)
+cfg = snakemake.params.cfg
+out = snakemake.output
+dataset = snakemake.wildcards.rsdata
+motion = prepare_motion(Motion.load_npz(snakemake.input.npz), cfg["max_frames"], cfg["frame_step"])
 min_k = {}  # (method, metric, global flag) -> k of the configuration's first min-k row
-for gdof, path in zip(snakemake.params.gdof, snakemake.input.min_k):  # noqa: F821
+for gdof, path in zip(snakemake.params.gdof, snakemake.input.min_k):
     for _, r in pd.read_csv(path).iterrows():
         min_k.setdefault((r["method"], r["metric"], gdof), int(r["k_used"]))
 
-for i, (method, metric, gdof) in enumerate(snakemake.params.configs):  # noqa: F821
+for i, (method, metric, gdof) in enumerate(snakemake.params.configs):
     k = min_k[(method, metric, gdof)]
     paths, (main_path, main), per_path, per_tr = resequence(motion, gdof_flag(gdof), method, metric, k, cfg,
-                                                            seed=snakemake.params.seed,  # noqa: F821
-                                                            budget_gib=snakemake.config.get("memory_budget_gib"))  # noqa: F821
+                                                            seed=snakemake.params.seed,
+                                                            budget_gib=snakemake.config.get("memory_budget_gib"))
     rows = [{"pair": "main", "start": int(main_path[0]), "end": int(main_path[-1]), "step": j, "frame": int(f)}
             for j, f in enumerate(main_path)]
     rows += [{"pair": p, "start": int(path[0]), "end": int(path[-1]), "step": j, "frame": int(f)}

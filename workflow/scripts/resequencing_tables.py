@@ -2,21 +2,25 @@
 import pandas as pd
 
 from animsynth.atomic import atomic_path
-from animsynth.resequencing.study import (check_lee_weights, min_k_table, read_published, summarise_paths,
-                                          with_defaults)
+from animsynth.resequencing.jobs import lee_weights_table, min_k_table, published_table2, summarise_paths
 from animsynth.resequencing.verdicts import all_verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-inp, out = snakemake.input, snakemake.output  # noqa: F821
-cfg = with_defaults(snakemake.params.cfg)  # noqa: F821
-pub_cfg = snakemake.params.published  # noqa: F821
-trials = snakemake.params.trials  # noqa: F821
+log = setup_logging(snakemake)
+inp, out = snakemake.input, snakemake.output
+cfg = snakemake.params.cfg
+trials = snakemake.params.trials
 
 
 def cat(paths):
     return pd.concat([pd.read_csv(p) for p in paths], ignore_index=True)
+
+
+def published(files):
+    """A published table's declared input: its path, or None when the file is absent (no input)."""
+    files = [files] if isinstance(files, str) else list(files)
+    return files[0] if files else None
 
 
 def csv(df, path):
@@ -24,10 +28,10 @@ def csv(df, path):
         df.to_csv(tmp, index=False, lineterminator="\n", float_format="%.6g")
 
 
-published = read_published(pub_cfg.get("table2"))
+table2_paper = published_table2(published(inp.published_table2))
 grid = cat(inp.explain)
 step = int(cfg["frame_step"])
-table2 = min_k_table(grid, published, step)
+table2 = min_k_table(grid, table2_paper, step)
 CLIPS = ("Our clips differ from the paper's: CMU 35_01 has 358 frames at 120 fps (paper: a 516-frame walk), 35_17 "
          "has 167 (paper: a 405-frame run), and 05_02 is an expressive dance, not hip-hop (paper: 800 frames); the "
          "paper states neither the frame rate nor the source of its clips. ")
@@ -41,12 +45,12 @@ write_table(table2, out.table2, title="Table 2: smallest k giving one connected 
                  "ST-Isomap L2 rows repeat its Isomap L2 values (79, 107), which a graph holding the temporal chain "
                  "cannot give, while its ST-Isomap Lee rows (1) match ours. min_k_paper: the "
                  "paper's value on the rows of its setting (global DOF excluded for walk and run, included for dance)"
-                 + ("." if published is not None else "; empty: the published file was not found."))
+                 + ("." if table2_paper is not None else "; empty: the published file was not found."))
 write_table(grid, out.explanations, title="Minimum k under the candidate explanations of the paper's Table 2",
             note=CLIPS + "Every combination of sign mode, frame step (120 fps / frame_step) and global DOF.")
 flips = cat(inp.flips)
 csv(flips, out.flips)
-lw = check_lee_weights(pub_cfg.get("lee_weights"), cfg["lee"]["weights"])
+lw = lee_weights_table(published(inp.published_lee_weights), cfg["lee"]["weights"])
 csv(lw if lw is not None else pd.DataFrame(columns=["group", "weight_paper", "weight_ours", "match"]), out.lee_weights)
 if lw is not None and not lw["match"].all():
     log.warning("Lee weights differ from the paper's: %s", lw[~lw["match"]].to_dict("records"))
@@ -62,7 +66,7 @@ write_table(smooth, out.smooth, title="Re-sequenced motions: transitions and per
                  "docs/config_resequencing.md for definitions.")
 trial_txt = " ".join(f"{d} {t}" for d, t in trials.items())
 npairs = int(per_path.groupby(["dataset", "method", "metric", "global_dof"]).size().max()) if len(per_path) else 0
-v = all_verdicts(table2, grid, published, per_path, step, cfg, data_min_k=trial_txt,
+v = all_verdicts(table2, grid, table2_paper, per_path, step, cfg, data_min_k=trial_txt,
                  data_paths=f"{trial_txt} ({npairs} pairs per configuration)")
 write_table(v, out.verdicts, title="Re-sequencing: verdicts on the paper's claims")
 for r in v.itertuples():

@@ -2,7 +2,7 @@
 from animsynth.simplicial.jobs import figures_job
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-p = snakemake.params  # noqa: F821
-figures_job(list(snakemake.input), list(p.ids), p.dataset, dict(p.cfg), dict(snakemake.output.items()))  # noqa: F821
-log.info("wrote %s", ", ".join(map(str, snakemake.output)))  # noqa: F821
+log = setup_logging(snakemake)
+p = snakemake.params
+figures_job(list(snakemake.input), list(p.ids), p.dataset, dict(p.cfg), dict(snakemake.output.items()))
+log.info("wrote %s", ", ".join(map(str, snakemake.output)))

@@ -2,7 +2,7 @@
 from animsynth.simplicial.jobs import grid_job
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-wc, p = snakemake.wildcards, snakemake.params  # noqa: F821
-grid_job(list(snakemake.input), list(p.ids), wc.dataset, wc.grid, dict(p.cfg), int(p.seed),  # noqa: F821
-         dict(snakemake.output.items()))  # noqa: F821
+log = setup_logging(snakemake)
+wc, p = snakemake.wildcards, snakemake.params
+grid_job(list(snakemake.input), list(p.ids), wc.dataset, wc.grid, dict(p.cfg), int(p.seed),
+         dict(snakemake.output.items()))

@@ -42,7 +42,8 @@ Known defects of 0.0.4 that are left as released (the peer row measures what a u
 cut before each appended piece is placed at the wrong frame, and ``append_and_blend`` computes the blend's
 source time as ``fps * frame`` instead of ``frame / fps``, so it blends from the last pose of the previous
 piece, held still. Together, with the defaults here at 30 fps, every appended piece adds 5 of its 15
-frames to the output, all of them blended, and the walk runs through the clips at about 3 times their speed. Its ``ops.motion.cut`` also shares the Pose objects with the loaded
+frames to the output, all of them blended, and the walk runs through the clips at about 3 times their speed.
+Its ``ops.motion.cut`` also shares the Pose objects with the loaded
 clips and ``append_and_blend`` moves them in place, so a walk displaces poses that later pieces of the same
 walk reuse (a node visited twice, the blend frames shared by consecutive nodes). All of this was changed
 upstream after the release. Only between walks do we step in: every :meth:`FairmotionGraph.generate` walks

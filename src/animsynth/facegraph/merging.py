@@ -199,7 +199,8 @@ def _finish_graph(rd, nodes, node_map, visit_map, n, Dmean, cnt, vin_mean, vin_o
         weights=weights,
         start_of_sample=start_of, peak_of_sample=peak_of,
         info={"merge_threshold": (float(threshold) if np.ndim(threshold) == 0
-                                  else float(np.nanmedian(threshold))), "n_sample_nodes": int(nodes.n), "n_poses": int(rd.n_poses),
+                                  else float(np.nanmedian(threshold))),
+                "n_sample_nodes": int(nodes.n), "n_poses": int(rd.n_poses),
               "n_frames": int(rd.forward.sum())},
     )
 

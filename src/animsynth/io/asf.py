@@ -123,7 +123,8 @@ def read_asf(path) -> Skeleton:
                     if req not in bone:
                         raise MotionFormatError(path, bone["line"], f"bone without {req}")
                 if bone["dof"] and len(bone["limits"]) not in (0, len(bone["dof"])):
-                    raise MotionFormatError(path, ln, f"bone {bone['name']!r}: {len(bone['dof'])} dof but {len(bone['limits'])} limits")
+                    raise MotionFormatError(
+                        path, ln, f"bone {bone['name']!r}: {len(bone['dof'])} dof but {len(bone['limits'])} limits")
                 if bone["name"] in bones:
                     raise MotionFormatError(path, bone["line"], f"duplicate bone {bone['name']!r}")
                 bones[bone["name"]] = bone

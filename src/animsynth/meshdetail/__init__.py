@@ -6,9 +6,12 @@ fit          per-frame pose fitting (Kabsch + Levenberg-Marquardt), joint centre
 gp           shared GPLVM with GPDM dynamics (:class:`SharedGPDM`), GP regression, analytic gradients
 detail       control meshes (replayed edge collapses / vertex subset), RBF reconstruction, Laplacian coordinates
 models       :class:`HybridModel` (hybrid / plain GP / CV ridge / LBS-only / full-deformation), :class:`MeshContext`
-experiments  the paper's experiments as functions returning tables (blocked cross-validation)
-verdicts     the paper's claims checked against the tables
-jobs         workflow steps (character generation, loading, skeleton fit)
+rigfit       skeleton fitting of a sequence: 18-joint embedding, skinning weights, per-frame poses, fit tables
+evaluation   the paper's experiments as functions returning tables (blocked cross-validation)
+dembones     the Dem Bones (SSDR) LBS floor under the same blocked cross-validation
+settings     config checks beyond the schema, the mesh sequences of a run
+verdicts     the paper's claims checked against the tables (common verdict format)
+jobs         workflow steps (character generation, loading, skeleton fit, Dem Bones floor, scale steps)
 plots        Fig. 5 panels and rendered frames
 
 The skeleton, forward kinematics, linear blend skinning and skinning weights

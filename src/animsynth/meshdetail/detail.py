@@ -68,11 +68,6 @@ def uniform_laplacian(edges: np.ndarray, n: int) -> sparse.csr_matrix:
     return (sparse.diags((deg > 0).astype(float)) - sparse.diags(inv) @ A).tocsr()
 
 
-def dominant_rotations(W: np.ndarray, dom: np.ndarray) -> np.ndarray:
-    """Per-vertex rotation (F, V, 3, 3) of each vertex's dominant joint."""
-    return W[:, dom]
-
-
 def to_local(d_world: np.ndarray, R: np.ndarray) -> np.ndarray:
     """World vectors (F, V, 3) -> frames of rotations R (F, V, 3, 3): R^T d."""
     return np.einsum("fvba,fvb->fva", R, d_world, optimize=True)

@@ -142,7 +142,6 @@ class PoseFitter:
         F, V = frames.shape[:2]
         J = rig.n_joints
         sets = [np.flatnonzero(Wt[:, j] >= self.min_weight) for j in range(J)]
-        robust_w = np.ones((F, V))
         # 1. initial pass: dominant vertices, Kabsch about the joint start
         W = np.tile(np.eye(3), (F, J, 1, 1))
         S = np.zeros((F, J, 3))

@@ -17,6 +17,7 @@ import logging
 import os
 
 import numpy as np
+from scipy import sparse
 
 from ..io import read_amc, read_asf
 from ..atomic import atomic_path
@@ -24,33 +25,39 @@ from ..io.obj import MeshSequence, read_obj_sequence, write_obj_sequence
 from ..skinning import Rig, cmu_motion_to_rig, default_rig, rebase, rebase_pose
 from ..synth.character import SkirtParams, build_character, edit_motion, procedural_motion, simulate
 from ..synth.mocap import cmu_like_skeleton, generate_motion
-from .experiments import (Prepared, fit_skeleton, joint_rotation_errors, pack_weights, rig_fit_table, rig_from_joints,
-                          split_frames, unpack_weights)
+from .evaluation import Prepared, blocks, split_frames
+from .rigfit import fit_skeleton, joint_rotation_errors, rig_fit_table, rig_from_joints
+from .settings import check_character
 
 log = logging.getLogger("animsynth.meshdetail.jobs")
+
+
+def pack_weights(w: sparse.csr_matrix) -> dict:
+    """Sparse skinning weights as the arrays of ``data/pose.npz``."""
+    w = sparse.csr_matrix(w)
+    return {"w_data": w.data, "w_indices": w.indices, "w_indptr": w.indptr, "w_shape": np.array(w.shape)}
+
+
+def unpack_weights(z) -> sparse.csr_matrix:
+    """The skinning weights stored by :func:`pack_weights` (``z``: the loaded npz)."""
+    return sparse.csr_matrix((z["w_data"], z["w_indices"], z["w_indptr"]), shape=tuple(z["w_shape"]))
 
 
 def driving_motion(cfg: dict, seed: int, speed: float = 1.0):
     """Rig and pose (root_t, angles) that drive the synthetic character."""
 
+    check_character(cfg)
     drv, fps, n = cfg["driver"], float(cfg["fps"]), int(cfg["frames"])
     if drv == "procedural":
         rig = default_rig()
         rt, A = procedural_motion(cfg["motion"], n, fps, seed, rig, speed=speed)
         return rig, rt, A
+    step = 120.0 / fps
     if drv == "cmu_synthetic":
-        step = 120.0 / fps
-        if abs(step - round(step)) > 1e-9:
-            raise ValueError(f"config key 'meshdetail.character.fps': must divide 120 for the CMU-like generator, got {fps}")
         sk = cmu_like_skeleton("syn_skirt", seed)
         m = generate_motion(cfg["motion"], int(np.ceil(n * step * speed)) + 2, seed, sk, fps=120.0)
-    elif drv == "amc":
-        if not cfg.get("asf") or not cfg.get("amc"):
-            raise ValueError("config keys 'meshdetail.character.asf' and '.amc' are needed for driver 'amc'")
+    else:  # amc
         m = read_amc(cfg["amc"], read_asf(cfg["asf"]), 120.0)
-        step = 120.0 / fps
-    else:
-        raise ValueError(f"config key 'meshdetail.character.driver': unknown driver {drv!r}")
     rig, rt, A = cmu_motion_to_rig(m)
     src = np.arange(n) * step * speed
     if src[-1] > len(rt) - 1:
@@ -194,7 +201,6 @@ def dembones_floor(seq_npz: str, cfg: dict, cv_folds: int, render_frames, out_np
     error-map frame (the first render frame) per bone count to ``out_npz``.
     """
     from .dembones import floor_cv, floor_summary
-    from .experiments import blocks
 
     seq = MeshSequence.load_npz(seq_npz)
     frame = min(max(int(list(render_frames)[0]), 0), seq.n_frames - 1)

@@ -367,11 +367,5 @@ def reconstruction_seconds_per_frame(model: HybridModel, ctx: MeshContext, root_
     return best, best_cpu
 
 
-def angles_from_matrices(L: np.ndarray) -> np.ndarray:
-    from ..skinning import matrix_to_euler
-
-    return np.unwrap(matrix_to_euler(L), axis=0)
-
-
 __all__ = ["HybridModel", "MeshContext", "pose_features", "joint_features", "mean_vertex_error",
            "reconstruction_seconds_per_frame", "euler_to_matrix"]

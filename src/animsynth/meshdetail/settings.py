@@ -1,4 +1,5 @@
-"""Cross-key checks of the ``meshdetail`` config block (beyond the JSON Schema)."""
+"""Config of the ``meshdetail`` block: its cross-key checks (beyond the JSON Schema, which holds the
+defaults) and the mesh sequences of a run."""
 
 from __future__ import annotations
 
@@ -9,10 +10,52 @@ import numpy as np
 from ..config import ConfigError
 from ..skinning import JOINTS
 
+__all__ = ["check", "check_character", "check_sequence", "mesh_sequences"]
 
-def check_meshdetail_config(md: dict, mesh_dir: str | None, key: str = "meshdetail") -> None:
-    """Raise :class:`ConfigError` naming the key for values the schema cannot check."""
-    joints = md["rig"].get("joints")
+DRIVERS = ("cmu_synthetic", "procedural", "amc")
+
+
+def check(config: dict) -> None:
+    """Every meshdetail check the schema cannot make; raise :class:`ConfigError` naming the key.
+
+    ``config``: the whole workflow config, validated by ``config/schema.yaml`` (defaults filled in). Checks
+    the ``meshdetail.sequences`` entries (:func:`mesh_sequences`), each sequence's block
+    (:func:`check_sequence`) and, when the first sequence is the synthetic character, its driver
+    (:func:`check_character`).
+    """
+    md = config["meshdetail"]
+    seqs = mesh_sequences(config)
+    for name, entry in (md["sequences"] or {}).items():
+        unknown = sorted(set(entry.get("rig") or {}) - set(md["rig"]))
+        if unknown:
+            raise ConfigError(f"config key 'meshdetail.sequences.{name}.rig': unknown key(s) {unknown} "
+                              f"(keys: {sorted(md['rig'])})")
+    first = next(iter(seqs))
+    if not seqs[first]["mesh_dir"]:
+        check_character(md["character"])
+    for name, s in seqs.items():
+        check_sequence({**md, "rig": s["rig"]}, s["mesh_dir"],
+                       key="meshdetail" if name == first else f"meshdetail.sequences.{name}")
+
+
+def check_character(ch: dict, key: str = "meshdetail.character") -> None:
+    """The synthetic character's driver: a known driver, a frame rate the CMU-like generator can resample
+    (it records at 120 fps), the ASF/AMC files of driver ``amc``."""
+    drv = ch["driver"]
+    if drv not in DRIVERS:
+        raise ConfigError(f"config key '{key}.driver': unknown driver {drv!r} (one of {list(DRIVERS)})")
+    fps = float(ch["fps"])
+    if drv == "cmu_synthetic" and abs(120.0 / fps - round(120.0 / fps)) > 1e-9:
+        raise ConfigError(f"config key '{key}.fps': must divide 120 for the CMU-like generator, got {fps:g}")
+    if drv == "amc" and not (ch.get("asf") and ch.get("amc")):
+        raise ConfigError(f"config keys '{key}.asf' and '{key}.amc' are needed for driver 'amc'")
+
+
+def check_sequence(md: dict, mesh_dir: str | None, key: str = "meshdetail") -> None:
+    """One sequence's ``meshdetail`` block (``md``, with the sequence's own ``rig``): the 18-joint embedding
+    of real data, the leaves' ends, the frames the synthetic character (``mesh_dir`` None) leaves for
+    training and for the blocked cross-validation, the Fig. 5b levels."""
+    joints = md["rig"]["joints"]
     if mesh_dir and joints:
         missing = [n for n in JOINTS if n not in joints]
         if missing:
@@ -20,7 +63,7 @@ def check_meshdetail_config(md: dict, mesh_dir: str | None, key: str = "meshdeta
         extra = sorted(set(joints) - set(JOINTS))
         if extra:
             raise ConfigError(f"config key '{key}.rig.joints': unknown joint(s) {extra} (names: {list(JOINTS)})")
-    for name in md["rig"].get("ends") or {}:
+    for name in md["rig"]["ends"] or {}:
         if name not in JOINTS:
             raise ConfigError(f"config key '{key}.rig.ends': unknown joint {name!r}")
     if not mesh_dir:
@@ -48,7 +91,9 @@ def mesh_sequences(config: dict) -> dict:
     ``samba``) or, when that is null, the synthetic character (``character``); then every
     entry of ``meshdetail.sequences`` (real sequences only). An entry's ``rig`` keys
     override ``meshdetail.rig`` except the embedding (``joints``, ``ends``), which is the
-    entry's own; unset ``mesh_fps`` / ``render_frames`` come from ``meshdetail``.
+    entry's own; unset ``mesh_fps`` / ``render_frames`` come from ``meshdetail``. Raises
+    :class:`ConfigError` for an entry it cannot place (name taken or malformed, unknown key, no mesh_dir);
+    :func:`check` checks the rest.
     """
     from ..sources import mesh_source_name
 
@@ -58,7 +103,7 @@ def mesh_sequences(config: dict) -> dict:
     seqs = {first: {"mesh_dir": top, "mesh_sha256": config.get("mesh_sha256") if top else None,
                     "mesh_fps": md["mesh_fps"] if top else md["character"]["fps"],
                     "render_frames": list(md["render_frames"]), "rig": dict(md["rig"])}}
-    for name, entry in (md.get("sequences") or {}).items():
+    for name, entry in (md["sequences"] or {}).items():
         key = f"meshdetail.sequences.{name}"
         if name in seqs:
             raise ConfigError(f"config key '{key}': the name is already taken by the top-level mesh_dir "
@@ -74,8 +119,4 @@ def mesh_sequences(config: dict) -> dict:
         seqs[name] = {"mesh_dir": entry["mesh_dir"], "mesh_sha256": entry.get("mesh_sha256"),
                       "mesh_fps": entry.get("mesh_fps") or md["mesh_fps"],
                       "render_frames": list(entry.get("render_frames") or md["render_frames"]), "rig": rig}
-    for name, s in seqs.items():
-        if s["mesh_dir"]:
-            check_meshdetail_config({**md, "rig": s["rig"]}, s["mesh_dir"], key=f"meshdetail.sequences.{name}"
-                                    if name != first else "meshdetail")
     return seqs

@@ -1,8 +1,8 @@
 """Claims of the hybrid mesh animation paper checked against the meshdetail tables.
 
-Common verdict format: ``claim, paper_value, ours, data, verdict, evidence, source``
-with ``verdict`` one of ``reproduced``, ``partly``, ``not reproduced``,
-``contradicted``, ``within noise``. Model comparisons are keyed on held-out
+Common verdict format (:mod:`animsynth.verdicts`; every row built with :func:`animsynth.verdicts.row`):
+``claim, paper_value, ours, data, verdict, evidence, source`` with ``verdict`` one of ``reproduced``,
+``partly``, ``not reproduced``, ``contradicted``, ``within noise``. Model comparisons are keyed on held-out
 frames of the blocked cross-validation: the margin is the mean over blocks of
 the per-block difference, and it counts only when every block agrees and the
 margin exceeds the spread (SD) of the per-block differences; otherwise the
@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-COLUMNS = ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
+from .. import verdicts as common
 
 
 def block_margin(fig5c: pd.DataFrame, better: str, worse: str):
@@ -59,13 +59,11 @@ def verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame, gen:
             note = f"; not better on block(s) {lost} (block 0 holds the rest frame, where LBS is exact)" \
                 if better != "lbs_mm" and worse == "lbs_mm" and 0 in lost else f"; not better on block(s) {lost}" + note
         v = _compare_verdict(m, sd, share)
-        rows.append({"claim": claim, "paper_value": paper_value,
-                     "ours": f"{f(b)} vs {f(w)} mm held-out", "data": f"{data} (blocked CV, {k} blocks)",
-                     "verdict": v,
-                     "evidence": f"held-out mean vertex error {f(b)} vs {f(w)} mm; margin {f(m)} mm, per-block spread "
-                                 f"(SD) {f(sd)} mm; better on {100 * share:.0f}% of {k} blocks" + note
-                                 + SKIN_NOTE[cv_rig],
-                     "source": source})
+        rows.append(common.row(
+            claim, v, f"held-out mean vertex error {f(b)} vs {f(w)} mm; margin {f(m)} mm, per-block spread "
+                      f"(SD) {f(sd)} mm; better on {100 * share:.0f}% of {k} blocks" + note + SKIN_NOTE[cv_rig],
+            paper_value=paper_value, ours=f"{f(b)} vs {f(w)} mm held-out", data=f"{data} (blocked CV, {k} blocks)",
+            source=source))
 
     compare("Hybrid (LBS + learned detail) reconstructs held-out frames better than LBS alone (Fig. 5c)",
             "hybrid_mm", "lbs_mm", "plotted only (Fig. 5c)")
@@ -78,39 +76,37 @@ def verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame, gen:
     a_tr, a_te = fig5a[fig5a.split == "train"], fig5a[fig5a.split == "test"]
     ok_tr = a_tr.detail_only_mm.mean() < a_tr.full_deformation_mm.mean()
     ok_te = a_te.detail_only_mm.mean() < a_te.full_deformation_mm.mean() if len(a_te) else ok_tr
-    rows.append({"claim": "Learning only the fine detail is more accurate than learning the full deformation (Fig. 5a)",
-                 "paper_value": "plotted only (Fig. 5a)",
-                 "ours": f"{f(a_te.detail_only_mm.mean())} vs {f(a_te.full_deformation_mm.mean())} mm held-out",
-                 "data": f"{data} (first frames train, rest held out)",
-                 "verdict": "reproduced" if ok_tr and ok_te else ("partly" if ok_tr or ok_te else "contradicted"),
-                 "evidence": f"training {f(a_tr.detail_only_mm.mean())} vs {f(a_tr.full_deformation_mm.mean())} mm; "
-                             f"held-out {f(a_te.detail_only_mm.mean())} vs {f(a_te.full_deformation_mm.mean())} mm",
-                 "source": "meshdetail/fig5a.csv"})
+    rows.append(common.row(
+        "Learning only the fine detail is more accurate than learning the full deformation (Fig. 5a)",
+        "reproduced" if ok_tr and ok_te else ("partly" if ok_tr or ok_te else "contradicted"),
+        f"training {f(a_tr.detail_only_mm.mean())} vs {f(a_tr.full_deformation_mm.mean())} mm; "
+        f"held-out {f(a_te.detail_only_mm.mean())} vs {f(a_te.full_deformation_mm.mean())} mm",
+        paper_value="plotted only (Fig. 5a)",
+        ours=f"{f(a_te.detail_only_mm.mean())} vs {f(a_te.full_deformation_mm.mean())} mm held-out",
+        data=f"{data} (first frames train, rest held out)", source="meshdetail/fig5a.csv"))
     ed = gen[gen.case.str.startswith("edited motion")]
     if len(ed):
         better = int(np.sum(ed.hybrid_mm < ed.lbs_mm))
-        rows.append({"claim": "The learned detail transfers to edited motions (beats LBS against re-simulated truth)",
-                     "paper_value": "shown qualitatively",
-                     "ours": f"hybrid better on {better} of {len(ed)} edits", "data": data,
-                     "verdict": "reproduced" if better == len(ed) else ("partly" if better else "not reproduced"),
-                     "evidence": "; ".join(f"{c.split(': ')[-1]}: {f(h)} ± {f(hs)} vs {f(lb)} mm (mean ± SD over folds)"
-                                           for c, h, hs, lb in zip(ed.case, ed.hybrid_mm, ed.hybrid_fold_sd_mm, ed.lbs_mm)),
-                     "source": "meshdetail/generalisation.csv"})
+        rows.append(common.row(
+            "The learned detail transfers to edited motions (beats LBS against re-simulated truth)",
+            "reproduced" if better == len(ed) else ("partly" if better else "not reproduced"),
+            "; ".join(f"{c.split(': ')[-1]}: {f(h)} ± {f(hs)} vs {f(lb)} mm (mean ± SD over folds)"
+                      for c, h, hs, lb in zip(ed.case, ed.hybrid_mm, ed.hybrid_fold_sd_mm, ed.lbs_mm)),
+            paper_value="shown qualitatively", ours=f"hybrid better on {better} of {len(ed)} edits", data=data,
+            source="meshdetail/generalisation.csv"))
     b = fig5b[fig5b.decimation != "farthest-point subset"].sort_values("level_pct")
     if len(b) >= 2:
         lo, hi = b.iloc[0], b.iloc[-1]
         ratio = lo.test_mm / hi.test_mm if hi.test_mm > 0 else np.nan
-        rows.append({"claim": "A coarse control mesh suffices: held-out error changes little from the full mesh down to "
-                              "the smallest level while the stored size shrinks (Fig. 5b)",
-                     "paper_value": "plotted only (Fig. 5b)",
-                     "ours": f"x{f(ratio)} error at {lo.level_pct:g}% vs {hi.level_pct:g}%",
-                     "data": f"{data} (edge collapse replayed on every frame, RBF reconstruction)",
-                     "verdict": "reproduced" if ratio <= 1.5 else ("partly" if ratio <= 3 else "not reproduced"),
-                     "evidence": f"held-out {f(hi.test_mm)} mm at {hi.level_pct:g}% vs {f(lo.test_mm)} mm at "
-                                 f"{lo.level_pct:g}%; size {f(hi.size_pct_of_original)}% -> "
-                                 f"{f(lo.size_pct_of_original)}% of the original",
-                     "source": "meshdetail/fig5b.csv"})
-    return pd.DataFrame(rows, columns=COLUMNS)
+        rows.append(common.row(
+            "A coarse control mesh suffices: held-out error changes little from the full mesh down to "
+            "the smallest level while the stored size shrinks (Fig. 5b)",
+            "reproduced" if ratio <= 1.5 else ("partly" if ratio <= 3 else "not reproduced"),
+            f"held-out {f(hi.test_mm)} mm at {hi.level_pct:g}% vs {f(lo.test_mm)} mm at "
+            f"{lo.level_pct:g}%; size {f(hi.size_pct_of_original)}% -> {f(lo.size_pct_of_original)}% of the original",
+            paper_value="plotted only (Fig. 5b)", ours=f"x{f(ratio)} error at {lo.level_pct:g}% vs {hi.level_pct:g}%",
+            data=f"{data} (edge collapse replayed on every frame, RBF reconstruction)", source="meshdetail/fig5b.csv"))
+    return common.table(rows)
 
 
 def holds_on(verdicts_by_seq: dict) -> tuple[str, str]:
@@ -140,18 +136,20 @@ def combine_verdicts(per_seq: dict) -> pd.DataFrame:
     rows = []
     for name, t in per_seq.items():
         for r in t.to_dict("records"):
-            rows.append({**r, "claim": f"[{name}] {r['claim']}", "source": f"meshdetail/{name}/{r['source'].split('/')[-1]}"})
+            rows.append(common.row(f"[{name}] {r['claim']}", r["verdict"], r["evidence"], paper_value=r["paper_value"],
+                                   ours=r["ours"], data=r["data"],
+                                   source=f"meshdetail/{name}/{r['source'].split('/')[-1]}"))
     claims = list(dict.fromkeys(c for t in per_seq.values() for c in t["claim"]))
     for claim in claims:
         got = {n: t[t.claim == claim].iloc[0] for n, t in per_seq.items() if (t.claim == claim).any()}
         words, verdict = holds_on({n: r.verdict for n, r in got.items()})
         missing = [n for n in per_seq if n not in got]
-        rows.append({"claim": f"[all sequences] {claim}", "paper_value": next(iter(got.values())).paper_value,
-                     "ours": words + (f"; not tested on {', '.join(missing)}" if missing else ""),
-                     "data": "sequences: " + ", ".join(got), "verdict": verdict,
-                     "evidence": "; ".join(f"{n}: {r.verdict} ({r.ours})" for n, r in got.items()),
-                     "source": ", ".join(f"meshdetail/{n}/verdicts.csv" for n in got)})
-    return pd.DataFrame(rows, columns=COLUMNS)
+        rows.append(common.row(
+            f"[all sequences] {claim}", verdict, "; ".join(f"{n}: {r.verdict} ({r.ours})" for n, r in got.items()),
+            paper_value=next(iter(got.values())).paper_value,
+            ours=words + (f"; not tested on {', '.join(missing)}" if missing else ""),
+            data="sequences: " + ", ".join(got), source=", ".join(f"meshdetail/{n}/verdicts.csv" for n in got)))
+    return common.table(rows)
 
 
 SIDE_BY_SIDE = [("our skin (LBS, fitted 18-joint skeleton)", "lbs"), ("hybrid (SGPLVM+GPDM)", "hybrid"),

@@ -9,7 +9,11 @@ embedding   k-NN graphs (optionally with always-present edges), exact minimum co
             Isomap (no silent graph joining), ST-Isomap (Jenkins & Mataric 2004), residual variance
 paths       Dijkstra re-sequencing, padding, playing a path as a motion
 metrics     transitions, path classes, per-transition and whole-path smoothness
-study       the workflow steps (analyse, explain, resequence, tables)
+landmark    Landmark Isomap (geodesics from a few frames) for large databases
+sparse      the sparse (k-NN candidate) pipeline of large databases
+jobs        the workflow steps (analyse, explain, resequence, tables, published values), the one-call
+            :func:`~.jobs.resequence_motion`, the scale study's measured steps
+settings    config checks beyond the schema
 verdicts    the paper's claims in the common verdict format
 plots       Fig. 2 (embeddings with edges) and Fig. 3 (residual variance)
 """

@@ -37,7 +37,6 @@ run on a graph that may hold the always-present edges.
 from __future__ import annotations
 
 import logging
-import warnings
 
 import numpy as np
 from scipy.sparse import csr_matrix

@@ -1,17 +1,18 @@
-"""Cross-key checks of the ``resequencing`` config block (beyond the JSON Schema)."""
+"""Cross-key checks of the ``resequencing`` config block (beyond the JSON Schema, which holds the defaults)."""
 
 from __future__ import annotations
 
 from ..config import ConfigError
 
-__all__ = ["check_resequencing_config"]
+__all__ = ["check"]
 
 
-def check_resequencing_config(rs: dict, trials: dict) -> None:
-    """Raise :class:`ConfigError` naming the key for values the schema cannot check.
+def check(config: dict) -> None:
+    """Raise :class:`ConfigError` naming the key for ``resequencing`` values the schema cannot check.
 
-    ``rs``: the ``resequencing`` block; ``trials``: the ``resequencing_trials`` mapping.
+    ``config``: the whole workflow config, validated by ``config/schema.yaml`` (defaults filled in).
     """
+    rs, trials = config["resequencing"], config["resequencing_trials"]
     for ds in rs["datasets"]:
         if ds not in trials:
             raise ConfigError(f"config key 'resequencing.datasets': {ds!r} is not a key of 'resequencing_trials' "

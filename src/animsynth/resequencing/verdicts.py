@@ -1,8 +1,7 @@
-"""Verdicts on the re-sequencing paper's claims, in the common verdict format.
+"""Verdicts on the re-sequencing paper's claims, in the common verdict format (:mod:`animsynth.verdicts`).
 
-Columns: ``claim, paper_value, ours, data, verdict, evidence, source``;
-``verdict`` is one of ``reproduced``, ``partly``, ``not reproduced``,
-``contradicted``, ``within noise``.
+Every row is built with :func:`animsynth.verdicts.row` (columns ``claim, paper_value, ours, data,
+verdict, evidence, source``; ``verdict`` a word of :data:`animsynth.verdicts.VOCABULARY`).
 
 * **Table 2 explanations** (:func:`explanation_verdicts`): which condition
   -- quaternion signs from rotation matrices (``matrix_naive``), a lower frame
@@ -30,16 +29,17 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-__all__ = ["VERDICT_COLUMNS", "explanation_verdicts", "lee_vs_l2_verdict", "paired_share", "st_smoother_verdict",
+from .. import verdicts as common
+
+__all__ = ["explanation_verdicts", "lee_vs_l2_verdict", "paired_share", "st_smoother_verdict",
            "global_dof_verdict", "all_verdicts"]
 
-VERDICT_COLUMNS = ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
 PRIMARY = "velocity_jump_ratio"
 SECONDARY = ["pose_jump_ratio", "accel_jump_ratio", "foot_skate_ratio"]
 
 
 def _row(claim, paper_value, ours, data, verdict, evidence, source):
-    return dict(zip(VERDICT_COLUMNS, [claim, paper_value, ours, data, verdict, evidence, source]))
+    return common.row(claim, verdict, evidence, paper_value=paper_value, ours=ours, data=data, source=source)
 
 
 def _pick(grid, dataset, step, gdof, mode, method, metric):
@@ -293,4 +293,4 @@ def all_verdicts(table2, grid, published, per_path, frame_step: int, cfg: dict, 
     rows.append(lee_vs_l2_verdict(table2, f, data_min_k))
     rows.append(st_smoother_verdict(per_path, float(cfg["verdict_share"]), float(cfg["verdict_alpha"]), data_paths))
     rows.append(global_dof_verdict(per_path, float(cfg["verdict_share"]), float(cfg["verdict_alpha"]), data_paths))
-    return pd.DataFrame(rows, columns=VERDICT_COLUMNS)
+    return common.table(rows)

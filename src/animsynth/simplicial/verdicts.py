@@ -30,7 +30,8 @@ def _share_text(share: float, what: str) -> str:
 
 def build_verdicts(*, table2: pd.DataFrame, table2_ens: pd.DataFrame, members: pd.DataFrame, paired: pd.DataFrame,
                    deriv: pd.DataFrame, folds: pd.DataFrame, beyond: pd.DataFrame | None = None,
-                   beyond_folds: pd.DataFrame | None = None, beyond_members: pd.DataFrame | None = None, claim: str, main_derivative: str, baseline: str,
+                   beyond_folds: pd.DataFrame | None = None, beyond_members: pd.DataFrame | None = None,
+                   claim: str, main_derivative: str, baseline: str,
                    datasets, data: str, methods=("delaunay", "knn"), magnitude_factor: float = 2.0,
                    alpha: float = 0.05) -> pd.DataFrame:
     """Verdict rows from the result tables.

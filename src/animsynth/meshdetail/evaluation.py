@@ -1,27 +1,25 @@
 """The paper's experiments (Fig. 5 a-c, representations, resolution, generalisation, timing)
-as functions from prepared data to tables.
+as functions from a prepared sequence (:class:`Prepared`: frames, fitted skeleton, split) to tables.
 
 Errors are per-frame mean Euclidean vertex distances in millimetres (the
 meshes are in metres). Frames are split into a contiguous training block (the
-first ``train_fraction``) and the held-out remainder.
+first ``train_fraction``) and the held-out remainder; model comparisons use
+blocked cross-validation (:func:`blocks`).
 """
 
 from __future__ import annotations
 
 import logging
-import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
 from scipy import sparse
 
-from ..skinning import (JOINTS, PARENTS, Rig, bone_heat_weights, dominant_joint, joint_transforms, pose_vertices,
-                        refit_weights, skinning_weights)
-from .fit import PoseFitter, _fk_from_world, place_joints
+from ..skinning import Rig
 from .models import HybridModel, MeshContext, mean_vertex_error, pose_features, reconstruction_seconds_per_frame
 
-log = logging.getLogger("animsynth.meshdetail.experiments")
+log = logging.getLogger("animsynth.meshdetail.evaluation")
 
 MM = 1000.0
 
@@ -51,147 +49,6 @@ def split_frames(n: int, train_fraction: float):
     if k < 8 or k > n:
         raise ValueError(f"train_fraction {train_fraction} leaves {k} of {n} frames for training (need >= 8)")
     return np.arange(k), np.arange(k, n)
-
-
-def rig_from_joints(joints: dict, ends: dict | None = None) -> Rig:
-    """A rig from user-supplied joint start positions ``{name: [x, y, z]}`` (all 18 names).
-
-    Segment ends are the start of the (first) child; leaves (head, hands, feet)
-    take ``ends[name]`` if given, else continue the parent direction for half
-    the parent's length.
-    """
-    missing = [n for n in JOINTS if n not in joints]
-    if missing:
-        raise ValueError(f"config key 'meshdetail.rig.joints' misses {missing}")
-    st = np.array([joints[n] for n in JOINTS], float)
-    en = np.zeros_like(st)
-    ends = ends or {}
-    for j, n in enumerate(JOINTS):
-        kids = [k for k, p in enumerate(PARENTS) if p == j]
-        if n in ends:
-            en[j] = ends[n]
-        elif n == "hips":
-            en[j] = st[JOINTS.index("spine")]
-        elif kids:
-            en[j] = st[kids[0]]
-        else:
-            p = PARENTS[j]
-            en[j] = st[j] + 0.5 * (st[j] - st[p])
-    return Rig(st, en)
-
-
-SKINNINGS = ("heat", "heat+refit", "distance")
-
-
-def skin_weights(method: str, rest, faces, rig: Rig, max_influences: int = 4, heat_c: float = 1.0,
-                 weight_power: float = 4.0):
-    """First-frame skinning weights: ``heat`` (bone heat, also the start of ``heat+refit``) or ``distance``."""
-    if method == "distance":
-        return skinning_weights(rest, rig, power=weight_power, max_influences=max_influences)
-    if method in ("heat", "heat+refit"):
-        return bone_heat_weights(rest, faces, rig, c=heat_c, max_influences=max_influences)
-    raise ValueError(f"config key 'meshdetail.rig.skinning': must be one of {SKINNINGS}, got {method!r}")
-
-
-def _transforms(rig: Rig, fitter: PoseFitter):
-    return joint_transforms(rig, fitter.W_, _fk_from_world(rig, fitter.W_, fitter.root_t_))
-
-
-def fit_skeleton(frames: np.ndarray, faces: np.ndarray, rig: Rig, train: np.ndarray, skinning: str = "heat+refit",
-                 refine: bool = False, max_influences: int = 4, iterations: int = 8, heat_c: float = 1.0,
-                 weight_power: float = 4.0, compare: bool = False):
-    """Place the joints, compute weights, fit every frame's pose.
-
-    1. (``refine``) joints from the mesh motion of the **training** frames, each
-       checked to lie inside the first-frame mesh (:func:`~.fit.place_joints`);
-    2. first-frame weights (``heat`` / ``distance``);
-    3. per-frame pose fit of all frames (each frame alone: a held-out frame's
-       pose uses only that frame);
-    4. ``heat+refit``: weights refitted (non-negative, sum to one) on the
-       training frames' poses and meshes only, then every pose refitted.
-
-    Parameters
-    ----------
-    frames : (F, V, 3); faces : (T, 3); rig : initial embedding; train : training frame indices
-    compare : bool
-        Also fit the other skinning methods and return their residuals (the
-        measurement behind the default).
-
-    Returns
-    -------
-    rig, weights (csr), fitter (:class:`PoseFitter`), joints table, comparison table (or None)
-    """
-    rest = frames[0]
-    train = np.asarray(train)
-    if refine:
-        w0 = skin_weights("heat" if skinning != "distance" else "distance", rest, faces, rig, max_influences,
-                          heat_c, weight_power)
-        rig, joints = place_joints(rig, w0, rest, faces, frames[train])
-    else:
-        rig, joints = place_joints(rig, None, rest, faces, None)
-    results = {}
-    methods = SKINNINGS if compare else (skinning,)
-    for m in ("distance", "heat", "heat+refit"):
-        if m not in methods and not (m == "heat" and skinning == "heat+refit"):
-            continue
-        if m == "heat+refit":
-            w_h, fit_h = results["heat"]
-            w = refit_weights(w_h, rest, _transforms(rig, fit_h)[train], frames[train], parents=rig.parents,
-                              max_influences=max_influences)
-        else:
-            w = skin_weights(m, rest, faces, rig, max_influences, heat_c, weight_power)
-        results[m] = (w, PoseFitter(iterations=iterations).fit(rig, w, rest, frames))
-        log.info("skinning %s: LBS residual train %.2f mm, held-out %.2f mm", m,
-                 MM * results[m][1].residual_[train].mean(),
-                 MM * np.delete(results[m][1].residual_, train).mean() if len(train) < len(frames) else np.nan)
-    weights, fitter = results[skinning]
-    comparison = None
-    if compare:
-        test = np.setdiff1d(np.arange(len(frames)), train)
-        comparison = pd.DataFrame([{
-            "skinning": m, "used": m == skinning,
-            "train_mean_mm": round(float(MM * f.residual_[train].mean()), 3),
-            "heldout_mean_mm": round(float(MM * f.residual_[test].mean()), 3) if len(test) else np.nan}
-            for m, (_, f) in results.items()])
-    return rig, weights, fitter, joints, comparison
-
-
-def rig_fit_table(frames, rig, weights, fitter, train, labels=None) -> pd.DataFrame:
-    """LBS residual of the fitted skeleton, overall and per bone, on training and held-out frames.
-
-    A bone's vertices are those it dominates (largest weight); ``labels``
-    (name -> vertex mask) adds rows for named vertex sets (e.g. body / skirt).
-    Columns: part, split, n_frames, n_vertices, mean_mm, median_mm, p95_mm.
-    """
-    P = pose_vertices(rig, weights, frames[0], fitter.root_t_, fitter.angles_)
-    r = np.linalg.norm(P - frames, axis=-1) * MM
-    dom = dominant_joint(weights)
-    test = np.setdiff1d(np.arange(len(frames)), train)
-    parts = [("all", np.ones(r.shape[1], bool))] + [(n, dom == j) for j, n in enumerate(rig.names)]
-    parts += [(f"[{k}]", v) for k, v in (labels or {}).items()]
-    rows = []
-    for split, idx in (("train", np.asarray(train)), ("held-out", test)):
-        if not len(idx):
-            continue
-        for name, mask in parts:
-            x = r[np.ix_(idx, np.flatnonzero(mask))]
-            rows.append({"part": name, "split": split, "n_frames": len(idx), "n_vertices": int(mask.sum()),
-                         "mean_mm": round(float(x.mean()), 3) if x.size else np.nan,
-                         "median_mm": round(float(np.median(x)), 3) if x.size else np.nan,
-                         "p95_mm": round(float(np.percentile(x, 95)), 3) if x.size else np.nan})
-    return pd.DataFrame(rows)
-
-
-def joint_rotation_errors(fitter, true_angles) -> np.ndarray:
-    """Per-joint mean angle (degrees) between fitted and true local rotations (root excluded: NaN)."""
-    from scipy.spatial.transform import Rotation
-
-    F, J = fitter.angles_.shape[:2]
-    a = Rotation.from_euler("xyz", fitter.angles_.reshape(-1, 3))
-    b = Rotation.from_euler("xyz", np.asarray(true_angles)[:F].reshape(-1, 3))
-    err = np.rad2deg((a.inv() * b).magnitude()).reshape(F, J).mean(axis=0)
-    err[0] = np.nan
-    return err
 
 
 # --------------------------------------------------------------------------- models
@@ -235,11 +92,12 @@ def _err(model, ctx, frames, root_t, angles):
     return mean_vertex_error(model.predict(ctx, root_t, angles), frames) * MM
 
 
-def context(d: Prepared, levels=(5.0,), cfg: dict | None = None) -> MeshContext:
+def context(d: Prepared, levels, cfg: dict) -> MeshContext:
+    """The mesh context of ``d`` for control levels ``levels`` (``cfg``: the meshdetail model keys, with
+    ``decimation`` and ``rbf_neighbors``)."""
     below = [lv for lv in levels if lv < 100]
-    cfg = cfg or {}
     return MeshContext(d.rest, d.faces, d.rig, d.weights, max_level=max(below) if below else 5.0,
-                       decimation=cfg.get("decimation", "collapse"), rbf_neighbors=cfg.get("rbf_neighbors", 24))
+                       decimation=cfg["decimation"], rbf_neighbors=cfg["rbf_neighbors"])
 
 
 def blocks(n: int, k: int) -> list:
@@ -379,18 +237,3 @@ def run_representations(d: Prepared, cfg: dict) -> pd.DataFrame:
                          "train_mm": round(float(e[d.train].mean()), 4),
                          "test_mm": round(float(e[d.test].mean()), 4) if len(d.test) else np.nan})
     return pd.DataFrame(rows)
-
-
-def pack_weights(w: sparse.csr_matrix) -> dict:
-    w = sparse.csr_matrix(w)
-    return {"w_data": w.data, "w_indices": w.indices, "w_indptr": w.indptr, "w_shape": np.array(w.shape)}
-
-
-def unpack_weights(z) -> sparse.csr_matrix:
-    return sparse.csr_matrix((z["w_data"], z["w_indices"], z["w_indptr"]), shape=tuple(z["w_shape"]))
-
-
-def timed(fn, *a, **k):
-    t0 = time.perf_counter()
-    out = fn(*a, **k)
-    return out, time.perf_counter() - t0

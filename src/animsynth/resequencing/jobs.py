@@ -1,4 +1,4 @@
-"""The re-sequencing study: one function per workflow step (scripts stay thin).
+"""The re-sequencing workflow steps: one function per step (scripts stay thin).
 
 A *configuration* is dataset x global-DOF flag x method (``isomap``,
 ``stisomap``) x metric (``l2``, ``lee``). :func:`analyse` handles every
@@ -8,30 +8,31 @@ fit, residual variance, 2-D embedding) plus the labelled fixed-k sweep;
 :func:`explain` computes the minimum k over the candidate explanations of the
 paper's Table 2 (sign mode x frame rate x global DOF) and the quaternion sign
 flips; :func:`resequence` makes and measures the re-sequenced motions;
-:func:`min_k_table` and :mod:`.verdicts` aggregate.
+:func:`min_k_table` and :mod:`.verdicts` aggregate; :func:`read_published_table2`
+and :func:`lee_weights_table` put the paper's published values beside ours.
 
 The configuration dictionary ``cfg`` is the ``resequencing`` block of the
-workflow config (``docs/config_resequencing.md``); :data:`DEFAULTS` holds
-the same defaults for library use.
+workflow config as validated by ``config/schema.yaml`` (every key present; the
+schema holds the defaults, ``docs/config_resequencing.md`` the meanings).
+:func:`resequence_motion` is the one-call library route (CLI, notebooks) with
+explicit keyword arguments instead.
 """
 
 from __future__ import annotations
 
-import copy
 import logging
 import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
 from ..motion import Motion
+from ..published import PublishedError, read_table
 from ..tables import add_paper_differences
-from .distances import PAPER_WEIGHTS, l2_distances, lee_distances
+from .distances import l2_distances, lee_distances
 from .embedding import (DisconnectedGraphError, PrecomputedIsomap, graph_components, knn_graph,
-                        min_connected_k, neighbor_ranks, residual_variance, spatio_temporal_distances,
-                        temporal_adjacency)
+                        min_connected_k, neighbor_ranks, residual_variance, spatio_temporal_distances)
 from .landmark import EMBED_METHODS, embed
 from .features import SIGN_MODES, matrix_naive_quaternions, motion_features, sign_flips
 from .metrics import (Reference, TransitionReference, classify_path, jerk_magnitude, joint_quats, pass_jumps,
@@ -45,33 +46,6 @@ METRICS = ("l2", "lee")
 GDOF = {"noglobal": False, "global": True}
 METHOD_LABEL = {"isomap": "Isomap", "stisomap": "ST-Isomap"}
 METRIC_LABEL = {"l2": "L2", "lee": "Lee"}
-
-DEFAULTS = {
-    "datasets": ["walk", "run", "dance"],
-    "methods": list(METHODS),
-    "metrics": list(METRICS),
-    "global_dof": [False, True],
-    "max_frames": 800,
-    "frame_step": 1,
-    "linearisation": {"sign_mode": "continuous", "translation_scale": 1.0},
-    "fixed_k_sweep": [10],
-    "max_dim": 10,
-    "embedding": {"method": "auto", "exact_max_frames": 4000, "n_landmarks": 500, "landmarks": "maxmin", "seed": 0},
-    "lee": {"weights": dict(PAPER_WEIGHTS), "nu": 0.01, "sqrt": False},
-    "stisomap": {"temporal_window": 1, "c_atn": 10.0, "c_ctn": 10.0, "ctn_neighbors": 4,
-                 "ctn_min_gap_s": 0.25, "ctn_tolerance": 2, "ctn_reach_s": 0.05},
-    "explanations": {"sign_modes": ["continuous", "matrix_naive"], "frame_steps": [1, 4],
-                     "global_dof": [False, True], "magnitude_factor": 3.16, "lee_small_max": 7},
-    "path": {"start": -1, "end": 0, "random_pairs": 20, "min_separation": 0.3, "context_s": 0.25,
-             "transition_window_s": 0.1, "pad_to": None, "pad_mode": "hold", "root_playback": "integrate"},
-    "smoothness": {"contact_height_m": 0.02, "reversal_speed_mps": 0.1},
-    "verdict_share": 0.75,
-    "verdict_alpha": 0.05,
-    "gif_fps": 30,
-    "published": {"table2": "../shared/papers/s2_table2_min_k.csv",
-                  "lee_weights": "../shared/papers/s2_lee_weights.csv"},
-}
-
 
 #: N x N float64 arrays the distance steps hold at once (base distances,
 #: method distances, geodesics, the centred kernel / path graph).
@@ -101,17 +75,6 @@ def check_distance_budget(n_frames: int, trial: str, budget_gib: float | None = 
                  f"{n_frames} x {n_frames}; lower config key 'resequencing.max_frames')",
                  8.0 * DISTANCE_MATRICES * float(n_frames) ** 2,
                  DEFAULT_MEMORY_BUDGET_GIB if budget_gib is None else float(budget_gib))
-
-
-def with_defaults(cfg: dict | None) -> dict:
-    """``cfg`` completed with :data:`DEFAULTS` (nested dicts merged one level deep)."""
-    out = copy.deepcopy(DEFAULTS)
-    for k, v in copy.deepcopy(cfg or {}).items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k].update(v)  # one level: e.g. lee.weights given -> replaces the default weights
-        else:
-            out[k] = v
-    return out
 
 
 def gdof_flag(name: str) -> bool:
@@ -262,7 +225,6 @@ def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg:
     animsynth.limits.BudgetError
         The distance matrices would exceed ``budget_gib`` (:func:`check_distance_budget`).
     """
-    cfg = with_defaults(cfg)
     check_distance_budget(motion.n_frames, trial, budget_gib)
     feats = motion_features(motion)
     n = feats.n_frames
@@ -339,7 +301,6 @@ def explain(motion: Motion, dataset: str, trial: str, cfg: dict, budget_gib: flo
         The distance matrices of the smallest frame step would exceed
         ``budget_gib`` (:func:`check_distance_budget`); checked before any is built.
     """
-    cfg = with_defaults(cfg)
     ex = cfg["explanations"]
     check_distance_budget(prepare_motion(motion, cfg["max_frames"], int(min(ex["frame_steps"]))).n_frames, trial,
                           budget_gib)
@@ -416,17 +377,21 @@ def splice(path, n: int, context: int) -> np.ndarray:
     return np.concatenate([pre, path, post])
 
 
+def checked_graph(Dm, k: int, always=None, what: str = ""):
+    """The ``k``-NN graph of ``Dm`` (plus the ``always`` edges), refused when it is disconnected."""
+    ncomp = graph_components(Dm, k, always=always)
+    if ncomp > 1:
+        raise DisconnectedGraphError(f"{what}: the {k}-NN graph has {ncomp} components "
+                                     f"(the smallest connected k is {min_connected_k(Dm, always=always)})")
+    return knn_graph(Dm, k, always=always)
+
+
 def config_graph(motion: Motion, include_global: bool, method: str, metric: str, k: int, cfg: dict):
     """The weighted neighbourhood graph a configuration's paths run on (k checked)."""
-    cfg = with_defaults(cfg)
     feats = motion_features(motion)
     D = base_distances(feats, metric, include_global, cfg)
     Dm, always, _ = method_distances(D, method, cfg, motion.fps)
-    ncomp = graph_components(Dm, k, always=always)
-    if ncomp > 1:
-        raise DisconnectedGraphError(f"{method}/{metric}: the {k}-NN graph has {ncomp} components "
-                                     f"(the smallest connected k is {min_connected_k(Dm, always=always)})")
-    return knn_graph(Dm, k, always=always)
+    return checked_graph(Dm, k, always, f"{method}/{metric}")
 
 
 #: Per-transition measures (ratios to the capture; 1 = an ordinary step of the capture, larger = rougher).
@@ -460,7 +425,6 @@ def resequence(motion: Motion, include_global: bool, method: str, metric: str, k
     animsynth.limits.BudgetError
         The distance matrices would exceed ``budget_gib`` (:func:`check_distance_budget`).
     """
-    cfg = with_defaults(cfg)
     n = motion.n_frames
     check_distance_budget(n, motion.name, budget_gib)
     G = config_graph(motion, include_global, method, metric, k, cfg)
@@ -547,34 +511,48 @@ def summarise_paths(per_path: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def read_published(path) -> pd.DataFrame | None:
-    """The paper's Table 2 from ``path`` (CSV: motion, frames, global_dof, method, metric, min_k),
-    mapped to our names; ``None`` when the file does not exist (no published values)."""
-    if path is None or not Path(path).is_file():
-        log.info("published Table 2 %s not found: min_k_paper left empty", path)
+#: The paper's Table 2 names -> ours.
+PAPER_GLOBAL_DOF = {"included": True, "excluded": False}
+PAPER_METHODS = {"isomap": "isomap", "st-isomap": "stisomap", "stisomap": "stisomap"}
+TABLE2_COLUMNS = ("motion", "frames", "global_dof", "method", "metric", "min_k")
+
+
+def published_table2(path) -> pd.DataFrame | None:
+    """The paper's Table 2 (CSV: motion, frames, global_dof, method, metric, min_k) in our names.
+
+    Read with :func:`animsynth.published.read_table`: ``None`` (and a WARNING) when ``path`` is None or
+    absent. Returns columns ``dataset, paper_frames, global_dof (bool), method, metric, min_k_paper``.
+
+    Raises
+    ------
+    animsynth.published.PublishedError
+        A missing column, a non-number, an empty count, or a global_dof / method / metric the table's
+        layout does not have (the message names the file and line).
+    """
+    df = read_table(path, TABLE2_COLUMNS, numeric=("frames", "min_k"), what="re-sequencing paper Table 2",
+                    config_key="published.resequencing.table2")
+    if df is None:
         return None
-    df = pd.read_csv(path)
-    need = {"motion", "frames", "global_dof", "method", "metric", "min_k"}
-    if not need <= set(df.columns):
-        raise ValueError(f"{path}: expected columns {sorted(need)}, got {list(df.columns)}")
-    gd = {"included": True, "excluded": False}
-    meth = {"isomap": "isomap", "st-isomap": "stisomap", "stisomap": "stisomap"}
-    bad = df[~df["global_dof"].isin(gd) | ~df["method"].isin(meth) | ~df["metric"].isin(METRICS)]
-    if len(bad):
-        raise ValueError(f"{path} line {int(bad.index[0]) + 2}: unknown global_dof/method/metric "
-                         f"{bad.iloc[0][['global_dof', 'method', 'metric']].tolist()}")
+    bad = ~df["global_dof"].isin(PAPER_GLOBAL_DOF) | ~df["method"].isin(PAPER_METHODS) | ~df["metric"].isin(METRICS)
+    bad |= df["frames"].isna() | df["min_k"].isna()
+    if bad.any():
+        i = int(bad.to_numpy().nonzero()[0][0])
+        raise PublishedError(f"{path}, line {i + 2}: unknown global_dof/method/metric or an empty count "
+                             f"{df.iloc[i][list(TABLE2_COLUMNS[1:])].tolist()}")
     return pd.DataFrame({"dataset": df["motion"], "paper_frames": df["frames"].astype(int),
-                         "global_dof": df["global_dof"].map(gd), "method": df["method"].map(meth),
+                         "global_dof": df["global_dof"].map(PAPER_GLOBAL_DOF), "method": df["method"].map(PAPER_METHODS),
                          "metric": df["metric"], "min_k_paper": df["min_k"].astype(int)})
 
 
-def check_lee_weights(path, weights: dict) -> pd.DataFrame | None:
-    """Our Lee weights beside the paper's (``joint_pair, weight``); ``None`` without the file."""
-    if path is None or not Path(path).is_file():
+def lee_weights_table(path, weights: dict) -> pd.DataFrame | None:
+    """Our Lee weights beside the paper's (CSV: joint_pair, weight); ``None`` without the file.
+
+    Columns: ``group, weight_paper, weight_ours, weight_minus_paper, match`` (equal to the paper's four
+    printed decimals)."""
+    df = read_table(path, ("joint_pair", "weight"), numeric=("weight",), what="re-sequencing paper Lee weights",
+                    config_key="published.resequencing.lee_weights")
+    if df is None:
         return None
-    df = pd.read_csv(path)
-    if not {"joint_pair", "weight"} <= set(df.columns):
-        raise ValueError(f"{path}: expected columns joint_pair, weight; got {list(df.columns)}")
     df = df.rename(columns={"joint_pair": "group", "weight": "weight_paper"})
     df["weight_ours"] = df["group"].map(lambda g: float(weights.get(g, 0.0)))
     df["weight_minus_paper"] = df["weight_ours"] - df["weight_paper"]
@@ -608,27 +586,64 @@ def min_k_table(grid: pd.DataFrame, published: pd.DataFrame | None, frame_step: 
 
 
 def resequence_motion(motion: Motion, start: int, end: int, method: str = "stisomap", metric: str = "l2",
-                      k: int | None = None, global_dof: bool = False, length: int | None = None,
-                      cfg: dict | None = None) -> tuple[np.ndarray, Motion]:
+                      k: int | None = None, global_dof: bool = False, length: int | None = None, *,
+                      sign_mode: str = "continuous", lee: dict | None = None, st: dict | None = None,
+                      root_playback: str = "integrate") -> tuple[np.ndarray, Motion]:
     """One-call re-sequencing (CLI, notebooks): Dijkstra from ``start`` to ``end``.
 
-    ``k`` defaults to the smallest k giving one connected component of the
-    method's graph. Returns the frame index path (padded to ``length`` if
-    given) and the motion it plays (root: ``path.root_playback``).
+    Parameters
+    ----------
+    motion : Motion
+        The capture, ``(frames, dof)`` values.
+    start, end : int
+        First and last frame of the path (negative counts from the end).
+    method : {"stisomap", "st-isomap", "isomap"}
+    metric : {"l2", "lee"}
+    k : int, optional
+        Neighbours; default the smallest k giving one connected component of the method's graph.
+    global_dof : bool
+        Include the root translation and orientation in the distances.
+    length : int, optional
+        Pad the path to this many frames (holding the last frame).
+    sign_mode : str
+        Quaternion linearisation of the L2 features (:func:`.features.linearize_quaternions`).
+    lee : dict, optional
+        Keyword arguments of :func:`.distances.lee_distances` (``weights``, ``nu``, ``sqrt``,
+        ``translation_scale``); its defaults (the paper's weights) otherwise.
+    st : dict, optional
+        Keyword arguments of :func:`.embedding.spatio_temporal_distances` (in frames); its defaults otherwise.
+    root_playback : {"integrate", "absolute"}
+        Root of the played motion (:func:`.paths.play_path`).
+
+    Returns
+    -------
+    path : int array (frames,)
+        The frame index path (padded to ``length`` if given).
+    played : Motion
+        The motion it plays.
     """
     method = {"st-isomap": "stisomap"}.get(method, method)
-    cfg = with_defaults(cfg)
     feats = motion_features(motion)
     n = feats.n_frames
     a, b = resolve_frame(start, n, "start"), resolve_frame(end, n, "end")
+    if metric == "l2":
+        D = l2_distances(feats.linearised(global_dof, sign_mode))
+    elif metric == "lee":
+        D = lee_distances(feats, include_global=global_dof, **(lee or {}))
+    else:
+        raise ValueError(f"unknown metric {metric!r} (expected one of {METRICS})")
+    if method == "isomap":
+        Dm, always = D, None
+    elif method == "stisomap":
+        Dm, always, _ = spatio_temporal_distances(D, **(st or {}))
+    else:
+        raise ValueError(f"unknown method {method!r} (expected one of {METHODS})")
     if k is None:
-        D = base_distances(feats, metric, global_dof, cfg)
-        Dm, always, _ = method_distances(D, method, cfg, motion.fps)
         k = min_connected_k(Dm, always=always)
-    G = config_graph(motion, global_dof, method, metric, int(k), cfg)
+    G = checked_graph(Dm, int(k), always, f"{method}/{metric}")
     path, _ = shortest_path_frames(G, a, b)
     path = pad_path(path, length, "hold")
-    return path, play_path(motion, path, root=cfg["path"]["root_playback"], name="resequenced")
+    return path, play_path(motion, path, root=root_playback, name="resequenced")
 
 
 # ----------------------------------------------------------------------------- cost curves (animsynth.scale)
