@@ -4,12 +4,12 @@ from animsynth.motion import Motion
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-p = snakemake.params  # noqa: F821
-trials = {t: Motion.load_npz(f) for t, f in zip(p.trials, snakemake.input)}  # noqa: F821
+log = setup_logging(snakemake)
+p = snakemake.params
+trials = {t: Motion.load_npz(f) for t, f in zip(p.trials, snakemake.input)}
 for t, m in trials.items():
     m.name = t
 clips = prepare_clips(trials, dict(p.subsets), dict(p.resequencing), dict(p.cfg))
-save_clips(snakemake.output.clips, clips)  # noqa: F821
-write_table(clips_table(clips), snakemake.output.table, md=snakemake.output.table_md)  # noqa: F821
+save_clips(snakemake.output.clips, clips)
+write_table(clips_table(clips), snakemake.output.table, md=snakemake.output.table_md)
 log.info("%d held-out clips", len(clips))

@@ -2,8 +2,8 @@
 from animsynth.compare.tables import tables_job
 from animsynth.workflow_utils import setup_logging
 
-log = setup_logging(snakemake)  # noqa: F821
-p = snakemake.params  # noqa: F821
-inp = snakemake.input  # noqa: F821
+log = setup_logging(snakemake)
+p = snakemake.params
+inp = snakemake.input
 tables_job({"clips": inp.clips, "metrics": list(inp.metrics), "timing": list(inp.timing)},
-           dict(snakemake.output), list(p.generators), dict(p.left_out), dict(p.cfg), p.source)  # noqa: F821
+           dict(snakemake.output), list(p.generators), dict(p.left_out), dict(p.cfg), p.source)

@@ -19,7 +19,7 @@ if p.timing:
              + ", ".join(f"`{t}`" for t in p.timing) + ".")
 claims = claims_table(verdicts, p.family_data, p.family_real)
 write_table(claims, out.claims, md=False)
-side_by_side = list(snakemake.input.side_by_side)  # noqa: F821
+side_by_side = list(snakemake.input.side_by_side)
 side = pd.read_csv(side_by_side[0]) if side_by_side else None
 atomic_write_text(out.home, claims_rst(claims, provenance, p.report_outputs, side, p.side_by_side_data,
                                        bool(p.side_by_side_real)))
