@@ -253,7 +253,8 @@ def test_verdict_builder_on_known_outcomes():
     v = CV.build(metrics, vc, "test data", {"fairmotion": "not installed here"}).set_index("claim")
     assert set(v["verdict"]) <= set(VOCABULARY)
     assert v.loc["the classic motion graph skates less than ST-Isomap re-sequencing", "verdict"] == "reproduced"
-    assert "16 of 16" in v.loc["the classic motion graph skates less than ST-Isomap re-sequencing", "evidence"]
+    ev = v.loc["the classic motion graph skates less than ST-Isomap re-sequencing", "evidence"]
+    assert "holds in 8 of 8 untied clips" in ev and "clip x seed pairs: 16 of 16" in ev
     fm = v.loc["our motion graph's transitions skate less than fairmotion's"]
     assert fm["verdict"] == "not reproduced" and "not installed here" in fm["evidence"]
     assert v.loc["ST-Isomap re-sequencing jumps less at its seams than Isomap re-sequencing",
@@ -264,7 +265,7 @@ def test_verdict_builder_on_known_outcomes():
                     "this metric)"]
     # "every generator" is decided generator by generator: isomap skates less than the capture on every pair
     assert capture["verdict"] == "partly" and "not stably lower than: isomap (contradicted)" in capture["evidence"]
-    assert "motion_graph 16/16" in capture["evidence"]
+    assert "motion_graph 8/8" in capture["evidence"] and "isomap 0/8" in capture["evidence"]
     everyone_higher = metrics.copy()
     everyone_higher.loc[everyone_higher["generator"] == "isomap", "skate_share"] = 0.5
     again = CV.build(everyone_higher, vc, "test data", {}).set_index("claim")
@@ -366,7 +367,18 @@ def test_partly_when_groups_hold_stably_in_opposite_directions():
     groups = pd.Series(["a"] * 20 + ["b"] * 20)
     outcome = pd.Series([1] * 20 + [-1] * 20)
     verdict, per = CV.by_group(groups, outcome, "within noise", 0.75, 0.05)
-    assert verdict == "partly" and per == {"a": "reproduced", "b": "contradicted"}
+    assert verdict == "partly" and per == {"a": "holds", "b": "opposite"}
     outcome = pd.Series([1] * 20 + [1, -1] * 10)
     assert CV.by_group(groups, outcome, "within noise", 0.75, 0.05)[0] == "within noise"
     assert CV.by_group(groups, pd.Series([1] * 40), "reproduced", 0.75, 0.05)[0] == "reproduced"
+
+
+def test_the_seeds_of_one_clip_count_once():
+    # five seeds of one clip for the claim, one seed each of four clips against: 5 of 9 pairs, but 1 of 5 clips
+    j = pd.DataFrame({"clip": ["x"] * 5 + ["y", "z", "u", "w"], "group": ["g"] * 9,
+                      "outcome": [1, 1, 1, 1, 1, -1, -1, -1, -1]})
+    c = CV.per_clip(j).set_index("clip")
+    assert c["outcome"].to_dict() == {"x": 1, "y": -1, "z": -1, "u": -1, "w": -1}
+    assert c.loc["x", "seeds_for"] == 5 and c.loc["x", "seeds_against"] == 0
+    tie = CV.per_clip(pd.DataFrame({"clip": ["x", "x"], "group": ["g", "g"], "outcome": [1, -1]}))
+    assert tie["outcome"].tolist() == [0]
