@@ -462,9 +462,9 @@ def test_analyse_is_deterministic(walk):
 
 def _published():
     return pd.DataFrame([
-        {"motion": "walk", "frames": 516, "global_dof": "excluded", "method": "isomap", "metric": "l2", "min_k": 79},
-        {"motion": "walk", "frames": 516, "global_dof": "excluded", "method": "isomap", "metric": "lee", "min_k": 3},
-        {"motion": "walk", "frames": 516, "global_dof": "excluded", "method": "st-isomap", "metric": "lee",
+        {"motion": "walk", "frames": 500, "global_dof": "excluded", "method": "isomap", "metric": "l2", "min_k": 70},
+        {"motion": "walk", "frames": 500, "global_dof": "excluded", "method": "isomap", "metric": "lee", "min_k": 3},
+        {"motion": "walk", "frames": 500, "global_dof": "excluded", "method": "st-isomap", "metric": "lee",
          "min_k": 1}])
 
 
@@ -481,13 +481,13 @@ def test_min_k_table_fills_published_values(tmp_path):
     assert len(t) == 4 and (t["fps"] == 120).all()
     assert t["global_dof"].tolist() == [False, False, True, True]
     assert t["sign_mode"].tolist() == ["continuous", "matrix_naive"] * 2
-    assert t.loc[~t["global_dof"], "min_k_paper"].tolist() == [79, 79]
+    assert t.loc[~t["global_dof"], "min_k_paper"].tolist() == [70, 70]
     assert t.loc[t["global_dof"], "min_k_paper"].isna().all()
     # ours - paper beside the paper's value; empty where the paper has none
     cols = list(t.columns)
     assert cols[cols.index("min_k_paper") + 1] == "min_k_minus_paper"
-    assert t.loc[~t["global_dof"], "min_k_minus_paper"].tolist() == [3 - 79, 3 - 79]
-    assert t.loc[~t["global_dof"], "frames_minus_paper"].tolist() == [10 - 516, 10 - 516]
+    assert t.loc[~t["global_dof"], "min_k_minus_paper"].tolist() == [3 - 70, 3 - 70]
+    assert t.loc[~t["global_dof"], "frames_minus_paper"].tolist() == [10 - 500, 10 - 500]
     assert t.loc[t["global_dof"], "min_k_minus_paper"].isna().all()
     bad = _published()
     bad.loc[1, "method"] = "lle"
@@ -533,7 +533,7 @@ def test_explanation_verdict_names_the_matching_candidate(tmp_path):
     naive = v[v["claim"].str.contains(r"matrix_naive, 120")].iloc[0]
     assert naive["verdict"] == "reproduced"
     assert v[v["claim"].str.contains("lower frame rate")].iloc[0]["verdict"] == "not reproduced"
-    # 60 vs 79 is within the factor; 30 (matrix_naive at 30 fps) is too
+    # 60 vs 70 is within the factor; 30 (matrix_naive at 30 fps) is too
     assert v[v["claim"].str.contains("matrix_naive signs at frame_step 4")].iloc[0]["verdict"] == "reproduced"
     none = explanation_verdicts(grid, None, 1)
     assert len(none) == 1 and "not available" in none[0]["evidence"]

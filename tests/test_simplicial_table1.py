@@ -45,17 +45,17 @@ def test_length_match_names_matches_and_stand_ins():
 
 def test_read_paper_table1(tmp_path, caplog):
     p = tmp_path / "t1.csv"
-    p.write_text("dataset,dims,n_sequences,lengths,total_nodes\nw1,56,2,443 360,803\nr1,56,1,167,167\n")
-    assert read_paper_table1(p) == {"w1": [443, 360], "r1": [167]}
+    p.write_text("dataset,dims,n_sequences,lengths,total_nodes\nw1,56,2,400 350,750\nr1,56,1,150,150\n")
+    assert read_paper_table1(p) == {"w1": [400, 350], "r1": [150]}
     with caplog.at_level("WARNING", logger="animsynth.published"):
         assert read_paper_table1(tmp_path / "absent.csv") is None
     assert "absent.csv" in caplog.text and "published.simplicial.table1" in caplog.text
     bad = tmp_path / "bad.csv"
-    bad.write_text("dataset,lengths\nw1,443 360\nw2,347 x\n")
+    bad.write_text("dataset,lengths\nw1,400 350\nw2,300 x\n")
     with pytest.raises(PublishedError, match=r"bad.csv, line 3: lengths must be integers"):
         read_paper_table1(bad)
     nocol = tmp_path / "nocol.csv"
-    nocol.write_text("dataset,frames\nw1,443\n")
+    nocol.write_text("dataset,frames\nw1,400\n")
     with pytest.raises(PublishedError, match=r"nocol.csv, line 1: .*lacks column\(s\) \['lengths'\]"):
         read_paper_table1(nocol)
 
