@@ -62,7 +62,7 @@ def copy_workflow(dest: Path) -> Path:
     for name in ("Snakefile", "config", "workflow", "profiles", "benchmarks"):
         src = REPO / name
         if src.is_dir():
-            skip = {"rules", ".results"} if name == "benchmarks" else set()
+            skip = set()
             shutil.copytree(src, dest / name, dirs_exist_ok=True,
                             ignore=lambda d, names, skip=skip, top=str(src): [
                                 n for n in names if n == "__pycache__" or (d == top and n in skip)])

@@ -1,7 +1,7 @@
 """Table assembly: Gauch & Peters' Table II in the paper's layout, in every unit, over the ensemble of starts,
 and per fold, from the fold and member rows of :mod:`~animsynth.simplicial.folds`.
 
-The published values (``paper``) come from :func:`animsynth.simplicial.settings.paper_table2`.
+The published values (``paper``) come from :func:`animsynth.simplicial.settings.read_paper_table2`.
 """
 
 from __future__ import annotations
