@@ -368,6 +368,9 @@ def test_partly_when_groups_hold_stably_in_opposite_directions():
     outcome = pd.Series([1] * 20 + [-1] * 20)
     verdict, per = CV.by_group(groups, outcome, "within noise", 0.75, 0.05)
     assert verdict == "partly" and per == {"a": "holds", "b": "opposite"}
+    # a group of one clip decides nothing
+    one = CV.by_group(pd.Series(["a", "a", "b"]), pd.Series([1, 1, -1]), "within noise", 0.75, 0.05)
+    assert one == ("within noise", {"a": "holds", "b": "one clip"})
     outcome = pd.Series([1] * 20 + [1, -1] * 10)
     assert CV.by_group(groups, outcome, "within noise", 0.75, 0.05)[0] == "within noise"
     assert CV.by_group(groups, pd.Series([1] * 40), "reproduced", 0.75, 0.05)[0] == "reproduced"

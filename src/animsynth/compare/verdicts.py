@@ -12,7 +12,7 @@ decided over clips:
   sign test over clips gives p below ``compare.verdicts.alpha``;
 * ``contradicted`` -- the same for the opposite;
 * ``partly`` -- anything between overall, but the claim holds on every untied clip of some groups
-  (subsets or re-sequencing clips) and its opposite on every untied clip of others;
+  (subsets of at least two untied clips) and its opposite on every untied clip of others;
 * ``within noise`` -- anything between (the evidence gives the share and p);
 * ``not reproduced`` -- no pair can be compared (a generator did not run: the evidence says why).
 
@@ -54,15 +54,19 @@ def decide(holds: int, fails: int, share: float, alpha: float) -> tuple[str, flo
 def by_group(groups: pd.Series, outcome: pd.Series, verdict: str, share: float, alpha: float, order=None):
     """``partly`` instead of ``within noise`` when the claim holds on every untied clip of some groups
     (subsets or re-sequencing clips) and its opposite on every untied clip of others; else ``verdict``.
+    A group decides only with at least two untied clips (a re-sequencing clip is a group of one).
 
     ``groups`` and ``outcome`` are per clip (see :func:`per_clip`). Returns ``(verdict, {group: holds |
-    opposite | mixed | no clip})``.
+    opposite | mixed | one clip | no clip})``.
     """
     per = {}
     for g in (order if order is not None else dict.fromkeys(groups)):
         o = outcome[groups == g]
         o = o[o != 0]
-        per[g] = "no clip" if not len(o) else "holds" if (o > 0).all() else "opposite" if (o < 0).all() else "mixed"
+        if len(o) < 2:  # one clip is no evidence that a group behaves one way
+            per[g] = "no clip" if not len(o) else "one clip"
+        else:
+            per[g] = "holds" if (o > 0).all() else "opposite" if (o < 0).all() else "mixed"
     words = set(per.values())
     if verdict == "within noise" and {"holds", "opposite"} <= words:
         return "partly", per
