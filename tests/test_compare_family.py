@@ -301,9 +301,6 @@ def test_summary_and_winners_tables():
 
 
 @pytest.mark.parametrize("mutate, key", [
-    (lambda c: c["compare"].update(subsets=["w1", "w9"]), "compare.subsets"),
-    (lambda c: (c["subsets"].update(w2=None), c["compare"].update(subsets=["w1", "w2"])), "compare.subsets"),
-    (lambda c: c["compare"].update(resequencing=["walk", "hop"]), "compare.resequencing"),
     (lambda c: c["compare"].update(fps=50), "compare.fps"),
     (lambda c: c["compare"].update(min_length=100), "compare.min_length"),
     (lambda c: c["compare"]["showcase"].update(clip="w1/nope"), "compare.showcase.clip"),
@@ -385,3 +382,33 @@ def test_the_seeds_of_one_clip_count_once():
     assert c.loc["x", "seeds_for"] == 5 and c.loc["x", "seeds_against"] == 0
     tie = CV.per_clip(pd.DataFrame({"clip": ["x", "x"], "group": ["g", "g"], "outcome": [1, -1]}))
     assert tie["outcome"].tolist() == [0]
+
+
+@pytest.mark.parametrize("mutate, key", [
+    (lambda c: c["compare"].update(subsets=["w1", "w9"]), "compare.subsets"),
+    (lambda c: (c["subsets"].update(w2=None), c["compare"].update(subsets=["w1", "w2"])), "compare.subsets"),
+    (lambda c: c["compare"].update(resequencing=["walk", "hop"]), "compare.resequencing"),
+])
+def test_names_the_run_lacks_are_warnings_naming_the_key(mutate, key, caplog):
+    import copy
+    import logging
+
+    cfg = copy.deepcopy(_config())
+    mutate(cfg)
+    with caplog.at_level(logging.WARNING, logger="animsynth.compare"):
+        settings.check(cfg)
+    assert f"config key '{key}'" in caplog.text and "left out of the comparison" in caplog.text
+
+
+def test_a_subset_the_run_lacks_is_left_out_with_a_warning(caplog):
+    import copy
+    import logging
+
+    cfg = copy.deepcopy(_config())
+    cfg["subsets"] = {"w1": cfg["subsets"]["w1"], "w2": None, "r1": None, "r2": None}
+    cfg["compare"]["subsets"] = ["r1"]  # the demo default, on a run that only has w1
+    with caplog.at_level(logging.WARNING, logger="animsynth.compare"):
+        settings.check(cfg)
+    assert "'compare.subsets': 'r1' is not a subset of this run" in caplog.text
+    subsets, reseq = settings.groups(cfg)
+    assert subsets == {} and reseq  # the re-sequencing clips still give the comparison its clips

@@ -6,7 +6,11 @@ Defaults live only in ``config/schema.yaml`` (the validator fills them in); ever
 
 from __future__ import annotations
 
+import logging
+
 from ..config import ConfigError
+
+log = logging.getLogger("animsynth.compare")
 
 __all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "generator_cfg", "unavailable"]
 
@@ -73,14 +77,17 @@ def generator_cfg(config: dict) -> dict:
 def check(config: dict) -> None:
     """Raise :class:`ConfigError` naming the key for values the schema cannot check."""
     cmp = config["compare"]
+    # a subset or clip the run does not have is left out with a warning (the demo default names r1; a user's
+    # config with other subsets must still run every family), never an error that stops the other families
     have = {k for k, v in config["subsets"].items() if v}
     for s in cmp["subsets"] or []:
         if s not in have:
-            raise ConfigError(f"config key 'compare.subsets': {s!r} is not a subset of this run ({sorted(have)})")
+            log.warning("config key 'compare.subsets': %r is not a subset of this run (%s): left out of the "
+                        "comparison", s, sorted(have))
     for d in cmp["resequencing"] or []:
         if d not in config["resequencing_trials"]:
-            raise ConfigError(f"config key 'compare.resequencing': {d!r} is not a key of resequencing_trials "
-                              f"({sorted(config['resequencing_trials'])})")
+            log.warning("config key 'compare.resequencing': %r is not a key of resequencing_trials (%s): left out "
+                        "of the comparison", d, sorted(config["resequencing_trials"]))
     subsets, reseq = groups(config)
     if not subsets and not reseq:
         raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': no clip to compare")
