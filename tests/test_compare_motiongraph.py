@@ -225,7 +225,8 @@ def test_search_reaches_the_target_node(sk):
     target_frame = 75
     out = g.search(start, p.values[target_frame], 150)
     t = out.meta["target_frame"]
-    assert t >= 0 and out.n_frames == 150
+    assert 0 <= t < out.n_frames == 150  # the path reaches the goal inside the output (-1 if not)
+    assert tuple(out.meta["source_frames"][t]) == tuple(out.meta["target_node"])  # frame t plays the goal
     assert out.meta["target_node"][1] % 30 == target_frame % 30  # the same phase of the periodic motion
     assert tuple(out.meta["source_frames"][t]) == out.meta["target_node"]
     # the played frame is the target pose (up to its place on the floor)

@@ -26,6 +26,18 @@ FIGURE_METRICS = (
 _BETTER = {m: b for m, _u, b in METRICS}
 
 
+def _save(fig, path, title: str) -> None:
+    """Title, layout, an atomic PNG write, and the figure closed."""
+    import matplotlib.pyplot as plt
+
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp)
+    plt.close(fig)
+
+
 def metrics_figure(path, metrics: pd.DataFrame, order, title: str = "") -> None:
     """One panel per metric of :data:`FIGURE_METRICS`: every generator's values over clips x seeds as a box
     (median, IQR, whiskers at 5-95 %); the reference rows (replay, concat) in grey."""
@@ -61,12 +73,7 @@ def metrics_figure(path, metrics: pd.DataFrame, order, title: str = "") -> None:
         ax.grid(axis="y", alpha=0.3)
     for ax in axes.ravel()[n:]:
         ax.axis("off")
-    if title:
-        fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    with atomic_path(path, suffix=".png") as tmp:
-        fig.savefig(tmp)
-    plt.close(fig)
+    _save(fig, path, title)
 
 
 def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None:
@@ -109,9 +116,4 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
         ax.set_aspect("equal")
         ax.axis("off")
         ax.set_title(g, fontsize=8.5, loc="left")
-    if title:
-        fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    with atomic_path(path, suffix=".png") as tmp:
-        fig.savefig(tmp)
-    plt.close(fig)
+    _save(fig, path, title)
