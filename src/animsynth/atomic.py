@@ -10,6 +10,7 @@ temporaries in the same folder. Errors name the target, not the temporary.
 from __future__ import annotations
 
 import contextlib
+import errno
 import glob
 import logging
 import os
@@ -18,6 +19,9 @@ import tempfile
 log = logging.getLogger("animsynth.io")
 
 TMP_PREFIX = ".tmp-"
+
+#: errno values of a full disk or quota: raised by a write, they name no file.
+_FULL = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG}
 
 
 def _tmp_prefix(path: str) -> str:
@@ -41,7 +45,9 @@ def atomic_path(path, suffix: str | None = None):
     ------
     OSError
         (e.g. ``PermissionError``) naming ``path`` when its folder cannot be
-        created or written.
+        created or written, and when the disk or quota is full while the
+        caller writes the temporary (``ENOSPC``, ``EDQUOT``, ``EFBIG``: the
+        system's message names no file).
     """
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
@@ -59,7 +65,12 @@ def atomic_path(path, suffix: str | None = None):
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)
     try:
-        yield tmp
+        try:
+            yield tmp
+        except OSError as exc:
+            if exc.errno in _FULL:  # the write itself names no file: name the output
+                raise _reraise_for_target(exc, path) from None
+            raise
         try:
             os.replace(tmp, path)
         except OSError as exc:

@@ -69,7 +69,8 @@ def fps_float(text: str) -> float:
     from .io.bvh import MAX_FRAME_TIME, MIN_FRAME_TIME
 
     value = positive_float(text)
-    if not 1.0 / MAX_FRAME_TIME <= value <= 1.0 / MIN_FRAME_TIME:
+    # 1 / 1e-5 is 99999.99999999999 in floating point: the stated ends are accepted as printed
+    if not 1.0 / MAX_FRAME_TIME * (1 - 1e-12) <= value <= 1.0 / MIN_FRAME_TIME * (1 + 1e-12):
         raise argparse.ArgumentTypeError(f"must be between {1.0 / MAX_FRAME_TIME:g} and {1.0 / MIN_FRAME_TIME:g} "
                                          f"frames per second, got {text!r}")
     return value
@@ -173,6 +174,9 @@ def cmd_generate(a) -> None:
     if a.start_trial >= len(a.train):
         raise UsageError("--start-trial", f"{a.start_trial} but only {len(a.train)} training file(s) given (0-based)")
     sk = read_asf(a.asf)
+    n_angles = sk.n_dof - len(sk.joints[0].dofs)
+    if a.latent_dim > n_angles:
+        raise UsageError("--latent-dim", f"{a.latent_dim} exceeds the {n_angles} joint angles of {a.asf}")
     # output values, joint angles, latent path and the GIF's joint positions, float64
     check_budget(f"argument --steps: {a.steps} steps",
                  8.0 * (a.steps + 1) * (2 * sk.n_dof + a.latent_dim + 3 * len(sk.joints)), a.memory_budget_gib)
@@ -230,15 +234,16 @@ def cmd_face(a) -> None:
 
 
 def _write_motion(path: str, motion) -> None:
-    if path.endswith(".bvh"):
+    kind = path.lower()  # the same rule as the --out check (OUT.BVH is a BVH file)
+    if kind.endswith(".bvh"):
         from .io.bvh import write_bvh
 
         write_bvh(path, motion)
-    elif path.endswith(".amc"):
+    elif kind.endswith(".amc"):
         from .io.amc import write_amc
 
         write_amc(path, motion)
-    elif path.endswith(".gif"):
+    elif kind.endswith(".gif"):
         from .viz import motion_previews
 
         motion_previews(motion, gif_path=path)
@@ -304,6 +309,33 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+#: The option whose size a command's arrays grow with (named when memory runs out anyway).
+SIZE_OPTIONS = {"generate": "--steps", "resequence": "--length"}
+
+
+def _check_out_is_not_an_input(a) -> None:
+    """Refuse an output that is one of the command's input files (it would be replaced)."""
+    out = getattr(a, "out", None)
+    if not out or not os.path.exists(out):
+        return
+    inputs = [getattr(a, k, None) for k in ("asf", "amc")] + list(getattr(a, "train", None) or [])
+    for inp in inputs:
+        if inp and os.path.exists(inp) and os.path.samefile(inp, out):
+            option = "--out" if a.command in ("generate", "resequence") else "out"
+            raise UsageError(option, f"{out!r} is the input file {inp!r}; writing it would replace the input")
+
+
+def _out_of_memory(a) -> str:
+    option = SIZE_OPTIONS.get(a.command)
+    if option and getattr(a, option[2:].replace("-", "_"), None) is not None:
+        return (f"argument {option}: out of memory for {option} {getattr(a, option[2:].replace('-', '_'))} "
+                f"(the machine gives less than the --memory-budget-gib {a.memory_budget_gib:g} GiB budget "
+                f"allowed); lower {option} or --memory-budget-gib")
+    return (f"out of memory reading or processing the input (the machine gives less than the "
+            f"--memory-budget-gib {a.memory_budget_gib:g} GiB budget allowed); lower --memory-budget-gib "
+            "to be told which input is too large")
+
+
 def main(argv=None) -> int:
     """Run one command; return the exit status (0 ok, 2 bad argument or input)."""
     try:
@@ -312,7 +344,16 @@ def main(argv=None) -> int:
         return int(exc.code or 0)
     logging.basicConfig(level=logging.WARNING, format="animsynth: %(levelname)s: %(message)s")
     try:
+        _check_out_is_not_an_input(args)
         args.func(args)
+    except MemoryError:  # numpy's _ArrayMemoryError too: a budget above what the machine has
+        print(f"animsynth {args.command}: error: {_out_of_memory(args)}", file=sys.stderr)
+        return 2
+    except RecursionError:
+        inputs = [getattr(args, k, None) for k in ("asf", "amc")] + list(getattr(args, "train", None) or [])
+        print(f"animsynth {args.command}: error: {', '.join(i for i in inputs if i) or 'the input'}: "
+              "nested too deeply to process", file=sys.stderr)
+        return 2
     except (ValueError, KeyError, IndexError, OSError, ImportError, RuntimeError) as exc:
         # UsageError names the argument; MotionFormatError names file and line
         msg = " ".join(str(exc).split()) or type(exc).__name__  # one line

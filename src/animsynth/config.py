@@ -151,6 +151,12 @@ def check_results_dir(config: dict, project: str | None = None) -> None:
         if norm == "." or norm == ".." or norm.startswith("../"):
             raise ConfigError(f"config key 'results_dir': {rd!r} is not a folder inside the project {project!r}; "
                               "give a relative path such as results/myrun")
+        # symbolic links resolved: a link inside the project may point anywhere
+        real = os.path.realpath(os.path.join(project, norm))
+        if real == project or os.path.commonpath([real, project]) != project:
+            raise ConfigError(f"config key 'results_dir': {rd!r} resolves to {real!r}, outside the project "
+                              f"{project!r} (a symbolic link leaving it); give a folder inside the project, or set "
+                              "results_outside_project: true and give the absolute folder")
         return
     if not config.get("results_outside_project"):
         raise ConfigError(f"config key 'results_dir': {rd!r} is absolute; give a relative path inside the project, "
@@ -163,10 +169,21 @@ def check_results_dir(config: dict, project: str | None = None) -> None:
 
 
 def check_config(config: dict) -> None:
-    """Cross-key checks on a schema-validated config; raise :class:`ConfigError`."""
-    from .limits import DEFAULT_MEMORY_BUDGET_GIB, BudgetError, check_budget, synthetic_trial_bytes
+    """Cross-key checks on a schema-validated config; raise :class:`ConfigError`.
+
+    Every size that allocates (:func:`animsynth.limits.config_requests`, the
+    synthetic trials' frames) is checked against ``memory_budget_gib`` here,
+    before any job starts.
+    """
+    from .limits import DEFAULT_MEMORY_BUDGET_GIB, BudgetError, check_budget, config_requests, synthetic_trial_bytes
 
     check_results_dir(config)
+    budget = float(config.get("memory_budget_gib", DEFAULT_MEMORY_BUDGET_GIB))
+    for what, nbytes in config_requests(config):
+        try:
+            check_budget(what, nbytes, budget)
+        except BudgetError as exc:
+            raise ConfigError(str(exc)) from None
     ids = [t["id"] for t in config["trials"]]
     dup = sorted({i for i in ids if ids.count(i) > 1})
     if dup:
@@ -182,8 +199,7 @@ def check_config(config: dict) -> None:
                 raise ConfigError(f"{where}: synthetic trials need 'frames'")
             try:
                 check_budget(f"config keys 'trials[{k}].frames' ({t['frames']}) x 'fps' ({config.get('fps', 120)})",
-                             synthetic_trial_bytes(t["frames"], float(config.get("fps", 120))),
-                             float(config.get("memory_budget_gib", DEFAULT_MEMORY_BUDGET_GIB)))
+                             synthetic_trial_bytes(t["frames"], float(config.get("fps", 120))), budget)
             except BudgetError as exc:
                 raise ConfigError(str(exc)) from None
             if t["kind"] not in ("walk_straight", "walk_turn", "run_straight", "run_turn", "dance"):
@@ -251,12 +267,55 @@ def explain_schema_error(config: dict, schema: dict) -> str | None:
             "  (keys and their meaning: config/README.md and config/schema.yaml)")
 
 
+def check_finite(config, path=()) -> None:
+    """Refuse NaN and infinity anywhere in ``config``, naming the key.
+
+    A JSON Schema ``minimum`` / ``maximum`` cannot refuse NaN (every
+    comparison with NaN is false), so ``memory_budget_gib: .nan`` would switch
+    every budget check off and ``fps: .nan`` fail deep inside a job.
+    """
+    import math
+
+    if isinstance(config, float):
+        if not math.isfinite(config):
+            raise ConfigError(f"config key '{_where(path) or '<top level>'}': {config!r} is not a finite number")
+    elif isinstance(config, dict):
+        for k, v in config.items():
+            check_finite(v, path + (k,))
+    elif isinstance(config, (list, tuple)):
+        for i, v in enumerate(config):
+            check_finite(v, path + (i,))
+
+
+def coerce_booleans(config: dict, schema: dict) -> None:
+    """Read the text ``true`` / ``false`` (any case) of a boolean schema key as a boolean, in place.
+
+    Snakemake's ``--config key=value`` keeps ``true`` as text (only ``True`` /
+    ``False`` become booleans), so ``--config results_outside_project=true``
+    would be refused as a string.
+    """
+    props = schema.get("properties") or {}
+    for key, value in list(config.items()):
+        sub = props.get(key)
+        if not isinstance(sub, dict):
+            continue
+        types = sub.get("type")
+        types = [types] if isinstance(types, str) else (types or [])
+        if "boolean" in types and isinstance(value, str) and value.strip().lower() in ("true", "false"):
+            config[key] = value.strip().lower() == "true"
+        elif isinstance(value, dict) and sub.get("properties"):
+            coerce_booleans(value, sub)
+
+
 def validate_config(config: dict, schema_path: str) -> None:
     """Validate ``config`` against the YAML JSON Schema and fill in defaults.
 
     A config whose YAML aliases expand past :data:`MAX_CONFIG_VALUES` values
     is refused first (:func:`check_config_size`), so validation never walks a
-    "billion laughs" file.
+    "billion laughs" file; then any NaN or infinite number
+    (:func:`check_finite`: the schema's minimum and maximum let NaN through).
+    ``true`` / ``false`` given as text (``--config key=true``) to a boolean
+    key are read as booleans (:func:`coerce_booleans`).
 
     Wraps :func:`snakemake.utils.validate` (which also sets defaults) so that
     a violation raises a :class:`ConfigError` of a few lines (see
@@ -266,11 +325,13 @@ def validate_config(config: dict, schema_path: str) -> None:
     from snakemake.utils import validate
 
     check_config_size(config)
+    check_finite(config)
+    with open(schema_path, encoding="utf-8") as fh:
+        schema = yaml.safe_load(fh)
+    coerce_booleans(config, schema)
     try:
         validate(config, schema_path)
     except Exception as exc:  # snakemake's WorkflowError embeds the whole schema and config
-        with open(schema_path, encoding="utf-8") as fh:
-            schema = yaml.safe_load(fh)
         short = explain_schema_error(config, schema)
         if short is None:
             short = "\n".join(str(exc).splitlines()[:5])

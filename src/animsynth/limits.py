@@ -80,3 +80,58 @@ def count_nodes(obj, limit: int, children=_python_children) -> int:
             inner = ancestors + (id(o),)
             stack.extend((x, inner) for x in items)
     return count
+
+
+#: Body vertices of the synthetic skirt character at resolution 1 (measured: a
+#: few thousand); the count grows with the square of ``resolution``.
+CHARACTER_BODY_VERTICES = 4000
+
+#: Joint angles a decoded simplicial path carries per frame (CMU skeleton, root excluded).
+SIMPLICIAL_POSE_DOF = 56
+
+
+def config_requests(config: dict) -> list[tuple[str, float]]:
+    """The sizes of a config that allocate, each as (config keys and values, bytes).
+
+    Every estimate counts the largest float64 arrays of one job of the run
+    (what a job holds at once, not the total of the run), so a size the
+    memory budget refuses here would end in a MemoryError later. The config
+    is a schema-validated one (defaults filled in); missing blocks count as
+    their defaults.
+
+    Returns
+    -------
+    list of (str, float)
+        ``what`` names the keys and their values, e.g.
+        ``"config key 'simplicial.steps' (1000000)"``; the bytes are the
+        estimate for that request.
+    """
+    out = []
+    s = config.get("simplicial") or {}
+    steps = s.get("steps", "held_out")
+    if isinstance(steps, int) and not isinstance(steps, bool):
+        starts = int((s.get("ensemble") or {}).get("n_starts", 16)) + 1
+        variants = len(s.get("methods") or [0, 0])
+        dims = [int(s.get("latent_dim", 2))] + [int(d) for d in (s.get("beyond") or {}).get("latent_dims") or [4]]
+        d = max(dims)
+        # one fold job: batched path points and velocities of every start and method, plus decoded poses
+        out.append((f"config key 'simplicial.steps' ({steps}) x {starts} starts x {variants} methods",
+                    8.0 * (steps + 1) * (starts * variants * 2 * d + starts * SIMPLICIAL_POSE_DOF)))
+    beyond = s.get("beyond") or {}
+    if "max_all_pairs" in beyond:
+        n = int(beyond["max_all_pairs"])
+        out.append((f"config key 'simplicial.beyond.max_all_pairs' ({n}): up to {n} x {n} shortest-path matrices",
+                    8.0 * 2 * n * n))
+    m = config.get("meshdetail") or {}
+    ch = m.get("character") or {}
+    if not config.get("mesh_dir"):
+        rings, around = int(ch.get("skirt_rings", 16)), int(ch.get("skirt_around", 56))
+        frames = int(ch.get("frames", 160))
+        res = float(ch.get("resolution", 1.0))
+        verts = CHARACTER_BODY_VERTICES * res * res + rings * around
+        clips = 1 + len(ch.get("edits") or [])
+        # vertex positions of the main clip and every edit, plus four predictions of the main clip
+        out.append((f"config keys 'meshdetail.character.skirt_rings' ({rings}) x 'skirt_around' ({around}) x "
+                    f"'frames' ({frames}) x 'resolution' ({res:g})",
+                    8.0 * 3 * frames * verts * (clips + 4)))
+    return out

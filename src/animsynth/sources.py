@@ -246,8 +246,18 @@ def fetch_mesh_frames(source: str, dest: str | os.PathLike, timeout: float = 120
 
 
 def read_sha256_list(path: str | os.PathLike) -> dict[str, str]:
-    """Read a ``sha256sum``-style list (``<64 hex>  <file name>`` per line) into {name: hash}."""
+    """Read a ``sha256sum``-style list (``<64 hex>  <file name>`` per line) into {name: hash}.
+
+    Raises
+    ------
+    MeshSourceError
+        Naming file and line: a malformed line, or a frame listed twice (the
+        same name, or names that are the same frame such as ``a.obj`` and
+        ``a.obj.gz``; both lines named): a later entry must not silently
+        replace an earlier one, or a wrong first hash would verify.
+    """
     out: dict[str, str] = {}
+    first: dict[str, tuple[int, str]] = {}  # frame -> (line, name as listed)
     with open(path, encoding="utf-8") as f:
         for ln, line in enumerate(f, 1):
             line = line.strip()
@@ -256,7 +266,14 @@ def read_sha256_list(path: str | os.PathLike) -> dict[str, str]:
             parts = line.split(None, 1)
             if len(parts) != 2 or not re.fullmatch(r"[0-9a-fA-F]{64}", parts[0]):
                 raise MeshSourceError(f"{path}:{ln}: expected '<sha256>  <file>', got {line[:60]!r}")
-            out[parts[1].lstrip("*").strip()] = parts[0].lower()
+            name = parts[1].lstrip("*").strip()
+            frame = frame_stem(name) if is_frame_name(name) else name
+            if frame in first:
+                ln0, name0 = first[frame]
+                raise MeshSourceError(f"{path}:{ln}: frame {frame!r} is listed twice, as {name0!r} on line {ln0} and "
+                                      f"as {name!r} on line {ln}; keep one entry")
+            first[frame] = (ln, name)
+            out[name] = parts[0].lower()
     return out
 
 

@@ -21,7 +21,8 @@ def limit_compiled_threads(n: int) -> None:
 
 
 def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None = None) -> logging.Logger:
-    """Send ``animsynth`` log records (INFO and up) to the rule's ``log:`` file.
+    """Send ``animsynth`` log records (INFO and up) to the rule's ``log:`` file,
+    and warnings also to stderr (the console of the run).
 
     Uncaught exceptions are logged too, so the log explains a failed job.
     Figures of the job are drawn with matplotlib's non-interactive Agg backend.
@@ -46,6 +47,12 @@ def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None 
         handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     root.addHandler(handler)
+    if log_path:
+        # warnings (an implausible skeleton height, a fallback taken) also reach the console, not only the log
+        console = logging.StreamHandler(sys.stderr)
+        console.addFilter(lambda record: record.levelno == logging.WARNING)  # a failure's traceback is printed anyway
+        console.setFormatter(logging.Formatter("animsynth: %(levelname)s: %(message)s"))
+        root.addHandler(console)
     logger = logging.getLogger(name if name.startswith("animsynth") else f"animsynth.{name}")
     if snakemake is not None:
         from .atomic import clean_stale_temporaries

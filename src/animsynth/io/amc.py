@@ -21,6 +21,10 @@ from ..errors import MotionFormatError, parse_float, read_text_lines
 log = logging.getLogger("animsynth.io")
 
 
+#: Longest frame number read (digits); a longer one is refused naming file and line.
+MAX_FRAME_NUMBER_DIGITS = 12
+
+
 def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
     """Parse an AMC file against ``skeleton``.
 
@@ -73,6 +77,9 @@ def read_amc(path, skeleton: Skeleton, fps: float = 120.0) -> Motion:
             continue
         tok = line.split()
         if len(tok) == 1 and tok[0].isascii() and tok[0].isdigit():
+            if len(tok[0]) > MAX_FRAME_NUMBER_DIGITS:
+                raise MotionFormatError(path, ln, f"frame number of {len(tok[0])} digits (at most "
+                                                  f"{MAX_FRAME_NUMBER_DIGITS} are read)")
             finish(ln)
             n = int(tok[0])
             if frame_no is not None and n != frame_no + 1:

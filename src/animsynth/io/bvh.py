@@ -21,7 +21,8 @@ silent misreading would follow; each of these is a
   ``OFFSET`` added to the child's offset and positions (logged). With several
   children (an armature with several root bones) it is refused: one skeleton
   with one root translation per file is supported;
-* joint names must be unique;
+* joint names must be unique; joints may nest at most
+  :data:`MAX_JOINT_DEPTH` deep;
 * nothing may follow the root joint's closing brace before ``MOTION`` (a
   second ``ROOT``, a stray ``}``);
 * the frame time must lie in [:data:`MIN_FRAME_TIME`, :data:`MAX_FRAME_TIME`]
@@ -89,6 +90,10 @@ CHILD_POSITION_REL_TOL = 1e-5
 MIN_FRAME_TIME = 1e-5
 #: Longest frame time accepted (seconds): one frame a minute.
 MAX_FRAME_TIME = 60.0
+#: Deepest joint chain accepted (a hand's finger tip in a full-body rig is about
+#: 30 joints below the root); deeper nesting is refused naming file and line,
+#: before the recursive parser and the forward kinematics run out of stack.
+MAX_JOINT_DEPTH = 256
 #: Values of the channels and offsets are written with this many decimals.
 DECIMALS = 6
 
@@ -256,7 +261,10 @@ def read_bvh(path, fps: float | None = None) -> Motion:
                                                "each axis may appear once")
         return ax
 
-    def parse_joint(parent: int, kw: str, ln0: int):
+    def parse_joint(parent: int, kw: str, ln0: int, depth: int = 1):
+        if depth > MAX_JOINT_DEPTH:
+            raise MotionFormatError(path, ln0, f"joints nested more than {MAX_JOINT_DEPTH} deep (a skeleton "
+                                               "chain this long is a broken or hostile file)")
         name, lnn = nxt()
         if name in ("{", "}"):
             raise MotionFormatError(path, lnn, f"{kw} without a name")
@@ -297,7 +305,7 @@ def read_bvh(path, fps: float | None = None) -> Motion:
                 rec["channels"] = chans
                 rec["chan_line"] = lnc
             elif t == "JOINT":
-                parse_joint(idx, t, ln)
+                parse_joint(idx, t, ln, depth + 1)
             elif t == "End":
                 s, lns = nxt()
                 b2, _ = nxt()

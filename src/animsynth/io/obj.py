@@ -69,12 +69,12 @@ def _slow_parse(path, lines):
                 try:
                     i = int(head)
                 except ValueError:
-                    raise MotionFormatError(path, ln, f"non-integer face index {t!r}") from None
+                    raise MotionFormatError(path, ln, f"non-integer face index {t[:40]!r}") from None
                 if i == 0:
                     raise MotionFormatError(path, ln, "face index 0 (OBJ indices are 1-based)")
                 i = i - 1 if i > 0 else len(verts) + i
                 if i < 0 or i >= len(verts):
-                    raise MotionFormatError(path, ln, f"face index {t!r} refers to a vertex not defined before it")
+                    raise MotionFormatError(path, ln, f"face index {t[:40]!r} refers to a vertex not defined before it")
                 idx.append(i)
             for k in range(1, len(idx) - 1):
                 faces.append([idx[0], idx[k], idx[k + 1]])
@@ -110,7 +110,7 @@ def _fast_parse(lines):
     try:
         verts = np.array(vrec, dtype=float).reshape(-1, 3)
         faces = np.array(frec, dtype=np.int64).reshape(-1, 3)
-    except ValueError:
+    except (ValueError, OverflowError):  # an index past int64: the careful parser names file and line
         return None
     if not np.all(np.isfinite(verts)):
         return None
