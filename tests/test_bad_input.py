@@ -415,15 +415,15 @@ def test_workflow_checksum_mismatch_is_one_line_not_retried(user_workflow):
     from conftest import run_snakemake
 
     wd = user_workflow(sha256="0" * 64)
-    res = run_snakemake(wd, "resources/mocap/t1.amc", "--configfile", "config/bad.yaml")
+    res = run_snakemake(wd, "results/resources/mocap/t1.amc", "--configfile", "config/bad.yaml")
     out = res.stdout + res.stderr
     assert res.returncode != 0
     log = (wd / "logs" / "data" / "download_trial" / "t1.log").read_text()
     assert "checksum mismatch for me/t1.amc" in log and "expected " + "0" * 64 + ", got " in log
     assert "Traceback" not in log and "Traceback" not in out
     assert out.count("Error in rule download_trial") == 1  # no retries
-    assert not (wd / "resources" / "mocap" / "t1.amc").exists()
-    assert not list((wd / "resources").rglob(".tmp-*"))
+    assert not (wd / "results" / "resources" / "mocap" / "t1.amc").exists()
+    assert not list((wd / "results" / "resources").rglob(".tmp-*"))
 
 
 @pytest.mark.workflow
@@ -431,9 +431,9 @@ def test_workflow_refuses_a_path_leaving_data_dir(user_workflow):
     from conftest import run_snakemake
 
     wd = user_workflow(amc="../../../../../../etc/hostname")
-    res = run_snakemake(wd, "resources/mocap/t1.amc", "--configfile", "config/bad.yaml")
+    res = run_snakemake(wd, "results/resources/mocap/t1.amc", "--configfile", "config/bad.yaml")
     out = res.stdout + res.stderr
     assert res.returncode != 0
     assert "config key 'trials[0].amc'" in out and "leaves" in out
     assert len(out.strip().splitlines()) < 15, out
-    assert not (wd / "resources").exists()
+    assert not (wd / "results" / "resources").exists()

@@ -24,7 +24,7 @@ def test_tiny_workflow_facegraph_outputs(tiny_workflow):
     missing = [p for p in OUTPUTS if not (wd / p).exists()]
     assert not missing, missing
     # synthetic CK+ layout generated and parsed
-    assert (wd / "resources/facegraph/ckplus_synthetic/Landmarks").is_dir()
+    assert (wd / "results/resources/facegraph/ckplus_synthetic/Landmarks").is_dir()
     db = pd.read_csv(wd / "results/facegraph/database.csv")
     assert db.used.sum() == 14 and (db.emotion.fillna("") == "").sum() == 1
     t1 = pd.read_csv(wd / "results/facegraph/table1.csv")

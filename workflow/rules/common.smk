@@ -38,10 +38,10 @@ BVH_TRIALS = {t for t, rec in TRIALS.items() if "bvh" in rec and "amc" not in re
 def raw_trial_files(trial):
     """Raw files of one trial: ASF + AMC, or BVH."""
     if trial in BVH_TRIALS:
-        return {"bvh": f"resources/mocap/{trial}.bvh"}
+        return {"bvh": R(f"resources/mocap/{trial}.bvh")}
     return {
-        "amc": f"resources/mocap/{trial}.amc",
-        "asf": f"resources/mocap/{trial}.asf",
+        "amc": R(f"resources/mocap/{trial}.amc"),
+        "asf": R(f"resources/mocap/{trial}.asf"),
     }
 
 

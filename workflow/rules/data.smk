@@ -17,8 +17,8 @@ if SOURCE == "synthetic":
     # reruns that trial's jobs and the studies that read it, nothing else.
     rule synth_trial:
         output:
-            amc="resources/mocap/{trial}.amc",
-            asf="resources/mocap/{trial}.asf",
+            amc=R("resources/mocap/{trial}.amc"),
+            asf=R("resources/mocap/{trial}.asf"),
         params:
             spec=trial_spec,
             seed=synthetic_trial_seed,
@@ -41,8 +41,8 @@ else:
 
     rule download_trial:
         output:
-            amc="resources/mocap/{trial}.amc",
-            asf="resources/mocap/{trial}.asf",
+            amc=R("resources/mocap/{trial}.amc"),
+            asf=R("resources/mocap/{trial}.asf"),
         params:
             source=MOCAP_MIRROR,
             amc=trial_field("amc"),
@@ -64,7 +64,7 @@ else:
 
     rule download_bvh_trial:
         output:
-            bvh="resources/mocap/{trial}.bvh",
+            bvh=R("resources/mocap/{trial}.bvh"),
         params:
             source=MOCAP_MIRROR,
             bvh=trial_field("bvh"),
@@ -114,18 +114,18 @@ DATA_TARGETS = [trial_npz(t) for t in USED_TRIALS]
 # ---- mesh sequences of the hybrid mesh experiments -------------------------
 # Each sequence's mesh_dir (MD_SEQS, common.smk) is a folder of OBJ / OBJ.gz
 # frames, an archive of one (.zip, .tar.gz) or a URL of such an archive;
-# archives are unpacked into resources/mesh/<name>/. With mesh_sha256 set, every
+# archives are unpacked into <results_dir>/resources/mesh/<name>/. With mesh_sha256 set, every
 # frame is checked against that list before any experiment reads it, and a
 # mismatch names the frame.
 MD_FRAMES = {}  # sequence name -> folder of frames (or the synthetic character's)
-MESH_FETCH = {}  # resources/mesh/<name> -> archive or URL
-MESH_FETCH_SUMS = {}  # resources/mesh/<name> -> [its SHA-256 list] or []
+MESH_FETCH = {}  # <name> (of <results_dir>/resources/mesh/<name>) -> archive or URL
+MESH_FETCH_SUMS = {}  # <name> -> [its SHA-256 list] or []
 for _name, _s in MD_SEQS.items():
     _src = _s["mesh_dir"]
     if not _src:
         MD_FRAMES[_name] = R("meshdetail/character/main")
     elif is_url(_src) or is_archive(_src):
-        MD_FRAMES[_name] = f"resources/mesh/{mesh_source_name(_src)}"
+        MD_FRAMES[_name] = R(f"resources/mesh/{mesh_source_name(_src)}")
         MESH_FETCH[mesh_source_name(_src)] = _src
         # the fetch checks the frames against the sequence's list before it places them
         MESH_FETCH_SUMS[mesh_source_name(_src)] = [_s["mesh_sha256"]] if _s["mesh_sha256"] else []
@@ -139,7 +139,7 @@ if MESH_FETCH:
         input:
             sums=mesh_fetch_sums,
         output:
-            directory("resources/mesh/{meshsrc}"),
+            directory(R("resources/mesh/{meshsrc}")),
         params:
             source=mesh_fetch_source,
             max_unpacked_mb=config["meshdetail"]["max_unpacked_mb"],

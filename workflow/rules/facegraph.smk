@@ -20,7 +20,7 @@ FG_SHOWCASE = FG_SHOWCASE_CONF["name"]
 FG_CONFIG_MAP = {c["name"]: c for c in FG_TABLE_CONFIGS + FG_SWEEP_CONFIGS}
 FG_CONFIG_MAP.setdefault(FG_SHOWCASE, FG_SHOWCASE_CONF)
 FG_SYNTHETIC = FG["ckplus_dir"] is None
-FG_DB_DIR = "resources/facegraph/ckplus_synthetic" if FG_SYNTHETIC else FG["ckplus_dir"]
+FG_DB_DIR = R("resources/facegraph/ckplus_synthetic") if FG_SYNTHETIC else FG["ckplus_dir"]
 FG_SOURCE = "synthetic CK+-layout database (animsynth.synth.faces)" if FG_SYNTHETIC else f"CK+ at {FG['ckplus_dir']}"
 FG_SEED_GRAPH = seed_for("facegraph", FG["seed"], "graph")
 FG_SHOWCASE_GRAPH = R(f"facegraph/graphs/{FG_SHOWCASE}.npz")
@@ -36,7 +36,7 @@ if FG_SYNTHETIC:
 
     rule facegraph_synth_db:
         output:
-            directory("resources/facegraph/ckplus_synthetic"),
+            directory(FG_DB_DIR),
         params:
             cfg=FG["synthetic"],
             seed=seed_for("facegraph", FG["seed"], "synthetic"),

@@ -1,4 +1,4 @@
-"""Unpack mesh_dir (an archive, or a URL of one) into resources/mesh/<name>/."""
+"""Unpack mesh_dir (an archive, or a URL of one) into <results_dir>/resources/mesh/<name>/."""
 from animsynth.sources import fetch_mesh_frames, read_sha256_list
 from animsynth.workflow_utils import setup_logging
 
