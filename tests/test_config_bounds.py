@@ -4,6 +4,7 @@ through a symbolic link, and boolean keys given as text. Each is refused (or
 read) at validation, naming the key, before any job starts."""
 
 import copy
+import os
 import re
 
 import pytest
@@ -206,3 +207,22 @@ def test_other_text_for_a_boolean_is_still_refused():
     cfg["results_outside_project"] = "yes please"
     with pytest.raises(ConfigError, match="results_outside_project"):
         validate_config(copy.deepcopy(cfg), SCHEMA)
+
+
+def test_results_dir_through_a_link_with_the_opt_in(tmp_path):
+    # results_outside_project: true lets a link name an outside folder, never the root or the home folder
+    from animsynth.config import check_results_dir
+
+    project = tmp_path / "project"
+    project.mkdir()
+    (tmp_path / "scratch").mkdir()
+    (project / "scratchlink").symlink_to(tmp_path / "scratch")
+    (project / "rootlink").symlink_to("/")
+    (project / "homelink").symlink_to(os.path.expanduser("~"))
+    cfg = filled_config()
+    cfg.update(results_outside_project=True, results_dir="scratchlink/run")
+    check_results_dir(cfg, str(project))
+    for bad in ("rootlink", "homelink"):
+        cfg["results_dir"] = bad
+        with pytest.raises(ConfigError, match="config key 'results_dir'.*filesystem root, the home folder"):
+            check_results_dir(cfg, str(project))

@@ -142,8 +142,11 @@ def check_config_file(path, limit: int = MAX_CONFIG_VALUES) -> None:
 
 def check_results_dir(config: dict, project: str | None = None) -> None:
     """``results_dir`` is a relative path inside the project, or (with
-    ``results_outside_project: true``) an absolute folder that is neither a
-    filesystem root, the home folder, nor the project or a folder holding it."""
+    ``results_outside_project: true``) an absolute folder, or a relative path
+    through a symbolic link, that is neither a filesystem root, the home
+    folder, nor the project or a folder holding it. Symbolic links are
+    resolved before the check, so a link inside the project that points
+    outside it counts as outside."""
     rd = str(config.get("results_dir") or "results")
     project = os.path.realpath(project or os.getcwd())
     norm = posixpath.normpath(rd)
@@ -153,15 +156,16 @@ def check_results_dir(config: dict, project: str | None = None) -> None:
                               "give a relative path such as results/myrun")
         # symbolic links resolved: a link inside the project may point anywhere
         real = os.path.realpath(os.path.join(project, norm))
-        if real == project or os.path.commonpath([real, project]) != project:
+        if real != project and os.path.commonpath([real, project]) == project:
+            return
+        if not config.get("results_outside_project"):
             raise ConfigError(f"config key 'results_dir': {rd!r} resolves to {real!r}, outside the project "
                               f"{project!r} (a symbolic link leaving it); give a folder inside the project, or set "
-                              "results_outside_project: true and give the absolute folder")
-        return
-    if not config.get("results_outside_project"):
+                              "results_outside_project: true to write to the folder the link names")
+    elif not config.get("results_outside_project"):
         raise ConfigError(f"config key 'results_dir': {rd!r} is absolute; give a relative path inside the project, "
                           "or set results_outside_project: true to write to a folder you name explicitly")
-    real = os.path.realpath(rd)
+    real = os.path.realpath(os.path.join(project, rd))
     home = os.path.realpath(os.path.expanduser("~"))
     if real == os.path.dirname(real) or real == home or os.path.commonpath([real, project]) == real:
         raise ConfigError(f"config key 'results_dir': {rd!r} is a filesystem root, the home folder, or holds the "
