@@ -1,0 +1,198 @@
+"""Motion matching and GenMM: known answers, the interface, determinism (small synthetic databases)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from animsynth.compare import generators as G
+from animsynth.compare import jobs
+from animsynth.compare.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
+from animsynth.compare.motionmatching import (MotionMatching, decay_spring, make_motion_matching, spring_angle,
+                                              spring_position)
+from animsynth.compare.poses import decode, encode
+from animsynth.kinematics import root_translation
+from animsynth.motion import Motion
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+INF = float("inf")
+
+
+@pytest.fixture(scope="module")
+def walks():
+    """Four synthetic walks of one subject at 30 fps (60 frames each)."""
+    sk = cmu_like_skeleton("cmp", 3)
+    return [jobs.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
+
+
+def _cut(m: Motion, a: int, b: int, name: str = "part") -> Motion:
+    return Motion(np.asarray(m.values[a:b], float).copy(), m.skeleton, m.fps, name)
+
+
+def _angle_diff(a, b) -> float:
+    """Largest difference of DOF values, angles compared modulo 360 degrees."""
+    return float(np.abs((np.asarray(a) - np.asarray(b) + 180.0) % 360.0 - 180.0).max())
+
+
+# ----------------------------------------------------------------------------- the shared pose representation
+
+
+def test_encode_then_decode_from_the_frame_before_gives_the_motion_back(walks):
+    m = walks[1]
+    tr = encode(m)
+    c = 5
+    back = decode(m.skeleton, tr.rotations[c:], tr.tilt[c:], tr.height[c:], tr.step[c:], tr.turn[c:], m.values[c - 1])
+    assert _angle_diff(back, m.values[c:]) < 1e-8
+
+
+# ----------------------------------------------------------------------------- motion matching
+
+
+def test_inertialization_offset_after_one_half_life_is_0597_of_the_start():
+    x, v = decay_spring(1.0, 0.0, 0.1, 0.1)
+    assert x == pytest.approx((1.0 + 2.0 * np.log(2.0)) / 4.0, abs=1e-12)
+    assert round(float(x), 3) == 0.597
+    # the exact spring: three steps of a third of a half-life land where one step does
+    y, w = 1.0, 0.0
+    for _ in range(3):
+        y, w = decay_spring(y, w, 0.1, 0.1 / 3.0)
+    assert (y, w) == pytest.approx((float(x), float(v)), abs=1e-12)
+    assert float(v) < 0.0  # moving back towards zero
+
+
+def test_gamepad_springs_hold_a_steady_velocity_and_turn_to_the_goal():
+    dt = np.array([1 / 3, 2 / 3, 1.0])
+    p = spring_position(np.array([1.0, 2.0]), np.array([0.5, -1.0]), np.zeros(2), np.array([0.5, -1.0]), 0.27,
+                        dt[:, None])
+    assert np.allclose(p, [1.0, 2.0] + dt[:, None] * [0.5, -1.0])  # already at the goal velocity: a straight line
+    a = spring_angle(3.0, 0.0, -3.0, 0.27, np.array([0.0, 5.0]))  # the short way round through pi
+    assert a[0] == pytest.approx(3.0) and np.cos(a[1] + 3.0) == pytest.approx(1.0, abs=1e-6)
+    assert a[1] > 3.0  # it crossed pi instead of turning back through 0
+
+
+def test_gamepad_below_the_deadzone_asks_to_stand(walks):
+    mm = MotionMatching().fit(walks[1:])
+    still = np.zeros((8, 2))
+    still[:, 0] = np.linspace(0.0, 0.03, 8)  # 0.13 m/s
+    v, yaw = mm._gamepad(still, 0.7, 30.0)
+    assert np.array_equal(v, [0.0, 0.0]) and yaw == 0.7
+    moving = still * 3.0  # 0.39 m/s (0.09 m in 7 frames)
+    v, yaw = mm._gamepad(moving, 0.7, 30.0)
+    assert v == pytest.approx([0.09 * 30 / 7, 0.0]) and yaw == pytest.approx(np.pi / 2)
+
+
+def test_motion_matching_on_a_clip_of_its_database_with_the_true_trajectory_is_the_replay(walks):
+    db = walks
+    clip, c, length = walks[2], 8, 40
+    mm = MotionMatching().fit(db)
+    start, truth = _cut(clip, 0, c, "start"), _cut(clip, c, clip.n_frames, "truth")
+    m = mm.generate(start, length, 0, trajectory=truth)
+    costs = m.meta["costs"]
+    assert costs[0] < 1e-12  # the start's last frame is found at cost 0 ...
+    assert tuple(m.meta["source_frames"][0]) == (2, c)  # ... so its next frame plays first
+    assert np.all(costs < 1e-12) and m.meta["seams"].size == 0 and m.meta["switches"] == 1  # the entry only
+    assert np.array_equal(m.meta["source_frames"][:, 1], np.arange(c, c + length))
+    replay = G.Replay(held_out=clip).fit(db).generate(start, length, 0)
+    assert _angle_diff(m.values, replay.values) < 1e-8
+
+
+def test_motion_matching_is_deterministic_and_keeps_the_interface(walks):
+    mm = MotionMatching().fit(walks[1:])
+    start, length = _cut(walks[0], 0, 8), 45
+    a = mm.generate(start, length, 5)
+    b = mm.generate(start, length, 6)  # the seed is not used: seed diversity 0
+    assert np.array_equal(a.values, b.values)
+    assert a.values.shape == (length, walks[0].skeleton.n_dof) and np.all(np.isfinite(a.values))
+    assert a.fps == 30.0 and a.skeleton.columns() == walks[0].skeleton.columns()
+    src, seams = a.meta["source_frames"], a.meta["seams"]
+    assert src.shape == (length, 2) and (src >= 0).all()
+    follows = (src[1:, 0] == src[:-1, 0]) & (src[1:, 1] == src[:-1, 1] + 1)
+    assert set(np.flatnonzero(~follows) + 1) == set(seams.tolist())
+    # each match lies outside its clip's last 1/3 s (10 frames) and 1/3 s away from the frame it left
+    n = np.array([w.n_frames for w in walks[1:]])
+    for t in seams:
+        clip_j, j = src[t, 0], src[t, 1] - 1
+        assert j < n[clip_j] - mm.exclude_frames_
+        if clip_j == src[t - 1, 0]:
+            assert abs(j - src[t - 1, 1]) >= mm.exclude_frames_
+    # searches every 0.1 s (3 frames) unless a clip ends in between
+    assert np.all(np.diff(a.meta["search_frames"]) <= 3)
+    # the output continues the start where it stands
+    gap = np.linalg.norm(root_translation(a.skeleton, a.values[:1])[0, [0, 2]]
+                         - root_translation(start.skeleton, start.values[-1:])[0, [0, 2]])
+    step = np.linalg.norm(np.diff(root_translation(start.skeleton, walks[0].values)[:, [0, 2]], axis=0), axis=1)
+    assert gap < 2 * step.max()
+
+
+def test_motion_matching_without_trajectory_weights_matches_on_the_pose_only(walks):
+    full = MotionMatching().fit(walks[1:])
+    pose = make_motion_matching({}, trajectory_weight=0.0).fit(walks[1:])
+    assert np.all(pose.features_[:, 15:] == 0.0) and np.any(full.features_[:, 15:] != 0.0)
+    assert np.array_equal(pose.features_[:, :15], full.features_[:, :15])
+    with pytest.raises(ValueError, match="trajectory_weight"):
+        MotionMatching(trajectory_weight=-1).fit(walks[1:])
+
+
+# ----------------------------------------------------------------------------- GenMM
+
+
+def test_patch_votes_of_a_sequences_own_patches_give_it_back():
+    x = np.random.default_rng(0).normal(size=(20, 3))
+    p = extract_patches(x, 5)
+    assert p.shape == (16, 15) and np.array_equal(p[3].reshape(5, 3), x[3:8])
+    assert np.allclose(vote(p, 5, 20), x)
+
+
+def test_completeness_sends_the_second_patch_to_the_unused_target():
+    keys = np.array([[0.0, 0.0], [1.0, 1.0]])  # two target patches
+    queries = np.array([[0.0, 0.0], [0.4, 0.4]])  # both nearer the first
+    nn, _ = match_patches(queries, keys, INF)
+    assert nn.tolist() == [0, 0]  # plain nearest neighbours: the second target is never used
+    nn, dist = match_patches(queries, keys, 0.01)
+    assert nn.tolist() == [0, 1]  # completeness: the second query takes the unused target
+    assert dist == pytest.approx([0.0, 0.36])
+
+
+def test_genmm_without_noise_from_a_database_segment_returns_that_segment(walks):
+    clip, a, c, length = walks[1], 10, 8, 35
+    g = GenMM(noise_sigma=0.0, alpha=INF, coarse_patches=100).fit(walks[1:])  # one level: the full rate
+    assert g.scales_ == [1.0]
+    segment = _cut(clip, a, a + c + length, "segment")
+    m = g.generate(_cut(clip, a, a + c, "start"), length, 0, initial=segment)
+    # every patch is the segment's own; only the start's first frame (its step from the frame before it is
+    # not in the start) differs a little from the database's
+    assert m.meta["match_distance"] < 1e-6
+    assert _angle_diff(m.values, clip.values[a + c:a + c + length]) < 1e-8
+    # with noise the same start gives something else
+    n = GenMM(alpha=INF, coarse_patches=100).fit(walks[1:]).generate(_cut(clip, a, a + c), length, 0,
+                                                                     initial=segment)
+    assert _angle_diff(n.values, clip.values[a + c:a + c + length]) > 1.0
+
+
+@pytest.mark.parametrize("root", ["local", "world"])
+def test_genmm_keeps_the_interface_and_is_seeded(walks, root):
+    g = make_genmm({}, root=root).fit(walks[1:])
+    assert g.scales_[-1] == 1.0 and np.all(np.diff(g.scales_) > 0) and len(g.scales_) > 1
+    assert g.scales_[0] == pytest.approx(5 * 11 / max(w.n_frames for w in walks[1:]))
+    start, length = _cut(walks[0], 0, 8), 40
+    a = g.generate(start, length, 5)
+    assert a.values.shape == (length, walks[0].skeleton.n_dof) and np.all(np.isfinite(a.values))
+    assert a.meta["seams"].size == 0 and (a.meta["source_frames"] == -1).all()
+    assert a.meta["levels"][-1] == 8 + length and np.all(np.diff(a.meta["levels"]) > 0)
+    b = g.generate(start, length, 5)
+    assert np.array_equal(a.values, b.values)
+    assert not np.array_equal(a.values, g.generate(start, length, 6).values)
+    gap = np.linalg.norm(root_translation(a.skeleton, a.values[:1])[0, [0, 2]]
+                         - root_translation(start.skeleton, start.values[-1:])[0, [0, 2]])
+    step = np.linalg.norm(np.diff(root_translation(start.skeleton, walks[0].values)[:, [0, 2]], axis=0), axis=1)
+    assert gap < 3 * step.max()
+
+
+def test_genmm_refuses_bad_parameters(walks):
+    for kw, key in (({"root": "up"}, "root"), ({"patch_size": 10}, "patch_size"), ({"pyramid_factor": 1.2},
+                                                                                    "pyramid_factor"),
+                    ({"alpha": 0.0}, "alpha")):
+        with pytest.raises(ValueError, match=key):
+            GenMM(**kw).fit(walks[1:])
+    with pytest.raises(ValueError, match="shorter than a patch"):
+        GenMM().fit(walks[1:]).generate(_cut(walks[0], 0, 2), 3, 0)
