@@ -61,7 +61,7 @@ from ..joints import resolve_roles
 from ..kinematics import forward_kinematics
 from ..motion import Motion
 from .generators import Database, Generator
-from .poses import Track, decode, encode, rest_forward, wrap_angle, yaw_rotation
+from .poses import Track, decode, encode, qexp, qinv, qlog, qmul, rest_forward, wrap_angle, yaw_rotation
 
 __all__ = ["MotionMatching", "make_motion_matching", "decay_spring", "spring_position", "spring_angle",
            "halflife_to_damping", "pose_features", "trajectory_features"]
@@ -413,8 +413,7 @@ class MotionMatching(Generator):
                     else:
                         src_q, src_w, src_x, src_v = self.rot_[cur], self.angular_velocity_[cur], self.vec_[cur], \
                             self.root_velocity_[cur]
-                    shown = Rotation.from_quat(off_q) * Rotation.from_quat(src_q)
-                    oq = (shown * Rotation.from_quat(self.rot_[best]).inv()).as_quat()
+                    oq = qmul(qmul(off_q, src_q), qinv(self.rot_[best]))
                     oq[oq[:, 3] < 0] *= -1
                     off_q = oq
                     off_w = off_w + src_w - self.angular_velocity_[best]
@@ -426,11 +425,10 @@ class MotionMatching(Generator):
             # play the next frame with the decayed offsets
             cur += 1
             timer -= 1
-            rv = Rotation.from_quat(off_q).as_rotvec()
-            rv, off_w = decay_spring(rv, off_w, hl, dt)
-            off_q = Rotation.from_rotvec(rv).as_quat()
+            rv, off_w = decay_spring(qlog(off_q), off_w, hl, dt)
+            off_q = qexp(rv)
             off_x, off_v = decay_spring(off_x, off_v, hl, dt)
-            out_q[t] = (Rotation.from_quat(off_q) * Rotation.from_quat(self.rot_[cur])).as_quat()
+            out_q[t] = qmul(off_q, self.rot_[cur])
             out_vec[t] = self.vec_[cur] + off_x
             played[t] = cur
             # the generated root (for the next query)

@@ -25,12 +25,13 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..joints import resolve_roles
-from ..kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_rotation, root_translation
+from ..kinematics import forward_kinematics, local_rotations, root_rotation, root_translation
 from ..motion import Motion
-from ..skeleton import ROT_DOFS
+from ..skeleton import ROT_DOFS, TRANS_DOFS
 
 __all__ = ["Track", "encode", "decode", "facing_yaw", "rotation_yaw", "rest_forward", "rotating_joints", "yaw_rotation",
-           "wrap_angle", "rot6d", "from_rot6d"]
+           "wrap_angle", "rot6d", "from_rot6d", "qmul", "qinv", "qlog", "qexp",
+           "dof_values"]
 
 
 def wrap_angle(a):
@@ -92,6 +93,41 @@ def from_rot6d(x: np.ndarray) -> np.ndarray:
     c3 = np.cross(c1, c2)
     m = np.stack([c1, c2, c3], axis=-1)
     return Rotation.from_matrix(m.reshape(-1, 3, 3)).as_quat().reshape(x.shape[:-1] + (4,))
+
+
+def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Quaternion products ``a b`` (x, y, z, w; ``b`` applied first, as ``Rotation`` products), broadcasting."""
+    ax, ay, az, aw = np.moveaxis(np.asarray(a, float), -1, 0)
+    bx, by, bz, bw = np.moveaxis(np.asarray(b, float), -1, 0)
+    return np.stack([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz], axis=-1)
+
+
+def qinv(q: np.ndarray) -> np.ndarray:
+    """Inverse of unit quaternions (x, y, z, w)."""
+    q = np.array(q, float, copy=True)
+    q[..., :3] *= -1.0
+    return q
+
+
+def qlog(q: np.ndarray) -> np.ndarray:
+    """Rotation vectors (radians) of unit quaternions, the shorter way round: ``(..., 3)``."""
+    q = np.asarray(q, float)
+    q = np.where(q[..., 3:] < 0, -q, q)
+    v = q[..., :3]
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    angle = 2.0 * np.arctan2(n, q[..., 3:])
+    small = n < 1e-12
+    return v * np.where(small, 2.0 / np.maximum(q[..., 3:], 1e-12), angle / np.where(small, 1.0, n))
+
+
+def qexp(r: np.ndarray) -> np.ndarray:
+    """Unit quaternions of rotation vectors ``(..., 3)`` (radians)."""
+    r = np.asarray(r, float)
+    a = np.linalg.norm(r, axis=-1, keepdims=True)
+    small = a < 1e-12
+    k = np.where(small, 0.5, np.sin(0.5 * a) / np.where(small, 1.0, a))
+    return np.concatenate([r * k, np.cos(0.5 * a)], axis=-1)
 
 
 @dataclass
@@ -156,25 +192,60 @@ def encode(motion: Motion, forward: np.ndarray | None = None) -> Track:
                  turn, yaw, ground)
 
 
-def _branch_and_unwrap(skeleton, values: np.ndarray, anchor: np.ndarray) -> np.ndarray:
-    """Rotational DOF of ``values`` moved to the Euler branch and the 360-degree turn of ``anchor`` (n_dof,),
-    then unwrapped over time from it."""
-    out = np.array(values, float, copy=True)
-    sl = skeleton.dof_slices()
-    for j in skeleton.joints:
-        cols = [sl[j.name].start + k for k, d in enumerate(j.dofs) if d in ROT_DOFS]
-        if not cols:
-            continue
-        ang = out[:, cols]
-        if len(cols) == 3:
-            alt = np.stack([ang[:, 0] + 180.0, 180.0 - ang[:, 1], ang[:, 2] + 180.0], axis=1)
-            d0 = np.abs((ang[0] - anchor[cols] + 180.0) % 360.0 - 180.0).sum()
-            d1 = np.abs((alt[0] - anchor[cols] + 180.0) % 360.0 - 180.0).sum()
-            if d1 < d0:
-                ang = alt
-        full = np.vstack([anchor[cols][None, :], ang])
-        out[:, cols] = np.rad2deg(np.unwrap(np.deg2rad(full), axis=0))[1:]
+def _euler_from(anchor, ang: np.ndarray) -> np.ndarray:
+    """Euler triples ``ang (T, 3)`` (degrees, scipy's branch) made continuous from ``anchor (3,)``: each frame
+    takes the branch (``(a, b, c)`` or ``(a + 180, 180 - b, c + 180)``) nearer the frame before, then the
+    360-degree turn nearest it. A loop over plain floats: a few hundred frames per joint."""
+    out = np.empty_like(ang)
+    pa, pb, pc = (float(v) for v in anchor)
+    for t, (a, b, c) in enumerate(ang.tolist()):
+        best = None
+        for x, y, z in ((a, b, c), (a + 180.0, 180.0 - b, c + 180.0)):
+            x = pa + ((x - pa + 180.0) % 360.0 - 180.0)
+            y = pb + ((y - pb + 180.0) % 360.0 - 180.0)
+            z = pc + ((z - pc + 180.0) % 360.0 - 180.0)
+            d = abs(x - pa) + abs(y - pb) + abs(z - pc)
+            if best is None or d < best[0]:
+                best = (d, x, y, z)
+        _, pa, pb, pc = best
+        out[t] = (pa, pb, pc)
     return out
+
+
+def dof_values(skeleton, rotations: list, root_t: np.ndarray, anchor) -> np.ndarray:
+    """DOF values ``(T, n_dof)`` from local rotations (one ``Rotation`` of T per joint) and root translations,
+    every angle continuous from the pose ``anchor (n_dof,)`` (same Euler branch, unwrapped from it).
+
+    :func:`animsynth.kinematics.dof_values_from_local` with the continuity anchored to the frame before the
+    first (the generated frames continue a start) and the branch loop on plain floats (it runs per sample).
+    Joints with fewer than three rotational DOF keep their own axes (the others, applied last, are dropped).
+    """
+    anchor = np.asarray(anchor, float)
+    n = root_t.shape[0]
+    values = np.zeros((n, skeleton.n_dof))
+    sl = skeleton.dof_slices()
+    for i, j in enumerate(skeleton.joints):
+        start = sl[j.name].start
+        rd = [(k, d) for k, d in enumerate(j.dofs) if d in ROT_DOFS]
+        if rd:
+            C = j.axis_rotation()
+            M = C.inv() * rotations[i] * C
+            axes = [d[1] for _, d in rd]
+            full = axes + [a for a in "xyz" if a not in axes]
+            ang = M.as_euler("".join(full), degrees=True)
+            cols = [start + k for k, _ in rd]
+            if len(axes) == 3:
+                ang = _euler_from(anchor[cols], ang)
+            else:
+                ang = ang[:, :len(axes)]
+                ang = anchor[cols] + ((ang - anchor[cols] + 180.0) % 360.0 - 180.0)
+                ang = np.rad2deg(np.unwrap(np.deg2rad(np.vstack([anchor[cols][None, :], ang])), axis=0))[1:]
+            values[:, cols] = ang
+        for k, d in enumerate(j.dofs):
+            if d in TRANS_DOFS:
+                a = TRANS_DOFS.index(d)
+                values[:, start + k] = root_t[:, a] - j.offset[a]
+    return values
 
 
 def decode(skeleton, rotations: np.ndarray, tilt: np.ndarray, height: np.ndarray, step: np.ndarray,
@@ -211,5 +282,4 @@ def decode(skeleton, rotations: np.ndarray, tilt: np.ndarray, height: np.ndarray
     where = {int(i): k for k, i in enumerate(joints)}
     for i in range(1, len(skeleton.joints)):
         rots.append(Rotation.from_quat(rotations[:, where[i]]) if i in where else ident)
-    values = dof_values_from_local(skeleton, rots, pos)
-    return _branch_and_unwrap(skeleton, values, anchor)
+    return dof_values(skeleton, rots, pos, anchor)
