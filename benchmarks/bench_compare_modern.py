@@ -10,12 +10,14 @@ Rows (family ``compare``, unit ``ms``, CPU by ``time.process_time`` with one BLA
 jobs; wall and the load average in the row's ``baseline`` text):
 
 * ``motion_matching_sample_cpu_ms_<data>_w1``: :meth:`animsynth.compare.motionmatching.MotionMatching.generate`
-  (gamepad query, searches every 0.1 s, inertialization, decoding), mean over the paper's 5 seeds;
+  (gamepad query, searches every 0.1 s, inertialization, decoding), the first call from the start;
 * ``genmm_sample_cpu_ms_<data>_w1``: :meth:`animsynth.compare.genmm.GenMM.generate` (pyramid, 3 EM steps
-  per level, decoding), mean over 5 seeds.
+  per level, decoding), the first seed.
 
-Baseline, measured in the same run: the classic motion graph's sample on the same clip
-(:class:`animsynth.compare.motiongraph.MotionGraph`), ratio = ours / motion graph. The build (``fit``) CPU is
+The text gives the mean over the paper's 5 seeds too: motion matching is deterministic and keeps its last
+rollout, so its other seeds cost almost nothing. Baseline, measured in the same run: the classic motion graph's
+first sample on the same clip (:class:`animsynth.compare.motiongraph.MotionGraph`), ratio = ours / motion
+graph. The build (``fit``) CPU is
 in the text. Report only: the budget these rows serve (the compare family's paper-run job CPU may grow by at
 most 60 s for the two rows) is judged on the run's ``cost_timing.csv``, where scoring counts too.
 
@@ -67,14 +69,16 @@ def _clips(cmu: bool, crop: int | None) -> tuple[list[Motion], str]:
 
 
 def _sample_cost(gen, database, start, length, seeds):
-    """(fit CPU s, mean CPU s per sample, mean wall s per sample)."""
+    """(fit CPU s, CPU s of the first sample, mean CPU s per sample over ``seeds``, wall s of the first)."""
     c0 = time.process_time()
     gen.fit(database)
     fit = time.process_time() - c0
     c0, w0 = time.process_time(), time.perf_counter()
-    for s in range(seeds):
+    gen.generate(start, length, 1000)
+    first, first_wall = time.process_time() - c0, time.perf_counter() - w0
+    for s in range(1, seeds):
         gen.generate(start, length, 1000 + s)
-    return fit, (time.process_time() - c0) / seeds, (time.perf_counter() - w0) / seeds
+    return fit, first, (time.process_time() - c0) / seeds, first_wall
 
 
 def run(size: str = "full") -> list[dict]:
@@ -86,17 +90,18 @@ def run(size: str = "full") -> list[dict]:
         held, database = clips[0], clips[1:]
         start = Motion(np.asarray(held.values[:CONTEXT], float), held.skeleton, held.fps, "start")
         frames = sum(c.n_frames for c in database)
-        mg_fit, mg_cpu, mg_wall = _sample_cost(MotionGraph(), database, start, p["length"], p["seeds"])
+        mg_fit, mg_cpu, _mean, mg_wall = _sample_cost(MotionGraph(), database, start, p["length"], p["seeds"])
         load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
         for name, gen in (("motion_matching", MotionMatching()), ("genmm", GenMM())):
-            fit, cpu, wall = _sample_cost(gen, database, start, p["length"], p["seeds"])
+            fit, cpu, mean, wall = _sample_cost(gen, database, start, p["length"], p["seeds"])
             rows.append({
                 "family": "compare", "benchmark": f"{name}_sample_cpu_ms_{label}_w1",
                 "value": round(1000 * cpu, 1), "unit": "ms",
                 "baseline": f"motion graph sample on the same clip (build {mg_fit:.2f} s CPU, sample wall "
-                            f"{1000 * mg_wall:.0f} ms); ours: build {fit:.2f} s CPU, sample wall {1000 * wall:.0f} ms; "
+                            f"{1000 * mg_wall:.0f} ms); ours: build {fit:.2f} s CPU, first sample wall {1000 * wall:.0f} ms, "
+                            f"mean over the seeds {1000 * mean:.1f} ms CPU; "
                             f"database {frames} frames at {FPS:g} fps, {CONTEXT} + {p['length']} frames per sample, "
-                            f"mean of {p['seeds']} seeds; load average {load:.1f}",
+                            f"{p['seeds']} seeds; load average {load:.1f}",
                 "baseline_value": round(1000 * mg_cpu, 1), "ratio": round(cpu / mg_cpu, 2),
                 "target": "report only", "meets_target": np.nan})
     return rows

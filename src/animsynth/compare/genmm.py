@@ -60,7 +60,8 @@ def extract_patches(x: np.ndarray, size: int) -> np.ndarray:
     return np.ascontiguousarray(w.transpose(0, 2, 1)).reshape(T - size + 1, size * D)
 
 
-def match_patches(queries: np.ndarray, keys: np.ndarray, alpha: float = 0.01) -> tuple[np.ndarray, np.ndarray]:
+def match_patches(queries: np.ndarray, keys: np.ndarray, alpha: float = 0.01,
+                  key_norms: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Nearest key patch of every query patch, GenMM's distance.
 
     Parameters
@@ -70,6 +71,7 @@ def match_patches(queries: np.ndarray, keys: np.ndarray, alpha: float = 0.01) ->
     alpha : completeness normalisation: distances to key ``j`` are divided by ``alpha + min_i D[i, j]``
         (a key already matched well by some query costs more to the others, so unused keys are drawn
         in); ``inf``: plain nearest neighbours
+    key_norms : (m,) ``sum(keys ** 2, axis=1)`` when known (the database's patches do not change)
 
     Returns
     -------
@@ -79,7 +81,8 @@ def match_patches(queries: np.ndarray, keys: np.ndarray, alpha: float = 0.01) ->
     q = np.asarray(queries, float)
     k = np.asarray(keys, float)
     d = q.shape[1]
-    D = (np.sum(q * q, axis=1)[:, None] + np.sum(k * k, axis=1)[None, :] - 2.0 * (q @ k.T)) / d
+    kk = np.einsum("ij,ij->i", k, k) if key_norms is None else key_norms
+    D = (np.einsum("ij,ij->i", q, q)[:, None] + kk[None, :] - 2.0 * (q @ k.T)) / d
     np.maximum(D, 0.0, out=D)
     S = D if not np.isfinite(alpha) else D / (float(alpha) + D.min(axis=0)[None, :])
     nn = np.argmin(S, axis=1)
@@ -144,6 +147,7 @@ class GenMM(Generator):
     frames_ : list of ndarray (T_i, D), every clip's rows
     scales_ : list of float, the levels' scales, coarsest first
     keys_ : list of ndarray (m_k, patch_size * D), the database patches of each level
+    key_norms_ : list of ndarray (m_k,), their squared norms
     """
 
     name = "genmm"
@@ -223,10 +227,12 @@ class GenMM(Generator):
         self.scales_ = level_scales(longest, P, float(self.coarse_patches), float(self.pyramid_factor))
         self.level_frames_ = []
         self.keys_ = []
+        self.key_norms_ = []
         for s in self.scales_:
             lv = [resample_rows(f, max(2, int(round(f.shape[0] * s)))) for f in self.frames_]
             self.level_frames_.append(lv)
             self.keys_.append(np.vstack([extract_patches(f, P) for f in lv]))
+            self.key_norms_.append(np.einsum("ij,ij->i", self.keys_[-1], self.keys_[-1]))
         return self
 
     def generate(self, start: Motion, length: int, seed: int, initial: Motion | None = None) -> Motion:
@@ -275,7 +281,7 @@ class GenMM(Generator):
             ctx_rows = self._context_rows(ctx, pos[fixed])
             x[fixed] = ctx_rows
             for _ in range(int(self.n_steps)):
-                nn, dist = match_patches(extract_patches(x, P), keys, float(self.alpha))
+                nn, dist = match_patches(extract_patches(x, P), keys, float(self.alpha), self.key_norms_[k])
                 x = vote(keys[nn], P, L)
                 x[fixed] = ctx_rows
         values = self._decode(x[c:], np.asarray(start.values, float)[-1])

@@ -292,6 +292,7 @@ class MotionMatching(Generator):
                              f"{self.exclude_frames_ + 1} frames at {fps:g} fps)")
         q, vec = self._state(self.track_, fps, m)
         self.rot_, self.vec_ = q, vec
+        self._memo = None
         self.angular_velocity_ = self._angular_velocity(q, fps, starts)
         self.root_velocity_ = self._vec_velocity(vec, fps, starts)
         return self
@@ -335,8 +336,27 @@ class MotionMatching(Generator):
         ``meta``: ``seams``, ``source_frames`` (the database frame each output frame plays, before the
         offsets), ``costs`` (cost of the frame chosen at each search), ``search_frames`` (output frames
         whose pose follows a search), ``switches`` (searches that changed frame, the entry included).
+
+        Deterministic, so the last gamepad rollout is kept and a call with the same start and length (the
+        family's other seeds) returns a copy of it instead of computing it again.
         """
         self._check_start(start, length)
+        key = None
+        if trajectory is None:
+            key = (int(length), np.asarray(start.values, float).tobytes())
+            memo = getattr(self, "_memo", None)
+            if memo is not None and memo[0] == key:
+                m = memo[1]
+                return Motion(m.values.copy(), m.skeleton, m.fps, m.name,
+                              {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in m.meta.items()})
+        out = self._rollout(start, length, trajectory)
+        if key is not None:
+            self._memo = (key, out)
+            return Motion(out.values.copy(), out.skeleton, out.fps, out.name,
+                          {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in out.meta.items()})
+        return out
+
+    def _rollout(self, start: Motion, length: int, trajectory: Motion | None) -> Motion:
         db, length = self.db_, int(length)
         sk, fps = db.skeleton, db.fps
         m = float(sk.length_to_m)
