@@ -199,3 +199,15 @@ def test_genmm_refuses_bad_parameters(walks):
             GenMM(**kw).fit(walks[1:])
     with pytest.raises(ValueError, match="shorter than a patch"):
         GenMM().fit(walks[1:]).generate(_cut(walks[0], 0, 2), 3, 0)
+
+
+def test_genmm_patches_never_cross_clips(walks):
+    db = [walks[1], _cut(walks[2], 0, 20, "short"), _cut(walks[3], 0, 9, "shorter than a patch")]
+    g = GenMM(coarse_patches=100).fit(db)
+    keys = g.keys_[-1]
+    assert keys.shape[0] == (60 - 10) + (20 - 10) + 0  # every 11-frame window inside one clip, none across
+    rows = g.frames_
+    assert np.array_equal(keys[50], extract_patches(rows[1], 11)[0])  # the second clip's first patch
+    joined = extract_patches(np.vstack(rows[:2]), 11)
+    crossing = joined[50:60]  # windows that would start in the first clip and end in the second
+    assert not any(np.any(np.all(np.isclose(keys, c), axis=1)) for c in crossing)
