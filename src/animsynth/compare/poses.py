@@ -157,10 +157,12 @@ class Track:
 
 
 def _continuous_sign(q: np.ndarray) -> np.ndarray:
+    """Quaternions ``(T, ..., 4)`` with signs flipped so that consecutive frames have a non-negative dot product
+    (the running product of the raw consecutive signs)."""
     q = np.array(q, float, copy=True)
-    for t in range(1, q.shape[0]):
-        flip = np.sum(q[t] * q[t - 1], axis=-1) < 0
-        q[t, flip] *= -1
+    if q.shape[0] > 1:
+        s = np.where(np.sum(q[1:] * q[:-1], axis=-1) < 0, -1.0, 1.0)
+        q[1:] *= np.cumprod(s, axis=0)[..., None]
     return q
 
 
