@@ -129,7 +129,8 @@ def test_motion_matching_is_deterministic_and_keeps_the_interface(walks):
 
 def test_motion_matching_without_trajectory_weights_matches_on_the_pose_only(walks):
     full = MotionMatching().fit(walks[1:])
-    pose = make_motion_matching({}, trajectory_weight=0.0).fit(walks[1:])
+    pose = make_motion_matching({}, trajectory_weight=0.0, name="motion_matching_pose").fit(walks[1:])
+    assert pose.generate(_cut(walks[0], 0, 8), 5, 0).name == "motion_matching_pose"
     assert np.all(pose.features_[:, 15:] == 0.0) and np.any(full.features_[:, 15:] != 0.0)
     assert np.array_equal(pose.features_[:, :15], full.features_[:, :15])
     with pytest.raises(ValueError, match="trajectory_weight"):

@@ -297,9 +297,13 @@ class GenMM(Generator):
         return ctx[i0] * (1.0 - f) + ctx[i1] * f
 
 
-def make_genmm(cfg: dict | None = None, **override) -> GenMM:
+def make_genmm(cfg: dict | None = None, name: str | None = None, **override) -> GenMM:
     """An unfitted :class:`GenMM` from a config block (its keys are the parameters; ``None``: the paper's
-    defaults); keyword arguments override the block (e.g. ``alpha=float("inf")``, ``root="world"``)."""
+    defaults); keyword arguments override the block (e.g. ``alpha=float("inf")``, ``root="world"``) and ``name``
+    sets the generator's name (the row)."""
     kw = dict(cfg or {})
     kw.update(override)
-    return GenMM(**kw)
+    gen = GenMM(**kw)
+    if name is not None:
+        gen.name = name
+    return gen

@@ -463,10 +463,15 @@ class MotionMatching(Generator):
                             search_frames=np.asarray(searched, np.int64), switches=int(switches))
 
 
-def make_motion_matching(cfg: dict | None = None, trajectory_weight: float | None = None) -> MotionMatching:
-    """An unfitted :class:`MotionMatching` from a config block (``{trajectory_weight: ..}`` or ``None`` for the
-    reference's constants); ``trajectory_weight`` overrides the block's (0: the pose-only ablation row)."""
+def make_motion_matching(cfg: dict | None = None, trajectory_weight: float | None = None,
+                         name: str | None = None) -> MotionMatching:
+    """An unfitted :class:`MotionMatching` from a config block (its keys are the parameters; ``None``: the
+    reference's constants); ``trajectory_weight`` overrides the block's (0: the pose-only ablation row) and
+    ``name`` the generator's name (the row, e.g. ``motion_matching_pose``)."""
     kw = dict(cfg or {})
     if trajectory_weight is not None:
         kw["trajectory_weight"] = trajectory_weight
-    return MotionMatching(**kw)
+    gen = MotionMatching(**kw)
+    if name is not None:
+        gen.name = name
+    return gen
