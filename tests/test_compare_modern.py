@@ -2,20 +2,24 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from animsynth.compare import generators as G
 from animsynth.compare import jobs
+from animsynth.compare.footlock import contact_points, leg_chains, lock_contacts, two_bone_ik
 from animsynth.compare.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
 from animsynth.compare.motionmatching import (MotionMatching, decay_spring, make_motion_matching, spring_angle,
                                               spring_position)
 from animsynth.compare.poses import decode, encode
-from animsynth.kinematics import root_translation
+from animsynth.kinematics import bone_lengths, forward_kinematics, root_translation
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 INF = float("inf")
+DATA = Path(__file__).parent / "data"
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +88,8 @@ def test_gamepad_below_the_deadzone_asks_to_stand(walks):
 def test_motion_matching_on_a_clip_of_its_database_with_the_true_trajectory_is_the_replay(walks):
     db = walks
     clip, c, length = walks[2], 8, 40
-    mm = MotionMatching().fit(db)
+    # the matching and blending; the reference's foot clean-up (below) then edits only the legs
+    mm = MotionMatching(foot_lock=False).fit(db)
     start, truth = _cut(clip, 0, c, "start"), _cut(clip, c, clip.n_frames, "truth")
     m = mm.generate(start, length, 0, trajectory=truth)
     costs = m.meta["costs"]
@@ -94,6 +99,13 @@ def test_motion_matching_on_a_clip_of_its_database_with_the_true_trajectory_is_t
     assert np.array_equal(m.meta["source_frames"][:, 1], np.arange(c, c + length))
     replay = G.Replay(held_out=clip).fit(db).generate(start, length, 0)
     assert _angle_diff(m.values, replay.values) < 1e-8
+    locked = MotionMatching().fit(db).generate(start, length, 0, trajectory=truth)
+    assert np.array_equal(locked.meta["source_frames"], m.meta["source_frames"])
+    sk = clip.skeleton
+    sl = sk.dof_slices()
+    legs = {sk.joints[j].name for j in leg_chains(sk)[:, :2].ravel()}
+    other = [c for j in sk.joints if j.name not in legs for c in range(sl[j.name].start, sl[j.name].stop)]
+    assert _angle_diff(locked.values[:, other], replay.values[:, other]) < 1e-8
 
 
 def test_motion_matching_is_deterministic_and_keeps_the_interface(walks):
@@ -135,6 +147,130 @@ def test_motion_matching_without_trajectory_weights_matches_on_the_pose_only(wal
     assert np.array_equal(pose.features_[:, :15], full.features_[:, :15])
     with pytest.raises(ValueError, match="trajectory_weight"):
         MotionMatching(trajectory_weight=-1).fit(walks[1:])
+
+
+# ----------------------------------------------------------------------------- foot locking and leg IK
+
+
+def _hip_and_ball(sk, values, chain):
+    starts = forward_kinematics(sk, values, ends=False) * sk.length_to_m
+    return starts[:, chain[0]], contact_points(sk, values, leg_chains(sk))[:, list(leg_chains(sk)[:, 0]).index(
+        chain[0])]
+
+
+def test_two_bone_ik_reaches_a_reachable_target_exactly_and_keeps_bone_lengths(walks):
+    m = walks[1]
+    sk, values = m.skeleton, np.asarray(m.values[:12], float)
+    legs = leg_chains(sk)
+    for f, chain in enumerate(legs):
+        hip, ball = _hip_and_ball(sk, values, chain)
+        # nearer the hip and off to the side: inside the leg's reach, not on its current circle
+        targets = hip + 0.85 * (ball - hip) + np.array([0.04, 0.03, -0.05])
+        out = two_bone_ik(sk, values, chain, targets)
+        _, got = _hip_and_ball(sk, out, chain)
+        assert np.abs(got - targets).max() < 1e-6  # metres
+        assert np.abs(got - ball).max() > 0.05  # it did move
+        assert np.allclose(bone_lengths(sk, out), bone_lengths(sk, values), atol=1e-9)
+        changed = np.flatnonzero(np.any(out != values, axis=0))
+        sl = sk.dof_slices()
+        leg_cols = set(range(sl[sk.joints[chain[0]].name].start, sl[sk.joints[chain[0]].name].stop)) | set(
+            range(sl[sk.joints[chain[1]].name].start, sl[sk.joints[chain[1]].name].stop))
+        assert set(changed.tolist()) <= leg_cols  # only the hip and the knee turn
+
+
+@pytest.mark.parametrize("buffer_m", [0.0, 0.015])
+def test_two_bone_ik_stretches_the_leg_towards_an_unreachable_target(walks, buffer_m):
+    m = walks[1]
+    sk, values = m.skeleton, np.asarray(m.values[3:4], float)
+    chain = leg_chains(sk)[0]
+    hip, ball = _hip_and_ball(sk, values, chain)
+    target = hip + np.array([[0.6, -2.5, 0.9]])  # metres away: out of reach
+    out = two_bone_ik(sk, values, chain, target, max_length_buffer_m=buffer_m)
+    _, got = _hip_and_ball(sk, out, chain)
+    d_got = got - hip
+    u = (target - hip) / np.linalg.norm(target - hip)
+    assert float(np.sum(d_got * u) / np.linalg.norm(d_got)) > 1.0 - 1e-12  # pointing at it
+    # fully stretched: the largest hip-to-ball distance any knee angle gives (a sweep of the knee's DOF)
+    knee = sk.joints[chain[1]]
+    col = sk.dof_slices()[knee.name].start
+    sweep = np.repeat(values, 7201, axis=0)
+    sweep[:, col] = np.linspace(-180.0, 180.0, 7201)
+    h, b = _hip_and_ball(sk, sweep, chain)
+    reach = float(np.linalg.norm(b - h, axis=1).max())
+    assert float(np.linalg.norm(d_got)) == pytest.approx(reach - buffer_m, abs=1e-5)
+    assert np.allclose(bone_lengths(sk, out), bone_lengths(sk, values), atol=1e-9)
+
+
+def test_a_locked_contact_stays_put_and_releases_beyond_the_unlock_radius():
+    fps, h = 30.0, 0.03
+    T = 40
+    x = np.zeros((T, 1, 3))
+    x[:, 0, 1] = h
+    x[9:, 0, 0] = 0.05 * np.arange(1, T - 8)  # at rest until frame 8, then sliding 1.5 m/s under the lock
+    states = np.zeros((T, 1), bool)
+    states[5:] = True  # in contact from frame 5 on
+    tg, locked = lock_contacts(x, states, fps, x[0], np.array([h]), unlock_radius_m=0.2,
+                               halflife_s=0.1)
+    assert np.array_equal(tg[:6], x[:6])  # free: the animation itself
+    assert not locked[:6].any() and locked[6:14].all() and not locked[14:].any()
+    # locked from frame 6: constant while the animation slides, up to 0.25 m away at frame 13
+    assert np.abs(tg[6:14] - x[5]).max() < 1e-6
+    assert np.linalg.norm(x[13, 0] - x[5, 0]) > 0.2 >= np.linalg.norm(x[12, 0] - x[5, 0])  # released only beyond
+    # released: blends back to the animation (no jump), the offset decaying with the half-life
+    assert np.linalg.norm(tg[14, 0] - tg[13, 0]) < 0.1
+    gap = np.linalg.norm(tg[:, 0] - x[:, 0], axis=1)
+    assert gap[-1] < 0.05 * gap[14] and np.all(np.diff(gap[16:]) < 0)
+    # the contact starting above its height: locked at the contact height, horizontally in place at once
+    y = x.copy()
+    y[:, 0, 1] = h + 0.02
+    tg2, _ = lock_contacts(y, states, fps, y[0], np.array([h]))
+    # (released a frame earlier: the distance is 3-D, and 0.2 m along the floor is beyond the radius at 2 cm up)
+    assert np.abs(tg2[6:13, 0, [0, 2]] - y[5, 0, [0, 2]]).max() < 1e-6
+    assert tg2[12, 0, 1] < tg2[6, 0, 1] < h + 0.02
+
+
+def test_motion_matching_without_foot_lock_is_unchanged(walks):
+    """The ablation row (foot_lock=False) is the motion matching of before foot locking, bit for bit
+    (tests/data/motion_matching_without_foot_lock.npz: generated by that code on these walks)."""
+    ref = np.load(DATA / "motion_matching_without_foot_lock.npz")
+    start = _cut(walks[0], 0, 8)
+    a = make_motion_matching({}, foot_lock=False).fit(walks[1:]).generate(start, 45, 0)
+    b = make_motion_matching({}, trajectory_weight=0.0, foot_lock=False).fit(walks[1:]).generate(start, 45, 0)
+    assert np.array_equal(a.values, ref["motion_matching"])
+    assert np.array_equal(b.values, ref["motion_matching_pose"])
+    assert "contact_targets" not in a.meta
+
+
+def test_motion_matching_locks_the_feet_by_default_with_the_leg_ik(walks):
+    assert MotionMatching().foot_lock is True and make_motion_matching({}).foot_lock is True
+    start = _cut(walks[0], 0, 8)
+    free = make_motion_matching({}, foot_lock=False).fit(walks[1:]).generate(start, 45, 0)
+    mm = MotionMatching().fit(walks[1:])
+    assert mm.contacts_.shape == (sum(w.n_frames for w in walks[1:]), 2) and mm.contacts_.any()
+    mm.contacts_[:] = True  # every frame in contact: both feet lock at the first frame
+    m = mm.generate(start, 45, 0)
+    assert np.array_equal(m.meta["source_frames"], free.meta["source_frames"])  # the same matches ...
+    sk = walks[0].skeleton
+    sl = sk.dof_slices()
+    legs = mm.legs_
+    cols = sorted(c for j in legs[:, :2].ravel() for c in range(sl[sk.joints[j].name].start,
+                                                                 sl[sk.joints[j].name].stop))
+    other = np.setdiff1d(np.arange(sk.n_dof), cols)
+    assert np.array_equal(m.values[:, other], free.values[:, other])  # ... only hips and knees differ
+    locked, tg = m.meta["contact_locked"], m.meta["contact_targets"]
+    assert locked[1:].any()
+    starts = forward_kinematics(sk, m.values, ends=False) * sk.length_to_m
+    pts = contact_points(sk, m.values, legs)
+    reached = 0
+    for f in range(2):
+        for t in np.flatnonzero(locked[:, f]):
+            hip = starts[t, legs[f, 0]]
+            d, want = pts[t, f] - hip, tg[t, f] - hip
+            # on the ray from the hip to the target: at it, or the leg stretched towards it
+            assert float(d @ want) / (np.linalg.norm(d) * np.linalg.norm(want)) > 1.0 - 1e-9
+            assert np.linalg.norm(d) <= np.linalg.norm(want) + 1e-6
+            reached += int(np.linalg.norm(pts[t, f] - tg[t, f]) < 1e-6)
+    assert reached > 0
 
 
 # ----------------------------------------------------------------------------- GenMM

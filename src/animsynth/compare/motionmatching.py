@@ -60,6 +60,7 @@ from scipy.spatial.transform import Rotation
 from ..joints import resolve_roles
 from ..kinematics import forward_kinematics
 from ..motion import Motion
+from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, two_bone_ik
 from .generators import Database, Generator
 from .poses import Track, decode, encode, qexp, qinv, qlog, qmul, rest_forward, wrap_angle, yaw_rotation
 
@@ -205,7 +206,9 @@ class MotionMatching(Generator):
 
     def __init__(self, trajectory_weight: float = 1.0, weights=(0.75, 1.0, 1.0, 1.0, 1.5), search_s: float = 0.1,
                  exclude_s: float = 1.0 / 3.0, future_s=(1.0 / 3.0, 2.0 / 3.0, 1.0), inertialize_halflife_s: float = 0.1,
-                 trajectory_halflife_s: float = 0.27, deadzone_m_s: float = 0.2):
+                 trajectory_halflife_s: float = 0.27, deadzone_m_s: float = 0.2, foot_lock: bool = True,
+                 unlock_radius_m: float = 0.2, foot_lock_halflife_s: float = 0.1, ik_max_length_buffer_m: float = 0.015,
+                 contact_speed_m_s: float = 0.15, contact_filter_s: float = 0.1):
         self.trajectory_weight = trajectory_weight
         self.weights = weights
         self.search_s = search_s
@@ -214,6 +217,12 @@ class MotionMatching(Generator):
         self.inertialize_halflife_s = inertialize_halflife_s
         self.trajectory_halflife_s = trajectory_halflife_s
         self.deadzone_m_s = deadzone_m_s
+        self.foot_lock = foot_lock
+        self.unlock_radius_m = unlock_radius_m
+        self.foot_lock_halflife_s = foot_lock_halflife_s
+        self.ik_max_length_buffer_m = ik_max_length_buffer_m
+        self.contact_speed_m_s = contact_speed_m_s
+        self.contact_filter_s = contact_filter_s
 
     # -- per-frame state -------------------------------------------------------------------------------
 
@@ -295,7 +304,26 @@ class MotionMatching(Generator):
         self._memo = None
         self.angular_velocity_ = self._angular_velocity(q, fps, starts)
         self.root_velocity_ = self._vec_velocity(vec, fps, starts)
+        if self.foot_lock:
+            self._fit_contacts(db)
         return self
+
+    def _fit_contacts(self, db: Database) -> None:
+        """Leg chains, the database's contact labels and heights (foot locking)."""
+        for key in ("unlock_radius_m", "foot_lock_halflife_s", "contact_speed_m_s"):
+            if not float(getattr(self, key)) > 0:
+                raise ValueError(f"motion matching: {key} must be > 0, got {getattr(self, key)!r}")
+        if float(self.ik_max_length_buffer_m) < 0 or float(self.contact_filter_s) < 0:
+            raise ValueError("motion matching: ik_max_length_buffer_m and contact_filter_s must be >= 0")
+        sk, fps = db.skeleton, db.fps
+        self.legs_ = leg_chains(sk)
+        pts = [contact_points(sk, c.values, self.legs_) for c in db.clips]
+        self.contacts_ = np.vstack([contact_labels(p, fps, float(self.contact_speed_m_s), float(self.contact_filter_s))
+                                    for p in pts])
+        heights = np.vstack(pts)[:, :, 1]
+        self.floor_ = heights.min(axis=0)
+        self.contact_height_ = np.array([float(np.median(heights[self.contacts_[:, f], f]))
+                                         if self.contacts_[:, f].any() else float(self.floor_[f]) for f in range(2)])
 
     def _normalise(self, raw: np.ndarray) -> np.ndarray:
         return (raw - self.mean_) / self.scale_ * self.weight_
@@ -459,18 +487,41 @@ class MotionMatching(Generator):
             yaws.append(yaw_prev + out_vec[t, 3] / fps)
         values = decode(sk, out_q[:, 1:], out_q[:, 0], out_vec[:, 0] / m, out_vec[:, 1:3] / (m * fps),
                         out_vec[:, 3] / fps, np.asarray(start.values, float)[-1], self.forward_)
+        extra = {}
+        if self.foot_lock:
+            values, extra = self._lock_feet(start, values, played)
         return self._motion(values, length, seams, db.sources(played), costs=np.asarray(costs),
-                            search_frames=np.asarray(searched, np.int64), switches=int(switches))
+                            search_frames=np.asarray(searched, np.int64), switches=int(switches), **extra)
+
+    def _lock_feet(self, start: Motion, values: np.ndarray, played: np.ndarray):
+        """The reference's foot locking and two-bone IK on the decoded frames (:mod:`.footlock`)."""
+        sk, fps = self.db_.skeleton, self.db_.fps
+        prev = contact_points(sk, np.asarray(start.values, float)[-1:], self.legs_)
+        pts = contact_points(sk, values, self.legs_)
+        targets, locked = lock_contacts(pts, self.contacts_[played], fps, prev[-1], self.contact_height_,
+                                        float(self.unlock_radius_m), float(self.foot_lock_halflife_s))
+        targets[:, :, 1] = np.maximum(targets[:, :, 1], self.floor_[None, :])
+        out = values.copy()
+        for f in range(2):
+            move = np.linalg.norm(targets[:, f] - pts[:, f], axis=1) > 1e-9
+            if move.any():
+                out[move] = two_bone_ik(sk, out[move], self.legs_[f], targets[move, f],
+                                        float(self.ik_max_length_buffer_m))
+        return out, {"contact_targets": targets, "contact_locked": locked,
+                     "contact_states": self.contacts_[played].copy()}
 
 
 def make_motion_matching(cfg: dict | None = None, trajectory_weight: float | None = None,
-                         name: str | None = None) -> MotionMatching:
+                         name: str | None = None, foot_lock: bool | None = None) -> MotionMatching:
     """An unfitted :class:`MotionMatching` from a config block (its keys are the parameters; ``None``: the
-    reference's constants); ``trajectory_weight`` overrides the block's (0: the pose-only ablation row) and
+    reference's constants); ``trajectory_weight`` overrides the block's (0: the pose-only ablation row),
+    ``foot_lock`` its foot locking (``False``: the ablation without the reference's foot locking and IK) and
     ``name`` the generator's name (the row, e.g. ``motion_matching_pose``)."""
     kw = dict(cfg or {})
     if trajectory_weight is not None:
         kw["trajectory_weight"] = trajectory_weight
+    if foot_lock is not None:
+        kw["foot_lock"] = bool(foot_lock)
     gen = MotionMatching(**kw)
     if name is not None:
         gen.name = name
