@@ -10,7 +10,8 @@ Rows (family ``compare``, unit ``ms``, CPU by ``time.process_time`` with one BLA
 jobs; wall and the load average in the row's ``baseline`` text):
 
 * ``motion_matching_sample_cpu_ms_<data>_w1``: :meth:`animsynth.compare.motionmatching.MotionMatching.generate`
-  (gamepad query, searches every 0.1 s, inertialization, decoding), the first call from the start;
+  (gamepad query, searches every 0.1 s, inertialization, decoding, and the reference's default foot locking
+  with two-bone leg IK), the first call from the start;
 * ``genmm_sample_cpu_ms_<data>_w1``: :meth:`animsynth.compare.genmm.GenMM.generate` (pyramid, 3 EM steps
   per level, decoding), the first seed.
 

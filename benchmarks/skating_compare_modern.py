@@ -13,7 +13,9 @@ Rows: ``motion_matching`` (the reference's defaults: foot locking and leg IK on)
 :func:`animsynth.compare.generators.make_generator`). Motion matching is deterministic, so one seed per clip;
 the motion graph gets the run's 5 seeds. Per clip the seeds' mean; printed: the mean, median and pooled values
 over clips, how many clips motion matching skates less than the motion graph on, and the CPU per sample
-(``time.process_time``, one BLAS thread; motion matching's first call, before its rollout is kept).
+(``time.process_time``, one BLAS thread; motion matching's first call, before its rollout is kept), and for
+motion matching the contact and skating foot-joint frames split by what the foot locking did (locked; labelled in
+contact but not locked; labelled moving).
 
 Run: ``python benchmarks/skating_compare_modern.py [out.csv]`` (a few minutes of one core).
 """
@@ -25,6 +27,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import yaml
 from threadpoolctl import threadpool_limits
@@ -63,6 +66,32 @@ def clips() -> tuple[list, dict]:
     return jobs.prepare_clips(motions, subsets, reseq, cfg), cfg
 
 
+def _by_lock(clip, ref, motion, mcfg) -> dict:
+    """Contact and skating foot-joint frames of the generated motion (as ``foot_skating`` counts them) split by
+    what the foot locking did to their foot: ``locked`` (the target is a locked point), ``label`` (the played
+    database frame is labelled in contact but the foot is not locked: released or not yet) and ``moving``
+    (labelled out of contact, so never locked). Empty for a motion without foot locking."""
+    if "contact_locked" not in motion.meta:
+        return {}
+    from animsynth.compare import metrics as M
+    from animsynth.motion import Motion
+
+    joined = Motion(np.vstack([clip.start.values[-1:], motion.values]), motion.skeleton, motion.fps)
+    P = M.positions(joined)[:, ref.foot_idx]
+    step = np.linalg.norm(np.diff(P[:, :, [0, 2]], axis=0), axis=-1) * motion.fps
+    contact = (P[1:, :, 1] - ref.floor) < float(mcfg["contact_height_m"])
+    skate = contact & (step > float(mcfg["skate_speed_m_s"]))
+    foot = np.array([0, 0, 1, 1])  # FOOT_ROLES: left ankle, left toe, right ankle, right toe
+    locked = motion.meta["contact_locked"][:, foot]
+    label = motion.meta["contact_states"][:, foot] & ~locked
+    moving = ~motion.meta["contact_states"][:, foot]
+    out = {}
+    for name, sel in (("locked", locked), ("label", label), ("moving", moving)):
+        out[f"contact_{name}"] = int((contact & sel).sum())
+        out[f"skate_{name}"] = int((skate & sel).sum())
+    return out
+
+
 def run(out: str | None = None) -> pd.DataFrame:
     with threadpool_limits(limits=1, user_api="blas"):
         cl, cfg = clips()
@@ -87,7 +116,7 @@ def run(out: str | None = None) -> pd.DataFrame:
                                  "skate_share": row["skate_share"], "contact_share": row["contact_share"],
                                  "transition_skate_share": row["transition_skate_share"],
                                  "skate_m_per_contact_frame": row["skate_m_per_contact_frame"],
-                                 "n_seams": row["n_seams"], "sample_cpu_ms": 1000 * cpu})
+                                 "n_seams": row["n_seams"], "sample_cpu_ms": 1000 * cpu, **_by_lock(clip, ref, m, mcfg)})
     df = pd.DataFrame(rows)
     if out:
         df.to_csv(out, index=False)
@@ -104,6 +133,11 @@ def summary(df: pd.DataFrame) -> str:
                      f"{d.contact_share.mean():.3f}; skate m/contact frame {d.skate_m_per_contact_frame.mean():.4f}; "
                      f"seams {d.n_seams.mean():.1f}; CPU/sample median {d.sample_cpu_ms.median():.1f} ms "
                      f"(mean {d.sample_cpu_ms.mean():.1f})")
+    mm = df[df.generator == "motion_matching"]
+    if "contact_locked" in mm:
+        parts = [f"{k}: {int(mm[f'skate_{k}'].sum())} of {int(mm[f'contact_{k}'].sum())} contact joint-frames skate "
+                 f"({mm[f'skate_{k}'].sum() / max(mm[f'contact_{k}'].sum(), 1):.2f})" for k in ("locked", "label", "moving")]
+        lines.append("motion_matching by foot state: " + "; ".join(parts))
     w = per.pivot(index="clip", columns="generator", values="skate_share")
     for a in ("motion_matching", "motion_matching_no_lock"):
         less = int((w[a] < w["motion_graph"]).sum())

@@ -46,10 +46,27 @@ position, velocity (backward difference; acceleration taken as zero) and facing 
 ``generate(..., trajectory=motion)`` replaces the gamepad with a given future (the known-answer tests:
 a clip's own continuation), its root positions and facings read relative to the generated root.
 
+Foot locking and leg IK (``foot_lock=True``, the reference's default ``ik_enabled``;
+:mod:`animsynth.compare.footlock`): the database's frames are labelled in contact where the foot's contact
+point (the end of the ankle role's segment: the ball of the foot, the reference's toe bone) moves slower
+than ``contact_speed_m_s`` (0.15 m/s), median-filtered over ``contact_filter_s`` (0.1 s; the reference: 6
+frames at 60 fps). While playing, a foot whose played frame starts a contact is locked where it is (at its
+median contact height in the database), stays there until its contact ends or the animation's point is more
+than ``unlock_radius_m`` (0.2 m) away, and every lock and release is blended by the same critically damped
+spring (``foot_lock_halflife_s``, 0.1 s); hips and knees are then turned by analytic two-bone IK so the
+contact points reach their targets, kept ``ik_max_length_buffer_m`` (0.015 m) short of full extension.
+These constants are the reference's (``ik_unlock_radius``, ``ik_blending_halflife``,
+``ik_max_length_buffer``, and its database script's contact speed and filter). What differs (details in
+:mod:`animsynth.compare.footlock`): the IK's end effector is the contact point itself, so there is no heel
+look-at and no toe alignment with the floor (``ik_toe_length``); the knee turns about its own DOF axis and
+the result is written back to the skeleton's Euler DOF; heights come from the database (lock height: the
+foot's median contact height; the floor clamp: its lowest height) instead of a floor at 0 with
+``ik_foot_height`` 0.02 m. ``foot_lock=False`` is the ablation: the matching and blending alone (exactly
+the output of this class before foot locking was added).
+
 Departures from the reference: offline, so there is no separate simulated character, no trajectory
-adjustment or clamping of the character to the simulation, no bounding-box acceleration of the search
-(brute force over at most a few thousand frames) and no foot locking or IK. Deterministic: the seed is
-not used (seed diversity 0).
+adjustment or clamping of the character to the simulation and no bounding-box acceleration of the search
+(brute force over at most a few thousand frames). Deterministic: the seed is not used (seed diversity 0).
 """
 
 from __future__ import annotations
@@ -187,6 +204,12 @@ class MotionMatching(Generator):
     inertialize_halflife_s : float, half-life of the transition offsets (0.1 s)
     trajectory_halflife_s : float, half-life of the gamepad springs (0.27 s)
     deadzone_m_s : float, a start slower than this asks to stand (0.2 m/s)
+    foot_lock : bool, the reference's foot locking and two-bone leg IK (True, its default; False: the ablation)
+    unlock_radius_m : float, a locked foot is released when the animation's is farther than this (0.2 m)
+    foot_lock_halflife_s : float, half-life of the lock and release blends (0.1 s)
+    ik_max_length_buffer_m : float, the IK keeps the leg this much short of full extension (0.015 m)
+    contact_speed_m_s : float, a database frame's foot is in contact below this speed (0.15 m/s)
+    contact_filter_s : float, median filter of the contact labels (0.1 s)
 
     Attributes
     ----------
@@ -200,6 +223,9 @@ class MotionMatching(Generator):
     root_velocity_ : ndarray (N, 4), derivative of height, ground velocity (x, z) and turning rate
     search_frames_, exclude_frames_, future_frames_ : the times in frames
     forward_ : ndarray (3,), the skeleton's rest forward direction (facing yaw 0)
+    legs_ : int ndarray (2, 3), hip, knee and ankle joints of the left and right legs (foot locking)
+    contacts_ : bool ndarray (N, 2), the database frames' contact labels (foot locking)
+    contact_height_, floor_ : ndarray (2,), each foot's median contact height and lowest height (m)
     """
 
     name = "motion_matching"
@@ -363,7 +389,9 @@ class MotionMatching(Generator):
 
         ``meta``: ``seams``, ``source_frames`` (the database frame each output frame plays, before the
         offsets), ``costs`` (cost of the frame chosen at each search), ``search_frames`` (output frames
-        whose pose follows a search), ``switches`` (searches that changed frame, the entry included).
+        whose pose follows a search), ``switches`` (searches that changed frame, the entry included); with
+        foot locking ``contact_targets`` (length, 2, 3) (where each foot's contact point was sent, m),
+        ``contact_locked`` and ``contact_states`` (length, 2) (locked; the played frame's label).
 
         Deterministic, so the last gamepad rollout is kept and a call with the same start and length (the
         family's other seeds) returns a copy of it instead of computing it again.
