@@ -15,7 +15,7 @@ the motion graph gets the run's 5 seeds. Per clip the seeds' mean; printed: the 
 over clips, how many clips motion matching skates less than the motion graph on, and the CPU per sample
 (``time.process_time``, one BLAS thread; motion matching's first call, before its rollout is kept), and for
 motion matching the contact and skating foot-joint frames split by what the foot locking did (locked; labelled in
-contact but not locked; labelled moving).
+contact but not locked; labelled moving) and how near its locked feet come to their locks.
 
 Run: ``python benchmarks/skating_compare_modern.py [out.csv]`` (a few minutes of one core).
 """
@@ -85,7 +85,13 @@ def _by_lock(clip, ref, motion, mcfg) -> dict:
     locked = motion.meta["contact_locked"][:, foot]
     label = motion.meta["contact_states"][:, foot] & ~locked
     moving = ~motion.meta["contact_states"][:, foot]
-    out = {}
+    from animsynth.compare.footlock import contact_points, leg_chains
+
+    sk = motion.skeleton
+    miss = np.linalg.norm(contact_points(sk, motion.values, leg_chains(sk)) - motion.meta["contact_targets"], axis=-1)
+    miss = miss[motion.meta["contact_locked"]]
+    out = {"locked_frames": int(miss.size), "lock_miss_mm_sum": 1000 * float(miss.sum()),
+           "lock_miss_under_1mm": int((miss < 0.001).sum())}
     for name, sel in (("locked", locked), ("label", label), ("moving", moving)):
         out[f"contact_{name}"] = int((contact & sel).sum())
         out[f"skate_{name}"] = int((skate & sel).sum())
@@ -138,6 +144,9 @@ def summary(df: pd.DataFrame) -> str:
         parts = [f"{k}: {int(mm[f'skate_{k}'].sum())} of {int(mm[f'contact_{k}'].sum())} contact joint-frames skate "
                  f"({mm[f'skate_{k}'].sum() / max(mm[f'contact_{k}'].sum(), 1):.2f})" for k in ("locked", "label", "moving")]
         lines.append("motion_matching by foot state: " + "; ".join(parts))
+        n = max(int(mm.locked_frames.sum()), 1)
+        lines.append(f"motion_matching locked foot-frames {int(mm.locked_frames.sum())}: contact point within 1 mm of "
+                     f"its lock on {mm.lock_miss_under_1mm.sum() / n:.2f}, mean miss {mm.lock_miss_mm_sum.sum() / n:.1f} mm")
     w = per.pivot(index="clip", columns="generator", values="skate_share")
     for a in ("motion_matching", "motion_matching_no_lock"):
         less = int((w[a] < w["motion_graph"]).sum())

@@ -9,7 +9,7 @@ import pytest
 
 from animsynth.compare import generators as G
 from animsynth.compare import jobs
-from animsynth.compare.footlock import contact_points, leg_chains, lock_contacts, two_bone_ik
+from animsynth.compare.footlock import contact_points, leg_chains, lock_contacts, place_feet, two_bone_ik
 from animsynth.compare.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
 from animsynth.compare.motionmatching import (MotionMatching, decay_spring, make_motion_matching, spring_angle,
                                               spring_position)
@@ -103,7 +103,7 @@ def test_motion_matching_on_a_clip_of_its_database_with_the_true_trajectory_is_t
     assert np.array_equal(locked.meta["source_frames"], m.meta["source_frames"])
     sk = clip.skeleton
     sl = sk.dof_slices()
-    legs = {sk.joints[j].name for j in leg_chains(sk)[:, :2].ravel()}
+    legs = {sk.joints[j].name for j in leg_chains(sk).ravel()}
     other = [c for j in sk.joints if j.name not in legs for c in range(sl[j.name].start, sl[j.name].stop)]
     assert _angle_diff(locked.values[:, other], replay.values[:, other]) < 1e-8
 
@@ -152,30 +152,59 @@ def test_motion_matching_without_trajectory_weights_matches_on_the_pose_only(wal
 # ----------------------------------------------------------------------------- foot locking and leg IK
 
 
-def _hip_and_ball(sk, values, chain):
+def _hip_and_ball(sk, values, chain, effector="ball"):
     starts = forward_kinematics(sk, values, ends=False) * sk.length_to_m
+    if effector == "heel":
+        return starts[:, chain[0]], starts[:, chain[2]]
     return starts[:, chain[0]], contact_points(sk, values, leg_chains(sk))[:, list(leg_chains(sk)[:, 0]).index(
         chain[0])]
 
 
-def test_two_bone_ik_reaches_a_reachable_target_exactly_and_keeps_bone_lengths(walks):
+def _cols(sk, joints):
+    sl = sk.dof_slices()
+    return {c for j in joints for c in range(sl[sk.joints[j].name].start, sl[sk.joints[j].name].stop)}
+
+
+@pytest.mark.parametrize("effector", ["ball", "heel"])
+def test_two_bone_ik_reaches_a_reachable_target_exactly_and_keeps_bone_lengths(walks, effector):
     m = walks[1]
     sk, values = m.skeleton, np.asarray(m.values[:12], float)
     legs = leg_chains(sk)
     for f, chain in enumerate(legs):
-        hip, ball = _hip_and_ball(sk, values, chain)
+        hip, ball = _hip_and_ball(sk, values, chain, effector)
         # nearer the hip and off to the side: inside the leg's reach, not on its current circle
         targets = hip + 0.85 * (ball - hip) + np.array([0.04, 0.03, -0.05])
-        out = two_bone_ik(sk, values, chain, targets)
-        _, got = _hip_and_ball(sk, out, chain)
+        out = two_bone_ik(sk, values, chain, targets, effector=effector)
+        _, got = _hip_and_ball(sk, out, chain, effector)
         assert np.abs(got - targets).max() < 1e-6  # metres
         assert np.abs(got - ball).max() > 0.05  # it did move
         assert np.allclose(bone_lengths(sk, out), bone_lengths(sk, values), atol=1e-9)
         changed = np.flatnonzero(np.any(out != values, axis=0))
-        sl = sk.dof_slices()
-        leg_cols = set(range(sl[sk.joints[chain[0]].name].start, sl[sk.joints[chain[0]].name].stop)) | set(
-            range(sl[sk.joints[chain[1]].name].start, sl[sk.joints[chain[1]].name].stop))
-        assert set(changed.tolist()) <= leg_cols  # only the hip and the knee turn
+        assert set(changed.tolist()) <= _cols(sk, chain[:2])  # only the hip and the knee turn
+
+
+def test_placing_a_foot_keeps_its_world_orientation(walks):
+    m = walks[1]
+    sk, values = m.skeleton, np.asarray(m.values[:12], float)
+    chain = leg_chains(sk)[0]
+    hip, ball = _hip_and_ball(sk, values, chain)
+    targets = hip + 0.85 * (ball - hip) + np.array([0.04, 0.03, -0.05])
+    out = place_feet(sk, values, chain, targets)
+    _, W0 = forward_kinematics(sk, values, ends=False, world_rotations=True)
+    _, W1 = forward_kinematics(sk, out, ends=False, world_rotations=True)
+    # the heel lands exactly where the animation's foot vector puts the contact point on the target ...
+    _, heel = _hip_and_ball(sk, out, chain, "heel")
+    foot = W0[chain[2]].apply(sk.joints[chain[2]].tail) * sk.length_to_m
+    assert np.abs(heel + foot - targets).max() < 1e-6
+    # ... and the foot keeps its world orientation but for the ankle's missing DOF (CMU's lfoot: rx rz), so the
+    # contact point lands within millimetres of the target
+    _, got = _hip_and_ball(sk, out, chain)
+    assert np.abs(got - targets).max() < 0.005
+    tip0 = W0[chain[2]].apply(sk.joints[chain[2]].tail)
+    tip1 = W1[chain[2]].apply(sk.joints[chain[2]].tail)
+    assert np.abs(tip1 - tip0).max() * sk.length_to_m < 0.005
+    assert set(np.flatnonzero(np.any(out != values, axis=0)).tolist()) <= _cols(sk, chain)
+    assert np.allclose(bone_lengths(sk, out), bone_lengths(sk, values), atol=1e-9)
 
 
 @pytest.mark.parametrize("buffer_m", [0.0, 0.015])
@@ -251,26 +280,28 @@ def test_motion_matching_locks_the_feet_by_default_with_the_leg_ik(walks):
     m = mm.generate(start, 45, 0)
     assert np.array_equal(m.meta["source_frames"], free.meta["source_frames"])  # the same matches ...
     sk = walks[0].skeleton
-    sl = sk.dof_slices()
     legs = mm.legs_
-    cols = sorted(c for j in legs[:, :2].ravel() for c in range(sl[sk.joints[j].name].start,
-                                                                 sl[sk.joints[j].name].stop))
-    other = np.setdiff1d(np.arange(sk.n_dof), cols)
-    assert np.array_equal(m.values[:, other], free.values[:, other])  # ... only hips and knees differ
+    other = np.setdiff1d(np.arange(sk.n_dof), sorted(_cols(sk, legs.ravel())))
+    assert np.array_equal(m.values[:, other], free.values[:, other])  # ... only hips, knees and ankles differ
     locked, tg = m.meta["contact_locked"], m.meta["contact_targets"]
     assert locked[1:].any()
-    starts = forward_kinematics(sk, m.values, ends=False) * sk.length_to_m
-    pts = contact_points(sk, m.values, legs)
+    # the heel goes for the lock less the animation's (``free``'s) foot vector: on locked frames it lies on the
+    # ray from the hip to that point (at it, or the leg stretched towards it)
+    s_free, W_free = forward_kinematics(sk, free.values, ends=False, world_rotations=True)
+    s_lock = forward_kinematics(sk, m.values, ends=False) * sk.length_to_m
     reached = 0
     for f in range(2):
+        h, _k, a = legs[f]
+        foot = W_free[a].apply(sk.joints[a].tail) * sk.length_to_m
         for t in np.flatnonzero(locked[:, f]):
-            hip = starts[t, legs[f, 0]]
-            d, want = pts[t, f] - hip, tg[t, f] - hip
-            # on the ray from the hip to the target: at it, or the leg stretched towards it
+            d, want = s_lock[t, a] - s_lock[t, h], tg[t, f] - foot[t] - s_lock[t, h]
             assert float(d @ want) / (np.linalg.norm(d) * np.linalg.norm(want)) > 1.0 - 1e-9
             assert np.linalg.norm(d) <= np.linalg.norm(want) + 1e-6
-            reached += int(np.linalg.norm(pts[t, f] - tg[t, f]) < 1e-6)
+            reached += int(np.linalg.norm(d - want) < 1e-6)
     assert reached > 0
+    miss = np.linalg.norm(contact_points(sk, m.values, legs) - tg, axis=-1)[locked]
+    miss_free = np.linalg.norm(contact_points(sk, free.values, legs) - tg, axis=-1)[locked]
+    assert miss.mean() < 0.5 * miss_free.mean()  # the locked feet are much nearer their locks
 
 
 # ----------------------------------------------------------------------------- GenMM

@@ -43,7 +43,7 @@ from ..joints import resolve_roles
 from ..kinematics import forward_kinematics
 from ..skeleton import ROT_DOFS
 
-__all__ = ["leg_chains", "contact_points", "contact_labels", "lock_contacts", "two_bone_ik"]
+__all__ = ["leg_chains", "contact_points", "contact_labels", "lock_contacts", "two_bone_ik", "place_feet"]
 
 UP = 1
 
@@ -175,8 +175,47 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.where(n > 1e-12, n, 1.0)
 
 
-def two_bone_ik(skeleton, values, chain, targets, max_length_buffer_m: float = 0.015) -> np.ndarray:
-    """DOF values whose leg ``chain`` (hip, knee, ankle indices) puts the ankle segment's end on ``targets``.
+def _write_rotation(skeleton, j: int, L: Rotation, values: np.ndarray) -> None:
+    """Write local rotations ``L`` of joint ``j`` into its Euler DOF columns of ``values`` (in place), each
+    frame nearest its old values; a joint with fewer than three rotational DOF keeps its own axes (the
+    rotation about the others is dropped)."""
+    joint = skeleton.joints[j]
+    start = skeleton.dof_slices()[joint.name].start
+    rd = [(i, d[1]) for i, d in enumerate(joint.dofs) if d in ROT_DOFS]
+    cols = np.array([start + i for i, _ in rd])
+    if len(rd) == 3:
+        values[:, cols] = _joint_euler(skeleton, j, L, values[:, cols])
+        return
+    axes = [a for _, a in rd]
+    C = joint.axis_rotation()
+    ang = (C.inv() * L * C).as_euler("".join(axes + [a for a in "xyz" if a not in axes]), degrees=True)[:, :len(rd)]
+    old = values[:, cols]
+    values[:, cols] = old + ((ang - old + 180.0) % 360.0 - 180.0)
+
+
+def place_feet(skeleton, values, chain, targets, max_length_buffer_m: float = 0.015) -> np.ndarray:
+    """The reference's order: the heel (the ankle joint) is sent to the contact target less the animation's
+    heel-to-contact vector, hip and knee turned by :func:`two_bone_ik` on the heel, then the ankle turned back
+    to the animation's world orientation, so the foot lands on ``targets (T, 3)`` (m) as the animation held it.
+
+    With a three-DOF ankle the contact point reaches a reachable target exactly; with fewer (CMU's ``lfoot``:
+    two) the rotation about the missing axis is dropped and the point lands near it."""
+    values = np.array(values, float)
+    h, k, a = (int(i) for i in chain)
+    m = float(skeleton.length_to_m)
+    starts, W = forward_kinematics(skeleton, values, ends=False, world_rotations=True)
+    foot = W[a].apply(skeleton.joints[a].tail) * m  # heel to contact point, world, metres
+    out = two_bone_ik(skeleton, values, chain, np.asarray(targets, float) - foot, max_length_buffer_m,
+                      effector="heel")
+    _, W2 = forward_kinematics(skeleton, out, ends=False, world_rotations=True)
+    _write_rotation(skeleton, a, W2[k].inv() * W[a], out)
+    return out
+
+
+def two_bone_ik(skeleton, values, chain, targets, max_length_buffer_m: float = 0.015,
+                effector: str = "ball") -> np.ndarray:
+    """DOF values whose leg ``chain`` (hip, knee, ankle indices) puts the ankle segment's end (``effector``
+    "ball"; "heel": the ankle joint itself) on ``targets``.
 
     The knee turns about its hinge until the end's distance from the hip is the target's (clamped to the
     leg's reach minus ``max_length_buffer_m`` and to its shortest fold), then the hip turns by the smallest
@@ -190,6 +229,7 @@ def two_bone_ik(skeleton, values, chain, targets, max_length_buffer_m: float = 0
     chain : 3 ints, hip, knee, ankle (:func:`leg_chains`)
     targets : ndarray (T, 3), world targets in metres
     max_length_buffer_m : float, metres kept short of full extension (the reference: 0.015)
+    effector : "ball" (the ankle segment's end) or "heel" (the ankle joint)
 
     Returns
     -------
@@ -204,7 +244,9 @@ def two_bone_ik(skeleton, values, chain, targets, max_length_buffer_m: float = 0
     tgt = np.asarray(targets, float).reshape(T, 3) / m
     starts, W = forward_kinematics(skeleton, values, ends=False, world_rotations=True)
     sh, sk_ = starts[:, h], starts[:, k]
-    end = starts[:, a] + W[a].apply(skeleton.joints[a].tail)
+    if effector not in ("ball", "heel"):
+        raise ValueError(f"two_bone_ik: effector must be 'ball' or 'heel', got {effector!r}")
+    end = starts[:, a] + (W[a].apply(skeleton.joints[a].tail) if effector == "ball" else 0.0)
     knee = skeleton.joints[k]
     krot = [(i, d) for i, d in enumerate(knee.dofs) if d in ROT_DOFS]
     C = knee.axis_rotation()

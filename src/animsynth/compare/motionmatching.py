@@ -77,7 +77,7 @@ from scipy.spatial.transform import Rotation
 from ..joints import resolve_roles
 from ..kinematics import forward_kinematics
 from ..motion import Motion
-from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, two_bone_ik
+from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
 from .generators import Database, Generator
 from .poses import Track, decode, encode, qexp, qinv, qlog, qmul, rest_forward, wrap_angle, yaw_rotation
 
@@ -533,8 +533,8 @@ class MotionMatching(Generator):
         for f in range(2):
             move = np.linalg.norm(targets[:, f] - pts[:, f], axis=1) > 1e-9
             if move.any():
-                out[move] = two_bone_ik(sk, out[move], self.legs_[f], targets[move, f],
-                                        float(self.ik_max_length_buffer_m))
+                out[move] = place_feet(sk, out[move], self.legs_[f], targets[move, f],
+                                       float(self.ik_max_length_buffer_m))
         return out, {"contact_targets": targets, "contact_locked": locked,
                      "contact_states": self.contacts_[played].copy()}
 
