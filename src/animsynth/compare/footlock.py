@@ -11,17 +11,20 @@ A reimplementation written from the documented behaviour and constants of Holden
    contact height; while locked the output is the locked point; the lock is released when the contact ends or
    when the animation's point is more than the unlock radius (0.2 m) away from it; every lock and release is
    inertialized (the offset decays by the critically damped spring, half-life 0.1 s).
-3. **Two-bone IK** (:func:`two_bone_ik`): hip and knee turn so that the contact point reaches its target (its
-   distance from the hip kept 0.015 m short of the leg's reach, the reference's ``ik_max_length_buffer``).
+3. **Two-bone IK** (:func:`place_feet`, :func:`two_bone_ik`): as the reference, the heel (the ankle joint) is sent
+   to the contact target less the animation's heel-to-contact vector, hip and knee turn to put it there (its
+   distance from the hip kept 0.015 m short of the leg's reach, the reference's ``ik_max_length_buffer``), then
+   the foot is turned back to the animation's world orientation.
 
 Where this departs from the reference (the skeleton here is a file's, not the reference's BVH character):
 
 * the contact point is the end of the ``left_ankle`` / ``right_ankle`` role's segment (for an ASF ``lfoot``
   bone its tip: the ball of the foot; for a BVH skeleton the toe joint), the point the reference calls its
   toe bone, and the IK chain is the ``*_hip``, ``*_knee`` and ``*_ankle`` roles;
-* the IK's end effector is that contact point itself (the second bone is the shin with the foot held rigid),
-  so the reference's heel "look-at" that turns the foot onto the contact point is not needed, and its toe
-  alignment with the floor (``ik_toe_length``) is not done: the foot keeps the animation's local rotation;
+* the foot is turned back to the animation's world orientation instead of the reference's heel "look-at" onto
+  the contact point, and its toe alignment with the floor (``ik_toe_length``) is not done; an ankle with fewer
+  than three rotational DOF (CMU's ``lfoot``: two) drops the rotation about its missing axis, so the contact
+  point lands near the target (a millimetre or so) rather than on it;
 * the knee turns about its own hinge (its last rotational DOF's axis when it has fewer than three; the
   plane of the leg otherwise) and its and the hip's new rotations are written back to the skeleton's Euler
   DOF, so the leg stays a pose of the file's skeleton;

@@ -53,16 +53,17 @@ than ``contact_speed_m_s`` (0.15 m/s), median-filtered over ``contact_filter_s``
 frames at 60 fps). While playing, a foot whose played frame starts a contact is locked where it is (at its
 median contact height in the database), stays there until its contact ends or the animation's point is more
 than ``unlock_radius_m`` (0.2 m) away, and every lock and release is blended by the same critically damped
-spring (``foot_lock_halflife_s``, 0.1 s); hips and knees are then turned by analytic two-bone IK so the
-contact points reach their targets, kept ``ik_max_length_buffer_m`` (0.015 m) short of full extension.
+spring (``foot_lock_halflife_s``, 0.1 s); hips and knees are then turned by analytic two-bone IK so the heels
+reach the targets less the animation's heel-to-contact vectors, kept ``ik_max_length_buffer_m`` (0.015 m)
+short of full extension, and the feet are turned back to the animation's world orientation.
 These constants are the reference's (``ik_unlock_radius``, ``ik_blending_halflife``,
 ``ik_max_length_buffer``, and its database script's contact speed and filter). What differs (details in
-:mod:`animsynth.compare.footlock`): the IK's end effector is the contact point itself, so there is no heel
-look-at and no toe alignment with the floor (``ik_toe_length``); the knee turns about its own DOF axis and
-the result is written back to the skeleton's Euler DOF; heights come from the database (lock height: the
-foot's median contact height; the floor clamp: its lowest height) instead of a floor at 0 with
-``ik_foot_height`` 0.02 m. ``foot_lock=False`` is the ablation: the matching and blending alone (exactly
-the output of this class before foot locking was added).
+:mod:`animsynth.compare.footlock`): the foot keeps the animation's world orientation instead of the heel
+look-at, with no toe alignment with the floor (``ik_toe_length``); the knee turns about its own DOF axis and
+the result is written back to the skeleton's Euler DOF (an ankle with two DOF drops the rest); heights
+come from the database (lock height: the foot's median contact height; the floor clamp: its lowest
+height) instead of a floor at 0 with ``ik_foot_height`` 0.02 m. ``foot_lock=False`` is the ablation: the
+matching and blending alone (exactly the output of this class before foot locking was added).
 
 Departures from the reference: offline, so there is no separate simulated character, no trajectory
 adjustment or clamping of the character to the simulation and no bounding-box acceleration of the search
