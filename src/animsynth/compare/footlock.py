@@ -196,22 +196,26 @@ def _write_rotation(skeleton, j: int, L: Rotation, values: np.ndarray) -> None:
     values[:, cols] = old + ((ang - old + 180.0) % 360.0 - 180.0)
 
 
-def place_feet(skeleton, values, chain, targets, max_length_buffer_m: float = 0.015) -> np.ndarray:
+def place_feet(skeleton, values, chain, targets, max_length_buffer_m: float = 0.015, fk=None) -> np.ndarray:
     """The reference's order: the heel (the ankle joint) is sent to the contact target less the animation's
     heel-to-contact vector, hip and knee turned by :func:`two_bone_ik` on the heel, then the ankle turned back
     to the animation's world orientation, so the foot lands on ``targets (T, 3)`` (m) as the animation held it.
 
     With a three-DOF ankle the contact point reaches a reachable target exactly; with fewer (CMU's ``lfoot``:
-    two) the rotation about the missing axis is dropped and the point lands near it."""
+    two) the rotation about the missing axis is dropped and the point lands near it.
+
+    ``fk``: the ``(starts, world rotations)`` of ``values`` (:func:`animsynth.kinematics.forward_kinematics`
+    with ``ends=False, world_rotations=True``) when already computed."""
     values = np.array(values, float)
-    h, k, a = (int(i) for i in chain)
+    if values.ndim == 1:
+        values = values[None, :]
+    a = int(chain[2])
     m = float(skeleton.length_to_m)
-    starts, W = forward_kinematics(skeleton, values, ends=False, world_rotations=True)
+    starts, W = forward_kinematics(skeleton, values, ends=False, world_rotations=True) if fk is None else fk
     foot = W[a].apply(skeleton.joints[a].tail) * m  # heel to contact point, world, metres
-    out = two_bone_ik(skeleton, values, chain, np.asarray(targets, float) - foot, max_length_buffer_m,
-                      effector="heel")
-    _, W2 = forward_kinematics(skeleton, out, ends=False, world_rotations=True)
-    _write_rotation(skeleton, a, W2[k].inv() * W[a], out)
+    out, Wk = _two_bone(skeleton, values, chain, np.asarray(targets, float) - foot, max_length_buffer_m, "heel",
+                        starts, W)
+    _write_rotation(skeleton, a, Wk.inv() * W[a], out)
     return out
 
 
@@ -241,14 +245,20 @@ def two_bone_ik(skeleton, values, chain, targets, max_length_buffer_m: float = 0
     values = np.array(values, float)
     if values.ndim == 1:
         values = values[None, :]
+    if effector not in ("ball", "heel"):
+        raise ValueError(f"two_bone_ik: effector must be 'ball' or 'heel', got {effector!r}")
+    starts, W = forward_kinematics(skeleton, values, ends=False, world_rotations=True)
+    return _two_bone(skeleton, values, chain, targets, max_length_buffer_m, effector, starts, W)[0]
+
+
+def _two_bone(skeleton, values, chain, targets, max_length_buffer_m, effector, starts, W):
+    """:func:`two_bone_ik` on ``values`` (edited in place) with their forward kinematics ``starts`` and ``W``;
+    also returns the knee's new world rotations."""
     T = values.shape[0]
     h, k, a = (int(i) for i in chain)
     m = float(skeleton.length_to_m)
     tgt = np.asarray(targets, float).reshape(T, 3) / m
-    starts, W = forward_kinematics(skeleton, values, ends=False, world_rotations=True)
     sh, sk_ = starts[:, h], starts[:, k]
-    if effector not in ("ball", "heel"):
-        raise ValueError(f"two_bone_ik: effector must be 'ball' or 'heel', got {effector!r}")
     end = starts[:, a] + (W[a].apply(skeleton.joints[a].tail) if effector == "ball" else 0.0)
     knee = skeleton.joints[k]
     krot = [(i, d) for i, d in enumerate(knee.dofs) if d in ROT_DOFS]
@@ -307,4 +317,4 @@ def two_bone_ik(skeleton, values, chain, targets, max_length_buffer_m: float = 0
     Wp = W[hip.parent] if hip.parent >= 0 else Rotation.identity(T)
     Lh = Wp.inv() * R2 * W[h]
     values[:, hcols] = _joint_euler(skeleton, h, Lh, values[:, hcols])
-    return values
+    return values, R2 * turn * W[k]

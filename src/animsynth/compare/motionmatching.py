@@ -526,16 +526,19 @@ class MotionMatching(Generator):
         """The reference's foot locking and two-bone IK on the decoded frames (:mod:`.footlock`)."""
         sk, fps = self.db_.skeleton, self.db_.fps
         prev = contact_points(sk, np.asarray(start.values, float)[-1:], self.legs_)
-        pts = contact_points(sk, values, self.legs_)
+        starts, W = forward_kinematics(sk, values, ends=False, world_rotations=True)
+        pts = np.stack([starts[:, a] + W[a].apply(sk.joints[a].tail) for a in self.legs_[:, 2]], axis=1)
+        pts *= float(sk.length_to_m)
         targets, locked = lock_contacts(pts, self.contacts_[played], fps, prev[-1], self.contact_height_,
                                         float(self.unlock_radius_m), float(self.foot_lock_halflife_s))
         targets[:, :, 1] = np.maximum(targets[:, :, 1], self.floor_[None, :])
         out = values.copy()
         for f in range(2):
             move = np.linalg.norm(targets[:, f] - pts[:, f], axis=1) > 1e-9
-            if move.any():
-                out[move] = place_feet(sk, out[move], self.legs_[f], targets[move, f],
-                                       float(self.ik_max_length_buffer_m))
+            if move.any():  # the legs are separate subtrees: one forward kinematics serves both
+                idx = np.flatnonzero(move)
+                out[idx] = place_feet(sk, out[idx], self.legs_[f], targets[idx, f], float(self.ik_max_length_buffer_m),
+                                      fk=(starts[idx], [w[idx] for w in W]))
         return out, {"contact_targets": targets, "contact_locked": locked,
                      "contact_states": self.contacts_[played].copy()}
 
