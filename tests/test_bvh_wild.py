@@ -257,15 +257,20 @@ def test_child_positions_within_the_tolerance_are_read(tmp_path):
     np.testing.assert_allclose(forward_kinematics(m.skeleton, m.values, ends=False), pos, atol=1e-5)
 
 
-def test_varying_child_positions_are_refused(tmp_path):
+def test_varying_child_positions_are_read_as_translation(tmp_path, caplog):
     text = (DATA / "blender.bvh").read_text()
     col = _column_of(DATA / "blender.bvh", "upper_arm.R", "Xposition")
     p = _write(tmp_path, _perturb_column(text, col, lambda f, v: v + 0.5 * f))  # a stretching arm
-    with pytest.raises(MotionFormatError, match=r"joint 'upper_arm.R': Xposition varies .* by up to 5\.75 .*"
-                                                r"translation of a non-root joint is not supported") as ei:
-        read_bvh(p)
-    assert "x.bvh" in str(ei.value)
-    assert ei.value.line == _line_of(text, "JOINT upper_arm.R") + 3  # its CHANNELS line
+    with caplog.at_level("INFO", logger="animsynth.io"):
+        m = read_bvh(p)
+    assert m.skeleton["upper_arm.R"].dofs[:3] == ["tx", "ty", "tz"]
+    assert any("upper_arm.R (5.75)" in r.getMessage() and "translation DOF" in r.getMessage()
+               for r in caplog.records)
+    names, pos, endpos = _independent_fk(p)
+    np.testing.assert_allclose(forward_kinematics(m.skeleton, m.values, ends=False), pos, atol=1e-9)
+    write_bvh(tmp_path / "o.bvh", m)
+    back = read_bvh(tmp_path / "o.bvh")
+    np.testing.assert_allclose(forward_kinematics(back.skeleton, back.values, ends=False), pos, atol=1e-5)
 
 
 def _under_dummy_root(text, offset="1.5 -2.0 3.0"):
