@@ -11,7 +11,7 @@ third-party file:
   names (``UpperLeg_L`` ...), centimetres.
 * ``every6``: 6 channels on every joint (Truebones / 3ds Max ``Bip01_`` names,
   which the built-in role map does not know: the trial names its roles); the
-  spine's positions wobble by 2e-4 units, the clavicles really move (2.5 cm).
+  spine's positions wobble by 0.1 mm, the clavicles really move (2.5 cm).
 * ``rest_x``: the rest pose lies along +X (LAFAN1): every offset turned by a
   fixed rotation, the joint rotations compensating, so the motion is Y up.
 * ``zup``: Z up, -Y forward (a Blender export): the whole motion turned.
@@ -174,8 +174,8 @@ def every_six(m: Motion) -> Motion:
     for k, j in enumerate(sk.joints):
         if k:
             j.dofs = ["tx", "ty", "tz"] + [d for d in j.dofs if d[0] == "r"]
-        if j.name == "Bip01_Spine":
-            trans[:, k, 0] += 2e-4 * np.sin(t / 5.0)
+        if j.name == "Bip01_Spine":  # a wobble just above the reader's tolerance for constant channels
+            trans[:, k, 0] += 0.0001 / sk.length_to_m * np.sin(t / 5.0)
         if j.name.endswith("_Clavicle"):
             trans[:, k, 1] += 0.025 / sk.length_to_m * 0.5 * (1 - np.cos(2 * np.pi * t / max(n, 2)))
     sk.__post_init__()
