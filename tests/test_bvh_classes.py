@@ -130,3 +130,31 @@ def test_per_trial_settings_override_the_top_level():
     assert trial_setting(cfg, {"id": "u"}, "bvh_length_to_m") == 0.05644
     assert trial_setting(cfg, trial, "joint_roles") == {"head": "Kopf", "neck": "Neck"}
     assert trial_setting(cfg, trial, "up_axis") == "+z" and trial_setting(cfg, {}, "up_axis") == "auto"
+
+
+def test_command_line_takes_bvh_files(tmp_path, capsys):
+    from animsynth.cli import main
+
+    gif = tmp_path / "walk.gif"
+    assert main(["preview", str(DATA / "bandai.bvh"), str(gif), "--length-to-m", "0.01"]) == 0 and gif.stat().st_size
+    out = tmp_path / "gen.bvh"
+    assert main(["generate", str(DATA / "bandai.bvh"), str(DATA / "bandai.bvh"), str(out), "--steps", "12", "--k", "4",
+                 "--method", "knn"]) == 0
+    g = read_bvh(out)
+    assert g.n_frames == 13 and g.skeleton.joints[0].name == "Hips" and g.fps == 120.0
+    out = tmp_path / "re.bvh"
+    rc = main(["resequence", str(DATA / "every6_bip.bvh"), "--start", "2", "--end", "20", str(out),
+               "--length-to-m", "every6_bip.bvh=0.01", "--role", "every6_bip.bvh:left_hip=Bip01_L_Thigh"])
+    assert rc == 0, capsys.readouterr().err
+    assert read_bvh(out).skeleton.joints[0].name == "Bip01_Pelvis"
+    # a Z-up file comes out Y up
+    out = tmp_path / "z.bvh"
+    assert main(["resequence", str(DATA / "z_up.bvh"), "--start", "0", "--end", "20", "--out", str(out)]) == 0
+    m = read_bvh(out)
+    pos = forward_kinematics(m.skeleton, m.values)
+    assert np.ptp(pos[:, :, 1], axis=1).min() > np.ptp(pos[:, :, 2], axis=1).min()
+    # bad combinations name the argument
+    assert main(["preview", str(DATA / "bandai.bvh"), str(DATA / "z_up.bvh"), str(gif)]) == 2
+    assert "expected one .bvh file or an .asf and an .amc file" in capsys.readouterr().err
+    assert main(["preview", str(DATA / "bandai.bvh"), str(gif), "--up-axis", "up"]) == 2
+    assert "argument --up-axis" in capsys.readouterr().err
