@@ -200,8 +200,11 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     if moved:
         log.info("%s: joints other than the root with translation over the frames: %s (their translation is part "
                  "of the pose: see docs/data.md for how each family uses it)", where, ", ".join(moved))
-    height = standing_height(sk, v, CANONICAL_UP) * sk.length_to_m
-    if bvh is not None and not HEIGHT_RANGE_M[0] <= height <= HEIGHT_RANGE_M[1]:
+    height = standing_height(sk, v, CANONICAL_UP) * sk.length_to_m if bvh is not None else None
+    if height is not None:
+        log.info("%s: stands %.3g m tall (median over frames along the up axis) with bvh_length_to_m=%g", where,
+                 height, bvh_length_to_m)
+    if height is not None and not HEIGHT_RANGE_M[0] <= height <= HEIGHT_RANGE_M[1]:
         log.warning("%s: the skeleton stands %.3g m tall (median over frames along the up axis %s) with "
                     "bvh_length_to_m=%g; set bvh_length_to_m to the file's unit (0.01 for centimetres, 0.0254 for "
                     "inches, 0.05644 for cgspeed's CMU conversions)", where, height, up, bvh_length_to_m)
