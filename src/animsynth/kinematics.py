@@ -310,10 +310,44 @@ def hip_forward(skeleton: Skeleton, values, up="+y", overrides: dict | None = No
     from .joints import resolve_roles
 
     lh, rh = resolve_roles(skeleton, ("left_hip", "right_hip"), overrides)
+    a, b = skeleton.index(lh), skeleton.index(rh)
     if starts is None:
-        starts = forward_kinematics(skeleton, values, ends=False)
-    across = starts[:, skeleton.index(lh)] - starts[:, skeleton.index(rh)]
+        s = joint_starts(skeleton, values, [a, b])
+        across = s[:, 0] - s[:, 1]
+    else:
+        across = starts[:, a] - starts[:, b]
     return np.cross(across, axis_vector(up))
+
+
+def joint_starts(skeleton: Skeleton, values, joints) -> np.ndarray:
+    """World start positions (frames, len(joints), 3) of a few joints: forward kinematics along their chains
+    to the root only (the hips need the root and the hip joints, not the whole body)."""
+    values = _check_values(skeleton, values)
+    need: set[int] = set()
+    for i in joints:
+        while i >= 0 and i not in need:
+            need.add(i)
+            i = skeleton.joints[i].parent
+    sl = skeleton.dof_slices()
+    n = values.shape[0]
+    starts, W = {}, {}
+    for i in sorted(need):
+        j = skeleton.joints[i]
+        cols = values[:, sl[j.name]]
+        T = np.tile(np.asarray(j.offset, float), (n, 1))
+        for k, d in enumerate(j.dofs):
+            if d in TRANS_DOFS:
+                T[:, TRANS_DOFS.index(d)] += cols[:, k]
+        rdofs = [(k, d) for k, d in enumerate(j.dofs) if d in ROT_DOFS]
+        M = (Rotation.from_euler("".join(d[1] for _, d in rdofs), cols[:, [k for k, _ in rdofs]], degrees=True)
+             if rdofs else Rotation.identity(n))
+        C = j.axis_rotation()
+        L = C * M * C.inv()
+        if j.parent < 0:
+            starts[i], W[i] = T, L
+        else:
+            starts[i], W[i] = starts[j.parent] + W[j.parent].apply(T), W[j.parent] * L
+    return np.stack([starts[i] for i in joints], axis=1)
 
 
 def facing(skeleton: Skeleton, values, overrides: dict | None = None, starts: np.ndarray | None = None,
