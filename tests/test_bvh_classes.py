@@ -158,3 +158,24 @@ def test_command_line_takes_bvh_files(tmp_path, capsys):
     assert "expected one .bvh file or an .asf and an .amc file" in capsys.readouterr().err
     assert main(["preview", str(DATA / "bandai.bvh"), str(gif), "--up-axis", "up"]) == 2
     assert "argument --up-axis" in capsys.readouterr().err
+
+
+def test_dummy_root_with_a_constant_turn_is_merged_without_loss(tmp_path):
+    from test_bvh_wild import _perturb_column
+
+    text = (DATA / "bandai.bvh").read_text()
+    for col, deg in ((3, 12.0), (4, 30.0), (5, -7.0)):  # joint_Root: Zrotation Yrotation Xrotation, constant
+        text = _perturb_column(text, col, lambda f, v, deg=deg: deg)
+    p = tmp_path / "turned.bvh"
+    p.write_text(text)
+    m = read_bvh(p)
+    assert m.skeleton.joints[0].name == "Hips"
+    names, pos, endpos = _independent_fk(p)
+    np.testing.assert_allclose(forward_kinematics(m.skeleton, m.values, ends=False), pos[:, 1:], atol=1e-6)
+    # a root whose rotation varies is a real joint: kept
+    text = _perturb_column(text, 4, lambda f, v: 30.0 + f)
+    p.write_text(text)
+    m = read_bvh(p)
+    assert m.skeleton.joints[0].name == "joint_Root" and m.skeleton["Hips"].dofs[:3] == ["tx", "ty", "tz"]
+    names, pos, endpos = _independent_fk(p)
+    np.testing.assert_allclose(forward_kinematics(m.skeleton, m.values, ends=False), pos, atol=1e-9)
