@@ -160,6 +160,8 @@ def _family_status():
     faces = _status(f"CK+ from {ck}", ck) if ck else _status("synthetic CK+-layout database (not real CK+)")
     status = {"data": mocap, "simplicial": mocap, "resequencing": mocap, "meshdetail": mesh, "facegraph": faces,
               "compare": mocap}
+    if not config["resequencing"]["datasets"]:  # resequencing_trials all null (or none of them in the run)
+        status["resequencing"] = (mocap[0], False, "no trial in resequencing_trials")
     skipped = {}
     for fam, (_label, ok, why) in status.items():
         if not ok and fam != "data":
