@@ -179,3 +179,16 @@ def test_dummy_root_with_a_constant_turn_is_merged_without_loss(tmp_path):
     assert m.skeleton.joints[0].name == "joint_Root" and m.skeleton["Hips"].dofs[:3] == ["tx", "ty", "tz"]
     names, pos, endpos = _independent_fk(p)
     np.testing.assert_allclose(forward_kinematics(m.skeleton, m.values, ends=False), pos, atol=1e-9)
+
+
+@pytest.mark.workflow
+def test_no_resequencing_trial_leaves_the_family_out(tmp_path):
+    from conftest import copy_workflow, run_snakemake
+
+    wd = copy_workflow(tmp_path / "wf")
+    (wd / "config" / "none.yaml").write_text("resequencing_trials: {walk: null, run: null, dance: null}\n")
+    res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml", "config/none.yaml")
+    assert res.returncode == 0, (res.stdout + res.stderr)[-3000:]
+    out = res.stdout + res.stderr
+    assert "skipping resequencing" in out and "no trial in resequencing_trials" in out
+    assert "resequencing_analyse" not in out
