@@ -175,7 +175,8 @@ def _per_file(values, path: str, option: str, sep: str = "="):
 def _roles_for(values, path: str) -> dict:
     roles = {}
     for v in values or []:
-        file, _, rest = v.rpartition(":") if ".bvh:" in v else ("", "", v)
+        cut = v.lower().find(".bvh:")  # FILE.bvh:ROLE=JOINT (a joint name may hold ':', mixamorig:LeftArm)
+        file, rest = (v[:cut + 4], v[cut + 5:]) if cut >= 0 else ("", v)
         if file and os.path.normpath(file) != os.path.normpath(path) and os.path.basename(path) != file:
             continue
         role, found, joint = rest.partition("=")
