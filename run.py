@@ -13,6 +13,10 @@ checked first for YAML aliases that expand past a size limit ("billion
 laughs"), before Snakemake loads and merges it: a plain `snakemake
 --configfile` merges the file before any project code runs.
 
+Targets may come before or after --configfile / --config: a value of
+--configfile that is not a .yaml/.yml/.json file, or of --config without
+"=", is read as a target (run.py says so) and passed first.
+
 It creates ./.venv on first use (or when pyproject.toml changes) and installs
 the pinned stack from pyproject.toml into it. Set ANIMSYNTH_VENV to use
 another location.
@@ -87,6 +91,42 @@ def split_option(args: list[str], names: tuple[str, ...]) -> tuple[list[str], li
     return rest, values
 
 
+#: What a config file's name ends with; any other value after --configfile is a target.
+CONFIG_SUFFIXES = (".yaml", ".yml", ".json")
+
+
+def sort_targets(args: list[str]) -> tuple[list[str], list[str]]:
+    """``(args with the targets first, the targets moved)``.
+
+    Snakemake's ``--configfile`` (and ``--config``) take every value up to the next option, so a target
+    written after them (``--configfile mine.yaml results/x/verdicts.csv``) would be read as a config file
+    (or a KEY=VALUE pair). A value of ``--configfile`` / ``--configfiles`` whose name does not end with
+    :data:`CONFIG_SUFFIXES`, and a value of ``--config`` without ``=``, is a target: it is moved in front.
+    """
+    out, moved, mode = [], [], None
+    for a in args:
+        opt, eq, _ = a.partition("=")
+        if a.startswith("-"):
+            mode = opt if opt in ("--configfile", "--configfiles", "--config") and not eq else None
+            out.append(a)
+        elif mode in ("--configfile", "--configfiles") and not a.lower().endswith(CONFIG_SUFFIXES):
+            moved.append(a)
+        elif mode == "--config" and "=" not in a:
+            moved.append(a)
+        else:
+            out.append(a)
+    return moved + out, moved
+
+
+def with_targets_first(args: list[str]) -> list[str]:
+    """:func:`sort_targets`, saying which values it read as targets."""
+    args, moved = sort_targets(args)
+    if moved:
+        print(f"[run.py] read as target(s), not config: {' '.join(moved)} (config files end with "
+              f"{', '.join(CONFIG_SUFFIXES)}; --config takes KEY=VALUE)", flush=True)
+    return args
+
+
 def bench_args(argv: list[str]) -> tuple[list[str], list[str]]:
     """Split snakemake arguments into (the others, the KEY=VALUE pairs of a --config option)."""
     return split_option(argv, ("--config",))
@@ -134,6 +174,8 @@ def main(argv: list[str]) -> int:
         return 0
     ensure_venv()
     snakemake = str(BIN / "snakemake")
+    if argv and argv[0] in ("paper", "bench", "snakemake"):
+        argv = [argv[0], *with_targets_first(argv[1:])]
     if not argv:
         rc = sh(snakemake, "--cores", str(os.cpu_count() or 2))
         if rc == 0:

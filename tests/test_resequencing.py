@@ -610,6 +610,10 @@ def test_global_dof_verdict_per_dataset():
         lost[("dance", "isomap", "lee", True, p)] = ("resequences", 1.0)
     v = global_dof_verdict(_paths(lost))
     assert v["verdict"] == "reproduced" and "walk: re-sequencing paths 10/10 without vs 0/10 with" in v["ours"]
+    # a run without dance (resequencing_trials a subset): the dance half is not measured, at most partly
+    no_dance = {k: v for k, v in vals.items() if k[0] != "dance"}
+    v = global_dof_verdict(_paths(no_dance))
+    assert v["verdict"] == "partly" and "dance: not in this run" in v["ours"]
 
 
 def test_the_full_size_config_is_the_schema_defaults():

@@ -1,10 +1,20 @@
 """``animsynth``: one-off use of the library outside Snakemake.
 
     animsynth amc2bvh SKEL.asf MOTION.amc OUT.bvh
-    animsynth preview SKEL.asf MOTION.amc OUT.gif
+    animsynth preview SKEL.asf MOTION.amc OUT.gif        (or: preview WALK.bvh OUT.gif)
     animsynth generate --method delaunay TRAIN.amc ... --asf SKEL.asf --start-frame 0 --steps 300 OUT.bvh
-    animsynth resequence SKEL.asf MOTION.amc --start 10 --end 300 OUT.bvh
+    animsynth generate A.bvh B.bvh OUT.bvh
+    animsynth resequence SKEL.asf MOTION.amc --start 10 --end 300 OUT.bvh   (or: resequence WALK.bvh ...)
     animsynth face --labels fear,surprise,happy OUT.gif
+
+Every command that reads a motion takes a BVH file as well as an ASF/AMC
+pair. A BVH file is read as the workflow reads a trial
+(:func:`animsynth.data.load_trial`): its unit (``--length-to-m``, e.g. 0.01
+for centimetres, 0.05644 for cgspeed's CMU conversions), joint roles
+(``--role left_hip=Bip01_L_Thigh``) and axes (``--up-axis``,
+``--forward-axis``; default detected) may be given for all files or for one
+(``--length-to-m walk.bvh=0.01``, ``--role walk.bvh:head=Kopf``); the motion
+is turned into the canonical frame (+y up, +z forward) and written so.
 
 ``animsynth COMMAND --help`` explains each. Every argument is checked before
 any work (types and ranges in argparse; frame indices and ``--k`` against the
@@ -149,6 +159,83 @@ def _load(asf: str, amc: str, fps: float):
     return read_amc(amc, read_asf(asf), fps=fps)
 
 
+def _per_file(values, path: str, option: str, sep: str = "="):
+    """The value of a per-file option for ``path``: ``FILE=VALUE`` entries for this file win over plain ones."""
+    plain, own = None, None
+    for v in values or []:
+        head, found, tail = v.partition(sep)
+        if found and (os.path.normpath(head) == os.path.normpath(path) or os.path.basename(path) == head):
+            own = tail
+        elif found and head.lower().endswith(".bvh"):
+            continue
+        else:
+            plain = v
+    return own if own is not None else plain
+
+
+def _roles_for(values, path: str) -> dict:
+    roles = {}
+    for v in values or []:
+        cut = v.lower().find(".bvh:")  # FILE.bvh:ROLE=JOINT (a joint name may hold ':', mixamorig:LeftArm)
+        file, rest = (v[:cut + 4], v[cut + 5:]) if cut >= 0 else ("", v)
+        if file and os.path.normpath(file) != os.path.normpath(path) and os.path.basename(path) != file:
+            continue
+        role, found, joint = rest.partition("=")
+        if not found or not role or not joint:
+            raise UsageError("--role", f"expected ROLE=JOINT or FILE.bvh:ROLE=JOINT, got {v!r}")
+        roles[role] = joint
+    return roles
+
+
+def _load_bvh(a, path: str):
+    """A BVH file as the workflow reads a trial, with this file's --length-to-m, --role and axes."""
+    from .data import load_trial
+    from .kinematics import AXES
+
+    unit = _per_file(a.length_to_m, path, "--length-to-m")
+    try:
+        unit = 1.0 if unit is None else positive_float(unit)
+    except argparse.ArgumentTypeError as exc:
+        raise UsageError("--length-to-m", str(exc)) from None
+    axes = {}
+    for opt, key in (("--up-axis", "up_axis"), ("--forward-axis", "forward_axis")):
+        v = _per_file(getattr(a, key), path, opt) or "auto"
+        if v != "auto" and v.lower() not in AXES and "+" + v.lower() not in AXES:
+            raise UsageError(opt, f"expected auto or one of {', '.join(AXES)}, got {v!r}")
+        axes[key] = v
+    return load_trial(bvh=path, joint_roles=_roles_for(a.role, path), bvh_length_to_m=unit,
+                      name=os.path.splitext(os.path.basename(path))[0], **axes)
+
+
+def _split_motion_args(files: list[str], out: str | None, outputs: tuple[str, ...]):
+    """``(inputs, out)`` from positional files: the output is ``--out`` or the last file with an output suffix."""
+    files = list(files)
+    if out is None:
+        if len(files) >= 2 and files[-1].lower().endswith(outputs):
+            out = files.pop()
+        else:
+            raise UsageError("out", f"give the output file last (a {', '.join(outputs)} file name) or with --out")
+    for f in files:
+        if not os.path.isfile(f):
+            raise UsageError("input", f"no such file {f!r}")
+    try:
+        _out_with(outputs)(out)
+    except argparse.ArgumentTypeError as exc:
+        raise UsageError("out", str(exc)) from None
+    return files, out
+
+
+def _load_any(a, files: list[str]):
+    """One motion from ``files``: a .bvh file, or an .asf and an .amc file (either order)."""
+    low = [f.lower() for f in files]
+    if len(files) == 1 and low[0].endswith(".bvh"):
+        return _load_bvh(a, files[0]), files[0]
+    if len(files) == 2 and sorted(os.path.splitext(f)[1] for f in low) == [".amc", ".asf"]:
+        asf, amc = (files[0], files[1]) if low[0].endswith(".asf") else (files[1], files[0])
+        return _load(asf, amc, a.fps), amc
+    raise UsageError("input", f"expected one .bvh file or an .asf and an .amc file, got {' '.join(files)}")
+
+
 def cmd_amc2bvh(a) -> None:
     from .io.bvh import write_bvh
 
@@ -160,8 +247,9 @@ def cmd_amc2bvh(a) -> None:
 def cmd_preview(a) -> None:
     from .viz import motion_previews
 
-    m = _load(a.asf, a.amc, a.fps)
-    _check_frames(a, m.n_frames, len(m.skeleton.joints), "frames of " + a.amc)
+    files, a.out = _split_motion_args(a.files, None, (".gif",))
+    m, src = _load_any(a, files)
+    _check_frames(a, m.n_frames, len(m.skeleton.joints), "frames of " + src)
     motion_previews(m, gif_path=a.out)  # plays in real time at the motion's --fps
     print(f"wrote {a.out}")
 
@@ -171,16 +259,32 @@ def cmd_generate(a) -> None:
     from .motion import Motion
     from .simplicial import generate_from_trials
 
+    a.train, a.out = _split_motion_args(a.train, a.out, MOTION_OUTPUTS)
     if a.start_trial >= len(a.train):
         raise UsageError("--start-trial", f"{a.start_trial} but only {len(a.train)} training file(s) given (0-based)")
-    sk = read_asf(a.asf)
+    bvh = [p.lower().endswith(".bvh") for p in a.train]
+    if any(bvh) and not all(bvh):
+        raise UsageError("train", "give .bvh files or .amc files (with --asf), not both")
+    if all(bvh):
+        train = [_load_bvh(a, p) for p in a.train]
+        sk = train[0].skeleton
+        for p, m in zip(a.train[1:], train[1:]):
+            if m.skeleton.columns() != sk.columns():
+                raise UsageError("train", f"{p} has another skeleton than {a.train[0]} (the training files must share "
+                                          "joints and channels)")
+    else:
+        if a.asf is None:
+            raise UsageError("--asf", "training .amc files need the skeleton: --asf SKEL.asf")
+        sk = read_asf(a.asf)
     n_angles = sk.n_dof - len(sk.joints[0].dofs)
     if a.latent_dim > n_angles:
-        raise UsageError("--latent-dim", f"{a.latent_dim} exceeds the {n_angles} joint angles of {a.asf}")
+        raise UsageError("--latent-dim", f"{a.latent_dim} exceeds the {n_angles} joint angles of "
+                                         f"{a.train[0] if all(bvh) else a.asf}")
     # output values, joint angles, latent path and the GIF's joint positions, float64
     check_budget(f"argument --steps: {a.steps} steps",
                  8.0 * (a.steps + 1) * (2 * sk.n_dof + a.latent_dim + 3 * len(sk.joints)), a.memory_budget_gib)
-    train = [read_amc(p, sk, fps=a.fps) for p in a.train]
+    if not all(bvh):
+        train = [read_amc(p, sk, fps=a.fps) for p in a.train]
     n_start = train[a.start_trial].n_frames
     if a.start_frame >= n_start:
         raise UsageError("--start-frame", f"{a.start_frame} is outside {a.train[a.start_trial]} ({n_start} frames, 0-based)")
@@ -197,14 +301,15 @@ def cmd_generate(a) -> None:
     n_root = len(sk.joints[0].dofs)
     values[:, n_root:] = angles
     values[:, :n_root] = train[a.start_trial].values[a.start_frame, :n_root]  # root held at the start pose
-    _write_motion(a.out, Motion(values, sk, a.fps, "generated"))
+    _write_motion(a.out, Motion(values, sk, train[0].fps if all(bvh) else a.fps, "generated"))
     print(f"wrote {a.out}: {angles.shape[0]} frames ({info})")
 
 
 def cmd_resequence(a) -> None:
     from .resequencing.jobs import resequence_motion
 
-    m = _load(a.asf, a.amc, a.fps)
+    files, a.out = _split_motion_args(a.files, a.out, MOTION_OUTPUTS)
+    m, a.amc = _load_any(a, files)
     if a.length is not None:
         # played values, local rotations (quaternions) and joint positions of every frame, float64
         check_budget(f"argument --length: {a.length} frames",
@@ -262,15 +367,15 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--metres", action="store_true", help="write lengths in metres instead of ASF units")
     s.set_defaults(func=cmd_amc2bvh)
 
-    s = sub.add_parser("preview", help="animated GIF of an ASF/AMC trial's skeleton")
-    s.add_argument("asf", type=_existing_file), s.add_argument("amc", type=_existing_file)
-    s.add_argument("out", type=_out_with((".gif",)), help="output .gif")
+    s = sub.add_parser("preview", help="animated GIF of a trial's skeleton (BVH, or ASF + AMC)")
+    s.add_argument("files", nargs="+", metavar="FILE", help="MOTION.bvh, or SKEL.asf MOTION.amc; then OUT.gif")
     s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
     s.set_defaults(func=cmd_preview)
 
     s = sub.add_parser("generate", help="generate a motion with the Delaunay or k-NN vector field (Gauch & Peters)")
-    s.add_argument("train", nargs="+", type=_existing_file, help="training .amc files (same skeleton)")
-    s.add_argument("--asf", required=True, type=_existing_file)
+    s.add_argument("train", nargs="+", metavar="FILE",
+                   help="training .bvh files, or .amc files with --asf (same skeleton); then OUT (or --out)")
+    s.add_argument("--asf", default=None, type=_existing_file, help="the skeleton of training .amc files")
     s.add_argument("--method", choices=["delaunay", "knn"], default="delaunay")
     s.add_argument("--k", type=positive_int, default=16, help="neighbours for k-NN (and the Delaunay fallback)")
     s.add_argument("--latent-dim", type=positive_int, default=2)
@@ -280,11 +385,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--start-pose", default=None, help=argparse.SUPPRESS)
     s.add_argument("--seed", type=seed_int, default=0)
     s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
-    s.add_argument("--out", required=True, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
+    s.add_argument("--out", default=None, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_generate)
 
     s = sub.add_parser("resequence", help="re-sequence a trial between two frames (Isomap / ST-Isomap + Dijkstra)")
-    s.add_argument("asf", type=_existing_file), s.add_argument("amc", type=_existing_file)
+    s.add_argument("files", nargs="+", metavar="FILE",
+                   help="MOTION.bvh, or SKEL.asf MOTION.amc; then OUT (or --out)")
     s.add_argument("--start", type=index_int, required=True, help="first frame (0-based)")
     s.add_argument("--end", type=index_int, required=True, help="last frame (0-based)")
     s.add_argument("--method", choices=["isomap", "st-isomap"], default="st-isomap")
@@ -293,7 +399,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--global-dof", action="store_true", help="include root translation and orientation")
     s.add_argument("--length", type=positive_int, default=None, help="pad the path to this many frames")
     s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
-    s.add_argument("--out", required=True, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
+    s.add_argument("--out", default=None, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_resequence)
 
     s = sub.add_parser("face", help="synthesise a face animation (68 landmarks) from expression labels")
@@ -303,6 +409,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=seed_int, default=0)
     s.add_argument("out", type=_out_with((".gif", ".csv")), help="output .gif (or .csv of landmarks)")
     s.set_defaults(func=cmd_face)
+    for name in ("preview", "generate", "resequence"):
+        s = sub.choices[name]
+        s.add_argument("--length-to-m", action="append", metavar="[FILE=]M",
+                       help="metres per length unit of BVH input (default 1; 0.01 centimetres, 0.05644 cgspeed's CMU "
+                            "conversions); FILE=M for one file; repeatable")
+        s.add_argument("--role", action="append", metavar="[FILE:]ROLE=JOINT",
+                       help="joint role of BVH input (e.g. left_hip=Bip01_L_Thigh); repeatable")
+        s.add_argument("--up-axis", action="append", metavar="[FILE=]AXIS",
+                       help="up axis of BVH input (+x -x +y -y +z -z; default: detected)")
+        s.add_argument("--forward-axis", action="append", metavar="[FILE=]AXIS",
+                       help="forward axis of BVH input (default: the smallest turn taking up to +y)")
     for s in sub.choices.values():
         s.add_argument("--memory-budget-gib", type=positive_float, default=DEFAULT_MEMORY_BUDGET_GIB,
                        help=f"refuse requests whose arrays exceed this many GiB (default {DEFAULT_MEMORY_BUDGET_GIB:g})")
@@ -338,8 +455,16 @@ def _out_of_memory(a) -> str:
 
 def main(argv=None) -> int:
     """Run one command; return the exit status (0 ok, 2 bad argument or input)."""
+    parser = build_parser()
     try:
-        args = build_parser().parse_args(argv)
+        # files may come after options too (resequence walk.bvh --start 10 --end 300 out.bvh): argparse leaves
+        # the ones after an option over; they join the command's file list
+        args, extra = parser.parse_known_args(argv)
+        listed = next((k for k in ("files", "train") if hasattr(args, k)), None)
+        if extra and (listed is None or any(e.startswith("-") for e in extra)):
+            parser.error(f"unrecognized arguments: {' '.join(extra)}")
+        if extra:
+            setattr(args, listed, getattr(args, listed) + extra)
     except SystemExit as exc:  # argparse: --help (0) or a bad argument (2, message printed)
         return int(exc.code or 0)
     logging.basicConfig(level=logging.WARNING, format="animsynth: %(levelname)s: %(message)s")

@@ -172,6 +172,51 @@ def check_results_dir(config: dict, project: str | None = None) -> None:
                           "project; name a dedicated folder")
 
 
+def normalise_resequencing_trials(config: dict, defaults: dict | None = None) -> list[str]:
+    """Leave out the re-sequencing studies a config does not give a trial for; return the notes logged.
+
+    ``resequencing_trials`` may hold any subset of walk, run and dance: a key
+    set to null is left out, and so is a key the user's config does not set
+    whose value (merged in from the embedded default, ``defaults``) names a
+    trial that is not among ``trials``. ``resequencing.datasets`` then keeps
+    only the keys left. Changes ``config`` in place. A key the user set to an
+    unknown trial id stays, and :func:`check_config` refuses it.
+    """
+    import logging
+
+    log = logging.getLogger("animsynth.config")
+    known = {t["id"] for t in config.get("trials", [])}
+    rt = dict(config.get("resequencing_trials") or {})
+    notes = []
+    for key, tid in list(rt.items()):
+        if tid is None:
+            notes.append(f"config key 'resequencing_trials.{key}' is null: the {key} re-sequencing study is left out")
+            del rt[key]
+        elif tid not in known and defaults is not None and defaults.get(key) == tid:
+            notes.append(f"config key 'resequencing_trials.{key}' is not set (the default {tid!r} is not one of "
+                         f"your trials): the {key} re-sequencing study is left out")
+            del rt[key]
+    config["resequencing_trials"] = rt
+    rs = config.get("resequencing")
+    if isinstance(rs, dict) and "datasets" in rs:
+        rs["datasets"] = [d for d in rs["datasets"] if d in rt]
+    for n in notes:
+        log.warning(n)
+    return notes
+
+
+def trial_setting(config: dict, trial: dict, key: str):
+    """A per-trial setting: the trial record's ``key`` if it sets one, else the top-level config value.
+
+    ``joint_roles`` merge (the trial's roles over the top-level ones); the
+    others (``bvh_length_to_m``, ``up_axis``, ``forward_axis``) replace.
+    """
+    top = config.get(key)
+    if key == "joint_roles":
+        return {**(top or {}), **(trial.get(key) or {})}
+    return trial[key] if trial.get(key) is not None else top
+
+
 def check_config(config: dict) -> None:
     """Cross-key checks on a schema-validated config; raise :class:`ConfigError`.
 
@@ -214,6 +259,17 @@ def check_config(config: dict) -> None:
                 raise ConfigError(f"{where}: mocap_source {src!r} needs 'amc' and 'asf', or 'bvh'")
             if src == "cmu" and "sha256" not in t:
                 raise ConfigError(f"{where}: CMU trials need 'sha256' (LF-normalised) so downloads are verified")
+            for ax in ("up_axis", "forward_axis"):
+                if t.get(ax) is not None and t.get(ax) != "auto":
+                    from .kinematics import parse_axis
+
+                    try:
+                        parse_axis(t[ax])
+                    except ValueError as exc:
+                        raise ConfigError(f"config key 'trials[{k}].{ax}': {exc}") from None
+            up, fwd = trial_setting(config, t, "up_axis"), trial_setting(config, t, "forward_axis")
+            if up not in (None, "auto") and fwd not in (None, "auto") and up[-1] == fwd[-1]:
+                raise ConfigError(f"{where}: up_axis {up!r} and forward_axis {fwd!r} must be perpendicular")
             root = config.get("cmu_mirror") if src == "cmu" else config.get("data_dir")
             for field in TRIAL_FILE_KEYS:
                 if field in t:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import logging
+import os
 import time
 import urllib.error
 import urllib.request
@@ -97,35 +98,119 @@ def fetch_file(source: str, rel: str, dest, sha256: str | None, attempts: int = 
     return got
 
 
+#: A skeleton's standing height (metres) outside this range is logged as a probably wrong unit.
+HEIGHT_RANGE_M = (0.3, 3.0)
+
+
+def _rename_path(exc: Exception, files: dict, shown: dict):
+    """``exc`` (a MotionFormatError) naming the user's own file instead of the copy that was read."""
+    from .errors import MotionFormatError
+
+    if isinstance(exc, MotionFormatError):
+        for key, p in files.items():
+            if p is not None and key in shown and os.path.abspath(exc.path) == os.path.abspath(os.fspath(p)):
+                return MotionFormatError(shown[key], exc.line, exc.message)
+    return exc
+
+
 def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
-               bvh_length_to_m: float = 1.0) -> Motion:
-    """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion`.
+               bvh_length_to_m: float = 1.0, up_axis: str | None = "auto", forward_axis: str | None = "auto",
+               source_files: dict | None = None) -> Motion:
+    """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion` in the canonical frame (+y up, +z forward).
 
-    ``joint_roles`` (config ``joint_roles``) are checked against the skeleton
-    and stored on it (:attr:`Skeleton.roles`, see :mod:`animsynth.joints`).
-    A BVH file's lengths are ``bvh_length_to_m`` metres per unit; a skeleton
-    whose rest height is then below 0.3 m or above 3 m is logged as a warning
-    (the unit is probably wrong).
+    Parameters
+    ----------
+    amc, asf, bvh : path, optional
+        ASF + AMC, or BVH.
+    fps : float
+        Frame rate of an AMC file (a BVH file carries its own).
+    joint_roles : dict, optional
+        ``{role: joint name}`` (config ``joint_roles``, the trial's over the
+        top-level ones); checked against the skeleton and stored on it
+        (:attr:`Skeleton.roles`, see :mod:`animsynth.joints`).
+    bvh_length_to_m : float
+        A BVH file's metres per length unit (0.01 centimetres, 0.05644
+        cgspeed's CMU conversions, which keep the ASF unit).
+    up_axis, forward_axis : str or None
+        The file's world axes (``"+z"``, ...), or ``"auto"``/None. For BVH,
+        ``auto`` detects the up axis from the motion
+        (:func:`animsynth.kinematics.detect_up_axis`) and takes the forward
+        axis that the smallest turn to +y brings to +z; the motion is then
+        turned into the canonical frame
+        (:func:`animsynth.kinematics.to_canonical_frame`). ASF/AMC is +y up by
+        the format's convention (CMU): ``auto`` keeps it, logging a warning
+        if the motion looks otherwise.
+    source_files : dict, optional
+        ``{"amc"|"asf"|"bvh": the user's own path}``: named in errors instead
+        of the copy that is read (the workflow reads copies under resources/).
+
+    The standing height (median over frames of the extent along the up axis,
+    :func:`animsynth.kinematics.standing_height`) in metres outside
+    :data:`HEIGHT_RANGE_M` is logged as a warning (the unit is probably
+    wrong). One log line gives the axes used and how they were found.
     """
+    from .errors import MotionFormatError
     from .joints import check_role_overrides
+    from .kinematics import (CANONICAL_FORWARD, CANONICAL_UP, default_forward, detect_forward_axis, detect_up_axis,
+                             parse_axis, standing_height, to_canonical_frame, translated_joints)
 
-    if bvh is not None:
-        from .io.bvh import read_bvh
-        from .kinematics import forward_kinematics
+    files = {"amc": amc, "asf": asf, "bvh": bvh}
+    shown = dict(source_files or {})
+    where = shown.get("bvh") or shown.get("asf") or bvh or asf
+    try:
+        if bvh is not None:
+            from .io.bvh import read_bvh
 
-        m = read_bvh(bvh)
-        m.skeleton.length_to_m = float(bvh_length_to_m)
-        rest = forward_kinematics(m.skeleton, m.values[:1] * 0.0)[0] * m.skeleton.length_to_m
-        height = float(rest[:, 1].max() - rest[:, 1].min())
-        if not 0.3 <= height <= 3.0:
-            log.warning("%s: the skeleton is %.3g m tall at rest with bvh_length_to_m=%g; set bvh_length_to_m to "
-                        "the file's unit (0.01 for centimetres, 0.0254 for inches)", bvh, height, bvh_length_to_m)
-    else:
-        m = read_amc(amc, read_asf(asf), fps=fps)
+            m = read_bvh(bvh)
+            m.skeleton.length_to_m = float(bvh_length_to_m)
+        else:
+            m = read_amc(amc, read_asf(asf), fps=fps)
+    except MotionFormatError as exc:
+        raise _rename_path(exc, files, shown) from None
     try:
         check_role_overrides(m.skeleton.names, joint_roles)
     except ValueError as exc:
-        raise ConfigError(f"config key {exc} (in {bvh or asf})") from None
+        raise ConfigError(f"config key {exc} (in {where})") from None
     m.skeleton.roles = dict(joint_roles or {})
+    roles = m.skeleton.roles
+    sk, v = m.skeleton, m.values
+    auto_up = up_axis in (None, "auto")
+    detected, info = detect_up_axis(sk, v, roles)
+    if bvh is None and auto_up:
+        up = CANONICAL_UP
+        if detected != up:
+            log.warning("%s: the motion looks %s up (median extents x y z: %s), ASF/AMC is read +y up; set up_axis "
+                        "on the trial if the file is not", where, detected, _fmt(info["extent"]))
+    else:
+        up = detected if auto_up else parse_axis(up_axis)
+    fwd = default_forward(up) if forward_axis in (None, "auto") else parse_axis(forward_axis)
+    how = (f"detected (tallest along it in most frames, sign from {info['sign_from']}; median extents x y z "
+           f"{_fmt(info['extent'])})" if auto_up and bvh is not None else "given" if not auto_up else "ASF/AMC")
+    if auto_up and bvh is not None and info["ratio"] > 0.8:
+        log.warning("%s: the up axis %s is ambiguous (median extents x y z %s); set up_axis on the trial",
+                    where, up, _fmt(info["extent"]))
+    if (up, fwd) != (CANONICAL_UP, CANONICAL_FORWARD):
+        sk, v = to_canonical_frame(sk, v, up, fwd)
+        m = Motion(v, sk, m.fps, m.name, m.meta)
+    faces, src = detect_forward_axis(sk, v, CANONICAL_UP, roles)
+    log.info("%s: up axis %s (%s), forward axis %s%s; turned to +y up, +z forward; the body faces mostly %s in the "
+             "result (from the %s)", where, up, how, fwd, " (given)" if forward_axis not in (None, "auto") else "",
+             faces, src)
+    moved = translated_joints(sk)
+    if moved:
+        log.info("%s: joints other than the root with translation over the frames: %s (their translation is part "
+                 "of the pose: see docs/data.md for how each family uses it)", where, ", ".join(moved))
+    height = standing_height(sk, v, CANONICAL_UP) * sk.length_to_m if bvh is not None else None
+    if height is not None:
+        log.info("%s: stands %.3g m tall (median over frames along the up axis) with bvh_length_to_m=%g", where,
+                 height, bvh_length_to_m)
+    if height is not None and not HEIGHT_RANGE_M[0] <= height <= HEIGHT_RANGE_M[1]:
+        log.warning("%s: the skeleton stands %.3g m tall (median over frames along the up axis %s) with "
+                    "bvh_length_to_m=%g; set bvh_length_to_m to the file's unit (0.01 for centimetres, 0.0254 for "
+                    "inches, 0.05644 for cgspeed's CMU conversions)", where, height, up, bvh_length_to_m)
     m.name = name or m.name
     return m
+
+
+def _fmt(a) -> str:
+    return " ".join(f"{float(x):.4g}" for x in a)

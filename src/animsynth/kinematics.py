@@ -1,7 +1,23 @@
-"""Forward kinematics and joint rotations for :class:`~animsynth.skeleton.Skeleton`.
+"""Forward kinematics, joint rotations and the world axes for :class:`~animsynth.skeleton.Skeleton`.
 
 All functions are vectorised over frames. See :mod:`animsynth.skeleton` for the
-conventions (``L = C M C^-1``, extrinsic DOF order, offsets in world axes).
+conventions (``L = C M C^-1``, extrinsic DOF order, offsets in world axes,
+translation DOF on any joint).
+
+World axes: the one place
+-------------------------
+Every study works in the *canonical* world frame: ``+y`` up
+(:data:`UP`, :data:`HORIZONTAL`), ``+z`` forward. The height check, the
+floor, foot contacts, facing, heading, root alignment and the figures all read
+the up axis from here. A file in another frame (Z up, as Blender and 3ds Max
+write it) is turned into the canonical one when it is loaded
+(:func:`to_canonical_frame`, called by :func:`animsynth.data.load_trial`),
+with the up axis detected from the motion (:func:`detect_up_axis`: the axis
+along which the body is tallest in most frames, signed by head above feet) or
+given (config ``up_axis`` / ``forward_axis``). A rest pose lying along X
+(LAFAN1) is not a different frame: the up axis comes from the frames, not the
+rest pose, and facing from the hips (:func:`facing`), so such a file needs no
+change.
 """
 
 from __future__ import annotations
@@ -9,7 +25,21 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+import copy
+import logging
+
 from .skeleton import ROT_DOFS, TRANS_DOFS, Skeleton
+
+log = logging.getLogger("animsynth.kinematics")
+
+#: Index of the canonical up axis (+y).
+UP = 1
+#: Indices of the canonical horizontal axes (x, z).
+HORIZONTAL = (0, 2)
+#: Signed axis names accepted by ``up_axis`` / ``forward_axis``.
+AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
+#: The canonical frame's up and forward axes.
+CANONICAL_UP, CANONICAL_FORWARD = "+y", "+z"
 
 
 def _check_values(skeleton: Skeleton, values: np.ndarray) -> np.ndarray:
@@ -72,6 +102,36 @@ def root_translation(skeleton: Skeleton, values) -> np.ndarray:
     return t
 
 
+def joint_translations(skeleton: Skeleton, values) -> np.ndarray:
+    """Every joint's translation from its parent's start, in the parent's frame, per frame.
+
+    The joint's ``offset`` plus its translation DOF (``tx ty tz``; any joint may
+    have them, as BVH position channels on any joint). For the root this is
+    :func:`root_translation` (world).
+
+    Returns
+    -------
+    ndarray (frames, joints, 3), skeleton length units
+    """
+    values = _check_values(skeleton, values)
+    n = values.shape[0]
+    out = np.empty((n, len(skeleton.joints), 3))
+    sl = skeleton.dof_slices()
+    for i, j in enumerate(skeleton.joints):
+        out[:, i] = np.asarray(j.offset, float)
+        cols = values[:, sl[j.name]]
+        for k, d in enumerate(j.dofs):
+            if d in TRANS_DOFS:
+                a = TRANS_DOFS.index(d)
+                out[:, i, a] = cols[:, k] + j.offset[a]
+    return out
+
+
+def translated_joints(skeleton: Skeleton) -> list[str]:
+    """Names of the non-root joints that have translation DOF."""
+    return [j.name for j in skeleton.joints[1:] if any(d in TRANS_DOFS for d in j.dofs)]
+
+
 def forward_kinematics(skeleton: Skeleton, values, ends: bool = True, world_rotations: bool = False):
     """World positions of every joint, per frame.
 
@@ -91,19 +151,19 @@ def forward_kinematics(skeleton: Skeleton, values, ends: bool = True, world_rota
     positions : ndarray (frames, joints, 3) in skeleton length units
     """
     L = local_rotations(skeleton, values)
-    root_t = root_translation(skeleton, values)
-    n = root_t.shape[0]
+    T = joint_translations(skeleton, values)
+    n = T.shape[0]
     nj = len(skeleton.joints)
     starts = np.empty((n, nj, 3))
     endpos = np.empty((n, nj, 3))
     W: list[Rotation] = [None] * nj  # type: ignore[list-item]
     for i, j in enumerate(skeleton.joints):
         if j.parent < 0:
-            starts[:, i] = root_t
+            starts[:, i] = T[:, i]
             W[i] = L[i]
         else:
             p = j.parent
-            starts[:, i] = starts[:, p] + W[p].apply(j.offset)
+            starts[:, i] = starts[:, p] + W[p].apply(T[:, i])
             W[i] = W[p] * L[i]
         endpos[:, i] = starts[:, i] + W[i].apply(j.tail)
     pos = endpos if ends else starts
@@ -159,12 +219,15 @@ def _continuous_euler(ang: np.ndarray) -> np.ndarray:
     return out
 
 
-def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t: np.ndarray) -> np.ndarray:
+def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t: np.ndarray,
+                          translations: np.ndarray | None = None) -> np.ndarray:
     """Inverse of :func:`local_rotations`: DOF values (degrees) from local rotations.
 
     For a joint with fewer than three rotational DOF the missing axes are
     appended (applied last) and must come out ~0 if the rotation is
-    representable; their values are dropped.
+    representable; their values are dropped. ``translations`` (frames,
+    joints, 3; :func:`joint_translations`) gives the translation DOF of
+    non-root joints; without it they are 0 (the joint at its ``offset``).
     """
     n = root_t.shape[0]
     values = np.zeros((n, skeleton.n_dof))
@@ -186,6 +249,288 @@ def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t:
         for k, d in enumerate(j.dofs):
             if d in TRANS_DOFS:
                 a = TRANS_DOFS.index(d)
-                block[:, k] = root_t[:, a] - j.offset[a]
+                if i == 0:
+                    block[:, k] = root_t[:, a] - j.offset[a]
+                elif translations is not None:
+                    block[:, k] = translations[:, i, a] - j.offset[a]
         values[:, sl[j.name]] = block
     return values
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# world axes (see the module docstring: the one place the up and forward axes are defined)
+# ---------------------------------------------------------------------------------------------------------------
+def parse_axis(axis) -> str:
+    """A signed axis name (``"+y"``, ``"-z"``, ``"y"``; any case) as one of :data:`AXES`.
+
+    Raises
+    ------
+    ValueError
+        Anything else.
+    """
+    s = str(axis).strip().lower()
+    if len(s) == 1:
+        s = "+" + s
+    if s not in AXES:
+        raise ValueError(f"axis {axis!r} is not one of {', '.join(AXES)}")
+    return s
+
+
+def axis_vector(axis) -> np.ndarray:
+    """The unit vector (3,) of a signed axis name."""
+    s = parse_axis(axis)
+    v = np.zeros(3)
+    v["xyz".index(s[1])] = 1.0 if s[0] == "+" else -1.0
+    return v
+
+
+def _role_index(skeleton: Skeleton, roles, overrides=None):
+    """Joint indices of ``roles``, or None when one does not resolve."""
+    from .joints import JointRoleError, resolve_roles
+
+    try:
+        return [skeleton.index(n) for n in resolve_roles(skeleton, roles, overrides)]
+    except JointRoleError:
+        return None
+
+
+def hip_forward(skeleton: Skeleton, values, up="+y", overrides: dict | None = None,
+                starts: np.ndarray | None = None) -> np.ndarray:
+    """The body's forward direction from the hips, per frame: ``cross(left_hip - right_hip, up)``.
+
+    Not normalised, not projected (its length is the hip width times the sine of
+    the hip axis' angle to ``up``). ``starts``: joint starts (frames, joints, 3)
+    if already computed.
+
+    Raises
+    ------
+    animsynth.joints.JointRoleError
+        No joint plays ``left_hip`` or ``right_hip``.
+    """
+    from .joints import resolve_roles
+
+    lh, rh = resolve_roles(skeleton, ("left_hip", "right_hip"), overrides)
+    a, b = skeleton.index(lh), skeleton.index(rh)
+    if starts is None:
+        s = joint_starts(skeleton, values, [a, b])
+        across = s[:, 0] - s[:, 1]
+    else:
+        across = starts[:, a] - starts[:, b]
+    return np.cross(across, axis_vector(up))
+
+
+def joint_starts(skeleton: Skeleton, values, joints) -> np.ndarray:
+    """World start positions (frames, len(joints), 3) of a few joints: forward kinematics along their chains
+    to the root only (the hips need the root and the hip joints, not the whole body)."""
+    values = _check_values(skeleton, values)
+    need: set[int] = set()
+    for i in joints:
+        while i >= 0 and i not in need:
+            need.add(i)
+            i = skeleton.joints[i].parent
+    sl = skeleton.dof_slices()
+    n = values.shape[0]
+    starts, W = {}, {}
+    for i in sorted(need):
+        j = skeleton.joints[i]
+        cols = values[:, sl[j.name]]
+        T = np.tile(np.asarray(j.offset, float), (n, 1))
+        for k, d in enumerate(j.dofs):
+            if d in TRANS_DOFS:
+                T[:, TRANS_DOFS.index(d)] += cols[:, k]
+        rdofs = [(k, d) for k, d in enumerate(j.dofs) if d in ROT_DOFS]
+        M = (Rotation.from_euler("".join(d[1] for _, d in rdofs), cols[:, [k for k, _ in rdofs]], degrees=True)
+             if rdofs else Rotation.identity(n))
+        C = j.axis_rotation()
+        L = C * M * C.inv()
+        if j.parent < 0:
+            starts[i], W[i] = T, L
+        else:
+            starts[i], W[i] = starts[j.parent] + W[j.parent].apply(T), W[j.parent] * L
+    return np.stack([starts[i] for i in joints], axis=1)
+
+
+def facing(skeleton: Skeleton, values, overrides: dict | None = None, starts: np.ndarray | None = None,
+           name: str = "") -> np.ndarray:
+    """Horizontal facing direction per frame, from the hips and the up axis (canonical frame).
+
+    ``cross(left_hip - right_hip, +y)`` (the starts of the hip-role joints in
+    world positions) projected onto the floor: it does not depend on the
+    root's rotation convention or on the rest pose (a LAFAN1 rest pose lying
+    along X faces the same way as its hips). A frame whose hips are vertically
+    aligned (projection shorter than 1e-6 of the hip width) takes the facing of
+    the nearest frame that has one.
+
+    Returns
+    -------
+    ndarray (frames, 2)
+        Unit vectors ``(x, z)``.
+    """
+    f3 = hip_forward(skeleton, values, CANONICAL_UP, overrides, starts)
+    f = f3[:, list(HORIZONTAL)]
+    n = np.linalg.norm(f, axis=1)
+    scale = max(float(np.median(np.linalg.norm(f3, axis=1))), 1e-300)
+    ok = n > 1e-6 * scale
+    if not ok.any():
+        raise ValueError(f"motion {name or skeleton.name!r}: the hips never span a horizontal direction; "
+                         "no facing")
+    if not ok.all():
+        good = np.flatnonzero(ok)
+        t = np.arange(len(n))
+        after = good[np.clip(np.searchsorted(good, t), 0, len(good) - 1)]
+        before = good[np.clip(np.searchsorted(good, t) - 1, 0, len(good) - 1)]
+        pick = np.where(np.abs(t - before) <= np.abs(after - t), before, after)
+        f, n = f[pick], n[pick]
+    return f / n[:, None]
+
+
+def heading(skeleton: Skeleton, values, overrides: dict | None = None) -> np.ndarray:
+    """Heading (radians about +y, 0 = +z) per frame: :func:`facing` as an angle.
+
+    Falls back to the root's local +z axis projected on the floor when the
+    skeleton has no hip roles.
+    """
+    if _role_index(skeleton, ("left_hip", "right_hip"), overrides) is not None:
+        f = facing(skeleton, values, overrides)
+        return np.arctan2(f[:, 0], f[:, 1])
+    f = root_rotation(skeleton, values).apply(np.array([0.0, 0.0, 1.0]))
+    return np.arctan2(f[:, 0], f[:, 2])
+
+
+def standing_height(skeleton: Skeleton, values, up="+y", positions: np.ndarray | None = None) -> float:
+    """Median over frames of the body's extent along ``up`` (skeleton units): segment starts and ends."""
+    if positions is None:
+        positions = np.concatenate([forward_kinematics(skeleton, values, ends=False),
+                                    forward_kinematics(skeleton, values, ends=True)], axis=1)
+    h = positions @ axis_vector(up)
+    return float(np.median(h.max(axis=1) - h.min(axis=1)))
+
+
+def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) -> tuple[str, dict]:
+    """The up axis of a motion: the world axis along which the body is tallest in most frames.
+
+    The axis with the largest median per-frame extent of the joint positions
+    (a standing, walking or dancing body is taller than it is wide or deep;
+    the rest pose plays no part). Its sign: the head above the ankles (median
+    over frames), by joint role; without those roles the side holding more of
+    the joints (a body has more joints above its hips than below), which is
+    logged.
+
+    Returns
+    -------
+    axis : str
+        One of :data:`AXES`.
+    info : dict
+        ``extent`` (3,) median extents, ``ratio`` (second largest / largest:
+        near 1 means ambiguous), ``sign_from`` (``"head"`` or ``"joints"``).
+    """
+    starts = forward_kinematics(skeleton, values, ends=False)
+    pos = np.concatenate([starts, forward_kinematics(skeleton, values, ends=True)], axis=1)
+    ext = np.median(pos.max(axis=1) - pos.min(axis=1), axis=0)
+    a = int(np.argmax(ext))
+    ratio = float(np.sort(ext)[-2] / max(ext[a], 1e-300))
+    idx = _role_index(skeleton, ("head", "left_ankle", "right_ankle"), overrides)
+    if idx is not None:
+        d = starts[:, idx[0], a] - 0.5 * (starts[:, idx[1], a] + starts[:, idx[2], a])
+        sign, src = (1.0 if np.median(d) >= 0 else -1.0), "head"
+    else:
+        mid = 0.5 * (pos[:, :, a].max(axis=1) + pos[:, :, a].min(axis=1))
+        sign, src = (1.0 if np.median(np.mean(starts[:, :, a] > mid[:, None], axis=1)) >= 0.5 else -1.0), "joints"
+    axis = ("+" if sign > 0 else "-") + "xyz"[a]
+    return axis, {"extent": ext, "ratio": ratio, "sign_from": src}
+
+
+def detect_forward_axis(skeleton: Skeleton, values, up, overrides: dict | None = None) -> tuple[str, str]:
+    """The signed world axis, perpendicular to ``up``, the body faces most: from the hips, else the travel.
+
+    Returns ``(axis, source)`` with source ``"hips"`` (mean of the per-frame
+    unit :func:`hip_forward`) or ``"travel"`` (root displacement, first to last
+    frame) or ``"default"`` (neither gives a direction: the axis after ``up``
+    in ``x y z`` order).
+    """
+    u = axis_vector(up)
+    v, src = None, "default"
+    if _role_index(skeleton, ("left_hip", "right_hip"), overrides) is not None:
+        f = hip_forward(skeleton, values, up, overrides)
+        f = f - np.outer(f @ u, u)
+        n = np.linalg.norm(f, axis=1)
+        if np.any(n > 0):
+            v, src = (f[n > 0] / n[n > 0, None]).mean(axis=0), "hips"
+    if v is None or np.linalg.norm(v) < 1e-6:
+        t = root_translation(skeleton, values)
+        d = t[-1] - t[0]
+        d = d - (d @ u) * u
+        v, src = (d, "travel") if np.linalg.norm(d) > 0 else (None, "default")
+    ua = int(np.argmax(np.abs(u)))
+    cands = [s + "xyz"[k] for k in range(3) if k != ua for s in "+-"]
+    if v is None:
+        return cands[0], src
+    return max(cands, key=lambda c: float(axis_vector(c) @ v)), src
+
+
+def frame_rotation(up, forward) -> Rotation:
+    """The rotation taking the file's ``up`` to +y and ``forward`` to +z.
+
+    Raises
+    ------
+    ValueError
+        ``up`` and ``forward`` are not perpendicular.
+    """
+    u, f = axis_vector(up), axis_vector(forward)
+    if abs(u @ f) > 0:
+        raise ValueError(f"up axis {up!r} and forward axis {forward!r} must be perpendicular")
+    return Rotation.from_matrix(np.stack([np.cross(u, f), u, f]))
+
+
+def default_forward(up) -> str:
+    """The forward axis that the smallest turn taking ``up`` to +y takes to +z (``+z`` up -> ``-y`` forward,
+    Blender's and 3ds Max's convention)."""
+    u = axis_vector(up)
+    e_y = np.array([0.0, 1.0, 0.0])
+    c = np.cross(u, e_y)
+    if np.linalg.norm(c) < 1e-12:
+        R = Rotation.identity() if u[1] > 0 else Rotation.from_euler("x", 180, degrees=True)
+    else:
+        R = Rotation.from_rotvec(c / np.linalg.norm(c) * np.arccos(np.clip(u @ e_y, -1.0, 1.0)))
+    back = R.inv().apply(np.array([0.0, 0.0, 1.0]))
+    k = int(np.argmax(np.abs(back)))
+    return ("+" if back[k] > 0 else "-") + "xyz"[k]
+
+
+def to_canonical_frame(skeleton: Skeleton, values, up, forward) -> tuple[Skeleton, np.ndarray]:
+    """Express a motion in the canonical frame (+y up, +z forward): turn the whole body by
+    :func:`frame_rotation`.
+
+    Only the root changes: its world rotation becomes ``R @ W_root`` and its
+    translation ``R @ t`` (the children's offsets are in the root's frame and
+    follow). A root without three rotation or three translation DOF gets the
+    missing ones (zero in the rest pose), so the turn is exact; every joint's
+    world position becomes ``R @ p``. Returns ``(skeleton, values)``, the
+    skeleton a copy when it changed.
+    """
+    values = _check_values(skeleton, values)
+    R = frame_rotation(up, forward)
+    if np.allclose(R.as_matrix(), np.eye(3)):
+        return skeleton, values
+    sk = copy.deepcopy(skeleton)
+    root = sk.joints[0]
+    old = skeleton.joints[0]
+    t = root_translation(skeleton, values)
+    W = root_rotation(skeleton, values)
+    trans = [d for d in old.dofs if d in TRANS_DOFS]
+    rots = [d for d in old.dofs if d in ROT_DOFS]
+    trans += [d for d in TRANS_DOFS if d not in trans]
+    rots += [d for d in ROT_DOFS if d not in rots]
+    root.dofs = trans + rots
+    root.limits = []
+    root.offset = R.apply(np.asarray(old.offset, float))
+    n = values.shape[0]
+    tn = R.apply(t)
+    C = root.axis_rotation()
+    ang = _continuous_euler((C.inv() * R * W * C).as_euler("".join(d[1] for d in rots), degrees=True))
+    block = np.concatenate([tn[:, [TRANS_DOFS.index(d) for d in trans]] - root.offset[[TRANS_DOFS.index(d)
+                                                                                       for d in trans]], ang], axis=1)
+    sl = skeleton.dof_slices()[old.name]
+    out = np.concatenate([block, values[:, sl.stop:]], axis=1).reshape(n, sk.n_dof)
+    sk.__post_init__()
+    return sk, out

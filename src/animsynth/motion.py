@@ -46,7 +46,8 @@ class Motion:
         return int(self.values.shape[0])
 
     def without_root(self) -> np.ndarray:
-        """The joint angles with the root joint's DOF dropped (CMU: 56 columns)."""
+        """The joint DOF with the root joint's dropped (CMU: the 56 joint angles; a BVH joint other than the
+        root with translation DOF keeps them here, in skeleton length units)."""
         n_root = len(self.skeleton.joints[0].dofs)
         return self.values[:, n_root:]
 

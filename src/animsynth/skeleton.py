@@ -12,8 +12,14 @@ Conventions (the Acclaim ones, which BVH maps onto losslessly):
   from the joint's rotational DOF values (degrees) as an *extrinsic* Euler
   rotation in the order the DOF are listed (Acclaim convention: ``rx ry rz``
   gives ``M = Rz Ry Rx``).
+* Any joint may have translation DOF (``tx ty tz``, BVH position channels on
+  any joint): its translation from the parent is then ``T_j = offset_j + t_j``
+  per frame (for the root, ``T`` is its world position), else ``offset_j``.
 * World rotation ``W_j = W_parent @ L_j``; world start of a joint
-  ``s_j = s_parent + W_parent @ offset_j``; world end ``e_j = s_j + W_j @ tail_j``.
+  ``s_j = s_parent + W_parent @ T_j``; world end ``e_j = s_j + W_j @ tail_j``.
+* The world frame the studies use is Y up, Z forward
+  (:mod:`animsynth.kinematics`); the data layer turns a file in another frame
+  into it.
 * A motion is a ``(frames, n_dof)`` array whose columns are
   :meth:`Skeleton.columns`: joints in :attr:`Skeleton.joints` order, each
   joint's DOF in its listed order, named ``"<joint>.<dof>"`` (``root.tx`` ...).

@@ -6,13 +6,19 @@ from pathlib import Path
 
 from snakemake.io import is_flagged, strip_wildcard_constraints
 
-from animsynth.config import check_config, derive_seed
+from animsynth.config import check_config, derive_seed, normalise_resequencing_trials, trial_setting
 from animsynth.meshdetail.settings import mesh_sequences
 from animsynth.sources import is_archive, is_url, mesh_source_name, probe_source
 
 
 # Config checks beyond the schema, in one place: the shared ones, then each family's
 # settings.check(config) (which names the offending config key).
+# resequencing_trials may hold any subset of walk, run, dance: the studies without a trial of
+# this config are left out with a note (the default's trial ids are not a user's).
+import yaml as _yaml
+
+with open(Path(workflow.basedir) / "config" / "config.yaml") as _f:
+    normalise_resequencing_trials(config, (_yaml.safe_load(_f) or {}).get("resequencing_trials") or {})
 check_config(config)
 for _family in ("simplicial", "resequencing", "facegraph", "meshdetail", "compare"):
     importlib.import_module(f"animsynth.{_family}.settings").check(config)
@@ -154,6 +160,8 @@ def _family_status():
     faces = _status(f"CK+ from {ck}", ck) if ck else _status("synthetic CK+-layout database (not real CK+)")
     status = {"data": mocap, "simplicial": mocap, "resequencing": mocap, "meshdetail": mesh, "facegraph": faces,
               "compare": mocap}
+    if not config["resequencing"]["datasets"]:  # resequencing_trials all null (or none of them in the run)
+        status["resequencing"] = (mocap[0], False, "no trial in resequencing_trials")
     skipped = {}
     for fam, (_label, ok, why) in status.items():
         if not ok and fam != "data":
@@ -445,6 +453,21 @@ def trial_spec(wildcards):
 
 def synthetic_trial_seed(wildcards):
     return seed_for("synthetic_mocap", config["synthetic_mocap"]["seed"], wildcards.trial)
+
+
+def trial_settings(wildcards):
+    """Params function: the per-trial reading settings of one trial (its own over the top-level ones),
+    and the user's own file (named in error messages instead of the copy under resources/)."""
+    rec = TRIALS[wildcards.trial]
+    own = {k: rec[k] for k in ("amc", "asf", "bvh") if k in rec}
+    root = MOCAP_MIRROR if SOURCE != "synthetic" else None
+    return {
+        "joint_roles": trial_setting(config, rec, "joint_roles"),
+        "bvh_length_to_m": trial_setting(config, rec, "bvh_length_to_m"),
+        "up_axis": trial_setting(config, rec, "up_axis"),
+        "forward_axis": trial_setting(config, rec, "forward_axis"),
+        "source_files": {k: (f"{root.rstrip('/')}/{v}" if root else v) for k, v in own.items()},
+    }
 
 
 def trial_field(field, required=True):

@@ -73,7 +73,7 @@ rule compare_run:
     params:
         cfg=compare_job_cfg,
         seed=config["seed"],
-        roles=config["joint_roles"],
+        roles={},  # each trial's roles (top-level joint_roles merged with its own) are stored on its skeleton
         showcase=CMP_SHOWCASE,
     threads: 1
     resources:

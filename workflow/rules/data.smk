@@ -92,8 +92,7 @@ rule parse_trial:
         R("data/trials/{trial}.npz"),
     params:
         fps=config["fps"],
-        joint_roles=config["joint_roles"],
-        bvh_length_to_m=config["bvh_length_to_m"],
+        settings=trial_settings,
     threads: 1
     resources:
         mem_mb=500,

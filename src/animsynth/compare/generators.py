@@ -48,6 +48,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
+from ..kinematics import heading as _heading
 from ..kinematics import root_rotation, root_translation
 from ..motion import Motion
 from ..skeleton import ROT_DOFS, TRANS_DOFS
@@ -67,9 +68,9 @@ REFERENCES = ("replay", "concat")
 
 
 def heading(skeleton, values) -> np.ndarray:
-    """Heading (radians about +Y) of the root's local +Z axis, per frame: shape ``(frames,)``."""
-    f = root_rotation(skeleton, values).apply(np.array([0.0, 0.0, 1.0]))
-    return np.arctan2(f[:, 0], f[:, 2])
+    """Heading (radians about +Y) per frame, shape ``(frames,)``: the facing from the hips
+    (:func:`animsynth.kinematics.heading`; the root's local +Z axis when the skeleton has no hip roles)."""
+    return _heading(skeleton, values)
 
 
 def _set_root(skeleton, values: np.ndarray, R: Rotation, pos: np.ndarray) -> np.ndarray:

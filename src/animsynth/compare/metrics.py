@@ -31,7 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..joints import resolve_roles
-from ..kinematics import forward_kinematics, root_rotation
+from ..kinematics import HORIZONTAL as _KIN_HORIZONTAL
+from ..kinematics import UP as _KIN_UP
+from ..kinematics import facing as _hip_facing
+from ..kinematics import forward_kinematics
 
 __all__ = [
     "UP", "FOOT_ROLES", "positions", "foot_indices", "facing", "body_frame", "pose_features",
@@ -40,10 +43,10 @@ __all__ = [
     "window_scores", "coverage", "local_diversity", "seed_diversity", "novelty",
 ]
 
-#: Index of the vertical axis (y up).
-UP = 1
+#: Index of the vertical axis (y up: the canonical frame of :mod:`animsynth.kinematics`).
+UP = _KIN_UP
 #: Indices of the horizontal axes (x, z).
-_HORIZONTAL = [0, 2]
+_HORIZONTAL = list(_KIN_HORIZONTAL)
 #: Joint roles tracked by the foot metrics (:mod:`animsynth.joints`): the end of the ankle's segment is the
 #: ball of the foot, the end of the toe's the toe tip.
 FOOT_ROLES = ("left_ankle", "left_toe", "right_ankle", "right_toe")
@@ -93,12 +96,12 @@ def foot_indices(skeleton, overrides: dict | None = None) -> np.ndarray:
 
 
 def facing(motion, overrides: dict | None = None) -> np.ndarray:
-    """Horizontal facing direction of the pelvis per frame.
+    """Horizontal facing direction of the body per frame, from the hips and the up axis.
 
-    The rest-pose forward vector is ``cross(left_hip - right_hip, up)`` (the starts of the hip-role joints in
-    the zero pose, so it does not depend on the file's forward-axis convention); each frame rotates it by the
-    root joint's rotation and projects it onto the floor. A frame whose pelvis points straight up or down
-    (projection shorter than 1e-6) takes the facing of the nearest frame that has one.
+    ``cross(left_hip - right_hip, up)`` from the world positions of the hip-role joints, projected onto the
+    floor (:func:`animsynth.kinematics.facing`, the one definition the workflow uses): it does not depend on
+    the root's rotation convention or the rest pose. A frame whose hips are vertically aligned takes the
+    facing of the nearest frame that has one.
 
     Parameters
     ----------
@@ -111,27 +114,7 @@ def facing(motion, overrides: dict | None = None) -> np.ndarray:
     ndarray, shape (T, 2)
         Unit vectors ``(x, z)``.
     """
-    sk = motion.skeleton
-    lh, rh = resolve_roles(sk, ("left_hip", "right_hip"), overrides)
-    rest = forward_kinematics(sk, np.zeros((1, sk.n_dof)), ends=False)[0]
-    across = rest[sk.index(lh)] - rest[sk.index(rh)]
-    f0 = np.cross(across, np.eye(3)[UP])
-    if np.linalg.norm(f0) < 1e-9 * max(np.linalg.norm(across), 1e-300):
-        raise ValueError(f"skeleton {sk.name!r}: the hips ({lh}, {rh}) are vertically aligned in the zero pose; "
-                         "no facing direction")
-    f = root_rotation(sk, motion.values).apply(f0 / np.linalg.norm(f0))[:, _HORIZONTAL]
-    n = np.linalg.norm(f, axis=1)
-    ok = n > 1e-6
-    if not ok.any():
-        raise ValueError(f"motion {motion.name!r}: the pelvis never faces a horizontal direction")
-    if not ok.all():
-        good = np.flatnonzero(ok)
-        t = np.arange(len(n))
-        after = good[np.clip(np.searchsorted(good, t), 0, len(good) - 1)]
-        before = good[np.clip(np.searchsorted(good, t) - 1, 0, len(good) - 1)]
-        pick = np.where(np.abs(t - before) <= np.abs(after - t), before, after)
-        f, n = f[pick], n[pick]
-    return f / n[:, None]
+    return _hip_facing(motion.skeleton, motion.values, overrides, name=motion.name)
 
 
 def _rotate_to(v: np.ndarray, forward: np.ndarray) -> np.ndarray:

@@ -8,19 +8,29 @@ silent misreading would follow; each of these is a
 
 * a joint's rotation (or position) channels must name distinct axes
   (``Xrotation Xrotation Xrotation`` is refused);
-* position channels on a non-root joint (in BVH they replace the joint's
-  ``OFFSET`` in every frame; Blender's exporter writes them on every bone not
-  connected to its parent) must be constant over the frames, to within
+* position channels may sit on any joint (in BVH they replace the joint's
+  ``OFFSET`` in every frame, as Blender's importer reads them). Those of a
+  non-root joint that are constant over the frames, to within
   :data:`CHILD_POSITION_REL_TOL` of the skeleton's size (the sum of its bone
-  lengths) plus the printed precision: they are then read as the joint's
-  ``OFFSET`` (their mean; one log line names the joints). Translation
-  animation of a non-root joint is not supported (the skeleton has fixed bone
-  offsets) and is refused, naming the joint and its largest deviation;
+  lengths) plus the printed precision (Blender's exporter writes them on
+  every bone not connected to its parent), are read as the joint's
+  ``OFFSET`` (their mean; one log line names the joints). Varying ones (game
+  and research rigs with 6 channels on every joint) become translation DOF
+  of that joint (``tx ty tz``: the channel minus the ``OFFSET``, as for the
+  root), logged with the largest movement;
 * a root with no channels (``CHANNELS 0``, Blender's dummy ``ROOT __0``) and
   exactly one child is dropped: the child becomes the root, the dummy's
   ``OFFSET`` added to the child's offset and positions (logged). With several
   children (an armature with several root bones) it is refused: one skeleton
   with one root translation per file is supported;
+* a *dummy root with channels* (the Bandai-Namco layout: ``joint_Root`` with
+  6 channels whose rotation is constant, usually zero, over one child
+  ``Hips`` that has position channels and carries the motion) is merged into
+  its child without loss: the child becomes the root, its world translation
+  ``root position + R0 (child position)`` and its rotation ``R0 R_child``
+  (``R0`` the constant root rotation; with ``R0`` the identity the child's
+  rotation channels are kept as they are). Every joint's world position is
+  unchanged (logged);
 * joint names must be unique; joints may nest at most
   :data:`MAX_JOINT_DEPTH` deep;
 * nothing may follow the root joint's closing brace before ``MOTION`` (a
@@ -46,8 +56,9 @@ every leaf. A joint that came from a BVH file (no ASF axis frame) is written
 with its own channels in its own order, so reading a BVH and writing it back
 reproduces every channel value to the printed precision (6 decimals), except
 that constant position channels of a non-root joint are written back as that
-joint's ``OFFSET`` (the skeleton holds fixed offsets, not channels): the joint
-positions are the same, the joint has its rotation channels only. An ASF
+joint's ``OFFSET`` (the joint positions are the same, the joint has its
+rotation channels only) and a merged dummy root is written as its child.
+Varying position channels on any joint are written back as they were read. An ASF
 joint with rotational DOF gets ``Zrotation Yrotation Xrotation`` (the local
 rotation ``L = C M C^-1`` of :mod:`animsynth.kinematics` as intrinsic Z-Y-X
 Euler angles, degrees); an ASF joint without DOF (e.g. CMU ``lhipjoint``) gets
@@ -69,7 +80,7 @@ import os
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import dof_values_from_local, local_rotations, root_translation
+from ..kinematics import dof_values_from_local, joint_translations, local_rotations, root_translation
 from ..motion import Motion
 from ..skeleton import ROT_DOFS, TRANS_DOFS, Joint, Skeleton
 from ..atomic import atomic_write_text
@@ -133,6 +144,7 @@ def write_bvh(path, motion: Motion, scale: float = 1.0) -> None:
     _check_frame_time(1.0 / fps, f"refusing to write {path}")
     L = local_rotations(sk, values)
     root_t = root_translation(sk, values) * scale
+    T = joint_translations(sk, values) * scale
     sl = sk.dof_slices()
     n = values.shape[0]
     lines = ["HIERARCHY"]
@@ -154,11 +166,9 @@ def write_bvh(path, motion: Motion, scale: float = 1.0) -> None:
         if _native(j):
             trans = [d for d in j.dofs if d in TRANS_DOFS]
             rots = [d for d in j.dofs if d in ROT_DOFS][::-1]  # extrinsic DOF order -> intrinsic channel order
-            if i != 0 and trans:
-                raise ValueError(f"refusing to write {path}: joint {j.name!r} has position DOF (only the root may)")
             cols = values[:, sl[j.name]]
-            for d in trans:
-                blocks.append(root_t[:, TRANS_DOFS.index(d)][:, None])
+            for d in trans:  # position channels replace the OFFSET: offset + translation DOF
+                blocks.append(T[:, i, TRANS_DOFS.index(d)][:, None])
             for d in rots:
                 blocks.append(cols[:, [j.dofs.index(d)]])
             chans = [_CH_NAME[d] for d in trans + rots]
@@ -377,6 +387,7 @@ def read_bvh(path, fps: float | None = None) -> Motion:
         raise MotionFormatError(path, len(raw), f"header says {nframes} frames, file has {len(rows)} (truncated?)")
     data = np.array(rows, float).reshape(nframes, ncols)
     joints, data = _drop_dummy_root(path, joints, data)
+    joints, data = _merge_dummy_root(path, joints, data)
     data = _constant_child_positions(path, joints, data)
     # the generic skeleton: DOF = position channels, then rotation channels
     # reversed (intrinsic channel order -> extrinsic DOF order)
@@ -394,11 +405,13 @@ def read_bvh(path, fps: float | None = None) -> Motion:
         cols += [order[c] for c in trans + rots]
     values = data[:, cols] if cols else np.zeros((nframes, 0))
     sk = Skeleton(sk_joints, name=os.path.splitext(os.path.basename(os.fspath(path)))[0])
-    # root positions in BVH are absolute; our root translation adds the offset
-    root = sk.joints[0]
-    for k, d in enumerate(root.dofs):
-        if d in TRANS_DOFS:
-            values[:, k] -= root.offset[TRANS_DOFS.index(d)]
+    # position channels (root: absolute; other joints: the translation from the parent) replace the OFFSET;
+    # our translation DOF are added to it
+    slices = sk.dof_slices()
+    for j in sk.joints:
+        for k, d in enumerate(j.dofs):
+            if d in TRANS_DOFS:
+                values[:, slices[j.name].start + k] -= j.offset[TRANS_DOFS.index(d)]
     return Motion(values, sk, float(fps) if fps is not None else _frame_rate(ft_s, ftime), sk.name)
 
 
@@ -430,10 +443,13 @@ def _drop_dummy_root(path, joints: list[dict], data: np.ndarray):
 
 
 def _constant_child_positions(path, joints: list[dict], data: np.ndarray) -> np.ndarray:
-    """Read constant position channels of non-root joints as their OFFSET.
+    """Read constant position channels of non-root joints as their OFFSET; keep varying ones.
 
-    Changes ``joints`` in place (offset replaced, position channels removed)
-    and returns ``data`` without those columns; refuses varying ones.
+    Changes ``joints`` in place (offset replaced, constant position channels
+    removed) and returns ``data`` without those columns. A joint with a
+    varying position channel keeps all its position channels (they become its
+    translation DOF); one log line names those joints and their largest
+    movement.
     """
     start, col = [], 0
     for r in joints:
@@ -445,28 +461,85 @@ def _constant_child_positions(path, joints: list[dict], data: np.ndarray) -> np.
     size = sum(float(np.linalg.norm(r["offset"])) for r in joints[1:])
     size += sum(float(np.linalg.norm(r["end"])) for r in joints if r["end"] is not None)
     tol = CHILD_POSITION_REL_TOL * size + 0.5 * 10.0 ** -DECIMALS
-    drop = []
+    drop, const, varying = [], [], []
     for k in moved:
         r = joints[k]
+        cols = [(i, c) for i, c in enumerate(r["channels"]) if c.endswith("position")]
+        devs = {c: float(np.max(np.abs(data[:, start[k] + i] - data[:, start[k] + i].mean()))) for i, c in cols}
+        if max(devs.values()) > tol:
+            varying.append(f"{r['name']} ({max(devs.values()):.6g})")
+            continue
         off = np.asarray(r["offset"], float).copy()
-        for i, c in enumerate(r["channels"]):
-            if not c.endswith("position"):
-                continue
-            v = data[:, start[k] + i]
-            dev = float(np.max(np.abs(v - v.mean())))
-            if dev > tol:
-                f = int(np.argmax(np.abs(v - v.mean())))
-                raise MotionFormatError(path, r["chan_line"],
-                                        f"joint {r['name']!r}: {c} varies over the frames by up to {dev:g} from its "
-                                        f"mean (frame {f + 1}; tolerance {tol:g} file units); translation of a "
-                                        "non-root joint is not supported (the skeleton has fixed bone offsets)")
-            off["XYZ".index(c[0])] = v.mean()
+        for i, c in cols:
+            off["XYZ".index(c[0])] = data[:, start[k] + i].mean()
             drop.append(start[k] + i)
         r["offset"] = off
         r["channels"] = [c for c in r["channels"] if not c.endswith("position")]
-    log.info("%s: position channels of non-root joint(s) %s are constant; read as their OFFSET",
-             os.fspath(path), ", ".join(joints[k]["name"] for k in moved))
+        const.append(r["name"])
+    if const:
+        log.info("%s: position channels of non-root joint(s) %s are constant (within %g file units); read as their "
+                 "OFFSET", os.fspath(path), ", ".join(const), tol)
+    if varying:
+        log.info("%s: non-root joint(s) with translation over the frames (largest movement from the mean, file "
+                 "units): %s; read as translation DOF of those joints", os.fspath(path), ", ".join(varying))
     return np.delete(data, drop, axis=1)
+
+
+#: A channelled root's rotation counts as constant (a dummy root) when no frame's rotation differs from the
+#: first frame's by more than this many degrees (the printed precision of the angles is 1e-6 degrees).
+DUMMY_ROOT_ROTATION_TOL_DEG = 1e-5
+
+
+def _joint_translation(rec: dict, data: np.ndarray, first: int) -> np.ndarray:
+    """(frames, 3): a joint's OFFSET with its position channels (columns from ``first``) replacing it."""
+    t = np.tile(np.asarray(rec["offset"], float), (data.shape[0], 1))
+    for i, c in enumerate(rec["channels"]):
+        if c.endswith("position"):
+            t[:, "XYZ".index(c[0])] = data[:, first + i]
+    return t
+
+
+def _joint_rotation(rec: dict, data: np.ndarray, first: int) -> Rotation:
+    """A joint's local rotation per frame from its rotation channels (intrinsic, in channel order)."""
+    idx = [i for i, c in enumerate(rec["channels"]) if c.endswith("rotation")]
+    if not idx:
+        return Rotation.identity(data.shape[0])
+    seq = "".join(rec["channels"][i][0] for i in idx)
+    return Rotation.from_euler(seq, data[:, [first + i for i in idx]], degrees=True)
+
+
+def _merge_dummy_root(path, joints: list[dict], data: np.ndarray):
+    """Merge a channelled root with constant rotation into its only child that has position channels
+    (see module docstring)."""
+    root = joints[0]
+    kids = [k for k, r in enumerate(joints) if r["parent"] == 0]
+    if not root["channels"] or len(kids) != 1 or root["end"] is not None:
+        return joints, data
+    child = joints[1]
+    if not any(c.endswith("position") for c in child["channels"]):
+        return joints, data
+    R_root = _joint_rotation(root, data, 0)
+    R0 = R_root[0]
+    if data.shape[0] > 1 and np.degrees((R0.inv() * R_root).magnitude()).max() > DUMMY_ROOT_ROTATION_TOL_DEG:
+        return joints, data
+    nr, nc = len(root["channels"]), len(child["channels"])
+    t = _joint_translation(root, data, 0) + R0.apply(_joint_translation(child, data, nr))
+    rot_ch = [c for c in child["channels"] if c.endswith("rotation")]
+    if np.degrees(R0.magnitude()) <= DUMMY_ROOT_ROTATION_TOL_DEG:
+        rot = data[:, [nr + i for i, c in enumerate(child["channels"]) if c.endswith("rotation")]]
+    else:
+        if len(rot_ch) < 3:
+            rot_ch = ["Zrotation", "Yrotation", "Xrotation"]
+        R = R0 * _joint_rotation(child, data, nr)
+        rot = R.as_euler("".join(c[0] for c in rot_ch), degrees=True)
+    new = dict(child, parent=-1, channels=["Xposition", "Yposition", "Zposition"] + rot_ch,
+               offset=np.asarray(root["offset"], float) + R0.apply(np.asarray(child["offset"], float)))
+    out = [new] + [dict(r, parent=r["parent"] - 1) for r in joints[2:]]
+    data = np.concatenate([t, rot, data[:, nr + nc:]], axis=1)
+    log.info("%s: root %r has a constant rotation (%.6g degrees) and one child %r with position channels, which "
+             "carries the motion; merged: %r is the root (every joint's world position unchanged)", os.fspath(path),
+             root["name"], float(np.degrees(R0.magnitude())), child["name"], child["name"])
+    return out, data
 
 
 def motion_from_bvh_on(bvh_motion: Motion, skeleton: Skeleton) -> Motion:

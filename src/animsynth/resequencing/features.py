@@ -15,12 +15,15 @@ Conventions
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import quaternions, root_translation
+from ..kinematics import quaternions, root_translation, translated_joints
+
+log = logging.getLogger("animsynth.resequencing")
 
 __all__ = ["quat_log", "relative_log", "linearize_quaternions", "MotionFeatures", "motion_features",
            "angular_velocity", "SIGN_MODES", "quat_multiply", "matrix_naive_quaternions", "naive_quat_log",
@@ -224,11 +227,23 @@ class MotionFeatures:
 
 
 def motion_features(motion) -> MotionFeatures:
-    """Extract :class:`MotionFeatures` from an :class:`animsynth.motion.Motion`."""
+    """Extract :class:`MotionFeatures` from an :class:`animsynth.motion.Motion`.
+
+    The pose is the joints' rotations (and, as global DOF, the root's rotation
+    and translation). A translation of a joint other than the root (BVH
+    position channels that move, :mod:`animsynth.io.bvh`) is left out of the
+    features, with one logged note naming the joints: the paper's features are
+    rotations. The re-sequenced motion still plays every frame's full pose,
+    translations included.
+    """
     sk = motion.skeleton
     values = np.asarray(motion.values, float)
     if values.ndim != 2 or values.shape[0] < 2:
         raise ValueError(f"motion {motion.name!r} needs at least 2 frames, got shape {values.shape}")
+    moved = translated_joints(sk)
+    if moved:
+        log.info("motion %r: the translation of joint(s) %s (not the root) is left out of the re-sequencing "
+                 "features (rotations only); the played frames keep it", motion.name, ", ".join(moved))
     q = quaternions(sk, values)
     keep = [i for i, j in enumerate(sk.joints) if i > 0 and j.rot_dofs]
     return MotionFeatures(

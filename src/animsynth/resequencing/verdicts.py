@@ -269,7 +269,10 @@ def global_dof_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: float
                      f"{eff_a}); where both re-sequence the global arm is smoother in {lo} of {lo + hi} pairs "
                      f"(p={p:.2g}: {eff_s}) -> {effect}")
     n = len([d for d in datasets if d in want])
-    if n and agree == n:
+    missing = [d for d in want if d not in datasets]
+    if missing:  # resequencing_trials without them: that half of the claim is not measured
+        parts.append(f"{', '.join(missing)}: not in this run (no trial in resequencing_trials), not measured")
+    if n and agree == n and not missing:
         verdict = "reproduced"
     elif agree > 0:
         verdict = "partly"

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import derive_seed
+from ..kinematics import translated_joints
 from ..motion import Motion
 from ..atomic import atomic_write_text
 from ..tables import write_table
@@ -38,6 +39,11 @@ def load_trials(paths, ids) -> tuple[dict, dict]:
             raise ValueError(f"trial file {p} does not match trial id {tid!r}")
         m = Motion.load_npz(p)
         a = np.asarray(m.without_root(), float)
+        moved = translated_joints(m.skeleton)
+        if moved:
+            log.info("trial %s: joint(s) %s move against their parent; their translation DOF (file length units) are "
+                     "columns of the pose vector beside the joint angles, as the root's are not", tid,
+                     ", ".join(moved))
         if not np.all(np.isfinite(a)):
             raise ValueError(f"trial file {p}: joint angles contain NaN/inf")
         angles[tid], motions[tid] = a, m

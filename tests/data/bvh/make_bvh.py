@@ -19,6 +19,13 @@ not come from any other project:
   every leaf, and ``CHANNELS 6 Xposition Yposition Zposition ...`` on every
   bone not connected to its parent (thighs, shoulders, upper arms) whose
   positions are constant, equal to the bone's ``OFFSET``.
+* the classes of tests/bvh_classes.py (made from the project's synthetic
+  mocap, a 24-frame walk, by the project's writer): ``bandai.bvh`` (a
+  6-channel dummy root over a 6-channel Hips, cm), ``every6_bip.bvh`` (6
+  channels on every joint, Bip01 names, joints that move, cm),
+  ``rest_along_x.bvh`` (the rest pose lying along +X, cm), ``z_up.bvh`` (Z
+  up, -Y forward, metres), ``mixed_orders.bvh`` (a different rotation order
+  on every joint, cm).
 * ``multiroot/blender_two_roots.bvh`` (a folder of its own: it is refused, the
   files above are read): what the exporter writes for an armature with two
   root bones, a dummy ``ROOT __0`` with ``OFFSET 0.0 0.0 0.0`` and
@@ -151,6 +158,25 @@ def main():
     write("blender.bvh", blender, "YXZ", "YXZ", 24.0, "0.041667", indent="\t",
           unconnected=("lupleg", "rupleg", "lshoulder", "rshoulder", "larm", "rarm"))
     write_two_roots()
+    write_classes()
+
+
+#: file name -> class of tests/bvh_classes.py
+CLASS_FILES = {"bandai.bvh": "bandai", "every6_bip.bvh": "every6", "rest_along_x.bvh": "rest_x",
+               "z_up.bvh": "zup", "mixed_orders.bvh": "mixed"}
+
+
+def write_classes() -> None:
+    """The files of the classes found in the wild, from a synthetic walk (tests/bvh_classes.py)."""
+    import sys
+
+    sys.path[:0] = [str(HERE.parents[1]), str(HERE.parents[2] / "src")]
+    from bvh_classes import write_class
+    from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+    walk = generate_motion("walk_turn", FRAMES, 3, cmu_like_skeleton("wild", 0), name="walk")
+    for name, cls in CLASS_FILES.items():
+        write_class(walk, cls, HERE / name)
 
 
 def write_two_roots() -> None:
