@@ -430,13 +430,19 @@ def build_parser() -> argparse.ArgumentParser:
 SIZE_OPTIONS = {"generate": "--steps", "resequence": "--length"}
 
 
+def _inputs(a) -> list[str]:
+    """The input files a command was given: ``--asf``/``amc``, the training files or the positional files."""
+    names = [getattr(a, k, None) for k in ("asf", "amc")]
+    names += list(getattr(a, "train", None) or []) + list(getattr(a, "files", None) or [])
+    return [n for n in dict.fromkeys(names) if n]
+
+
 def _check_out_is_not_an_input(a) -> None:
     """Refuse an output that is one of the command's input files (it would be replaced)."""
     out = getattr(a, "out", None)
     if not out or not os.path.exists(out):
         return
-    inputs = [getattr(a, k, None) for k in ("asf", "amc")] + list(getattr(a, "train", None) or [])
-    for inp in inputs:
+    for inp in _inputs(a):
         if inp and os.path.exists(inp) and os.path.samefile(inp, out):
             option = "--out" if a.command in ("generate", "resequence") else "out"
             raise UsageError(option, f"{out!r} is the input file {inp!r}; writing it would replace the input")
@@ -475,8 +481,7 @@ def main(argv=None) -> int:
         print(f"animsynth {args.command}: error: {_out_of_memory(args)}", file=sys.stderr)
         return 2
     except RecursionError:
-        inputs = [getattr(args, k, None) for k in ("asf", "amc")] + list(getattr(args, "train", None) or [])
-        print(f"animsynth {args.command}: error: {', '.join(i for i in inputs if i) or 'the input'}: "
+        print(f"animsynth {args.command}: error: {', '.join(_inputs(args)) or 'the input'}: "
               "nested too deeply to process", file=sys.stderr)
         return 2
     except (ValueError, KeyError, IndexError, OSError, ImportError, RuntimeError) as exc:
