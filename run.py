@@ -165,6 +165,110 @@ def sh(*args: str) -> int:
     return subprocess.call(list(args), cwd=ROOT)
 
 
+# ----------------------------------------------------------------------------- the run's CPU breakdown
+# Snakemake runs inside a small wrapper that records, when it exits, the CPU time of its own process
+# (DAG, job selection, benchmark sampling, status checks) apart from that of the processes it started
+# and waited for (the jobs, from interpreter start-up to exit). run.py writes them, beside the jobs' CPU
+# as their benchmark files measured it, to <results_dir>/run_cost.csv.
+MEASURED_SNAKEMAKE = """
+import atexit, json, os, resource, sys, time
+_pid, _t0 = os.getpid(), time.perf_counter()
+def _record():
+    if os.getpid() != _pid:
+        return
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    with open(os.environ["ANIMSYNTH_RUN_COST"], "a") as f:
+        f.write(json.dumps({"label": os.environ.get("ANIMSYNTH_RUN_COST_LABEL", ""), "wall_s": time.perf_counter() - _t0,
+                            "self_user_s": me.ru_utime, "self_system_s": me.ru_stime,
+                            "children_user_s": kids.ru_utime, "children_system_s": kids.ru_stime}) + "\\n")
+atexit.register(_record)
+sys.argv[0] = "snakemake"
+from snakemake.cli import main
+sys.exit(main())
+"""
+
+
+class RunCost:
+    """CPU accounting of one ``run.py`` call: every Snakemake call it makes, and run.py itself."""
+
+    def __init__(self) -> None:
+        import tempfile
+        import time
+
+        fd, self.path = tempfile.mkstemp(prefix="animsynth-run-cost-", suffix=".jsonl")
+        os.close(fd)
+        self.t0 = time.perf_counter()
+
+    def snakemake(self, label: str, *args: str) -> int:
+        """Run ``snakemake ARGS`` (as :func:`sh` does) and record its CPU under ``label``."""
+        print("[run.py] " + " ".join([str(BIN / "snakemake"), *args]), flush=True)
+        env = dict(os.environ, ANIMSYNTH_RUN_COST=self.path, ANIMSYNTH_RUN_COST_LABEL=label)
+        return subprocess.call([str(PY), "-c", MEASURED_SNAKEMAKE, *args], cwd=ROOT, env=env)
+
+    def write(self, results_dir: str) -> None:
+        """``results_dir``/run_cost.csv: where the CPU time of this run.py call went."""
+        import csv
+        import json
+        import resource
+        import time
+
+        with open(self.path) as f:
+            calls = [json.loads(line) for line in f if line.strip()]
+        os.unlink(self.path)
+        me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+        total_user, total_sys = me.ru_utime + kids.ru_utime, me.ru_stime + kids.ru_stime
+        rows = []
+
+        def row(part, user, system, note, wall=""):
+            rows.append({"part": part, "cpu_s": round(user + system, 1), "user_s": round(user, 1),
+                         "system_s": round(system, 1), "wall_s": wall if wall == "" else round(wall, 1),
+                         "note": note})
+
+        bench = Path(ROOT, results_dir, "rule_benchmarks.csv")
+        job_cpu = None
+        if bench.exists():
+            with open(bench, newline="") as f:
+                job_cpu = sum(float(r["cpu_time_s"] or 0) for r in csv.DictReader(f) if r["cpu_time_s"] not in ("", "nan"))
+        used_user = used_sys = 0.0
+        for c in calls:
+            used_user += c["self_user_s"] + c["children_user_s"]
+            used_sys += c["self_system_s"] + c["children_system_s"]
+            kid = c["children_user_s"] + c["children_system_s"]
+            if c["label"] == "run" and job_cpu is not None:
+                row("jobs: CPU in their benchmark files (rule_benchmarks.csv)", job_cpu, 0.0,
+                    "sum of cpu_time_s over this run's jobs (per family: rule_benchmarks_per_family.csv); "
+                    "user and system time together")
+                row("jobs: CPU their benchmark files missed", max(kid - job_cpu, 0.0), 0.0,
+                    "job processes as the OS counted them minus the benchmark files: Snakemake samples a job's "
+                    "CPU every 0.5 s, then every 30 s, so the time after a job's last sample is not in its file; "
+                    "negative differences (files of jobs that did not run in this call) count as 0")
+            else:
+                row(f"{c['label']}: processes Snakemake started", c["children_user_s"], c["children_system_s"],
+                    "every process the Snakemake call started and waited for")
+            row(f"{c['label']}: Snakemake's own process", c["self_user_s"], c["self_system_s"],
+                "parsing and DAG, job selection, benchmark sampling, status checks", c["wall_s"])
+        row("run.py (venv check, config prescan)", total_user - used_user, total_sys - used_sys,
+            "run.py and the processes it started other than Snakemake")
+        row("total", total_user, total_sys, "everything this run.py call used", time.perf_counter() - self.t0)
+        out = Path(ROOT, results_dir, "run_cost.csv")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with open(out, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+        print(f"[run.py] CPU time of this run: {(total_user + total_sys) / 60:.1f} min; breakdown in {out}",
+              flush=True)
+
+
+def results_dir_of(args: list[str], default: str) -> str:
+    """The results_dir a ``--config results_dir=DIR`` among ``args`` sets (else ``default``)."""
+    found = default
+    for a in args:
+        if a.startswith("results_dir="):
+            found = a.split("=", 1)[1]
+    return found
+
+
 def main(argv: list[str]) -> int:
     if argv[:1] == ["_check-configfiles"]:  # run by prescan() inside the venv
         msg = check_configfiles(argv[1:])
@@ -177,10 +281,12 @@ def main(argv: list[str]) -> int:
     if argv and argv[0] in ("paper", "bench", "snakemake"):
         argv = [argv[0], *with_targets_first(argv[1:])]
     if not argv:
-        rc = sh(snakemake, "--cores", str(os.cpu_count() or 2))
+        cost = RunCost()
+        rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2))
         if rc == 0:
-            rc = sh(snakemake, "--report", "results/report.html")
+            rc = cost.snakemake("report", "--report", "results/report.html")
         if rc == 0:
+            cost.write("results")
             print(DEMO_NOTE, flush=True)
         return rc
     if argv[0] in ("paper", "bench", "snakemake") and prescan([*PAPER_CONFIG, *argv[1:]] if argv[0] == "paper"
@@ -188,9 +294,12 @@ def main(argv: list[str]) -> int:
         return 2
     if argv[0] == "paper":
         # Extra arguments (e.g. --config cmu_mirror=DIR mesh_dir=DIR) go to both calls.
-        rc = sh(snakemake, "--cores", str(os.cpu_count() or 2), *PAPER_CONFIG, *argv[1:])
+        cost = RunCost()
+        rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2), *PAPER_CONFIG, *argv[1:])
         if rc == 0:
-            rc = sh(snakemake, *PAPER_CONFIG, *argv[1:], "--report", "results/paper/report.html")
+            rc = cost.snakemake("report", *PAPER_CONFIG, *argv[1:], "--report", "results/paper/report.html")
+        if rc == 0:
+            cost.write(results_dir_of(argv[1:], "results/paper"))
         return rc
     if argv[0] == "bench":
         # Extra arguments go to snakemake; KEY=VALUE pairs after --config join the bench run's own (snakemake

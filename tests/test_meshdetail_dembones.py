@@ -124,3 +124,41 @@ def test_mesh_sequences_names_and_own_rig():
         mesh_sequences(_config(sequences={"samba": {"mesh_dir": "x", "rig": {"joints": joints}}}))
     with pytest.raises(ConfigError, match="crane.rig.joints"):
         check(_config(sequences={"crane": {"mesh_dir": "x", "rig": {"joints": {"hips": [0, 0, 0]}}}}))
+
+
+def _solve_reference(W, rest, frames, sweeps, T):
+    """The block-coordinate Procrustes sweeps written frame-major, bone by bone, as in their definition."""
+    T = T.copy()
+    P = D.blend(W, rest, T)
+    for _ in range(sweeps):
+        for b in range(W.shape[1]):
+            idx = np.flatnonzero(W[:, b] > 0)
+            w, u = W[idx, b], rest[idx]
+            own = np.einsum("fij,vj->fvi", T[:, b, :, :3], u) + T[:, b, None, :, 3]
+            tgt = (frames[:, idx] - (P[:, idx] - w[None, :, None] * own)) / w[None, :, None]
+            c = w ** 2
+            mu_u = (c[:, None] * u).sum(0) / c.sum()
+            mu_t = np.einsum("v,fvi->fi", c, tgt) / c.sum()
+            H = np.einsum("v,vi,fvj->fij", c, u - mu_u, tgt - mu_t[:, None, :])
+            U, _, Vt = np.linalg.svd(H)
+            d = np.sign(np.linalg.det(np.swapaxes(Vt, 1, 2) @ np.swapaxes(U, 1, 2)))
+            Dm = np.tile(np.eye(3), (len(H), 1, 1))
+            Dm[:, 2, 2] = d
+            R = np.swapaxes(Vt, 1, 2) @ Dm @ np.swapaxes(U, 1, 2)
+            t = mu_t - np.einsum("fij,j->fi", R, mu_u)
+            P[:, idx] += w[None, :, None] * (np.einsum("fij,vj->fvi", R, u) + t[:, None, :] - own)
+            T[:, b, :, :3], T[:, b, :, 3] = R, t
+    return T
+
+
+def test_held_out_solve_matches_the_sweeps_written_frame_major():
+    rest, _, W, T, V = skinned_tube(frames=10)
+    rng = np.random.default_rng(2)
+    Vd = V[1:] + rng.normal(0, 0.01, V[1:].shape)  # not exact LBS: the sweeps have work to do
+    start = D.affine_transforms(W, rest, Vd)
+    start[..., :3] = D._nearest_rotation(start[..., :3])
+    np.testing.assert_allclose(D.solve_transforms(W, rest, Vd, sweeps=4, init=start),
+                               _solve_reference(W, rest, Vd, 4, start), rtol=0, atol=1e-12)
+    # the default start is that projected affine solve
+    np.testing.assert_array_equal(D.solve_transforms(W, rest, Vd, sweeps=4),
+                                  D.solve_transforms(W, rest, Vd, sweeps=4, init=start))

@@ -160,3 +160,52 @@ def test_rbf_upsampler_on_coplanar_control_points_interpolates():
     fine = np.c_[rng.uniform(-0.5, 0.5, (30, 2)), np.zeros(30)]
     np.testing.assert_allclose(RBFUpsampler(ctrl, fine, 12)(lin[:, None])[:, 0], fine[:, :2] @ [1.0, -2.0] + 0.5,
                                atol=1e-6)
+
+
+def _hits_brute_force(origins, targets, origin_ids, V, F, eps=1e-6):
+    """Möller-Trumbore of every segment against every triangle not incident to its origin vertex."""
+    out = np.zeros(len(origins), bool)
+    v0, e1, e2 = V[F[:, 0]], V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]
+    for i, (o, t) in enumerate(zip(origins, targets)):
+        d = t - o
+        pv = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, pv)
+        ok = (np.abs(det) > 1e-15) & ~np.any(F == origin_ids[i], axis=1)
+        det = np.where(ok, det, 1.0)
+        tv = o - v0
+        u = np.einsum("ij,ij->i", tv, pv) / det
+        qv = np.cross(tv, e1)
+        v = (qv @ d) / det
+        s = np.einsum("ij,ij->i", e2, qv) / det
+        out[i] = np.any(ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (s > eps) & (s < 1 - eps))
+    return out
+
+
+def test_visibility_search_near_each_segment_finds_every_crossing_that_testing_all_triangles_finds():
+    from animsynth.skinning import _segments_hit_mesh
+
+    V, F = closed_cylinder(length=2.0, radius=0.5, rings=81, around=24)  # cap triangles ~4x the side's
+    rng = np.random.default_rng(5)
+    ids = rng.choice(len(V), 60)
+    targets = rng.uniform([-0.5, -0.6, -0.6], [2.5, 0.6, 0.6], (60, 3))  # inside, outside, through the caps
+    got = _segments_hit_mesh(V[ids], targets, ids, V, F)
+    want = _hits_brute_force(V[ids], targets, ids, V, F)
+    assert want.any() and not want.all()
+    np.testing.assert_array_equal(got, want)
+
+
+def test_folds_sharing_a_cache_get_the_skeleton_they_get_alone():
+    from animsynth.meshdetail.rigfit import fit_skeleton
+
+    V, F = closed_cylinder()
+    rig = Rig(np.array([[0.0, 0, 0], [1.0, 0.25, 0]]), np.array([[1.0, 0.25, 0], [2.0, 0, 0]]),
+              names=("a", "b"), parents=(-1, 0))  # the joint sits outside: the interior search runs
+    frames = np.stack([V + [0.01 * f, 0, 0] for f in range(12)])
+    cache = {}
+    for train in (np.arange(3, 12), np.arange(0, 9)):
+        alone = fit_skeleton(frames, F, rig, train, refine=True, iterations=2)
+        shared = fit_skeleton(frames, F, rig, train, refine=True, iterations=2, cache=cache)
+        np.testing.assert_array_equal(alone[0].starts, shared[0].starts)
+        assert (alone[1] != shared[1]).nnz == 0
+        np.testing.assert_array_equal(alone[2].angles_, shared[2].angles_)
+    assert "initial_weights" in cache and ("nearest_interior", 1) in cache

@@ -371,23 +371,44 @@ def _segments_hit_mesh(origins: np.ndarray, targets: np.ndarray, origin_ids: np.
     """Does the open segment origin->target cross a mesh triangle not incident to the origin vertex?
 
     Möller-Trumbore intersection against the triangles near each segment
-    (triangle centroids within half the segment length plus the largest
-    triangle radius of its midpoint, found with a k-d tree).
+    (triangles whose centroid lies within their radius of the segment,
+    found with k-d trees).
     """
     from scipy.spatial import cKDTree
 
     tri = vertices[faces]
     cen = tri.mean(axis=1)
-    rad = float(np.max(np.linalg.norm(tri - cen[:, None], axis=-1)))
-    mid = 0.5 * (origins + targets)
-    half = 0.5 * np.linalg.norm(targets - origins, axis=1)
-    cand = cKDTree(cen).query_ball_point(mid, half + rad)
-    seg = np.repeat(np.arange(len(origins)), [len(c) for c in cand])
+    rad = np.max(np.linalg.norm(tri - cen[:, None], axis=-1), axis=1)  # (T,) each triangle's radius
+    # Candidates: triangles whose centroid lies within their radius of the segment (a triangle that meets the
+    # segment has every point within its largest vertex distance of its centroid). Triangles are searched in
+    # two groups (radius up to twice the median, and the larger rest), each with a k-d tree of centroids
+    # queried along the segment by balls of that group's largest radius plus half a piece (pieces no
+    # longer than twice that radius); a triangle found by several balls is tested more than once.
+    length = np.linalg.norm(targets - origins, axis=1)
+    cut = 2.0 * float(np.median(rad))
+    segs, fs = [], []
+    for group in (np.flatnonzero(rad <= cut), np.flatnonzero(rad > cut)):
+        if not len(group):
+            continue
+        r = float(rad[group].max())
+        pieces = np.maximum(1, np.ceil(0.5 * length / max(r, 1e-12))).astype(np.int64)
+        owner = np.repeat(np.arange(len(origins)), pieces)
+        frac = (np.arange(len(owner)) - np.repeat(np.cumsum(pieces) - pieces, pieces) + 0.5) / pieces[owner]
+        mid = origins[owner] + frac[:, None] * (targets - origins)[owner]
+        cand = cKDTree(cen[group]).query_ball_point(mid, 0.5 * length[owner] / pieces[owner] + r)
+        segs.append(np.repeat(owner, [len(c) for c in cand]))
+        fs.append(group[np.concatenate([np.asarray(c, np.int64) for c in cand])] if len(segs[-1]) else
+                  np.zeros(0, np.int64))
+    seg, f = np.concatenate(segs), np.concatenate(fs)
     if len(seg) == 0:
         return np.zeros(len(origins), bool)
-    f = np.concatenate([np.asarray(c, np.int64) for c in cand])
     keep = ~np.any(faces[f] == origin_ids[seg, None], axis=1)
     seg, f = seg[keep], f[keep]
+    o, d = origins[seg], targets[seg] - origins[seg]
+    s = np.clip(np.einsum("ij,ij->i", cen[f] - o, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+    gap = cen[f] - o - s[:, None] * d
+    near = np.einsum("ij,ij->i", gap, gap) <= (rad[f] * (1 + 1e-9)) ** 2
+    seg, f = seg[near], f[near]
     o, d = origins[seg], targets[seg] - origins[seg]
     v0, e1, e2 = tri[f, 0], tri[f, 1] - tri[f, 0], tri[f, 2] - tri[f, 0]
     pv = np.cross(d, e2)

@@ -107,31 +107,38 @@ def solve_transforms(W: np.ndarray, rest: np.ndarray, frames: np.ndarray, sweeps
         T[..., :3] = _nearest_rotation(T[..., :3])
     else:
         T = np.array(init, float)
-    support = [np.flatnonzero(W[:, b] > 0) for b in range(B)]
-    P = blend(W, rest, T)  # current prediction (F, V, 3)
-    for _ in range(int(sweeps)):
-        for b in range(B):
-            idx = support[b]
-            if not len(idx):
-                continue
+    # vertex-major layout (V, F, 3): a bone's vertices are whole rows, and its targets are gathered once
+    P = np.ascontiguousarray(blend(W, rest, T).transpose(1, 0, 2))  # current prediction
+    frames_vm = frames.transpose(1, 0, 2)
+    per_bone = []
+    for b in range(B):
+        idx = np.flatnonzero(W[:, b] > 0)
+        if len(idx):
             w = W[idx, b]
-            u = rest[idx]
-            own = np.einsum("fij,vj->fvi", T[:, b, :, :3], u) + T[:, b, None, :, 3]
-            q = frames[:, idx] - (P[:, idx] - w[None, :, None] * own)  # what bone b should explain
-            # weighted Procrustes: weights w^2, source u, target q / w
             c = w ** 2
-            tgt = q / w[None, :, None]
+            u = rest[idx]
             mu_u = (c[:, None] * u).sum(0) / c.sum()
-            mu_t = np.einsum("v,fvi->fi", c, tgt) / c.sum()
-            H = np.einsum("v,vi,fvj->fij", c, u - mu_u, tgt - mu_t[:, None, :])  # (F, 3, 3)
+            per_bone.append((b, idx, w[:, None, None], c, c.sum(), u, mu_u, (c[:, None] * (u - mu_u)).T,
+                             np.ascontiguousarray(frames_vm[idx])))
+
+    def place(R, t, u):  # R (F, 3, 3), t (F, 3), u (n, 3) -> R_f u_v + t_f as (n, F, 3)
+        return (u @ R.transpose(2, 0, 1).reshape(3, 3 * F)).reshape(len(u), F, 3) + t[None]
+
+    for _ in range(int(sweeps)):
+        for b, idx, w, c, csum, u, mu_u, A, target in per_bone:
+            own = place(T[:, b, :, :3], T[:, b, :, 3], u)
+            Pb = P[idx]
+            tgt = (target - (Pb - w * own)) / w  # what bone b should explain, over its weight
+            # weighted Procrustes: weights w^2, source u, target tgt
+            mu_t = (c @ tgt.reshape(len(idx), 3 * F)).reshape(F, 3) / csum
+            H = (A @ (tgt - mu_t[None]).reshape(len(idx), 3 * F)).reshape(3, F, 3).transpose(1, 0, 2)  # (F, 3, 3)
             U, _, Vt = np.linalg.svd(H)
             d = np.sign(np.linalg.det(np.transpose(Vt, (0, 2, 1)) @ np.transpose(U, (0, 2, 1))))
             D = np.tile(np.eye(3), (F, 1, 1))
             D[:, 2, 2] = d
             R = np.transpose(Vt, (0, 2, 1)) @ D @ np.transpose(U, (0, 2, 1))
             t = mu_t - np.einsum("fij,j->fi", R, mu_u)
-            new_own = np.einsum("fij,vj->fvi", R, u) + t[:, None, :]
-            P[:, idx] += w[None, :, None] * (new_own - own)
+            P[idx] = Pb + w * (place(R, t, u) - own)
             T[:, b, :, :3], T[:, b, :, 3] = R, t
     return T
 
@@ -171,7 +178,9 @@ def floor_cv(frames: np.ndarray, faces: np.ndarray, folds: list, bone_counts, ma
             c0, w0 = time.process_time(), time.perf_counter()
             T_aff = affine_transforms(W, rest, frames[te])
             aff_mm = float(vertex_error_mm(blend(W, rest, T_aff), frames[te]).mean())
-            T_te = solve_transforms(W, rest, frames[te], sweeps=sweeps)
+            T_start = T_aff.copy()  # solve_transforms' own start, computed once
+            T_start[..., :3] = _nearest_rotation(T_start[..., :3])
+            T_te = solve_transforms(W, rest, frames[te], sweeps=sweeps, init=T_start)
             P = blend(W, rest, T_te)
             solve_cpu, solve_wall = time.process_time() - c0, time.perf_counter() - w0
             err = vertex_error_mm(P, frames[te])

@@ -334,7 +334,7 @@ def nearest_interior_point(point: np.ndarray, vertices: np.ndarray, faces: np.nd
 
 
 def place_joints(rig: Rig, weights, rest: np.ndarray, faces: np.ndarray, frames: np.ndarray | None,
-                 max_move: float = 0.08):
+                 max_move: float = 0.08, cache: dict | None = None):
     """Joint centres from the mesh motion, checked to lie inside the first-frame mesh.
 
     Every non-root joint first gets its least-squares rotation centre
@@ -344,6 +344,11 @@ def place_joints(rig: Rig, weights, rest: np.ndarray, faces: np.ndarray, frames:
     ``max_move``; otherwise the initial position is kept if it is inside, and a
     joint that is still outside goes to :func:`nearest_interior_point`. Segment
     ends follow the child joints.
+
+    ``cache`` (optional dict, kept by the caller between calls with the same ``rig``, ``rest`` and
+    ``faces``, e.g. the folds of a cross-validation): the winding numbers of the initial starts and
+    the interior points found for them are computed once and reused (they depend on neither
+    ``weights`` nor ``frames``).
 
     Returns
     -------
@@ -360,7 +365,10 @@ def place_joints(rig: Rig, weights, rest: np.ndarray, faces: np.ndarray, frames:
                                   "moved_mm": 0.0, "winding_number": np.round(wn, 3), "inside": np.abs(wn) > 0.5,
                                   "placement": "given"})
     moved, status = refine_joints_from_motion(rig, weights, rest, frames, return_status=True)
-    wn0 = winding_number(rig.starts, rest, faces)
+    cache = {} if cache is None else cache
+    if "initial_winding" not in cache:
+        cache["initial_winding"] = winding_number(rig.starts, rest, faces)
+    wn0 = cache["initial_winding"]
     wn1 = winding_number(moved.starts, rest, faces)
     starts = rig.starts.copy()
     how = []
@@ -375,7 +383,10 @@ def place_joints(rig: Rig, weights, rest: np.ndarray, faces: np.ndarray, frames:
                                                    "too few rigid vertices": "n/a: < 4 dominated vertices with weight "
                                                    ">= 0.5 on a part"}.get(status[j], status[j])) + ")"
         else:
-            p = nearest_interior_point(rig.starts[j], rest, faces)
+            key = ("nearest_interior", j)
+            if key not in cache:
+                cache[key] = nearest_interior_point(rig.starts[j], rest, faces)
+            p = cache[key]
             if p is None:
                 h = "initial, outside the mesh (no interior point within 8 cm)"
                 log.warning("joint %s lies outside the first-frame mesh", rig.names[j])

@@ -148,12 +148,13 @@ def fold_rig_fitter(seq_npz: str, truth_npz: str | None, rig_cfg: dict):
     only, so a cross-validation fold's held-out frames never shape its skin."""
     seq = MeshSequence.load_npz(seq_npz)
     rig0, refine, _, _, _ = initial_rig(seq, truth_npz, rig_cfg)
+    cache: dict = {}  # what every fold shares (the initial embedding's weights and interior checks)
 
     def refit(train):
         rig, weights, fitter, _, _ = fit_skeleton(
             seq.vertices, seq.faces, rig0, np.asarray(train), skinning=rig_cfg["skinning"], refine=refine,
             max_influences=rig_cfg["max_influences"], iterations=rig_cfg["fit_iterations"],
-            heat_c=rig_cfg["heat_c"], weight_power=rig_cfg["weight_power"], compare=False)
+            heat_c=rig_cfg["heat_c"], weight_power=rig_cfg["weight_power"], compare=False, cache=cache)
         return rig, weights, fitter.root_t_, fitter.angles_
 
     return refit

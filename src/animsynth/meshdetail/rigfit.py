@@ -65,7 +65,7 @@ def _transforms(rig: Rig, fitter: PoseFitter):
 
 def fit_skeleton(frames: np.ndarray, faces: np.ndarray, rig: Rig, train: np.ndarray, skinning: str = "heat+refit",
                  refine: bool = False, max_influences: int = 4, iterations: int = 8, heat_c: float = 1.0,
-                 weight_power: float = 4.0, compare: bool = False):
+                 weight_power: float = 4.0, compare: bool = False, cache: dict | None = None):
     """Place the joints, compute weights, fit every frame's pose.
 
     1. (``refine``) joints from the mesh motion of the **training** frames, each
@@ -82,6 +82,11 @@ def fit_skeleton(frames: np.ndarray, faces: np.ndarray, rig: Rig, train: np.ndar
     compare : bool
         Also fit the other skinning methods and return their residuals (the
         measurement behind the default).
+    cache : dict, optional
+        Kept by the caller between calls on the same mesh and initial ``rig``
+        (the folds of a cross-validation): what depends only on those (the
+        initial embedding's weights for ``refine``, its winding numbers and
+        interior points) is computed once and reused.
 
     Returns
     -------
@@ -90,9 +95,11 @@ def fit_skeleton(frames: np.ndarray, faces: np.ndarray, rig: Rig, train: np.ndar
     rest = frames[0]
     train = np.asarray(train)
     if refine:
-        w0 = skin_weights("heat" if skinning != "distance" else "distance", rest, faces, rig, max_influences,
-                          heat_c, weight_power)
-        rig, joints = place_joints(rig, w0, rest, faces, frames[train])
+        cache = {} if cache is None else cache
+        if "initial_weights" not in cache:
+            cache["initial_weights"] = skin_weights("heat" if skinning != "distance" else "distance", rest, faces,
+                                                    rig, max_influences, heat_c, weight_power)
+        rig, joints = place_joints(rig, cache["initial_weights"], rest, faces, frames[train], cache=cache)
     else:
         rig, joints = place_joints(rig, None, rest, faces, None)
     results = {}
