@@ -16,10 +16,11 @@ for _gen, _why in CMP_LEFT_OUT.items():
 CMP_SHOWCASE = list(showcase(config))
 CMP_TRIALS = list(dict.fromkeys([t for ids in CMP_SUBSETS.values() for t in ids] + list(CMP_RESEQ.values())))
 CMP_CLIP_KEYS = ("fps", "context", "length", "min_length", "holdout_fraction")
-CMP_RUN_KEYS = ("seed", "seeds", "fps", "metrics")
+CMP_RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
 # each generator's own config block (a changed block reruns only that generator's job)
 CMP_GEN_BLOCK = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph", "stisomap": "resequencing_graph",
-                 "motion_graph": "motion_graph", "fairmotion": "fairmotion", "concat": "concat"}
+                 "motion_graph": "motion_graph", "fairmotion": "fairmotion",
+                 "fairmotion_fixed": "fairmotion", "concat": "concat"}
 CMP_CLIPS = R("compare/clips.npz")
 CMP_OUT = {
     "metrics": R("compare/runs/{cmpgen}.csv"),
