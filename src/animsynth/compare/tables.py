@@ -14,7 +14,7 @@ from .jobs import METRIC_NAMES, METRICS
 log = logging.getLogger("animsynth.compare.tables")
 
 __all__ = ["summary_table", "paired_share", "winners_table", "cost_table", "data_label", "summary_markdown",
-           "tables_job", "sensitivity_table", "sweep_table", "sweep_job"]
+           "tables_job", "sensitivity_table", "sweep_table", "sweep_job", "results_markdown"]
 
 #: the columns of the budget sweep table (medians over clips x seeds)
 SWEEP_METRICS = ("transitions_kept", "skate_share", "transition_skate_share", "skating_ratio_gmd", "velocity_jump_p95",
@@ -272,3 +272,48 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
              len(verdicts), ", ".join(verdicts["verdict"]))
     atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg,
                                                           not_built, sanity))
+
+
+#: the columns of the results section of docs/compare.md (metric, heading)
+RESULT_COLUMNS = (("skate_share", "skate share"), ("skating_ratio_gmd", "GMD skating ratio"),
+                  ("transition_skate_share", "skate share near seams"), ("velocity_jump", "seam velocity jump (m/s)"),
+                  ("velocity_jump_p95", "per-frame velocity jump p95 (m/s)"),
+                  ("velocity_jump_over_capture", "frames above the capture's largest jump"),
+                  ("ldlj", "LDLJ"), ("l2p", "L2P"), ("l2p_m", "L2P (m)"), ("coverage", "coverage"),
+                  ("novelty_median_m", "novelty (m)"))
+
+
+def results_markdown(compare_dir) -> str:
+    """The results section of docs/compare.md, generated from a run's tables (``compare_dir``: e.g.
+    ``results/paper/compare``): medians (IQR) per generator, the findings, the sanity checks, the skating
+    sensitivity and, when present, the budget sweep. Every number comes from those files."""
+    from pathlib import Path
+
+    from ..tables import to_markdown
+    from ..verdicts import fmt
+
+    d = Path(compare_dir)
+    summary = pd.read_csv(d / "summary.csv")
+    gens = list(dict.fromkeys(summary["generator"]))
+    rows = []
+    for g in gens:
+        row = {"generator": g + (" (bound)" if g in REFERENCES else "")}
+        for m, head in RESULT_COLUMNS:
+            r = summary[(summary["generator"] == g) & (summary["metric"] == m)]
+            row[head] = (f"{fmt(r['median'].iloc[0])} ({fmt(r['q25'].iloc[0])}-{fmt(r['q75'].iloc[0])})"
+                         if len(r) and r["n"].iloc[0] > 0 else "-")
+        rows.append(row)
+    out = ["Medians over clips x seeds, interquartile range in brackets (`summary.csv`):", "",
+           to_markdown(pd.DataFrame(rows)), ""]
+    v = pd.read_csv(d / "verdicts.csv", keep_default_na=False)
+    out += ["**Findings** (`verdicts.csv`):", "", to_markdown(v[["claim", "verdict", "ours", "evidence"]]), ""]
+    if (d / "sanity_checks.csv").exists():
+        sc = pd.read_csv(d / "sanity_checks.csv", keep_default_na=False)
+        out += ["**Sanity checks** (`sanity_checks.csv`):", "", to_markdown(sc[["claim", "verdict", "evidence"]]), ""]
+    if (d / "skating_sensitivity.csv").exists():
+        out += ["**Skating against its threshold** (`skating_sensitivity.csv`):", "",
+                to_markdown(pd.read_csv(d / "skating_sensitivity.csv")), ""]
+    if (d / "budget_sweep.csv").exists():
+        out += ["**Transition budget sweep** (`budget_sweep.csv`, figure `budget_sweep.png`):", "",
+                to_markdown(pd.read_csv(d / "budget_sweep.csv")), ""]
+    return "\n".join(out)

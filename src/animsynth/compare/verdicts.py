@@ -59,17 +59,23 @@ def independent_groups(clips: pd.DataFrame) -> dict:
     """``{clip: group label}`` from the clips table (``clip``, ``group``, ``held_out``, ``database``).
 
     A clip's trials are its held-out trial and its database trials (CMU ids ``<subject>_<trial>`` found in the
-    ``held_out`` and ``database`` columns); its subject is the held-out trial's subject (the text before
-    ``_``). Clips of one subset and subject form a group; groups sharing a trial are joined. The label names
-    the subsets / datasets joined (``r1 + run``) and, when one subset holds several groups, the subject.
+    clip id and the ``held_out`` and ``database`` columns; other names: the clip's trial and the database's
+    names); its subject is the held-out trial's subject (the text before ``_``; none for other names, so the
+    subset alone makes the group). Clips of one subset and subject form a group; groups sharing a trial are
+    joined. The label names the subsets / datasets joined (``r1 + run``) and, when one subset holds several
+    groups, the subject.
     """
     rows = list(clips.itertuples(index=False))
     trials, base = {}, {}
     for r in rows:
-        ts = set(_TRIAL.findall(f"{r.held_out} {r.database}")) or {str(r.clip)}
+        own = str(r.clip).split("/", 1)[-1]
+        text = f"{own} {r.held_out} {r.database}"
+        ts = set(_TRIAL.findall(text))
+        if not ts:  # not CMU ids: the clip's trial and the database's names (without a temporal split's range)
+            ts = {own} | {t for t in str(r.database).split() if t != "frames" and not re.fullmatch(r"\d+-\d+", t)}
         trials[r.clip] = ts
-        held = _TRIAL.findall(str(r.held_out))
-        subject = held[0].split("_")[0] if held else str(r.clip)
+        held = _TRIAL.findall(own) or _TRIAL.findall(str(r.held_out))
+        subject = held[0].split("_")[0] if held else ""  # no subject id: the subset is the group
         base[r.clip] = (str(r.group), subject)
     parent = {k: k for k in set(base.values())}
 
