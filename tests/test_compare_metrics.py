@@ -351,3 +351,57 @@ def test_seed_diversity(cmu):
     # pairs (f, f) 0, (f, raised) 0.2 twice
     assert M.seed_diversity([f, f, raised]) == pytest.approx(0.4 / 3, rel=1e-12)
     assert np.isnan(M.seed_diversity([f]))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# per-frame jumps, GMD's skating ratio, the robust floor, LDLJ's duration
+# ---------------------------------------------------------------------------------------------------------------
+def test_per_frame_jumps_find_a_discontinuity_between_reported_seams():
+    # constant velocity, a reported seam at 10 where nothing happens, a hidden 3 cm step at 30
+    pos = _seam_motion([1.0, 0.0, 0.0], [1.0, 0.0, 0.0], frames=60)
+    pos[30:, 0, 2] += 0.03
+    capture = _seam_motion([1.0, 0.0, 0.0], [1.2, 0.0, 0.0], seam=20, frames=40)  # its largest jump: 0.2 m/s
+    cmax = M.capture_max_jumps(capture, FPS)
+    assert cmax[0] == pytest.approx(0.2, rel=1e-9)
+    at_seams = M.seam_jumps(pos, FPS, [10], M.jump_reference([capture], FPS))
+    assert at_seams["velocity_jump"] == pytest.approx(0.0, abs=1e-9)  # the seams say: smooth
+    r = M.frame_jumps(pos, FPS, 2, cmax)
+    assert r["velocity_jump_max"] == pytest.approx(0.03 * FPS, rel=1e-9)  # the step in, then out
+    assert r["velocity_jump_over_capture"] == pytest.approx(2 / 58)  # frames 30 and 31 of 2..59
+    assert r["velocity_jump_p95"] == pytest.approx(0.0, abs=1e-9)
+    assert r["accel_jump_over_capture"] > 0
+    # measured from the first generated frame on
+    assert M.frame_jumps(pos, FPS, 40, cmax)["velocity_jump_max"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_gmd_skating_ratio_counts_both_frames_in_contact_and_the_mean_speed_over_all_steps():
+    feet = np.concatenate([_sliding_foot(0.9, 0.0)[:, 1:], _sliding_foot(0.9, 0.5)[:, 1:]], axis=1)  # one lifted
+    T = feet.shape[0]
+    r = M.skating_ratio(feet, FPS, [0, 1], height_m=0.02, speed_m_s=0.5, floor_m=0.0, window=5)
+    # the sliding foot skates on every step (the zero-padded 5-frame mean at the ends is 0.9 * 3/5 = 0.54 > 0.5):
+    # all T - 1 steps of one of the two feet, over all 2 (T - 1) joint-steps
+    assert r == pytest.approx(0.5)
+    # a foot in contact in one frame only of a step does not skate there
+    one = _sliding_foot(0.9, 0.0)[:, 1:].copy()
+    one[::2, 0, 1] = 0.05
+    assert M.skating_ratio(one, FPS, [0], 0.02, 0.5, 0.0) == 0.0
+    # a short burst of speed is removed by the 5-frame mean
+    burst = _sliding_foot(0.0, 0.0)[:, 1:].copy()
+    burst[31:, 0, 0] += 0.6 / FPS  # one step at 0.6 m/s
+    assert M.foot_skating(burst, FPS, [0], 0.02, 0.5, 0.0)["skate_share"] > 0
+    assert M.skating_ratio(burst, FPS, [0], 0.02, 0.5, 0.0) == 0.0
+    assert T == 60
+
+
+def test_the_robust_floor_ignores_a_few_frames_through_the_floor():
+    pos = _sliding_foot(0.9, 0.1)
+    pos[5, 1, 1] = -0.3  # one frame through the floor
+    assert M.floor_height([pos], [1]) == pytest.approx(-0.3)
+    assert M.floor_height([pos], [1], percentile=5) == pytest.approx(0.1)
+
+
+def test_ldlj_takes_the_duration_as_n_over_fs():
+    v = np.array([0.0, 1.0, 3.0, 2.0, 0.5, 0.0])
+    fps = 10.0
+    integral = np.sum((np.diff(v, 2) * fps * fps) ** 2) / fps
+    assert M.ldlj(v, fps) == pytest.approx(-np.log((6 / fps) ** 3 / 3.0 ** 2 * integral), rel=1e-12)

@@ -295,3 +295,125 @@ def test_fairmotion_peer_walks_its_graph_on_our_clips(sk):
         c, f = src[t]
         assert floor_alignment(pos[t], _positions(clips[c])[f])[3] < 1e-8
     assert np.all(src[seams[0]] == -1)  # a blended frame
+
+
+# ---------------------------------------------------------------- the peer's fixes and its native rate
+_FM_GRAPHS = {}
+
+
+def _fm(sk, fixes=(), native_fps=None, turn=False):
+    """A small fairmotion graph (built once per kind: the fixes change only the walk)."""
+    from animsynth.compare.fairmotion_peer import FairmotionGraph
+
+    a = generate_motion("walk_straight", 48, 1, sk, fps=FPS)
+    b = generate_motion("walk_straight", 48, 8, sk, fps=FPS)
+    if turn:  # the second clip walks another way: a transition into it turns the piece
+        b = _moved(b, 1.2, 30.0, -20.0, "b")
+    key = (native_fps, turn)
+    if key not in _FM_GRAPHS:
+        _FM_GRAPHS[key] = FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0,
+                                          native_fps=native_fps).fit([a, b])
+    g = _FM_GRAPHS[key]
+    g.fixes = fixes
+    return g, [a, b], Motion(a.values[:10], sk, FPS, "start")
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_output_rate_fix_appends_whole_pieces_at_the_data_rate(sk):
+    # released, fed 30 fps: the output is built at 60 fps, so every append cuts the piece short
+    g, _, start = _fm(sk)
+    g.generate(start, 40, seed=2)
+    assert g.last_walk_["out_fps"] == 60.0
+    released = np.diff([first for first, _n in g.last_walk_["pieces"]])[1:]
+    assert released.size and np.all(released < 8)
+    g, _, start = _fm(sk, fixes=("output_rate",))
+    g.generate(start, 40, seed=2)
+    assert g.last_walk_["out_fps"] == FPS
+    # base frames per piece (after the first, which fairmotion cuts at its blend start)
+    assert np.all(np.diff([first for first, _n in g.last_walk_["pieces"]])[1:] == 8)
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_blend_source_fix_blends_from_a_moving_source(sk):
+    # released: every blend of one append draws the previous piece's last pose, held still
+    for fixes, moving in [(("output_rate",), False), (("output_rate", "blend_source"), True)]:
+        g, _, start = _fm(sk, fixes=fixes)
+        g.generate(start, 40, seed=2)
+        src = g.last_walk_["blend_sources"]
+        n_blend = 4  # blend frames per append at the data's rate
+        assert src.shape[0] >= 2 * n_blend
+        steps = np.linalg.norm(np.diff(src.reshape(-1, n_blend, 3), axis=1), axis=-1)  # within one append
+        assert (steps.min() > 1e-3) == moving, fixes
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_rigid_turn_fix_turns_the_path_with_the_piece(sk):
+    # the first piece appended from the other clip (fresh poses: 0.0.4 moves the poses it appends in place,
+    # a defect left as released), past its blend, must be a rigid floor move of its source frames, path and
+    # orientation together; released, the orientation turns and the path does not
+    base_fixes = ("output_rate", "blend_source")
+    worst = {}
+    for fixes in (base_fixes, base_fixes + ("rigid_turn",)):
+        g, clips, start = _fm(sk, fixes=fixes, turn=True)
+        residuals = []
+        for seed in range(8):
+            out = g.generate(start, 40, seed=seed)
+            pos, src = _positions(out), out.meta["source_frames"]
+            bounds = list(out.meta["seams"]) + [40]
+            first_clip = src[0, 0]
+            for lo, hi in zip(bounds[:-1], bounds[1:]):
+                t = [i for i in range(lo, hi) if src[i, 0] >= 0]
+                if len(t) >= 3 and src[t[0], 0] != first_clip:
+                    ref = _positions(clips[src[t[0], 0]])[src[t, 1]]
+                    residuals.append(floor_alignment(pos[t].reshape(-1, 3), ref.reshape(-1, 3))[3])
+                    break
+        assert residuals, "no walk turned into the other clip"
+        worst[fixes] = max(residuals)
+    assert worst[base_fixes + ("rigid_turn",)] < 1e-8
+    assert worst[base_fixes] > 1e-4
+
+
+def test_fairmotion_runs_at_its_native_rate_and_answers_at_ours(sk):
+    g, clips, start = _fm(sk, native_fps=60.0)
+    g.fixes = ()
+    assert g.native_fps_ == 60.0 and g.upsample_ == 2 and g._graph_.fps == 60.0
+    out = g.generate(start, 40, seed=1)
+    assert out.fps == FPS and out.values.shape == (40, sk.n_dof)
+    # before the first seam the output plays database frames (every second frame of the 60 fps walk)
+    src, seams = out.meta["source_frames"], out.meta["seams"]
+    pos = _positions(out)
+    for t in range(int(seams[0])):
+        c, f = src[t]
+        assert floor_alignment(pos[t], _positions(clips[c])[f])[3] < 1e-8
+
+
+def test_upsample_keeps_every_frame_and_interpolates_between():
+    from animsynth.compare.fairmotion_peer import upsample
+
+    sk = cmu_like_skeleton("up", 2)
+    m = generate_motion("walk_straight", 20, 3, sk, fps=FPS)
+    u = upsample(m, 2)
+    assert u.fps == 2 * FPS and u.n_frames == 39
+    assert np.allclose(_positions(u)[::2], _positions(m), atol=1e-9)
+    mid = _positions(u)[1::2]
+    assert np.all(np.linalg.norm(mid - 0.5 * (_positions(m)[:-1] + _positions(m)[1:]), axis=-1) < 0.02)
+
+
+def test_budget_gives_every_graph_generator_the_same_transition_count(sk):
+    from animsynth.compare.motiongraph import budget_count
+
+    a = generate_motion("walk_straight", 48, 1, sk, fps=FPS)
+    b = generate_motion("walk_straight", 48, 8, sk, fps=FPS)
+    seconds = (a.n_frames + b.n_frames) / FPS
+    counts = {}
+    for budget in (1.0, 2.0):
+        ours = MotionGraph(window=6, transitions_per_s=budget).fit([a, b])
+        counts[("ours", budget)] = ours.n_below_threshold_
+        if not _fairmotion_reason():
+            from animsynth.compare.fairmotion_peer import FIXES, FairmotionGraph
+
+            fm = FairmotionGraph(base=8, blend=4, compare=4, transitions_per_s=budget, fixes=FIXES,
+                                 native_fps=60.0).fit([a, b])  # both rows build this graph (fixes: the walk)
+            counts[("fairmotion", budget)] = fm.n_below_threshold_
+        assert {v for (_g, bb), v in counts.items() if bb == budget} == {budget_count(budget, seconds)}
+    assert counts[("ours", 1.0)] == 3 and counts[("ours", 2.0)] == 6

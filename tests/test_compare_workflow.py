@@ -30,6 +30,13 @@ def test_compare_outputs(tiny_workflow):
     for g in gens:
         back = read_bvh(r / "bvh" / f"{g}.bvh")
         assert back.n_frames > 0
+    assert {"velocity_jump_p95", "velocity_jump_over_capture", "skating_ratio_gmd", "l2p_m"} <= set(m.columns)
+    sanity = pd.read_csv(r / "sanity_checks.csv")
+    assert list(sanity.columns) == list(v.columns) and set(sanity["verdict"]) <= set(VOCABULARY)
+    assert not set(sanity["claim"]) & set(v["claim"])  # true by construction: not among the findings
+    assert v["evidence"].str.contains("Holm").all() | (v["verdict"] == "not reproduced")
+    sens = pd.read_csv(r / "skating_sensitivity.csv")
+    assert set(sens["speed_m_s"]) == {0.15, 0.3, 0.5}
     for png in ("metrics.png", "strips.png"):
         assert (r / png).stat().st_size > 0
     md = (r / "summary.md").read_text()

@@ -37,7 +37,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-__all__ = ["COLUMNS", "VOCABULARY", "VerdictError", "row", "table", "read", "check", "fmt", "agreement_verdict"]
+__all__ = ["COLUMNS", "VOCABULARY", "VerdictError", "row", "table", "read", "check", "fmt", "agreement_verdict",
+           "holm"]
 
 COLUMNS = ("claim", "paper_value", "ours", "data", "verdict", "evidence", "source")
 VOCABULARY = ("reproduced", "partly", "not reproduced", "contradicted", "within noise")
@@ -127,3 +128,19 @@ def agreement_verdict(share: float) -> str:
     if share == 0.0:
         return "contradicted"
     return "within noise"
+
+
+def holm(pvalues) -> np.ndarray:
+    """Holm's step-down adjustment of a family of p-values (Holm 1979): the ``i``-th smallest is multiplied by
+    ``m - i`` (``i`` from 0, ``m`` the finite p-values), made monotone and capped at 1. A claim is significant
+    at ``alpha`` when its adjusted p is below ``alpha``. NaN stays NaN (no test) and does not count in ``m``."""
+    p = np.asarray(list(pvalues), float)
+    out = np.full(p.shape, np.nan)
+    ok = np.flatnonzero(np.isfinite(p))
+    m = ok.size
+    if m == 0:
+        return out
+    order = ok[np.argsort(p[ok], kind="stable")]
+    adj = np.minimum(1.0, np.maximum.accumulate(p[order] * (m - np.arange(m))))
+    out[order] = adj
+    return out

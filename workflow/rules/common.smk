@@ -400,6 +400,15 @@ def compare_job_cfg(wildcards):
     return cfg
 
 
+def compare_sweep_cfg(wildcards):
+    """A budget-sweep job's config: the graph generator's as in the main run, at the wildcard's budget, with
+    compare.budget_sweep_seeds seeds."""
+    cfg = compare_job_cfg(type("W", (), {"cmpgen": wildcards.cmpgraph})())
+    cfg["transitions_per_s"] = float(wildcards.budget)
+    cfg["seeds"] = min(int(CMP["seeds"]), int(CMP["budget_sweep_seeds"]))
+    return cfg
+
+
 # Benchmark files of this family's jobs (inputs of rule_benchmarks).
 def compare_benchmarks():
     return (
@@ -407,6 +416,9 @@ def compare_benchmarks():
         + job_benchmarks("compare_run", cmpgen=CMP_RUN)
         + job_benchmarks("compare_tables")
         + job_benchmarks("compare_figures")
+        + (job_benchmarks("compare_sweep_run", cmpgraph=[g for b in CMP_SWEEP for g in CMP_GRAPHS],
+                          budget=[b for b in CMP_SWEEP for g in CMP_GRAPHS])
+           + job_benchmarks("compare_sweep") if CMP_SWEEP and CMP_GRAPHS else [])
     )
 
 

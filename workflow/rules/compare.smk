@@ -16,10 +16,16 @@ for _gen, _why in CMP_LEFT_OUT.items():
 CMP_SHOWCASE = list(showcase(config))
 CMP_TRIALS = list(dict.fromkeys([t for ids in CMP_SUBSETS.values() for t in ids] + list(CMP_RESEQ.values())))
 CMP_CLIP_KEYS = ("fps", "context", "length", "min_length", "holdout_fraction")
-CMP_RUN_KEYS = ("seed", "seeds", "fps", "metrics")
+CMP_RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
 # each generator's own config block (a changed block reruns only that generator's job)
 CMP_GEN_BLOCK = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph", "stisomap": "resequencing_graph",
-                 "motion_graph": "motion_graph", "fairmotion": "fairmotion", "concat": "concat"}
+                 "motion_graph": "motion_graph", "fairmotion": "fairmotion",
+                 "fairmotion_fixed": "fairmotion", "concat": "concat"}
+# the transition budget sweep: our motion graph and fairmotion with upstream's walk fixes (the peer's method; the
+# as-released row builds the same graph) at every further budget of compare.budget_sweep, budget_sweep_seeds seeds
+CMP_GRAPHS = [g for g in ("motion_graph", "fairmotion_fixed") if g in CMP_RUN]
+CMP_SWEEP = [f"{float(b):g}" for b in CMP["budget_sweep"] if CMP["transitions_per_s"] is not None
+             and float(b) != float(CMP["transitions_per_s"])]
 CMP_CLIPS = R("compare/clips.npz")
 CMP_OUT = {
     "metrics": R("compare/runs/{cmpgen}.csv"),
@@ -30,6 +36,9 @@ CMP_OUT = {
 
 wildcard_constraints:
     cmpgen="|".join(CMP_RUN),
+    cmpgraph="|".join(CMP_GRAPHS) or "none",
+    budget="[0-9.]+",
+
 
 
 rule compare_clips:
@@ -124,6 +133,18 @@ rule compare_tables:
             category="The generators side by side",
         ),
         verdicts_md=R("compare/verdicts.md"),
+        sanity=report(
+            R("compare/sanity_checks.csv"),
+            caption="../report/compare_sanity.rst",
+            category="The generators side by side",
+        ),
+        sanity_md=R("compare/sanity_checks.md"),
+        sensitivity=report(
+            R("compare/skating_sensitivity.csv"),
+            caption="../report/compare_sensitivity.rst",
+            category="The generators side by side",
+        ),
+        sensitivity_md=R("compare/skating_sensitivity.md"),
         summary_md=report(
             R("compare/summary.md"),
             caption="../report/compare_summary_md.rst",
@@ -146,6 +167,65 @@ rule compare_tables:
         "../envs/animsynth.yaml"
     script:
         "../scripts/compare_tables.py"
+
+
+rule compare_sweep_run:
+    input:
+        CMP_CLIPS,
+    output:
+        metrics=R("compare/sweep/{cmpgraph}_{budget}.csv"),
+        timing=R("compare/sweep/{cmpgraph}_{budget}_timing.csv"),
+    params:
+        cfg=compare_sweep_cfg,
+        seed=config["seed"],
+        roles=config["joint_roles"],
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=30,
+    log:
+        L("compare/sweep/{cmpgraph}_{budget}.log"),
+    benchmark:
+        B("compare/sweep/{cmpgraph}_{budget}.tsv")
+    conda:
+        "../envs/animsynth.yaml"
+    script:
+        "../scripts/compare_sweep_run.py"
+
+
+rule compare_sweep:
+    input:
+        default=expand(CMP_OUT["metrics"], cmpgen=CMP_GRAPHS),
+        sweep=[R(f"compare/sweep/{g}_{b}.csv") for b in CMP_SWEEP for g in CMP_GRAPHS],
+    output:
+        table=report(
+            R("compare/budget_sweep.csv"),
+            caption="../report/compare_sweep.rst",
+            category="The generators side by side",
+        ),
+        table_md=R("compare/budget_sweep.md"),
+        figure=report(
+            R("compare/budget_sweep.png"),
+            caption="../report/compare_sweep_png.rst",
+            category="The generators side by side",
+        ),
+    params:
+        default=CMP["transitions_per_s"],
+        budgets=[float(b) for b in CMP_SWEEP],
+        generators=CMP_GRAPHS,
+        order=CMP["generators"],
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    log:
+        L("compare/sweep.log"),
+    benchmark:
+        B("compare/sweep.tsv")
+    conda:
+        "../envs/animsynth.yaml"
+    script:
+        "../scripts/compare_sweep.py"
 
 
 rule compare_figures:
@@ -188,10 +268,14 @@ COMPARE_TARGETS = [
     R("compare/winners.csv"),
     R("compare/cost_timing.csv"),
     R("compare/verdicts.csv"),
+    R("compare/sanity_checks.csv"),
+    R("compare/skating_sensitivity.csv"),
     R("compare/summary.md"),
     R("compare/metrics.png"),
     R("compare/strips.png"),
 ] + expand(R("compare/bvh/{cmpgen}.bvh"), cmpgen=CMP_RUN)
+if CMP_SWEEP and CMP_GRAPHS:
+    COMPARE_TARGETS += [R("compare/budget_sweep.csv"), R("compare/budget_sweep.png")]
 
 # Tables for results/summary.md (its section "The generators side by side") and the verdict file.
 COMPARE_SUMMARY = [

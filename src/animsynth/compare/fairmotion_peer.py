@@ -29,25 +29,51 @@ given to its ``MotionGraph`` (``construct``, ``reduce("scc")``, ``create_random_
   an edge with its difference), then the edges above the resolved threshold are removed, which is what
   ``construct(diff_threshold=threshold)`` would have kept. As for our graph, ``threshold=None`` resolves it
   as the ``threshold_quantile`` quantile of the differences (here of the node pairs that are not one clip
-  playing on).
+  playing on). With a transition budget (``transitions_per_s``, :func:`animsynth.compare.motiongraph.budget_count`)
+  the threshold is the difference of the budget's last kept pair instead: the same rule as our motion graph's.
 
-The output is observed, not altered: while ``create_random_motion`` runs, fairmotion's
+The output is observed, not altered, apart from the named fixes: while ``create_random_motion`` runs, fairmotion's
 ``ops.motion.append_and_blend`` is wrapped by a recorder that calls it unchanged and notes where each
 appended piece starts (the seams and source frames of the output). The whole output is then placed at the
 start context by the same floor transform as our graph's (a rigid move, which no metric but the distance to
 a ground truth sees).
 
-Known defects of 0.0.4 that are left as released (the peer row measures what a user installs): its
-``create_random_motion`` builds the output at fairmotion's default 60 fps whatever the data's rate, so the
-cut before each appended piece is placed at the wrong frame, and ``append_and_blend`` computes the blend's
-source time as ``fps * frame`` instead of ``frame / fps``, so it blends from the last pose of the previous
-piece, held still. Together, with the defaults here at 30 fps, every appended piece adds 5 of its 15
-frames to the output, all of them blended, and the walk runs through the clips at about 3 times their speed.
-Its ``ops.motion.cut`` also shares the Pose objects with the loaded
-clips and ``append_and_blend`` moves them in place, so a walk displaces poses that later pieces of the same
-walk reuse (a node visited twice, the blend frames shared by consecutive nodes). All of this was changed
-upstream after the release. Only between walks do we step in: every :meth:`FairmotionGraph.generate` walks
-a fresh copy of the loaded clips, so walks are reproducible and do not depend on each other.
+Its native rate
+---------------
+fairmotion's walk assumes 60 fps (its output motion is built at its default 60 fps whatever the data's rate).
+The peer is therefore fed its native rate: ``native_fps`` = 60 (default) upsamples every database clip from the
+working rate by an integer factor before it is written to BVH (:func:`upsample`: joint rotations slerped,
+the root translation interpolated linearly between neighbouring frames), lengths stay in seconds, and the walk's
+output is taken back to the working rate by keeping every factor-th frame. ``native_fps=None`` feeds the
+working rate unchanged.
+
+Defects of the release, and the fixes (``fixes``)
+-------------------------------------------------
+Three defects of 0.0.4's walk were changed upstream after the release (never released). The peer runs as
+released (``fixes=()``, the row ``fairmotion``) and with each fix applied as a small patch of the walk
+(``fixes=FIXES``, the row ``fairmotion_fixed``); each patch swaps one thing for the duration of one walk and is
+undone afterwards:
+
+``output_rate``
+    ``create_random_motion`` builds its output at fairmotion's default 60 fps, so away from 60 fps the cut
+    before each appended piece lands at the wrong frame. Patch: the empty output motion takes the appended
+    pieces' frame rate before the first append (upstream passes the graph's rate to the output motion).
+``blend_source``
+    ``append_and_blend`` starts the blend's source time at ``fps * frame`` instead of ``frame / fps``, so every
+    blend draws its source from past the end of the previous piece: its last pose, held still. Patch: for
+    each append, the previous motion's ``get_pose_by_time`` is offset by the difference of the two times, so
+    the source plays on from the blend's first frame (the overlap frames the walk cuts for it), as upstream's
+    "overlapping" blend does.
+``rigid_turn``
+    ``append_and_blend`` turns the appended piece with ``ops.motion.rotate`` (``transform(local=False)``), which
+    rotates every pose's orientation about the vertical but leaves its root path where it was, so a piece
+    walks sideways or backwards after a turn. Patch: ``ops.motion.rotate`` turns the piece rigidly about its
+    first pose's root (orientation and path), as upstream's ``transform(..., pivot=0)`` does.
+
+Left as released in both rows: ``ops.motion.cut`` shares the Pose objects with the loaded clips and
+``append_and_blend`` moves them in place, so a walk displaces poses that later pieces of the same walk reuse.
+Only between walks do we step in: every :meth:`FairmotionGraph.generate` walks a fresh copy of the loaded clips,
+so walks are reproducible and do not depend on each other.
 
 Random choices: fairmotion's walk draws from Python's global ``random`` module; :meth:`FairmotionGraph.generate`
 seeds it with ``seed`` and restores its previous state afterwards.
@@ -71,14 +97,22 @@ from ..io.bvh import write_bvh
 from ..kinematics import dof_values_from_local
 from ..motion import Motion
 from ..skeleton import Skeleton
-from .motiongraph import _pair_terms, _positions_m, _transform_from_terms, _window_clouds, apply_floor_transform
+from ..kinematics import local_rotations, root_translation
+from .motiongraph import (_pair_terms, _positions_m, _transform_from_terms, _window_clouds, apply_floor_transform,
+                          budget_keep)
 
-__all__ = ["FairmotionGraph", "FairmotionUnavailable", "INSTALL_COMMAND", "FAIRMOTION_VERSION"]
+__all__ = ["FairmotionGraph", "FairmotionUnavailable", "INSTALL_COMMAND", "FAIRMOTION_VERSION", "FIXES", "NATIVE_FPS",
+           "upsample"]
 
 #: The fairmotion release this peer is written for (the only one on the package index).
 FAIRMOTION_VERSION = "0.0.4"
 #: How to install it (and the two small libraries its motion-graph module imports) without its requirements.
 INSTALL_COMMAND = "pip install --no-deps fairmotion==0.0.4 networkx==3.6.1 tqdm==4.70.1"
+
+#: The fixes of the walk that upstream made after 0.0.4 (module docstring), in the order they are named.
+FIXES = ("output_rate", "blend_source", "rigid_turn")
+#: The frame rate fairmotion's walk assumes (its Motion's default).
+NATIVE_FPS = 60.0
 
 log = logging.getLogger("animsynth.compare")
 
@@ -136,6 +170,33 @@ def _bvh_ready(motion: Motion) -> Motion:
     return Motion(np.hstack(blocks), sk, motion.fps, motion.name)
 
 
+def upsample(motion: Motion, factor: int) -> Motion:
+    """``motion`` at ``factor`` times its frame rate: ``(T - 1) * factor + 1`` frames, every joint's local rotation
+    slerped and the root translation interpolated linearly between neighbouring frames (no frame is made
+    after the last one). Written here because our Motion stores DOF values, not poses; fairmotion's own
+    ``ops.motion.resample`` in 0.0.4 runs ``fps * frames`` seconds (the same rate-for-period slip as its blend)."""
+    k = int(factor)
+    if k < 1:
+        raise ValueError(f"upsampling factor must be a whole number >= 1, got {factor!r}")
+    if k == 1 or motion.n_frames < 2:
+        return motion
+    sk = motion.skeleton
+    T = motion.n_frames
+    frac = np.arange(k) / k
+    rots = []
+    for r in local_rotations(sk, motion.values):
+        q = r.as_quat()
+        r0, r1 = Rotation.from_quat(q[:-1]), Rotation.from_quat(q[1:])
+        step = (r0.inv() * r1).as_rotvec()  # the shortest turn from frame t to t + 1
+        parts = [r0 * Rotation.from_rotvec(step * f) for f in frac]
+        mats = np.stack([p.as_quat() for p in parts], axis=1).reshape(-1, 4)
+        rots.append(Rotation.from_quat(np.vstack([mats, q[-1:]])))
+    root = np.asarray(root_translation(sk, motion.values), float)
+    t_new = np.arange((T - 1) * k + 1) / k
+    root_new = np.stack([np.interp(t_new, np.arange(T), root[:, c]) for c in range(3)], axis=1)
+    return Motion(dof_values_from_local(sk, rots, root_new), sk, float(motion.fps) * k, motion.name)
+
+
 class FairmotionGraph:
     """fairmotion 0.0.4's motion graph behind the compare generator interface (see the module docstring).
 
@@ -153,6 +214,15 @@ class FairmotionGraph:
         fairmotion's ``diff_threshold`` (its own units); ``None``: the ``threshold_quantile`` quantile of
         the differences between nodes that are not one clip playing on.
     threshold_quantile : float
+    transitions_per_s : float or None
+        The transition budget (:func:`animsynth.compare.motiongraph.budget_count`): keep the node pairs of
+        smallest difference, ``transitions_per_s`` per second of database; overrides both thresholds.
+    native_fps : float or None
+        The rate the walk runs at (fairmotion's native 60 fps; an integer multiple of the database's rate);
+        ``None``: the database's rate.
+    fixes : sequence of str
+        Which of :data:`FIXES` to apply to the walk (``()``: as released). They change the walk, not the
+        graph: read at every :meth:`generate`.
     w_joint_pos, w_joint_vel, w_root_pos, w_root_vel, w_ee_pos, w_ee_vel, w_trajectory : float
         fairmotion's similarity weights.
     num_comparison : int
@@ -168,13 +238,24 @@ class FairmotionGraph:
     largest_scc_share_ : float
         ``n_nodes_`` / nodes before the reduction.
     fairmotion_version_ : str
-    skeleton_, fps_ : the output skeleton (the first clip's) and frame rate.
+    skeleton_, fps_ : the output skeleton (the first clip's) and frame rate (the database's).
+    native_fps_ : float
+        The rate fairmotion ran at; ``upsample_`` = native_fps_ / fps_.
+    fixes_ : tuple of str
+    last_walk_ : dict
+        Of the last :meth:`generate`: ``out_fps`` (the rate of fairmotion's output motion), ``pieces``
+        (first output frame, frames of each appended piece, at that rate), ``blend_sources`` (root position of
+        every source pose a blend drew, in order).
     """
 
     def __init__(self, base: int = 15, stride: int | None = None, blend: int = 10, compare: int = 10,
                  threshold: float | None = None, threshold_quantile: float = 0.5, w_joint_pos: float = 8.0,
                  w_joint_vel: float = 2.0, w_root_pos: float = 0.5, w_root_vel: float = 1.5, w_ee_pos: float = 3.0,
-                 w_ee_vel: float = 1.0, w_trajectory: float = 1.0, num_comparison: int = 3):
+                 w_ee_vel: float = 1.0, w_trajectory: float = 1.0, num_comparison: int = 3,
+                 transitions_per_s: float | None = None, native_fps: float | None = NATIVE_FPS, fixes=()):
+        self.transitions_per_s = transitions_per_s
+        self.native_fps = native_fps
+        self.fixes = fixes
         self.base = base
         self.stride = stride
         self.blend = blend
@@ -215,17 +296,24 @@ class FairmotionGraph:
             if c.skeleton.columns() != first.skeleton.columns() or not np.isclose(c.fps, first.fps):
                 raise ValueError(f"fairmotion graph: clip {c.name!r} differs from {first.name!r} in DOF columns or "
                                  "frame rate")
+        fixes = self._fixes()
         fps = float(first.fps)
+        native = fps if self.native_fps is None else float(self.native_fps)
+        up = native / fps
+        if abs(up - round(up)) > 1e-9 or round(up) < 1:
+            raise ValueError(f"fairmotion native_fps {native:g} must be a whole multiple of the database's "
+                             f"{fps:g} fps")
+        up = int(round(up))
         with tempfile.TemporaryDirectory(prefix="animsynth_fairmotion_") as tmp:
             files = []
             for i, c in enumerate(clips):
                 f = os.path.join(tmp, f"clip{i:03d}.bvh")
-                write_bvh(f, _bvh_ready(c), scale=c.skeleton.length_to_m)
+                write_bvh(f, _bvh_ready(upsample(c, up)), scale=c.skeleton.length_to_m)
                 files.append(f)
             loaded = [bvh.load(f) for f in files]
         for c, m in zip(clips, loaded):
-            if not np.isclose(m.fps, fps):
-                raise ValueError(f"fairmotion read clip {c.name!r} at {m.fps} fps, not {fps:g} (its BVH loader "
+            if not np.isclose(m.fps, native):
+                raise ValueError(f"fairmotion read clip {c.name!r} at {m.fps} fps, not {native:g} (its BVH loader "
                                  "rounds the frame rate to an integer)")
         skel = loaded[0].skel
         for j in skel.joints:
@@ -236,9 +324,10 @@ class FairmotionGraph:
             m.set_skeleton(skel)
             motions.append(velocity.MotionWithVelocity.from_motion(m))
         graph = motion_graph.MotionGraph(
-            motions=motions, motion_files=files, skel=skel, fps=fps, base_length=self._seconds(self.base, fps),
-            stride_length=self._seconds(stride, fps), blend_length=self._seconds(self.blend, fps),
-            compare_length=self._seconds(self.compare, fps), verbose=False)
+            motions=motions, motion_files=files, skel=skel, fps=native,
+            base_length=self._seconds(self.base * up, native), stride_length=self._seconds(stride * up, native),
+            blend_length=self._seconds(self.blend * up, native), compare_length=self._seconds(self.compare * up, native),
+            verbose=False)
         with contextlib.redirect_stderr(io.StringIO()):  # its tqdm progress bars
             graph.construct(w_joints=None, w_joint_pos=self.w_joint_pos, w_joint_vel=self.w_joint_vel,
                             w_root_pos=self.w_root_pos, w_root_vel=self.w_root_vel, w_ee_pos=self.w_ee_pos,
@@ -255,20 +344,28 @@ class FairmotionGraph:
             return (nodes[u]["motion_idx"] == nodes[v]["motion_idx"]
                     and nodes[u]["frame_end"] == nodes[v]["frame_start"])
 
-        jumps = np.array([w for u, v, w in edges if not plays_on(u, v)], float)
+        jump_edges = [(u, v, w) for u, v, w in edges if not plays_on(u, v)]
+        jumps = np.array([w for _u, _v, w in jump_edges], float)
         if jumps.size == 0:
             raise ValueError("fairmotion graph: no pair of nodes to connect")
-        self.threshold_ = (float(self.threshold) if self.threshold is not None
-                           else float(np.quantile(jumps, float(self.threshold_quantile))))
-        graph.graph.remove_edges_from([(u, v) for u, v, w in edges if w > self.threshold_])
+        if self.transitions_per_s is not None:
+            keep = budget_keep(jumps, float(self.transitions_per_s), sum(c.n_frames for c in clips) / fps)
+            self.threshold_ = float(jumps[keep].max())
+            graph.graph.remove_edges_from([(u, v) for (u, v, _w), k in zip(jump_edges, keep) if not k])
+        else:
+            self.threshold_ = (float(self.threshold) if self.threshold is not None
+                               else float(np.quantile(jumps, float(self.threshold_quantile))))
+            graph.graph.remove_edges_from([(u, v) for u, v, w in edges if w > self.threshold_])
+        self.n_below_threshold_ = int(graph.graph.number_of_edges() - (len(edges) - jumps.size))
         graph.reduce(method="scc")
         self.n_nodes_ = graph.graph.number_of_nodes()
         if graph.graph.number_of_edges() == 0:
             raise ValueError(f"fairmotion graph: its largest strongly connected component at threshold "
                              f"{self.threshold_:.4g} has no edge: raise the threshold or add clips")
         self.largest_scc_share_ = self.n_nodes_ / n_before
-        rows = [(nodes[u]["motion_idx"], nodes[u]["frame_end"], nodes[v]["motion_idx"], nodes[v]["frame_start"],
-                 d["weights"]) for u, v, d in graph.graph.edges(data=True) if not plays_on(u, v)]
+        rows = [(nodes[u]["motion_idx"], nodes[u]["frame_end"] // up, nodes[v]["motion_idx"],
+                 nodes[v]["frame_start"] // up, d["weights"])
+                for u, v, d in graph.graph.edges(data=True) if not plays_on(u, v)]
         self.transitions_ = pd.DataFrame(rows, columns=["from_clip", "from_frame", "to_clip", "to_frame", "distance"])
         self._graph_ = graph
         self._loaded_ = copy.deepcopy(graph.motions)
@@ -277,6 +374,9 @@ class FairmotionGraph:
         self.fairmotion_version_ = found
         self.skeleton_ = first.skeleton
         self.fps_ = fps
+        self.native_fps_ = native
+        self.upsample_ = up
+        self.fixes_ = fixes
         return self
 
     def _start(self, start: Motion):
@@ -290,10 +390,11 @@ class FairmotionGraph:
         q = _positions_m(start)
         m = min(self.blend, start.n_frames)
         nodes = self._graph_.graph.nodes
-        ids = [n for n in nodes if nodes[n]["frame_start"] >= m] or list(nodes)
+        up = self.upsample_
+        ids = [n for n in nodes if nodes[n]["frame_start"] // up >= m] or list(nodes)
         clouds = []
         for n in ids:
-            c, f = int(nodes[n]["motion_idx"]), int(nodes[n]["frame_start"])
+            c, f = int(nodes[n]["motion_idx"]), int(nodes[n]["frame_start"]) // up
             lo = max(f - m, 0)
             clouds.append(self._pos_[c][lo:lo + m])
         w = np.full(m * q.shape[1], 1.0 / (m * q.shape[1]))
@@ -302,57 +403,118 @@ class FairmotionGraph:
         place = _transform_from_terms(a[0, best], b[0, best], (cp[0][0], cp[1][0]), (cq[0][best], cq[1][best]))
         return ids[best], tuple(float(x) for x in place)
 
+    def _fixes(self) -> tuple:
+        fixes = tuple(self.fixes)
+        unknown = [f for f in fixes if f not in FIXES]
+        if unknown:
+            raise ValueError(f"fairmotion fixes {unknown} unknown; choose from {list(FIXES)}")
+        return fixes
+
+    def _patches(self, motion_ops, blend_sources: list):
+        """The walk's patches: ``(recorder wrapping append_and_blend, {name: replacement} of ops.motion)``.
+        The fixes act on the walk only (read from ``fixes`` at every :meth:`generate`; the graph is the same
+        for both rows)."""
+        from fairmotion.ops import conversions
+
+        fixes = self.fixes_ = self._fixes()
+        original = motion_ops.append_and_blend
+        original_blend = motion_ops.blend
+        pieces = []
+
+        def recorder(motion1, motion2, blend_length=0):
+            if "output_rate" in fixes and motion1.num_frames() == 0:
+                # fix: the empty output motion takes the appended pieces' rate (released: its default 60 fps)
+                motion1.fps, motion1.fps_inv = motion2.fps, 1.0 / motion2.fps
+            if "blend_source" in fixes and motion1.num_frames() > 0:
+                # fix: the blend's source time starts at frame_source / fps (released: fps * frame_source)
+                frame_source = motion1.time_to_frame(motion1.length() - blend_length)
+                shift = motion1.fps * frame_source - frame_source / motion1.fps
+                by_time = motion1.get_pose_by_time
+                motion1.get_pose_by_time = lambda t: by_time(t - shift)
+            try:
+                out = original(motion1, motion2, blend_length=blend_length)
+            finally:
+                motion1.__dict__.pop("get_pose_by_time", None)
+            out.__dict__.pop("get_pose_by_time", None)
+            pieces.append((out.num_frames() - motion2.num_frames(), motion2.num_frames(), motion1.num_frames() > 0))
+            return out
+
+        def blend_recorder(pose1, pose2, alpha=0.5):
+            blend_sources.append(np.array(conversions.T2p(pose1.get_root_transform()), float))
+            return original_blend(pose1, pose2, alpha)
+
+        def rigid_rotate(motion, R, local=False):
+            # fix: turn the piece rigidly about its first pose's root, orientation and path (released: the
+            # orientation only, ``transform(local=False)``)
+            if local or not motion.poses:
+                return motion_ops.transform(motion, conversions.R2T(R), local)
+            pivot = np.array(conversions.T2p(motion.poses[0].get_root_transform()), float)
+            for pose in motion.poses:
+                R0, p0 = conversions.T2Rp(pose.get_root_transform())
+                pose.set_root_transform(conversions.Rp2T(np.dot(R, R0), pivot + np.dot(R, p0 - pivot)), local=False)
+            return motion
+
+        swap = {"append_and_blend": recorder, "blend": blend_recorder}
+        if "rigid_turn" in fixes:
+            swap["rotate"] = rigid_rotate
+        return pieces, swap
+
     def generate(self, start: Motion, length: int, seed: int) -> Motion:
         """fairmotion's ``create_random_motion`` from the node nearest the end of ``start``, ``length`` frames.
+
+        The walk runs at ``native_fps_`` (``(length - 1) x upsample_ + 1`` frames) with the fixes of
+        ``fixes_`` patched in for its duration; its output is taken back to the database's rate by keeping
+        every ``upsample_``-th frame.
 
         Returns
         -------
         Motion (length, n_dof) on ``skeleton_`` at ``fps_``; ``meta``: ``seams`` (output frames where an
-        appended piece starts), ``source_frames`` ((length, 2): clip and frame, -1 for blended frames),
-        ``start_node`` (clip, frame), ``fairmotion_version``.
+        appended piece starts: the first output frame at or after it), ``source_frames`` ((length, 2): clip and
+        frame, -1 for blended frames), ``start_node`` (clip, frame), ``fairmotion_version``, ``fixes``.
         """
         if isinstance(length, bool) or not isinstance(length, (int, np.integer)) or length < 1:
             raise ValueError(f"length must be an integer >= 1 (frames), got {length!r}")
         length = int(length)
         node, place = self._start(start)
         _, _, velocity, motion_ops, _ = _fairmotion()
+        up = self.upsample_
+        n_native = (length - 1) * up + 1
 
         def velocity_default_fps() -> float:
             return float(velocity.MotionWithVelocity().fps)
 
         graph = self._graph_
         nodes = graph.graph.nodes
-        pieces = []
-        original = motion_ops.append_and_blend
-
-        def recorder(motion1, motion2, blend_length=0):
-            out = original(motion1, motion2, blend_length=blend_length)
-            pieces.append((out.num_frames() - motion2.num_frames(), motion2.num_frames(), motion1.num_frames() > 0))
-            return out
-
+        blend_sources = []
+        pieces, swap = self._patches(motion_ops, blend_sources)
+        saved = {name: getattr(motion_ops, name) for name in swap}
         state = random.getstate()
-        motion_ops.append_and_blend = recorder
+        for name, f in swap.items():
+            setattr(motion_ops, name, f)
         try:
             # the walk stops once its output, at the output's frame rate (0.0.4: its default 60 fps whatever
-            # the data's), lasts the requested seconds: ask for length frames at that rate, then, if a
-            # release builds the output at the data's rate, at the data's rate
-            for rate in (velocity_default_fps(), self.fps_):
+            # the data's), lasts the requested seconds: ask for the frames at that rate, then, if the output is
+            # built at the walk's rate (the output_rate fix, or a later release), at that rate
+            for rate in dict.fromkeys((velocity_default_fps(), self.native_fps_)):
                 graph.motions = copy.deepcopy(self._loaded_)  # 0.0.4's walk moves the poses it appends in place
                 pieces.clear()
+                blend_sources.clear()
                 random.seed(seed)
-                out, visited = graph.create_random_motion(length=length / rate, start_node=node)
-                if out.num_frames() >= length:
+                out, visited = graph.create_random_motion(length=n_native / rate, start_node=node)
+                if out.num_frames() >= n_native:
                     break
         finally:
-            motion_ops.append_and_blend = original
+            for name, f in saved.items():
+                setattr(motion_ops, name, f)
             random.setstate(state)
             graph.motions = self._loaded_
         n_out = out.num_frames()
-        if n_out < length:
-            raise ValueError(f"fairmotion's walk stopped after {n_out} of {length} frames (a dead end)")
+        if n_out < n_native:
+            raise ValueError(f"fairmotion's walk stopped after {n_out} of {n_native} frames at {self.native_fps_:g} "
+                             "fps (a dead end)")
         n_blend, t = 0, 0.0  # the frames append_and_blend blends: its running time, summed as it sums it
         while True:
-            t += 1 / self.fps_
+            t += 1 / self.native_fps_
             if t > graph.blend_length:
                 break
             n_blend += 1
@@ -366,7 +528,11 @@ class FairmotionGraph:
             if blended:
                 src[first:min(first + n_blend, stop)] = -1
                 seams.append(first)
-        mats = np.array([np.asarray(p.data, float) for p in out.poses[:length]])  # (length, joints, 4, 4), local
+        keep = np.arange(length) * up  # back to the database's rate
+        src = src[keep]
+        src[:, 1] = np.where(src[:, 1] >= 0, src[:, 1] // up, -1)
+        src[src[:, 1] < 0] = -1
+        mats = np.array([np.asarray(out.poses[i].data, float) for i in keep])  # (length, joints, 4, 4), local
         idx = {name: i for i, name in enumerate(self._names_)}
         rots = []
         for j in self.skeleton_.joints:
@@ -378,8 +544,11 @@ class FairmotionGraph:
         rots[0] = Rotation.from_euler("y", theta) * rots[0]
         root = apply_floor_transform(root[:, None, :], theta, x0, z0)[:, 0] / scale
         values = dof_values_from_local(self.skeleton_, rots, root)
-        seams = np.asarray([s for s in seams if 0 < s < length], int)
-        meta = {"seams": seams, "source_frames": src[:length], "generator": "fairmotion",
-                "start_node": (int(nodes[node]["motion_idx"]), int(nodes[node]["frame_start"])),
-                "fairmotion_version": self.fairmotion_version_}
+        seams = np.unique([-(-s // up) for s in seams]).astype(int)
+        seams = seams[(seams > 0) & (seams < length)]
+        self.last_walk_ = {"out_fps": float(out.fps), "pieces": [(int(a), int(b)) for a, b, _bl in pieces],
+                           "blend_sources": np.array(blend_sources).reshape(-1, 3)}
+        meta = {"seams": seams, "source_frames": src, "generator": "fairmotion",
+                "start_node": (int(nodes[node]["motion_idx"]), int(nodes[node]["frame_start"]) // up),
+                "fairmotion_version": self.fairmotion_version_, "fixes": self.fixes_}
         return Motion(values, self.skeleton_, self.fps_, f"fairmotion_walk_seed{seed}", meta)

@@ -31,8 +31,15 @@ Generators (``GENERATORS``):
 ``motion_graph``
     the classic motion graph of Kovar, Gleicher & Pighin 2002 (:mod:`animsynth.compare.motiongraph`).
 ``fairmotion``
-    fairmotion's motion graph on the same clips (:mod:`animsynth.compare.fairmotion_peer`), when its
-    package is installed (:func:`animsynth.compare.settings.unavailable` gives the reason when not).
+    fairmotion 0.0.4's motion graph as released, on the same clips fed at its native 60 fps
+    (:mod:`animsynth.compare.fairmotion_peer`), when its package is installed
+    (:func:`animsynth.compare.settings.unavailable` gives the reason when not).
+``fairmotion_fixed``
+    the same with upstream's later fixes of its walk (output rate, blend source, rigid turn of the
+    appended piece), each a named patch (:data:`animsynth.compare.fairmotion_peer.FIXES`).
+
+The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare.transitions_per_s``
+(:func:`animsynth.compare.motiongraph.budget_count`).
 ``replay``
     the held-out capture itself (upper bound for realism; the same for every seed).
 ``concat``
@@ -55,11 +62,16 @@ from ..skeleton import ROT_DOFS, TRANS_DOFS
 
 log = logging.getLogger("animsynth.compare.generators")
 
-__all__ = ["GENERATORS", "REFERENCES", "Database", "FieldFollower", "Resequencer", "Replay", "Concat",
-           "make_generator", "heading", "align_root", "check_generated"]
+__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "Database", "FieldFollower", "Resequencer",
+           "Replay", "Concat", "make_generator", "heading", "align_root", "check_generated"]
 
 #: every generator name, in the order of the tables
-GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "replay", "concat")
+GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "fairmotion_fixed", "replay",
+              "concat")
+#: the motion-graph generators: one transition budget for all of them
+GRAPHS = ("motion_graph", "fairmotion", "fairmotion_fixed")
+#: the generators that run fairmotion's package
+FAIRMOTION_ROWS = ("fairmotion", "fairmotion_fixed")
 #: the two reference rows (bounds, not methods)
 REFERENCES = ("replay", "concat")
 
@@ -526,11 +538,12 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
     if name == "motion_graph":
         from .motiongraph import MotionGraph
 
-        return MotionGraph(**cfg["motion_graph"])
-    if name == "fairmotion":
-        from .fairmotion_peer import FairmotionGraph
+        return MotionGraph(**cfg["motion_graph"], transitions_per_s=cfg.get("transitions_per_s"))
+    if name in FAIRMOTION_ROWS:
+        from .fairmotion_peer import FIXES, FairmotionGraph
 
-        return FairmotionGraph(**cfg["fairmotion"])
+        return FairmotionGraph(**cfg["fairmotion"], transitions_per_s=cfg.get("transitions_per_s"),
+                               fixes=FIXES if name == "fairmotion_fixed" else ())
     if name == "replay":
         return Replay(held_out)
     if name == "concat":

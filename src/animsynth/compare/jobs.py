@@ -49,17 +49,29 @@ METRICS = (
     ("skate_share", "share of contact joint-frames", "lower"),
     ("skate_m_per_contact_frame", "m", "lower"),
     ("transition_skate_share", "share of contact joint-frames near seams", "lower"),
+    ("skating_ratio_gmd", "share of foot steps (GMD)", "lower"),
+    *((f"skate_share_at_{v:g}", f"share of contact joint-frames, {v:g} m/s", "") for v in (0.15, 0.3, 0.5)),
+    *((f"skating_ratio_gmd_at_{v:g}", f"share of foot steps (GMD), {v:g} m/s", "") for v in (0.15, 0.3, 0.5)),
+    ("velocity_jump_p95", "m/s", "lower"),
+    ("velocity_jump_max", "m/s", "lower"),
+    ("velocity_jump_over_capture", "share of frames", "lower"),
+    ("accel_jump_p95", "m/s^2", "lower"),
+    ("accel_jump_max", "m/s^2", "lower"),
+    ("accel_jump_over_capture", "share of frames", "lower"),
     ("n_seams", "seams", ""),
     ("seams_per_s", "1/s", ""),
-    ("velocity_jump", "m/s", "lower"),
-    ("velocity_jump_ratio", "x capture median", "lower"),
-    ("velocity_jump_pct", "percentile in capture", "lower"),
-    ("accel_jump", "m/s^2", "lower"),
-    ("accel_jump_ratio", "x capture median", "lower"),
-    ("accel_jump_pct", "percentile in capture", "lower"),
+    ("transitions_kept", "transitions before pruning", ""),
+    # at the seams a generator reports (secondary: they trust the generator's own seams)
+    ("velocity_jump", "m/s", ""),
+    ("velocity_jump_ratio", "x capture median", ""),
+    ("velocity_jump_pct", "percentile in capture", ""),
+    ("accel_jump", "m/s^2", ""),
+    ("accel_jump_ratio", "x capture median", ""),
+    ("accel_jump_pct", "percentile in capture", ""),
     ("ldlj", "log dimensionless jerk", "higher"),
     ("sparc", "spectral arc length", "higher"),
-    ("l2p", "LAFAN1 L2P", "lower"),
+    ("l2p", "LAFAN1 L2P (run statistics)", "lower"),
+    ("l2p_m", "m", "lower"),
     ("l2q", "LAFAN1 L2Q", "lower"),
     ("npss", "NPSS", "lower"),
     ("coverage", "share of database windows", "higher"),
@@ -69,6 +81,8 @@ METRICS = (
     ("copy_share", "share of frames", ""),
 )
 METRIC_NAMES = [m for m, _u, _b in METRICS]
+#: the skating threshold sensitivity speeds (m/s) of the ``*_at_<speed>`` columns
+SENSITIVITY_SPEEDS = (0.15, 0.3, 0.5)
 KEY_COLUMNS = ["clip", "group", "protocol", "generator", "seed"]
 TIMING_COLUMNS = ["generator", "clip", "database_frames", "build_cpu_s", "build_wall_s", "generate_cpu_s",
                   "generate_wall_s", "frames_generated", "peak_rss_mb"]
@@ -228,7 +242,8 @@ class Reference:
     foot_idx : int array, the foot joints
     floor : float, the floor height (m)
     jumps : metrics.JumpReference, the database's own frame-to-frame jumps
-    std : ndarray (J, 3), LAFAN1 position statistics of the database's windows
+    std : ndarray (J, 3), LAFAN1 position statistics of the whole run's database windows (:func:`run_stats`)
+    capture_max : (float, float), the held-out capture's largest velocity and acceleration jump
     features : list of ndarray, the database clips' pose features
     truth_pos, truth_q : the ground truth's positions (m) and global quaternions
     truth_forward : ndarray (2,), the ground truth's facing at the last start frame
@@ -242,10 +257,35 @@ class Reference:
     truth_pos: np.ndarray
     truth_q: np.ndarray
     truth_forward: np.ndarray
+    capture_max: tuple = (np.nan, np.nan)
 
 
-def reference(clip: Clip, mcfg: dict, roles: dict | None = None) -> Reference:
-    """The database side of every metric of ``clip`` (``mcfg``: the ``compare.metrics`` block)."""
+def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> np.ndarray:
+    """LAFAN1's position statistics (std, (J, 3)) over the whole run's database: every distinct database clip
+    of every held-out clip (by name), as LAFAN1 normalises by its whole training set. Windows of
+    ``context + length`` frames (the longest of the run's clips; shorter if a database clip is shorter),
+    every ``compare.metrics.l2p_stride`` frames, aligned at the last context frame."""
+    from . import metrics as M
+
+    seen = {}
+    for c in clips:
+        for d in c.database:
+            seen.setdefault(d.name, d)
+    db = list(seen.values())
+    joints = {len(d.skeleton.joints) for d in db}
+    if len(joints) != 1:
+        raise ValueError(f"the run's database clips have different joint counts ({sorted(joints)}): no common L2P "
+                         "statistics")
+    window = min(max(c.context + c.length for c in clips), min(d.n_frames for d in db))
+    context = min(min(c.context for c in clips), window)
+    pos = [M.positions(d) for d in db]
+    fwd = [M.facing(d, roles) for d in db]
+    return M.position_stats(pos, fwd, window, int(mcfg["l2p_stride"]), context)[1]
+
+
+def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray | None = None) -> Reference:
+    """The database side of every metric of ``clip`` (``mcfg``: the ``compare.metrics`` block; ``std``: the
+    run's L2P statistics, :func:`run_stats`; ``None``: this clip's database only)."""
     from . import metrics as M
 
     sk = clip.held_out.skeleton
@@ -253,16 +293,18 @@ def reference(clip: Clip, mcfg: dict, roles: dict | None = None) -> Reference:
     foot = M.foot_indices(sk, roles)
     db_pos = [M.positions(d) for d in clip.database]
     db_fwd = [M.facing(d, roles) for d in clip.database]
-    floor = M.floor_height(db_pos, foot) if mcfg["floor_m"] is None else float(mcfg["floor_m"])
-    window = min(clip.context + clip.length, max(p.shape[0] for p in db_pos))
-    _mean, std = M.position_stats(db_pos, db_fwd, window, int(mcfg["l2p_stride"]), min(clip.context, window))
+    floor = (M.floor_height(db_pos, foot, float(mcfg["floor_percentile"])) if mcfg["floor_m"] is None
+             else float(mcfg["floor_m"]))
+    if std is None:
+        window = min(clip.context + clip.length, max(p.shape[0] for p in db_pos))
+        std = M.position_stats(db_pos, db_fwd, window, int(mcfg["l2p_stride"]), min(clip.context, window))[1]
     held_pos = M.positions(clip.held_out)
     held_fwd = M.facing(clip.held_out, roles)
     truth = clip.truth
     return Reference(foot, floor, M.jump_reference(db_pos, fps), std,
                      [M.pose_features(p, f) for p, f in zip(db_pos, db_fwd)],
                      held_pos[clip.context:clip.context + clip.length], M.global_quaternions(truth),
-                     held_fwd[clip.context - 1])
+                     held_fwd[clip.context - 1], M.capture_max_jumps(held_pos, fps))
 
 
 def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict,
@@ -292,6 +334,12 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     row = {}
     height, speed = float(mcfg["contact_height_m"]), float(mcfg["skate_speed_m_s"])
     row.update(M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, speed, ref.floor))
+    gmd_feet = ref.foot_idx[[0, 2]]  # left_ankle, right_ankle: the balls of the feet
+    row["skating_ratio_gmd"] = M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, speed, ref.floor)
+    for v in SENSITIVITY_SPEEDS:
+        row[f"skate_share_at_{v:g}"] = M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, v,
+                                                      ref.floor)["skate_share"]
+        row[f"skating_ratio_gmd_at_{v:g}"] = M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, v, ref.floor)
     # skating near seams: frames within transition_window of a seam, pooled over seams
     w = int(mcfg["transition_window"])
     n_contact = n_skate = 0.0
@@ -303,6 +351,7 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
         n_skate += (part["skate_share"] * nc) if nc else 0.0
     row["transition_skate_share"] = n_skate / n_contact if n_contact else np.nan
     jumps = M.seam_jumps(pos, fps, seams + c, ref.jumps)
+    row.update(M.frame_jumps(pos, fps, c, ref.capture_max))
     row["n_seams"] = int(seams.size)
     row["seams_per_s"] = seams.size / (motion.n_frames / fps)
     for k in ("velocity_jump", "velocity_jump_ratio", "velocity_jump_pct", "accel_jump", "accel_jump_ratio",
@@ -311,6 +360,7 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     row["ldlj"] = M.ldlj(gen_pos, fps)
     row["sparc"] = M.sparc(gen_pos, fps)
     row["l2p"] = M.l2p(gen_pos, ref.truth_pos, ref.std, forward=ref.truth_forward)
+    row["l2p_m"] = M.l2p(gen_pos, ref.truth_pos, None)
     row["l2q"] = M.l2q(q, ref.truth_q)
     row["npss"] = M.npss(q, ref.truth_q, spectrum=mcfg["npss_spectrum"], quaternions=True)
     feats = M.pose_features(gen_pos, M.facing(joined, roles)[c:])
@@ -374,6 +424,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     """
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
+    std = run_stats(clips, mcfg, roles)
     for clip in clips:
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
@@ -395,7 +446,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
             continue
         build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
         start = clip.start
-        ref = reference(clip, mcfg, roles)
+        ref = reference(clip, mcfg, roles, std)
         gen_cpu = gen_wall = 0.0
         feats = []
         for i, s in enumerate(seeds):
@@ -404,6 +455,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
             gen_cpu += cpu_seconds() - c0
             gen_wall += time.perf_counter() - w0
             row, f = score(clip, ref, m, generator, mcfg, roles)
+            row["transitions_kept"] = float(getattr(gen, "n_below_threshold_", np.nan))
             feats.append(f)
             rows.append({**key, "seed": i, **row, "note": ""})
             if showcase is not None and (clip.clip, i) == tuple(showcase):
@@ -448,7 +500,7 @@ def load_shown(path) -> Motion:
 
 def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase, out: dict) -> None:
     """One generator over every clip and seed (one workflow job): ``out`` names ``metrics``, ``timing``,
-    ``shown`` and ``bvh`` (the showcase as BVH, start frames included)."""
+    ``shown`` and ``bvh`` (the showcase as BVH, start frames included; both optional, together)."""
     from threadpoolctl import threadpool_limits
 
     from ..io.bvh import write_bvh
@@ -458,9 +510,10 @@ def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict
     # one BLAS thread, as the job's threads: 1 (the simplex searches make many small LAPACK calls)
     with threadpool_limits(1, user_api="blas"):
         metrics, timing, shown = run_generator(clips, generator, cfg, master_seed, roles, showcase)
-    if shown is None:
+    if "shown" in out and shown is None:
         raise ValueError(f"config key 'compare.showcase': clip {showcase[0]!r} seed {showcase[1]} was not run")
     write_table(metrics, out["metrics"], md=False)
     write_table(timing, out["timing"], md=False)
-    save_shown(out["shown"], shown)
-    write_bvh(out["bvh"], shown)
+    if "shown" in out:  # the budget sweep's jobs write metrics and timing only
+        save_shown(out["shown"], shown)
+        write_bvh(out["bvh"], shown)

@@ -8,9 +8,9 @@ Positions and features
     :func:`positions` (forward kinematics in metres), :func:`foot_indices`, :func:`facing`,
     :func:`body_frame`, :func:`pose_features`, :func:`global_quaternions`, :func:`align_quaternions`
 Foot skating
-    :func:`floor_height`, :func:`foot_skating`
-Transitions
-    :func:`jump_reference`, :func:`seam_jumps`
+    :func:`floor_height`, :func:`foot_skating`, :func:`skating_ratio` (GMD's)
+Transitions and per-frame jumps
+    :func:`jump_reference`, :func:`seam_jumps`, :func:`frame_jumps`
 Smoothness
     :func:`speed_profile`, :func:`ldlj` (log dimensionless jerk), :func:`sparc` (spectral arc length)
 Against a ground truth (LAFAN1 benchmark)
@@ -38,8 +38,9 @@ from ..kinematics import forward_kinematics
 
 __all__ = [
     "UP", "FOOT_ROLES", "positions", "foot_indices", "facing", "body_frame", "pose_features",
-    "global_quaternions", "align_quaternions", "floor_height", "foot_skating", "JumpReference", "jump_reference",
-    "seam_jumps", "speed_profile", "ldlj", "sparc", "position_stats", "l2p", "l2q", "npss", "window_nearest",
+    "global_quaternions", "align_quaternions", "floor_height", "foot_skating", "skating_ratio", "JumpReference",
+    "jump_reference", "seam_jumps", "frame_jumps", "capture_max_jumps", "speed_profile", "ldlj", "sparc",
+    "position_stats", "l2p", "l2q", "npss", "window_nearest",
     "window_scores", "coverage", "local_diversity", "seed_diversity", "novelty",
 ]
 
@@ -215,20 +216,73 @@ def global_quaternions(motion) -> np.ndarray:
 # ---------------------------------------------------------------------------------------------------------------
 # foot skating
 # ---------------------------------------------------------------------------------------------------------------
-def floor_height(pos_list, foot_idx) -> float:
-    """The lowest height (m) any foot joint reaches in a set of motions (the default floor).
+def floor_height(pos_list, foot_idx, percentile: float = 0.0) -> float:
+    """The floor height (m): the ``percentile`` percentile of every foot joint's height over every frame of a
+    set of motions (0: the lowest height any foot joint reaches).
+
+    A low percentile (the compare family's default: 1) is robust to a few frames of a foot poking through
+    the floor, which would otherwise lower the floor for the whole database (on CMU r2 the minimum is 2 mm
+    where the 1st percentile is 1.7 cm).
 
     Parameters
     ----------
     pos_list : sequence of ndarray, each shape (T_i, J, 3)
     foot_idx : array of int
+    percentile : float
+        In [0, 100].
 
     Returns
     -------
     float
     """
     idx = np.asarray(foot_idx, dtype=np.int64)
-    return float(min(np.asarray(p, float)[:, idx, UP].min() for p in pos_list))
+    if not 0.0 <= float(percentile) <= 100.0:
+        raise ValueError(f"percentile must lie in [0, 100], got {percentile!r}")
+    h = np.concatenate([np.asarray(p, float)[:, idx, UP].ravel() for p in pos_list])
+    return float(np.percentile(h, float(percentile)))
+
+
+def skating_ratio(pos, fps: float, foot_idx, height_m: float = 0.05, speed_m_s: float = 0.5,
+                  floor_m: float | None = None, window: int = 5) -> float:
+    """GMD's skating ratio (Karunratanakul et al. 2023, Guided Motion Diffusion; after its evaluation code).
+
+    Two foot joints (GMD: SMPL's left and right foot, the ball of each foot; here the ``left_ankle`` and
+    ``right_ankle`` roles, whose segment ends are the balls of the feet). Per joint and pair of adjacent frames
+    ``(t-1, t)``: *contact* when the height above the floor is below ``height_m`` in both frames; *skating*
+    when, in contact, both the horizontal speed of the step and its mean over a centred ``window``-frame box
+    (zeros beyond the ends, as ``scipy.ndimage.uniform_filter1d(mode="constant")``) exceed ``speed_m_s``.
+    The ratio is the skating joint-steps over **all** joint-steps (not over contact steps as
+    :func:`foot_skating`'s share).
+
+    Parameters
+    ----------
+    pos : ndarray, shape (T, J, 3)
+        Metres, ``T >= 2``.
+    fps : float
+    foot_idx : array of int, shape (2,)
+    height_m, speed_m_s : float
+        GMD: 0.05 m, 0.5 m/s.
+    floor_m : float, optional
+        Floor height (m); ``None``: 0 (GMD's data stand on y = 0).
+    window : int
+        GMD: 5 frames.
+
+    Returns
+    -------
+    float
+    """
+    from scipy.ndimage import uniform_filter1d
+
+    pos = np.asarray(pos, float)
+    if pos.ndim != 3 or pos.shape[0] < 2:
+        raise ValueError(f"pos must have shape (T >= 2, J, 3), got {pos.shape}")
+    P = pos[:, np.asarray(foot_idx, dtype=np.int64)]
+    h = P[:, :, UP] - (0.0 if floor_m is None else float(floor_m))
+    speed = np.linalg.norm(np.diff(P[:, :, _HORIZONTAL], axis=0), axis=-1) * fps  # (T-1, 2)
+    mean = uniform_filter1d(speed, size=int(window), axis=0, mode="constant")
+    contact = (h[:-1] < height_m) & (h[1:] < height_m)
+    skate = contact & (speed > speed_m_s) & (mean > speed_m_s)
+    return float(skate.sum()) / skate.size
 
 
 def foot_skating(pos, fps: float, foot_idx, height_m: float, speed_m_s: float, floor_m: float | None = None) -> dict:
@@ -378,6 +432,49 @@ def seam_jumps(pos, fps: float, seams, reference) -> dict:
     return out
 
 
+def frame_jumps(pos, fps: float, first: int, capture_max: tuple[float, float]) -> dict:
+    """The velocity and acceleration jump of **every** frame from ``first`` on, whatever a generator reports
+    as its seams (:func:`seam_jumps` measures only there).
+
+    Parameters
+    ----------
+    pos : ndarray, shape (T, J, 3)
+        Metres: the start and the generated frames joined (the stencils of the first generated frames reach
+        into the start).
+    fps : float
+    first : int
+        The first frame measured (the first generated frame).
+    capture_max : (float, float)
+        The held-out capture's own largest velocity jump (m/s) and acceleration jump (m/s^2) at the same rate
+        (:func:`_jumps` over its frames).
+
+    Returns
+    -------
+    dict
+        ``velocity_jump_p95``, ``velocity_jump_max`` (m/s), ``velocity_jump_over_capture`` (share of the
+        measured frames whose jump exceeds the capture's largest); the same for ``accel_jump`` (m/s^2).
+    """
+    jv, ja = _jumps(pos, fps)
+    out = {}
+    for key, vals, lag, cmax in (("velocity", jv, 2, capture_max[0]), ("accel", ja, 3, capture_max[1])):
+        x = vals[max(int(first), lag) - lag:]
+        if x.size == 0:
+            out[f"{key}_jump_p95"] = out[f"{key}_jump_max"] = out[f"{key}_jump_over_capture"] = _NAN
+            continue
+        out[f"{key}_jump_p95"] = float(np.percentile(x, 95))
+        out[f"{key}_jump_max"] = float(x.max())
+        out[f"{key}_jump_over_capture"] = float(np.mean(x > float(cmax)))
+    return out
+
+
+def capture_max_jumps(pos, fps: float) -> tuple[float, float]:
+    """The largest velocity jump (m/s) and acceleration jump (m/s^2) of one capture (:func:`frame_jumps`)."""
+    jv, ja = _jumps(pos, fps)
+    if jv.size == 0 or ja.size == 0:
+        raise ValueError("the capture needs at least 4 frames for its largest jumps")
+    return float(jv.max()), float(ja.max())
+
+
 # ---------------------------------------------------------------------------------------------------------------
 # smoothness
 # ---------------------------------------------------------------------------------------------------------------
@@ -412,8 +509,9 @@ def ldlj(x, fps: float) -> float:
     """Log dimensionless jerk of a speed profile (Balasubramanian et al. 2015).
 
     ``LDLJ = -ln( (t2 - t1)^3 / v_peak^2 * integral (d^2 v / dt^2)^2 dt )`` with the second derivative by
-    second differences and the integral by the rectangle rule (``t2 - t1 = (N - 1) / fps``). Higher (closer to
-    zero) is smoother; a minimum-jerk point-to-point movement gives ``-ln(204.8) = -5.322`` whatever its
+    second differences and the integral by the rectangle rule; the duration is ``t2 - t1 = N / fps``, as the
+    reference implementation (siva82kb/SPARC ``log_dimensionless_jerk``) takes it. Higher (closer to zero) is
+    smoother; a minimum-jerk point-to-point movement gives ``-ln(204.8) = -5.322`` whatever its
     amplitude and duration (the finite differences are off by about ``5 / (duration * fps)``).
 
     Parameters
@@ -433,7 +531,7 @@ def ldlj(x, fps: float) -> float:
     peak = float(np.max(np.abs(v)))
     if peak == 0.0:
         return _NAN
-    duration = (v.size - 1) / fps
+    duration = v.size / fps
     integral = float(np.sum((np.diff(v, 2) * fps * fps) ** 2)) / fps
     if integral == 0.0:
         return float("inf")

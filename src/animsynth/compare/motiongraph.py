@@ -77,6 +77,31 @@ __all__ = ["MotionGraph", "apply_floor_transform", "floor_alignment", "kovar_alp
 # --------------------------------------------------------------------------------------------------
 # the closed-form alignment
 # --------------------------------------------------------------------------------------------------
+def budget_count(transitions_per_s: float, database_seconds: float) -> int:
+    """Transitions a graph keeps under the transition budget: ``round(transitions_per_s * database_seconds)``,
+    at least 1.
+
+    The budget is the one strictness rule of every graph generator of the comparison (ours and both
+    fairmotion rows): each keeps the same number of its best candidate transitions per second of database.
+    A quantile of candidate distances would not be equally strict: our candidates are the local minima of a
+    frame-by-frame distance matrix, fairmotion's every pair of its nodes, so the same quantile keeps very
+    different numbers of transitions (docs/compare.md, "Equal strictness").
+    """
+    if not (np.isfinite(transitions_per_s) and transitions_per_s > 0):
+        raise ValueError(f"transitions_per_s must be a positive number, got {transitions_per_s!r}")
+    return max(1, int(round(float(transitions_per_s) * float(database_seconds))))
+
+
+def budget_keep(distances, transitions_per_s: float, database_seconds: float) -> np.ndarray:
+    """Boolean mask of the :func:`budget_count` smallest ``distances`` (ties broken by order, so exactly that
+    many are kept, or all when there are fewer candidates)."""
+    d = np.asarray(distances, float)
+    n = min(budget_count(transitions_per_s, database_seconds), d.size)
+    keep = np.zeros(d.size, bool)
+    keep[np.argsort(d, kind="stable")[:n]] = True
+    return keep
+
+
 def _normalised_weights(weights, n: int) -> np.ndarray:
     w = np.ones(n) if weights is None else np.asarray(weights, float).reshape(-1)
     if w.shape != (n,):
@@ -227,6 +252,9 @@ class MotionGraph:
         the ``threshold_quantile`` quantile of the candidate local minima.
     threshold_quantile : float
         In (0, 1]; used when ``threshold`` is None.
+    transitions_per_s : float or None
+        The transition budget (:func:`budget_count`): keep the ``transitions_per_s x database seconds``
+        candidates of smallest distance (before pruning); overrides ``threshold`` and ``threshold_quantile``.
     blend : int or None
         Frames blended per transition, ``1 <= blend <= window``; ``None``: ``window`` (the paper's).
     minima_radius : int
@@ -242,7 +270,7 @@ class MotionGraph:
         j + 1), ``distance`` (m, RMS), ``theta`` (rad), ``x0``, ``z0`` (m): the floor transform moving B
         onto A.
     threshold_ : float
-        The threshold used (metres).
+        The threshold used (metres; with a budget, the distance of the last kept candidate).
     n_candidates_ : int
         Candidate transitions (local minima, before the threshold).
     n_below_threshold_ : int
@@ -259,8 +287,10 @@ class MotionGraph:
     """
 
     def __init__(self, window: int = 10, threshold: float | None = None, threshold_quantile: float = 0.5,
-                 blend: int | None = None, minima_radius: int = 1, joint_weights=None):
+                 blend: int | None = None, minima_radius: int = 1, joint_weights=None,
+                 transitions_per_s: float | None = None):
         self.window = window
+        self.transitions_per_s = transitions_per_s
         self.threshold = threshold
         self.threshold_quantile = threshold_quantile
         self.blend = blend
@@ -341,9 +371,13 @@ class MotionGraph:
         self.n_candidates_ = int(cand.size)
         if cand.size == 0:
             raise ValueError("motion graph: no candidate transitions (local minima) in the database")
-        self.threshold_ = (float(self.threshold) if self.threshold is not None
-                           else float(np.quantile(cand, float(self.threshold_quantile))))
-        keep = cand <= self.threshold_
+        if self.transitions_per_s is not None:
+            keep = budget_keep(cand, float(self.transitions_per_s), float(lengths.sum()) / float(first.fps))
+            self.threshold_ = float(cand[keep].max())
+        else:
+            self.threshold_ = (float(self.threshold) if self.threshold is not None
+                               else float(np.quantile(cand, float(self.threshold_quantile))))
+            keep = cand <= self.threshold_
         self.n_below_threshold_ = int(keep.sum())
         rows, cols, cand = rows[keep], cols[keep], cand[keep]
         theta, x0, z0 = _transform_from_terms(a[rows, cols], bb[rows, cols],

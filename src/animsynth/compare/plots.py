@@ -9,13 +9,15 @@ from ..atomic import atomic_path
 from .generators import REFERENCES
 from .jobs import METRICS
 
-__all__ = ["FIGURE_METRICS", "metrics_figure", "strips_figure"]
+__all__ = ["FIGURE_METRICS", "metrics_figure", "strips_figure", "sweep_figure"]
 
 #: the panels of metrics.png: (column, title)
 FIGURE_METRICS = (
     ("skate_share", "foot skating: share of contact frames"),
     ("transition_skate_share", "skating near seams: share"),
-    ("velocity_jump_pct", "velocity jump at seams: percentile in capture"),
+    ("velocity_jump_p95", "per-frame velocity jump: 95th percentile (m/s)"),
+    ("velocity_jump_over_capture", "share of frames jumping more than the capture's largest"),
+    ("skating_ratio_gmd", "skating ratio (GMD-style)"),
     ("ldlj", "smoothness: log dimensionless jerk (higher smoother)"),
     ("l2p", "L2P vs held-out continuation"),
     ("npss", "NPSS vs held-out continuation"),
@@ -117,3 +119,28 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
         ax.axis("off")
         ax.set_title(g, fontsize=8.5, loc="left")
     _save(fig, path, title)
+
+
+def sweep_figure(table: pd.DataFrame, path, default_budget: float) -> None:
+    """The transition budget sweep (:func:`animsynth.compare.tables.sweep_table`): one panel per metric, one line
+    per graph generator against the budget (transitions per second of database, log scale); the default
+    budget, at which the claims are decided, dashed."""
+    import matplotlib.pyplot as plt
+
+    panels = (("transitions_kept_median", "transitions kept (before pruning)"),
+              ("transition_skate_share_median", "skating near seams: share"),
+              ("skate_share_median", "foot skating: share"),
+              ("velocity_jump_p95_median", "per-frame velocity jump p95 (m/s)"),
+              ("velocity_jump_median", "velocity jump at reported seams (m/s)"),
+              ("l2p_median", "L2P"))
+    fig, axes = plt.subplots(2, 3, figsize=(13.5, 6.4), dpi=100, squeeze=False)
+    for ax, (col, label) in zip(axes.ravel(), panels):
+        for g, sub in table.groupby("generator", sort=False):
+            sub = sub.sort_values("transitions_per_s")
+            ax.plot(sub["transitions_per_s"], sub[col], marker="o", label=g)
+        ax.axvline(default_budget, color="0.5", ls="--", lw=0.8)
+        ax.set_xscale("log")
+        ax.set_xlabel("transitions per second of database")
+        ax.set_title(label, fontsize=9)
+    axes[0, 0].legend(fontsize=8)
+    _save(fig, path, "Graph generators at equal transition budgets (median over clips x seeds)")

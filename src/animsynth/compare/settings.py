@@ -49,7 +49,7 @@ def unavailable(name: str) -> str:
     """
     import importlib.util
 
-    if name == "fairmotion" and importlib.util.find_spec("fairmotion") is None:
+    if name in ("fairmotion", "fairmotion_fixed") and importlib.util.find_spec("fairmotion") is None:
         return ("fairmotion is not installed (python3 run.py installs fairmotion 0.0.4 with --no-deps; "
                 "animsynth.compare.fairmotion_peer.INSTALL_COMMAND)")
     return ""

@@ -14,7 +14,11 @@ from .jobs import METRIC_NAMES, METRICS
 log = logging.getLogger("animsynth.compare.tables")
 
 __all__ = ["summary_table", "paired_share", "winners_table", "cost_table", "data_label", "summary_markdown",
-           "tables_job"]
+           "tables_job", "sensitivity_table", "sweep_table", "sweep_job", "results_markdown"]
+
+#: the columns of the budget sweep table (medians over clips x seeds)
+SWEEP_METRICS = ("transitions_kept", "skate_share", "transition_skate_share", "skating_ratio_gmd", "velocity_jump_p95",
+                 "velocity_jump_over_capture", "velocity_jump", "l2p")
 
 
 def _better(metric: str) -> str:
@@ -109,6 +113,74 @@ def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
 
 
 
+def sensitivity_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
+    """Skating against its speed threshold: per generator and speed (:data:`animsynth.compare.jobs.SENSITIVITY_SPEEDS`)
+    the median skate share (ours) and GMD-style skating ratio over clips x seeds, and each generator's rank
+    (1 = skates least, reference rows aside) by each, so a reader sees whether the order holds."""
+    from .jobs import SENSITIVITY_SPEEDS
+
+    rows = []
+    gens = order_generators(metrics["generator"].unique(), order)
+    for v in SENSITIVITY_SPEEDS:
+        med = {}
+        for g in gens:
+            sub = metrics[metrics["generator"] == g]
+            med[g] = {k: float(np.nanmedian(pd.to_numeric(sub[f"{k}_at_{v:g}"], errors="coerce")))
+                      if sub[f"{k}_at_{v:g}"].notna().any() else np.nan for k in ("skate_share", "skating_ratio_gmd")}
+        ranks = {k: pd.Series({g: med[g][k] for g in gens if g not in REFERENCES}).rank(method="min")
+                 for k in ("skate_share", "skating_ratio_gmd")}
+        for g in gens:
+            rows.append({"speed_m_s": v, "generator": g, "skate_share_median": med[g]["skate_share"],
+                         "skate_share_rank": ranks["skate_share"].get(g, np.nan),
+                         "skating_ratio_gmd_median": med[g]["skating_ratio_gmd"],
+                         "skating_ratio_gmd_rank": ranks["skating_ratio_gmd"].get(g, np.nan)})
+    return pd.DataFrame(rows)
+
+
+def sweep_table(runs: dict, order) -> pd.DataFrame:
+    """The transition budget sweep: ``runs`` = {budget (transitions per second of database): metrics of the
+    graph generators at that budget}; per generator and budget the median of :data:`SWEEP_METRICS` over clips
+    x seeds and the clips it could not be built on."""
+    rows = []
+    for budget in sorted(runs):
+        m = runs[budget]
+        for g in order_generators(m["generator"].unique(), order):
+            sub = m[m["generator"] == g]
+            row = {"transitions_per_s": float(budget), "generator": g,
+                   "clips_not_built": int(sub.loc[sub["note"].fillna("") != "", "clip"].nunique())}
+            for k in SWEEP_METRICS:
+                x = pd.to_numeric(sub[k], errors="coerce")
+                row[f"{k}_median"] = float(x.median()) if x.notna().any() else np.nan
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _read_metrics(paths) -> pd.DataFrame:
+    m = pd.concat([pd.read_csv(p, dtype={"note": str}, keep_default_na=False, na_values=[""]) for p in paths],
+                  ignore_index=True)
+    m["note"] = m["note"].fillna("")
+    return m
+
+
+def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, order) -> None:
+    """The sweep table and figure from the default run's graph-generator metrics (``inp["default"]``) and one
+    metrics file per budget and generator (``inp["sweep"]``, in the order of ``budgets`` x ``generators``)."""
+    from ..tables import write_table
+    from .plots import sweep_figure
+
+    runs = {float(default_budget): _read_metrics(inp["default"])}
+    runs[float(default_budget)] = runs[float(default_budget)][runs[float(default_budget)]["generator"]
+                                                              .isin(generators)]
+    paths = list(inp["sweep"])
+    k = 0
+    for b in budgets:
+        runs[float(b)] = _read_metrics(paths[k:k + len(generators)])
+        k += len(generators)
+    table = sweep_table(runs, order)
+    write_table(table, out["table"], md=out["table_md"])
+    sweep_figure(table, out["figure"], float(default_budget))
+
+
 # ----------------------------------------------------------------------------- the family's summary
 
 
@@ -119,7 +191,8 @@ def data_label(source: str, clips: pd.DataFrame, seeds: int) -> str:
 
 
 def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.DataFrame, generators, left_out: dict,
-                     data: str, cfg: dict, not_built: pd.DataFrame | None = None) -> str:
+                     data: str, cfg: dict, not_built: pd.DataFrame | None = None,
+                     sanity: pd.DataFrame | None = None) -> str:
     """``compare/summary.md``: the protocol in numbers, which generator wins which metric, the verdicts.
     Generated from the tables (no timing: cost is in ``cost_timing.csv``)."""
     from ..tables import to_markdown
@@ -144,7 +217,13 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
         cols = ["metric", "better", "best", "best_median", "second", "second_median", "margin", "beyond_spread",
                 "best_wins_share", "replay_median", "concat_median"]
         out += [to_markdown(winners[[c for c in cols if c in winners]]), ""]
-    out += ["## Verdicts", "", to_markdown(verdicts[["claim", "ours", "verdict", "evidence"]]), "",
+    out += ["## Verdicts", "", "Decided over independent groups of clips with a minimum effect per metric and "
+            "a Holm correction over the findings (docs/compare.md, Verdicts).", "",
+            to_markdown(verdicts[["claim", "ours", "verdict", "evidence"]]), ""]
+    if sanity is not None and len(sanity):
+        out += ["## Sanity checks", "", "Claims true by construction, decided the same way; not findings.", "",
+                to_markdown(sanity[["claim", "ours", "verdict", "evidence"]]), ""]
+    out += [
             "## Clips", "", to_markdown(clips), "",
             "Per clip x seed values: `metrics.csv`; medians and spreads: `summary.csv`; build time, generation "
             "speed and memory: `cost_timing.csv` (machine-dependent, not shown here).", ""]
@@ -163,12 +242,10 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     ``cost`` (+ ``cost_md``), ``verdicts`` (+ ``verdicts_md``), ``summary_md`` (the family's page)."""
     from ..atomic import atomic_write_text
     from ..tables import write_table
-    from .verdicts import build
+    from .verdicts import build, independent_groups, sanity_checks
 
     order = list(cfg["generators"])
-    metrics = pd.concat([pd.read_csv(p, dtype={"note": str}, keep_default_na=False, na_values=[""])
-                         for p in inp["metrics"]], ignore_index=True)
-    metrics["note"] = metrics["note"].fillna("")
+    metrics = _read_metrics(inp["metrics"])
     metrics["_g"] = metrics["generator"].map({g: i for i, g in enumerate(order)})
     clips = pd.read_csv(inp["clips"], dtype={"held_out": str})
     metrics["_c"] = metrics["clip"].map({c: i for i, c in enumerate(clips["clip"])})
@@ -176,17 +253,67 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     timing = pd.concat([pd.read_csv(p) for p in inp["timing"]], ignore_index=True)
     summary = summary_table(metrics, order)
     winners = winners_table(metrics, summary, order)
-    data = data_label(source, clips, cfg["seeds"])
-    verdicts = build(metrics, cfg["verdicts"], data, left_out)
+    clips_full = pd.read_csv(inp["clips"], dtype=str)
+    n_groups = len(set(independent_groups(clips_full).values()))
+    data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
+    verdicts = build(metrics, cfg["verdicts"], data, left_out, clips_full)
+    sanity = sanity_checks(metrics, cfg["verdicts"], data, left_out, clips_full)
     write_table(metrics, out["metrics"], md=False)
     write_table(timing, out["metrics_timing"], md=False)
     write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below
     write_table(winners, out["winners"], md=out["winners_md"])
     write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
     write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
+    write_table(sanity, out["sanity"], md=out["sanity_md"])
+    write_table(sensitivity_table(metrics, order), out["sensitivity"], md=out["sensitivity_md"])
     not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
     log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
              metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
              len(verdicts), ", ".join(verdicts["verdict"]))
     atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg,
-                                                          not_built))
+                                                          not_built, sanity))
+
+
+#: the columns of the results section of docs/compare.md (metric, heading)
+RESULT_COLUMNS = (("skate_share", "skate share"), ("skating_ratio_gmd", "GMD skating ratio"),
+                  ("transition_skate_share", "skate share near seams"), ("velocity_jump", "seam velocity jump (m/s)"),
+                  ("velocity_jump_p95", "per-frame velocity jump p95 (m/s)"),
+                  ("velocity_jump_over_capture", "frames above the capture's largest jump"),
+                  ("ldlj", "LDLJ"), ("l2p", "L2P"), ("l2p_m", "L2P (m)"), ("coverage", "coverage"),
+                  ("novelty_median_m", "novelty (m)"))
+
+
+def results_markdown(compare_dir) -> str:
+    """The results section of docs/compare.md, generated from a run's tables (``compare_dir``: e.g.
+    ``results/paper/compare``): medians (IQR) per generator, the findings, the sanity checks, the skating
+    sensitivity and, when present, the budget sweep. Every number comes from those files."""
+    from pathlib import Path
+
+    from ..tables import to_markdown
+    from ..verdicts import fmt
+
+    d = Path(compare_dir)
+    summary = pd.read_csv(d / "summary.csv")
+    gens = list(dict.fromkeys(summary["generator"]))
+    rows = []
+    for g in gens:
+        row = {"generator": g + (" (bound)" if g in REFERENCES else "")}
+        for m, head in RESULT_COLUMNS:
+            r = summary[(summary["generator"] == g) & (summary["metric"] == m)]
+            row[head] = (f"{fmt(r['median'].iloc[0])} ({fmt(r['q25'].iloc[0])}-{fmt(r['q75'].iloc[0])})"
+                         if len(r) and r["n"].iloc[0] > 0 else "-")
+        rows.append(row)
+    out = ["Medians over clips x seeds, interquartile range in brackets (`summary.csv`):", "",
+           to_markdown(pd.DataFrame(rows)), ""]
+    v = pd.read_csv(d / "verdicts.csv", keep_default_na=False)
+    out += ["**Findings** (`verdicts.csv`):", "", to_markdown(v[["claim", "verdict", "ours", "evidence"]]), ""]
+    if (d / "sanity_checks.csv").exists():
+        sc = pd.read_csv(d / "sanity_checks.csv", keep_default_na=False)
+        out += ["**Sanity checks** (`sanity_checks.csv`):", "", to_markdown(sc[["claim", "verdict", "evidence"]]), ""]
+    if (d / "skating_sensitivity.csv").exists():
+        out += ["**Skating against its threshold** (`skating_sensitivity.csv`):", "",
+                to_markdown(pd.read_csv(d / "skating_sensitivity.csv")), ""]
+    if (d / "budget_sweep.csv").exists():
+        out += ["**Transition budget sweep** (`budget_sweep.csv`, figure `budget_sweep.png`):", "",
+                to_markdown(pd.read_csv(d / "budget_sweep.csv")), ""]
+    return "\n".join(out)
