@@ -201,7 +201,7 @@ def test_summary_reads_top_down_with_scoreboard_first_and_provenance_once(tmp_pa
     # each family's key figure beside its key table, before its claims in full
     simp = md[md.index("## Gauch & Peters"): md.index("## Isomap")]
     assert simp.index("![red near black](simplicial/figures/fig6_paths_delaunay.png)") \
-        < simp.index("### Table II: median errors") < simp.index("### Claims in full")
+        < simp.index("### Table II: median errors") < simp.index("### Every claim in full")
     side = md[md.index("## The generators side by side"): md.index("## Detailed tables")]
     assert "(compare/metrics.png)" in side and "(compare/strips.png)" in side
 

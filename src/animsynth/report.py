@@ -189,7 +189,7 @@ LINE_LIMIT = 400
 #: and the claim's full text is one click away in its family's section)
 CELL_LIMITS = {"claim": 140, "paper_value": 60, "ours": 70, "verdict": 30}
 #: what "ours" means, said once above the claims table
-OURS_MEANS = ("*ours*: this run's number, computed by the workflow on the data in the table above; "
+OURS_MEANS = ("*ours*: this run's number, computed by the workflow on the data listed at the top; "
               "each id links to the claim in full (data, evidence, the table behind it) in its family's section.")
 
 
@@ -301,8 +301,13 @@ def _claims_rows_md(df: pd.DataFrame) -> str:
 
 
 def _verdict_counts(part: pd.DataFrame) -> str:
+    """'3 reproduced, 1 partly, ...': the verdicts from best to worst, then any other word."""
+    from .scoreboard import VERDICT_COLOURS
+
     counts = part["verdict"].value_counts()
-    return ", ".join(f"{counts[v]} {v}" for v in counts.index) + "."
+    order = [v for v in VERDICT_COLOURS if v in counts.index] + sorted(v for v in counts.index
+                                                                      if v not in VERDICT_COLOURS)
+    return ", ".join(f"{counts[v]} {v}" for v in order) + "."
 
 
 def claims_markdown(claims: pd.DataFrame) -> str:
@@ -321,10 +326,10 @@ def claims_markdown(claims: pd.DataFrame) -> str:
             out += ["(none in this run)", ""]
             continue
         if not part.empty:
-            out += [_verdict_counts(part), "", _claims_rows_md(part), ""]
+            out += [_verdict_counts(part), "", _claims_rows_md(part).rstrip("\n"), ""]
         if not checks.empty:
             out += ["Sanity checks (true by construction, not counted among the findings):", "",
-                    _claims_rows_md(checks), ""]
+                    _claims_rows_md(checks).rstrip("\n"), ""]
     return "\n".join(out)
 
 
@@ -438,7 +443,8 @@ def _rst_image(uri: str, alt: str, target: str = "") -> list[str]:
 def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_outputs=(),
                side_by_side: pd.DataFrame | None = None, side_by_side_data: str = "",
                side_by_side_real: bool = False, *, banner: str = "", scoreboard_png=None,
-               family_figures: dict | None = None, family_data: dict[str, str] | None = None) -> str:
+               family_figures: dict | None = None, family_data: dict[str, str] | None = None,
+               family_tables: dict | None = None) -> str:
     """The report's home page (reStructuredText): the scoreboard first, what ran on what, one line per claim,
     then one section per family with its key figures and every claim in full.
 
@@ -456,6 +462,7 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
     family_figures : {family: [{"png": path on disk, "src": path below the results folder, "caption": text}]}:
         each family's key figures, embedded in its section with their captions
     family_data : {family: what it ran on}
+    family_tables : {family: [path below the results folder]}: each family's key tables, linked from its section
     """
     from .scoreboard import sanity_checks, scoreboard_rows
 
@@ -464,6 +471,7 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
         names.setdefault(Path(path).name, []).append(path)
     family_figures = family_figures or {}
     family_data = family_data or {}
+    family_tables = family_tables or {}
 
     def target(src: str) -> str:
         paths = names.get(Path(src).name, [])
@@ -499,7 +507,7 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
         if part.empty:
             out += ["(none in this run)", ""]
             continue
-        out += [OURS_MEANS.replace("in the table above", "named in its family's section"), "",
+        out += [OURS_MEANS, "",
                 ".. list-table::", "   :header-rows: 1", "   :widths: 6 12 40 14 18 10", "",
                 "   * - id", "     - paper", "     - claim", "     - paper's number", "     - ours", "     - verdict"]
         for idx, r in part.iterrows():
@@ -528,6 +536,9 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
         for fig in family_figures.get(fam, []):
             out += _rst_image(png_data_uri(fig["png"]), fig.get("caption", ""), target(fig["src"]))
             out += [f"*{Path(fig['src']).name}:* {_rst_cell(fig.get('caption', ''))}", ""]
+        if family_tables.get(fam):
+            out += ["**Key table:** " + ", ".join(link(t) for t in family_tables[fam])
+                    + " (the menu's categories hold every table and figure).", ""]
         if fam == "compare" and side_by_side is not None:
             out += _side_by_side_rst(side_by_side, side_by_side_data)
         if len(part):
@@ -557,7 +568,7 @@ def scoreboard_markdown(counts: pd.DataFrame, png: str | None) -> list[str]:
     view = counts.drop(columns=["family"]).rename(columns={"sanity_checks": "sanity checks"})
     if not int(counts["sanity_checks"].sum()):
         view = view.drop(columns=["sanity checks"])
-    return out + [to_markdown(view)]
+    return out + [to_markdown(view).rstrip("\n")]
 
 
 def _provenance_md(provenance: pd.DataFrame, family_real: dict[str, bool] | None) -> list[str]:
@@ -565,7 +576,7 @@ def _provenance_md(provenance: pd.DataFrame, family_real: dict[str, bool] | None
     if family_real:
         view.insert(2, "kind", [("real" if family_real.get(f) else "synthetic") if f in family_real else ""
                                 for f in view["family"]])
-    return ["## What each part ran on", "", to_markdown(view)]
+    return ["## What each part ran on", "", to_markdown(view).rstrip("\n")]
 
 
 def build_summary(sections: list[dict], verdict_paths, source_note: str,
@@ -627,7 +638,7 @@ def build_summary(sections: list[dict], verdict_paths, source_note: str,
             out.append("")
             shown.add(id(s))
         if len(part):
-            out += ["### Claims in full", ""] + claims_in_full_md(part)
+            out += [f"### Every claim in full ({FAMILY_SHORT.get(fam, fam)})", ""] + claims_in_full_md(part)
     rest = [s for s in sections if id(s) not in shown]
     if rest:
         out += ["## Detailed tables", ""]
@@ -646,5 +657,5 @@ def _summary_section(s: dict, level: str) -> list[str]:
     if len(df) > s.get("max_rows", 60):
         out.append(f"(first {s.get('max_rows', 60)} of {len(df)} rows; full table in the CSV)")
         df = df.head(s.get("max_rows", 60))
-    out.append(to_markdown(df))
+    out.append(to_markdown(df).rstrip("\n"))
     return out
