@@ -37,6 +37,7 @@ VERDICT_COLOURS = {
 #: a verdict word outside the vocabulary (a family's newer word): drawn grey, named in the legend
 OTHER_COLOUR = "#bdbdbd"
 _DARK = {"reproduced", "contradicted"}  # white id text on these
+HATCH = "///"  # the cells of claims on synthetic data
 #: the order of the rows: the four papers as the project lists them, then the generators side by side;
 #: a family not named here follows in the order of ``claims.csv``
 ROW_ORDER = ("simplicial", "resequencing", "meshdetail", "facegraph", "compare")
@@ -225,11 +226,12 @@ def draw_scoreboard(claims: pd.DataFrame, title: str = "", per_line: int = 24):
                 real = _real(r["real"])
                 ax.add_patch(FancyBboxPatch((cx, cy), cell, cell, boxstyle="round,pad=0,rounding_size=0.05",
                                             facecolor=_colour(verdict), edgecolor="0.25",
-                                            linewidth=0.8, hatch=None if real else "////", zorder=2,
+                                            linewidth=0.8, hatch=None if real else HATCH, zorder=2,
                                             gid=f"cell:{r['id']}"))
+                # on a hatched cell the id sits on a light patch, so it stays readable
                 ax.text(cx + cell / 2, cy + cell / 2, str(r["id"]), fontsize=7, ha="center", va="center",
-                        color="white" if verdict in _DARK else "black", zorder=3,
-                        bbox=None if real else dict(boxstyle="round,pad=0.08", facecolor=_colour(verdict),
+                        color="white" if verdict in _DARK and real else "black", zorder=3,
+                        bbox=None if real else dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85,
                                                     edgecolor="none"))
         ax.text(left, y0 + 0.32 + lines * (cell + gap) + 0.1, counts_text(crow, words), fontsize=9, va="center",
                 ha="left", color="0.15")
@@ -241,7 +243,7 @@ def draw_scoreboard(claims: pd.DataFrame, title: str = "", per_line: int = 24):
     # legend: every verdict word with its total over the findings, then real / synthetic, then sanity checks
     handles = [Patch(facecolor=_colour(w), edgecolor="0.25", label=f"{w} ({int(counts[w].sum())})") for w in words]
     handles += [Patch(facecolor="white", edgecolor="0.25", label="real data"),
-                Patch(facecolor="white", edgecolor="0.25", hatch="////", label="synthetic data")]
+                Patch(facecolor="white", edgecolor="0.25", hatch=HATCH, label="synthetic data")]
     if any_sanity:
         handles.append(Patch(facecolor="white", edgecolor="0.6", linestyle="--",
                              label=f"sanity check, right of the line ({int(sanity.sum())}, not counted)"))
