@@ -420,11 +420,11 @@ def png_data_uri(path, max_width: int = 1100) -> str:
 
 #: The report's page is a flex box that centres its content vertically, so a home page taller than the
 #: screen opens in its middle (and its top cannot be scrolled to), in a column 32 rem wide: this style,
-#: part of the home page's own HTML, aligns it to the top and lets it use the page's width.
+#: part of the home page's own HTML, aligns it to the top and widens it (beside the rule graph).
 HOME_STYLE = (
     "<style>"
     "div.h-screen.overflow-auto.items-center{align-items:flex-start!important;justify-content:flex-start!important}"
-    "div.prose.max-w-lg{max-width:min(88rem,100%)!important}"
+    "div.prose.max-w-lg{max-width:none!important;width:min(58rem,calc(100vw - 20rem))}"
     "div.prose img{max-width:100%;height:auto}"
     "</style>"
 )
