@@ -7,7 +7,7 @@ dependency). Layers, bottom to top:
    the published-table reader, joint roles, the skeleton;
 1. config checks, tables, the Motion container, kinematics;
 2. io (file formats; knows no method);
-3. shared machinery on top of io: synthetic data, skinning, drawing, data sources, the data layer,
+3. shared machinery on top of io: synthetic data, skinning, drawing (the scoreboard too), data sources, the data layer,
    workflow logging;
 4. the four families (simplicial, resequencing, facegraph, meshdetail), which never import each other;
 5. compare, which scores the families' generators side by side (the one package that imports them);
@@ -30,7 +30,7 @@ LAYERS = {
     0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton"],
     1: ["config", "tables", "motion", "kinematics"],
     2: ["io"],
-    3: ["synth", "skinning", "viz", "sources", "data", "workflow_utils"],
+    3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "workflow_utils"],
     4: list(FAMILIES),
     5: ["compare"],
     6: ["report", "scale", "cli"],

@@ -48,7 +48,8 @@ def test_summary_renders_tables_and_verdicts(tmp_path):
     md = build_summary([{"title": "Table II", "csv": str(t), "note": "synthetic"}], [v], "Data: synthetic.",
                        family_data={"simplicial": "synthetic mocap"}, family_real={"simplicial": False})
     assert md.index("## Claims of the four papers") < md.index("## Table II")
-    assert "| Gauch & Peters (simplicial complex) | Delaunay beats k-NN |  |  | synthetic mocap | **partly** |" in md
+    assert "| [S1](#claim-s1) | Gauch & Peters | Delaunay beats k-NN |  |  | **partly** |" in md
+    assert "**Data:** synthetic mocap (synthetic data)" in md  # what it ran on: in the family's section
     assert "## Table II" in md and "| w1 | 0.0123 |" in md
     # a word outside the vocabulary is refused, naming the file and line
     pd.DataFrame([{**row, "verdict": "no"}]).to_csv(v, index=False)

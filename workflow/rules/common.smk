@@ -433,7 +433,7 @@ def run_benchmark_files(wildcards=None):
         "compare": compare_benchmarks,
     }
     files = [f for fam, fn in family_benchmarks.items() if FAMILY_RAN[fam] for f in fn()]
-    return files + job_benchmarks("summary") + job_benchmarks("benchmarks")
+    return files + [f for r in ("claims", "scoreboard", "summary", "benchmarks") for f in job_benchmarks(r)]
 
 
 def published_path(family, table):
