@@ -273,3 +273,23 @@ def test_home_page_opens_on_the_scoreboard_and_links_each_claim_to_its_full_text
     # the compare section shows its key figure (scaled down to the page) with its caption
     side = html[html.index("The generators side by side"):]
     assert "data:image/png;base64," in side and "boxes" in side
+
+
+def test_a_familys_sanity_checks_file_is_marked_apart_and_not_counted(tmp_path):
+    """Rows of compare/sanity_checks.csv (claims true by construction) reach claims.csv marked as sanity
+    checks: the scoreboard draws them apart and leaves them out of the counts; verdicts.csv rows are findings."""
+    paths, real, data, _ = _run(tmp_path)
+    sanity = tmp_path / "compare" / "sanity_checks.csv"
+    pd.DataFrame([{"claim": "re-sequencers copy frames (novelty 0)", "paper_value": "", "ours": "0 m",
+                   "data": "", "verdict": "reproduced", "evidence": "by construction", "source": ""}]).to_csv(
+        sanity, index=False)
+    claims = claims_table(paths + [sanity], data, real)
+    marked = claims.set_index("claim")["sanity_check"]
+    assert bool(marked["re-sequencers copy frames (novelty 0)"])
+    assert not marked.drop("re-sequencers copy frames (novelty 0)").any()
+    assert list(sanity_checks(claims)) == list(claims["sanity_check"])
+    counts = scoreboard_counts(claims)
+    without = scoreboard_counts(claims_table(paths, data, real))
+    assert counts.set_index("family").loc["compare", "sanity_checks"] == 1
+    pd.testing.assert_frame_equal(counts.drop(columns="sanity_checks").reset_index(drop=True),
+                                  without.drop(columns="sanity_checks").reset_index(drop=True))

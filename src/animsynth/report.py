@@ -193,6 +193,10 @@ OURS_MEANS = ("*ours*: this run's number, computed by the workflow on the data l
               "each id links to the claim in full (data, evidence, the table behind it) in its family's section.")
 
 
+#: A family's table of claims true by construction (same format as verdicts.csv); its rows are sanity checks.
+SANITY_FILE = "sanity_checks.csv"
+
+
 def claim_ids(families) -> list[str]:
     """The id of each claim: its family's letter (:data:`FAMILY_LETTER`) and its line in the family's verdicts.csv.
 
@@ -230,8 +234,8 @@ def claims_table(paths, family_data: dict[str, str] | None = None,
     Parameters
     ----------
     paths : iterable of path
-        ``<family>/verdicts.csv`` files (the family is the parent folder's name), each in the common
-        format of :mod:`animsynth.verdicts` (checked: columns and vocabulary).
+        ``<family>/verdicts.csv`` (and ``<family>/sanity_checks.csv``) files (the family is the parent folder's
+        name), each in the common format of :mod:`animsynth.verdicts` (checked: columns and vocabulary).
     family_data : dict, optional
         {family: what it ran on}; fills ``data`` where a verdict row leaves it empty.
     family_real : dict
@@ -241,9 +245,10 @@ def claims_table(paths, family_data: dict[str, str] | None = None,
     Returns
     -------
     claims : DataFrame
-        Columns ``id, paper, family, claim, paper_value, ours, data, verdict, evidence, source, real``
-        (``id``: :func:`claim_ids`; ``real`` is False for synthetic data), real data first, then by family in
-        the order given.
+        Columns ``id, paper, family, claim, paper_value, ours, data, verdict, evidence, source, real,
+        sanity_check`` (``id``: :func:`claim_ids`; ``real`` is False for synthetic data; ``sanity_check`` True for
+        the rows of a family's ``sanity_checks.csv``: claims true by construction, shown apart and not counted
+        among the findings), real data first, then by family in the order given.
     """
     family_data = family_data or {}
     family_real = family_real or {}
@@ -258,9 +263,11 @@ def claims_table(paths, family_data: dict[str, str] | None = None,
         df.insert(0, "family", fam)
         df.insert(0, "paper", FAMILY_PAPERS.get(fam, fam))
         df["real"] = bool(family_real[fam])
+        # a family's sanity_checks.csv (claims true by construction, same format) is shown apart, not counted
+        df["sanity_check"] = Path(p).name == SANITY_FILE
         df["order"] = len(frames)
         frames.append(df)
-    cols = ["id", "paper", "family", *verdict_format.COLUMNS, "real"]
+    cols = ["id", "paper", "family", *verdict_format.COLUMNS, "real", "sanity_check"]
     if not frames:
         return pd.DataFrame(columns=cols)
     out = pd.concat(frames, ignore_index=True)

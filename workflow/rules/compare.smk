@@ -294,4 +294,4 @@ COMPARE_SUMMARY = [
         "note": "Leave one out within each Gauch & Peters subset; temporal split of each re-sequencing clip.",
     },
 ]
-COMPARE_VERDICTS = [R("compare/verdicts.csv")]
+COMPARE_VERDICTS = [R("compare/verdicts.csv"), R("compare/sanity_checks.csv")]
