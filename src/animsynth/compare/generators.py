@@ -40,6 +40,15 @@ Generators (``GENERATORS``):
 
 The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare.transitions_per_s``
 (:func:`animsynth.compare.motiongraph.budget_count`).
+``motion_matching``
+    motion matching with inertialization and the reference's foot locking and leg IK (Clavet 2016; the
+    baseline of Holden et al. 2020; :mod:`animsynth.compare.motionmatching`), its query trajectory a
+    steady "gamepad" from the start; deterministic (every seed gives the same motion).
+``motion_matching_pose``
+    the same with the trajectory weights at 0: matching on the pose only.
+``genmm``
+    generative motion matching (Li et al. 2023; :mod:`animsynth.compare.genmm`) in keyframe mode from the
+    start; seeds differ by the initial noise.
 ``replay``
     the held-out capture itself (upper bound for realism; the same for every seed).
 ``concat``
@@ -62,18 +71,20 @@ from ..skeleton import ROT_DOFS, TRANS_DOFS
 
 log = logging.getLogger("animsynth.compare.generators")
 
-__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "Database", "FieldFollower", "Resequencer",
+__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINISTIC", "Database", "FieldFollower", "Resequencer",
            "Replay", "Concat", "make_generator", "heading", "align_root", "check_generated"]
 
 #: every generator name, in the order of the tables
-GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "fairmotion_fixed", "replay",
-              "concat")
+GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "fairmotion_fixed",
+              "motion_matching", "motion_matching_pose", "genmm", "replay", "concat")
 #: the motion-graph generators: one transition budget for all of them
 GRAPHS = ("motion_graph", "fairmotion", "fairmotion_fixed")
 #: the generators that run fairmotion's package
 FAIRMOTION_ROWS = ("fairmotion", "fairmotion_fixed")
 #: the two reference rows (bounds, not methods)
 REFERENCES = ("replay", "concat")
+#: the generators whose motion the seed does not change (seed diversity 0)
+DETERMINISTIC = ("motion_matching", "motion_matching_pose", "replay")
 
 
 # ----------------------------------------------------------------------------- root helpers
@@ -544,6 +555,18 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
 
         return FairmotionGraph(**cfg["fairmotion"], transitions_per_s=cfg.get("transitions_per_s"),
                                fixes=FIXES if name == "fairmotion_fixed" else ())
+    if name in ("motion_matching", "motion_matching_pose"):
+        from .motionmatching import make_motion_matching
+
+        mm = dict(cfg["motion_matching"])
+        return make_motion_matching(mm, trajectory_weight=0.0 if name == "motion_matching_pose" else None, name=name)
+    if name == "genmm":
+        from .genmm import make_genmm
+
+        gm = dict(cfg["genmm"])
+        if gm.get("alpha", 0.01) is None:  # null in the config: no completeness normalisation
+            gm["alpha"] = float("inf")
+        return make_genmm(gm, name=name)
     if name == "replay":
         return Replay(held_out)
     if name == "concat":
