@@ -19,7 +19,7 @@ def test_compare_outputs(tiny_workflow):
     assert {"delaunay", "knn", "isomap", "stisomap", "motion_graph", "motion_matching", "motion_matching_pose", "genmm",
             "replay", "concat"} <= set(gens)
     modern = m[m["generator"].isin(["motion_matching", "motion_matching_pose", "genmm"])]
-    assert (modern["note"].fillna("") == "").all()  # built on every tiny clip
+    assert not modern["note"].astype(str).str.startswith("not built").any()  # built on every tiny clip
     mm = modern[modern["generator"] != "genmm"]
     assert (mm["seed_diversity_m"] == 0).all()  # deterministic rows
     assert len(m) == len(clips) * len(gens) * m["seed"].nunique() and m["seed"].nunique() == 2
@@ -43,7 +43,7 @@ def test_compare_outputs(tiny_workflow):
     sanity = pd.read_csv(r / "sanity_checks.csv")
     assert list(sanity.columns) == list(v.columns) and set(sanity["verdict"]) <= set(VOCABULARY)
     assert not set(sanity["claim"]) & set(v["claim"])  # true by construction: not among the findings
-    assert v["evidence"].str.contains("Holm").all() | (v["verdict"] == "not reproduced")
+    assert (v["evidence"].str.contains("Holm") | (v["verdict"] == "not reproduced")).all()
     sens = pd.read_csv(r / "skating_sensitivity.csv")
     assert set(sens["speed_m_s"]) == {0.15, 0.3, 0.5}
     for png in ("metrics.png", "strips.png"):
