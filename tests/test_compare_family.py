@@ -48,7 +48,8 @@ def _start(m: Motion, n: int = 8) -> Motion:
     return Motion(m.values[:n].copy(), m.skeleton, m.fps, "start")
 
 
-NAMES = ["delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "replay", "concat"]
+NAMES = ["delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "motion_matching", "motion_matching_pose",
+         "genmm", "replay", "concat"]
 
 
 @pytest.fixture(scope="module")
@@ -76,8 +77,8 @@ def test_generator_returns_length_frames_on_the_skeleton_and_is_seeded(fitted, w
     b = gen.generate(start, length, 5)
     assert np.array_equal(a.values, b.values) and np.array_equal(seams, b.meta["seams"])
     c = gen.generate(start, length, 6)
-    if name == "replay":
-        assert np.array_equal(a.values, c.values)  # the capture itself, whatever the seed
+    if name in G.DETERMINISTIC:  # the capture itself, or motion matching: whatever the seed
+        assert np.array_equal(a.values, c.values), f"{name}: the seed changes the motion"
     else:
         assert not np.array_equal(a.values, c.values), f"{name}: the seed changes nothing"
     # the output continues the start where it stands: its first root is within a stride of the start's last
@@ -238,7 +239,7 @@ def _metrics(values: dict) -> pd.DataFrame:
 
 VC = {"share": 0.75, "alpha": 0.05, "min_groups": 3, "novelty_copy_m": 0.01,
       "min_effect": {"skate_share": 0.02, "transition_skate_share": 0.02, "velocity_jump_p95": 0.1, "l2p": 0.25,
-                     "novelty_median_m": 0.005}}
+                     "novelty_median_m": 0.005, "coverage": 0.02}}
 
 
 def test_holm_adjusts_a_family_of_p_values():
@@ -249,9 +250,11 @@ def test_holm_adjusts_a_family_of_p_values():
     assert np.isnan(adj[2])
 
 
-def _grouped(group_effects: list[list[float]], seeds: int = 2) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Metrics of motion_graph and stisomap on skate_share and a clips table: one subset per group (its own
-    subject), clip ``i`` of a group with effect ``group_effects[g][i]`` (stisomap minus motion_graph)."""
+def _grouped(group_effects: list[list[float]], seeds: int = 2, pair=("motion_graph", "stisomap"),
+             metric: str = "skate_share") -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Metrics of ``pair`` (default motion_graph and stisomap) on ``metric`` and a clips table: one subset per
+    group (its own subject), clip ``i`` of a group with effect ``group_effects[g][i]`` (the second's value minus
+    the first's)."""
     rows, crow = [], []
     for gi, effects in enumerate(group_effects):
         subset = f"s{gi}"
@@ -261,10 +264,10 @@ def _grouped(group_effects: list[list[float]], seeds: int = 2) -> tuple[pd.DataF
             crow.append({"clip": clip, "group": subset, "held_out": trials[i],
                          "database": " ".join(t for t in trials if t != trials[i])})
             for s in range(seeds):
-                for g, v in (("motion_graph", 0.2), ("stisomap", 0.2 + e)):
+                for g, v in ((pair[0], 0.2), (pair[1], 0.2 + e)):
                     row = {"clip": clip, "group": subset, "protocol": "leave one out", "generator": g, "seed": s}
                     row.update({m: np.nan for m in jobs.METRIC_NAMES})
-                    row.update(skate_share=v + 0.001 * s)
+                    row[metric] = v + 0.001 * s
                     rows.append(row)
     return pd.DataFrame(rows), pd.DataFrame(crow)
 
@@ -297,6 +300,62 @@ def test_counting_clips_says_reproduced_where_counting_groups_says_within_noise(
     assert verdict([[0.05, 0.06, 0.05]] * 5 + [[-0.05, -0.04]] * 2) == "partly"
     # effects below the metric's minimum effect are within noise however many clips agree
     assert verdict([[0.01, 0.012, 0.011]] * 7) == "within noise"
+
+
+@pytest.mark.parametrize("claim, pair, metric, sign", [
+    ("motion matching skates less than the motion graph", ("motion_matching", "motion_graph"), "skate_share", 1),
+    ("GenMM covers more of the database than the motion graph", ("genmm", "motion_graph"), "coverage", -1),
+])
+def test_the_modern_rows_claims_are_decided_over_groups(claim, pair, metric, sign):
+    # effect = second minus first: motion matching skating less is a positive effect, GenMM covering more a
+    # negative one (coverage: higher is better)
+    def verdict(effects, left_out=None, **kw):
+        m, c = _grouped([[sign * e for e in g] for g in effects], pair=pair, metric=metric)
+        if left_out:
+            m = m[m["generator"] != left_out]
+        v = CV.build(m, dict(VC, **kw), "test data", {left_out: "not in this run"} if left_out else {}, c)
+        return v.set_index("claim").loc[claim]
+
+    row = verdict([[0.05, 0.06, 0.05]] * 7)
+    assert row["verdict"] == "reproduced" and "7 independent groups" in row["evidence"]
+    assert "Holm-adjusted" in row["evidence"] and f"{metric} (" in row["ours"]
+    assert verdict([[-0.05, -0.06, -0.05]] * 7)["verdict"] == "contradicted"
+    assert verdict([[0.05, 0.06, 0.05]] * 4 + [[-0.05, -0.04]] * 3)["verdict"] == "partly"
+    assert verdict([[0.01, 0.012, 0.011]] * 7)["verdict"] == "within noise"  # below the minimum effect
+    missing = verdict([[0.05, 0.06, 0.05]] * 7, left_out=pair[0])
+    assert missing["verdict"] == "not reproduced" and "not in this run" in missing["evidence"]
+
+
+def test_the_default_minimum_effects_cover_every_metric_a_claim_uses():
+    vc = _config()["compare"]["verdicts"]
+    for metric in ("skate_share", "transition_skate_share", "velocity_jump_p95", "l2p", "coverage",
+                   "novelty_median_m"):
+        assert vc["min_effect"].get(metric, 0) > 0, metric
+
+
+def test_the_modern_rows_from_the_config(cfg):
+    mm = G.make_generator("motion_matching", cfg)
+    pose = G.make_generator("motion_matching_pose", cfg)
+    assert (mm.name, pose.name) == ("motion_matching", "motion_matching_pose")
+    assert mm.foot_lock is True and pose.foot_lock is True  # the reference's default, in both rows
+    assert mm.trajectory_weight == 1.0 and pose.trajectory_weight == 0.0
+    assert list(mm.weights) == [0.75, 1.0, 1.0, 1.0, 1.5] and mm.exclude_s == pytest.approx(1 / 3, abs=1e-15)
+    gm = G.make_generator("genmm", cfg)
+    assert gm.name == "genmm" and gm.alpha == 0.01 and gm.patch_size == 11 and gm.root == "local"
+    no_norm = G.make_generator("genmm", dict(cfg, genmm=dict(cfg["genmm"], alpha=None)))
+    assert no_norm.alpha == float("inf")  # null in the config: the ablation without completeness normalisation
+    assert set(G.DETERMINISTIC) <= set(G.GENERATORS) and "genmm" not in G.DETERMINISTIC
+
+
+def test_motion_matching_rows_have_seed_diversity_zero_and_genmm_does_not(walks, cfg):
+    trials = {f"t{i}": w for i, w in enumerate(walks)}
+    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
+    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
+    for name, zero in (("motion_matching", True), ("genmm", False)):
+        metrics, timing, _ = jobs.run_generator(clips, name, cfg, 7)
+        assert len(metrics) == 3 * cfg["seeds"] and (metrics["note"] == "").all()
+        assert ((metrics["seed_diversity_m"] == 0).all() if zero else (metrics["seed_diversity_m"] > 0).all()), name
+        assert (timing["generate_cpu_s"] >= 0).all() and (timing["frames_generated"] == 20 * cfg["seeds"]).all()
 
 
 def test_clips_sharing_a_trial_or_a_subject_in_a_subset_are_one_group():
@@ -377,6 +436,10 @@ def test_summary_and_winners_tables():
     (lambda c: c["compare"]["fairmotion"].update(compare=5), "compare.fairmotion.compare"),
     (lambda c: c["compare"]["fairmotion"].update(stride=20), "compare.fairmotion.stride"),
     (lambda c: c["compare"].update(subsets=[], resequencing=[]), "compare.subsets"),
+    (lambda c: c["compare"]["motion_matching"].update(future_s=[0.5, 0.4, 1.0]), "compare.motion_matching.future_s"),
+    (lambda c: c["compare"]["motion_matching"].update(weights=[0, 0, 0, 1, 1.5]), "compare.motion_matching.weights"),
+    (lambda c: c["compare"]["genmm"].update(patch_size=10), "compare.genmm.patch_size"),
+    (lambda c: c["compare"]["genmm"].update(patch_size=21), "compare.genmm.patch_size"),
 ])
 def test_settings_check_names_the_key(mutate, key):
     cfg = _config()

@@ -20,7 +20,8 @@ CMP_RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
 # each generator's own config block (a changed block reruns only that generator's job)
 CMP_GEN_BLOCK = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph", "stisomap": "resequencing_graph",
                  "motion_graph": "motion_graph", "fairmotion": "fairmotion",
-                 "fairmotion_fixed": "fairmotion", "concat": "concat"}
+                 "fairmotion_fixed": "fairmotion", "motion_matching": "motion_matching",
+                 "motion_matching_pose": "motion_matching", "genmm": "genmm", "concat": "concat"}
 # the transition budget sweep: our motion graph and fairmotion with upstream's walk fixes (the peer's method; the
 # as-released row builds the same graph) at every further budget of compare.budget_sweep, budget_sweep_seeds seeds
 CMP_GRAPHS = [g for g in ("motion_graph", "fairmotion_fixed") if g in CMP_RUN]

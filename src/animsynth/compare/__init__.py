@@ -7,9 +7,15 @@ sits above the four families: it imports their public functions to score them; n
 
 Modules
 -------
-generators      the one interface (``fit(database)``, ``generate(start, length, seed)``) and its adapters:
-                delaunay, knn, isomap, stisomap, motion_graph, fairmotion, replay, concat
+base            the one interface (``fit(database)``, ``generate(start, length, seed)``: Generator, Database,
+                root placement), which every generator builds on
+generators      the factory (``make_generator``) and the adapters:
+                delaunay, knn, isomap, stisomap, motion_graph, fairmotion, fairmotion_fixed, motion_matching,
+                motion_matching_pose, genmm, replay, concat
 motiongraph     the classic motion graph (Kovar, Gleicher & Pighin 2002)
+motionmatching  motion matching with inertialization and foot locking (Clavet 2016; Holden et al. 2020)
+genmm           generative motion matching (Li et al. 2023)
+poses           the pose representation the two share; footlock: motion matching's foot locking and leg IK
 fairmotion_peer fairmotion's motion graph on the same clips (the peer row), when it can be imported
 metrics         the metrics (pure numpy; metres, m/s)
 jobs            the protocol (held-out clips, starts, seeds), one generator over every clip, scored

@@ -43,7 +43,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
-from .generators import Database, Generator
+from .base import Database, Generator
 from .poses import decode, encode, rest_forward, from_rot6d, rot6d, rotation_yaw, wrap_angle, yaw_rotation
 
 __all__ = ["GenMM", "make_genmm", "extract_patches", "match_patches", "vote", "resample_rows", "level_scales"]

@@ -79,7 +79,7 @@ from ..joints import resolve_roles
 from ..kinematics import forward_kinematics
 from ..motion import Motion
 from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
-from .generators import Database, Generator
+from .base import Database, Generator
 from .poses import Track, decode, encode, qexp, qinv, qlog, qmul, rest_forward, wrap_angle, yaw_rotation
 
 __all__ = ["MotionMatching", "make_motion_matching", "decay_spring", "spring_position", "spring_angle",

@@ -119,6 +119,21 @@ def check(config: dict) -> None:
                           f"({fm['blend']})")
     if fm["stride"] is not None and fm["stride"] > fm["base"]:
         raise ConfigError(f"config key 'compare.fairmotion.stride': {fm['stride']} exceeds base ({fm['base']})")
+    mm = cmp["motion_matching"]
+    fut = [float(x) for x in mm["future_s"]]
+    if any(b <= a for a, b in zip(fut, fut[1:])):
+        raise ConfigError(f"config key 'compare.motion_matching.future_s': {mm['future_s']} must increase")
+    if not any(float(w) > 0 for w in mm["weights"][:3]):
+        raise ConfigError(f"config key 'compare.motion_matching.weights': the pose groups' weights (the first three, "
+                          f"{mm['weights'][:3]}) are all 0: motion_matching_pose would match on nothing")
+    gm = cmp["genmm"]
+    if gm["patch_size"] % 2 == 0:
+        raise ConfigError(f"config key 'compare.genmm.patch_size': {gm['patch_size']} must be odd (a patch is "
+                          "centred on its frame)")
+    if "genmm" in cmp["generators"] and gm["patch_size"] > cmp["context"] + cmp["min_length"]:
+        raise ConfigError(f"config key 'compare.genmm.patch_size': {gm['patch_size']} frames exceed "
+                          f"compare.context + compare.min_length ({cmp['context']} + {cmp['min_length']}): a short "
+                          "clip's start and continuation would hold no patch")
     sc = cmp["showcase"]
     if sc["clip"] is not None and sc["clip"] not in clip_ids(config):
         raise ConfigError(f"config key 'compare.showcase.clip': {sc['clip']!r} is not a clip of this run "

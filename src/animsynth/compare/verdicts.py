@@ -337,6 +337,13 @@ def build(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = No
          paper_value="ST-Isomap re-sequences more smoothly than Isomap (the re-sequencing paper)")
     pair("Delaunay field following stays closer to the held-out continuation than k-NN field following (L2P)",
          "delaunay", "knn", "l2p", paper_value="Delaunay gives lower Error A/F than k-NN (Gauch & Peters Table II)")
+    pair("motion matching skates less than the motion graph", "motion_matching", "motion_graph",
+         "skate_share", caveat="motion matching with the reference's foot locking and leg IK, its query a steady "
+                               "gamepad from the start; deterministic, so inside a clip only the motion graph's "
+                               "seeds vary")
+    pair("GenMM covers more of the database than the motion graph", "genmm", "motion_graph", "coverage",
+         better="higher", caveat="coverage: the share of the database's windows that a generated window comes within "
+                                 "compare.metrics.coverage_threshold_m of")
     if "replay" in configured and "replay" in present:
         capture = _capture_claims(metrics, groups, vc, data)
     rows = _holm_rows(claims + capture, vc, "findings of this table")
