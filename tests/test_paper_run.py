@@ -70,7 +70,7 @@ def test_mesh_archive_is_unpacked_and_checked(tmp_path, corrupt):
     out = res.stdout + res.stderr
     if corrupt is None:
         assert res.returncode == 0, out[-4000:]
-        got = sorted(p.name for p in (wd / "resources" / "mesh" / "seq").glob("*.obj.gz"))
+        got = sorted(p.name for p in (wd / "results" / "resources" / "mesh" / "seq").glob("*.obj.gz"))
         assert got == [f"mesh_{i:04d}.obj.gz" for i in range(4)]
         assert (wd / "results" / "data" / "mesh_checksums" / "seq.csv").read_text().count("\n") == 5
     else:
@@ -78,5 +78,5 @@ def test_mesh_archive_is_unpacked_and_checked(tmp_path, corrupt):
         # the fetch checks the frames in its temporary folder: the mismatch is its error, and nothing is left
         log = (wd / "logs" / "data" / "mesh_fetch" / "seq.log").read_text()
         assert "mesh_0002.obj" in log and "SHA-256" in log, log[-2000:]
-        assert not (wd / "resources" / "mesh" / "seq").exists()
+        assert not (wd / "results" / "resources" / "mesh" / "seq").exists()
         assert not (wd / "results" / "data" / "mesh_checksums" / "seq.csv").exists()
