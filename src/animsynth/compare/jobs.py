@@ -283,6 +283,24 @@ def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> np.nd
     return M.position_stats(pos, fwd, window, int(mcfg["l2p_stride"]), context)[1]
 
 
+def _joint_count(clip: Clip) -> int:
+    return len(clip.held_out.skeleton.joints)
+
+
+def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> dict:
+    """:func:`run_stats` per skeleton: {joint count: std (J, 3)}. A run of one skeleton (CMU, the demo) has one
+    entry, the whole run's database; a run mixing skeletons (a user's BVH files of several sources) normalises
+    each clip's L2P by the database clips of its own skeleton, logged (positions of different joint sets have no
+    common statistics)."""
+    groups: dict[int, list[Clip]] = {}
+    for c in clips:
+        groups.setdefault(_joint_count(c), []).append(c)
+    if len(groups) > 1:
+        log.warning("the run mixes skeletons of %s joints: each clip's L2P is normalised by the database clips of "
+                    "its own skeleton", sorted(groups))
+    return {n: run_stats(cs, mcfg, roles) for n, cs in groups.items()}
+
+
 def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray | None = None) -> Reference:
     """The database side of every metric of ``clip`` (``mcfg``: the ``compare.metrics`` block; ``std``: the
     run's L2P statistics, :func:`run_stats`; ``None``: this clip's database only)."""
@@ -424,7 +442,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     """
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
-    std = run_stats(clips, mcfg, roles)
+    std = run_stats_by_skeleton(clips, mcfg, roles)
     for clip in clips:
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
@@ -446,7 +464,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
             continue
         build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
         start = clip.start
-        ref = reference(clip, mcfg, roles, std)
+        ref = reference(clip, mcfg, roles, std[_joint_count(clip)])
         gen_cpu = gen_wall = 0.0
         feats = []
         for i, s in enumerate(seeds):
