@@ -417,3 +417,29 @@ def test_budget_gives_every_graph_generator_the_same_transition_count(sk):
             counts[("fairmotion", budget)] = fm.n_below_threshold_
         assert {v for (_g, bb), v in counts.items() if bb == budget} == {budget_count(budget, seconds)}
     assert counts[("ours", 1.0)] == 3 and counts[("ours", 2.0)] == 6
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_loads_a_shared_trial_once_and_builds_what_a_fresh_load_builds(sk):
+    """Two leave-one-out databases share a trial: the second build reuses fairmotion's loading of it (after
+    walks on the first graph, which move poses in place) and equals a build from a cold start."""
+    from animsynth.compare import fairmotion_peer as fp
+
+    a, b, c = (generate_motion("walk_straight", 48, s, sk, fps=FPS) for s in (1, 8, 5))
+    start = Motion(c.values[:10], sk, FPS, "start")
+
+    def build(db):
+        g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
+                               fixes=fp.FIXES).fit(db)
+        return g, g.transitions_.to_numpy(), [g.generate(start, 30, seed=s).values for s in (1, 2)]
+
+    fp._LOADED.clear()
+    _, cold_tr, cold_walks = build([c, b])
+    assert len(fp._LOADED) == 2
+    fp._LOADED.clear()
+    g1, _, _ = build([a, b])  # b loaded here, then its poses walked over
+    g1.generate(Motion(a.values[:10], sk, FPS, "s"), 30, seed=7)
+    _, warm_tr, warm_walks = build([c, b])
+    assert len(fp._LOADED) == 3  # a, b, c: b was loaded once
+    assert np.array_equal(cold_tr, warm_tr)
+    assert all(np.array_equal(x, y) for x, y in zip(cold_walks, warm_walks))

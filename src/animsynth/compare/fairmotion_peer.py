@@ -197,6 +197,52 @@ def upsample(motion: Motion, factor: int) -> Motion:
     return Motion(dof_values_from_local(sk, rots, root_new), sk, float(motion.fps) * k, motion.name)
 
 
+#: fairmotion's loading of a clip (:func:`_load_native`), kept for the rest of the process: ``{key: motion}``.
+_LOADED: dict = {}
+_LOADED_MAX = 64
+
+
+def _load_native(clip: Motion, up: int, bvh, velocity, on=None):
+    """fairmotion's ``MotionWithVelocity`` of ``clip`` at ``up`` times its rate: the clip upsampled
+    (:func:`upsample`), written to BVH, read by fairmotion's loader, put on the skeleton ``on`` and given
+    fairmotion's velocities (``MotionWithVelocity.from_motion``), as :meth:`FairmotionGraph.fit` needs it.
+
+    ``on``: ``(first clip, its fairmotion Skeleton)`` of the database, whose skeleton every clip is put on
+    before its velocities (fairmotion's ``set_skeleton``); ``None`` for the first clip itself.
+
+    Remembered for the rest of the process, keyed on the clip's values, rate and skeleton and the skeleton
+    it is put on (the first clip's, equal in a database of one subject), and handed out as a deep copy: the leave-one-out databases of a subset share their trials
+    (each trial is in three of the four databases) and the budget sweep loads the same clips again, so
+    fairmotion's loading and velocities (most of a graph's build) run once per trial and not once per database.
+    The copy is what fairmotion would have computed again: the same file, read and differentiated by the same
+    code (a test checks the graph and the walks equal those of a fresh load)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    parts = [np.ascontiguousarray(clip.values, np.float64).tobytes(), repr(float(clip.fps)).encode(),
+             str(int(up)).encode(), clip.skeleton.to_json().encode(), repr(clip.skeleton.length_to_m).encode()]
+    put_on = clip if on is None else on[0]  # the skeleton the velocities are computed on (a first clip: its own)
+    parts += [put_on.skeleton.to_json().encode(), repr(put_on.skeleton.length_to_m).encode()]
+    for part in parts:
+        h.update(part)
+        h.update(b"\0")
+    key = h.hexdigest()
+    if key not in _LOADED:
+        with tempfile.TemporaryDirectory(prefix="animsynth_fairmotion_") as tmp:
+            f = os.path.join(tmp, "clip.bvh")
+            write_bvh(f, _bvh_ready(upsample(clip, up)), scale=clip.skeleton.length_to_m)
+            m = bvh.load(f)
+        skel = m.skel if on is None else on[1]
+        for j in skel.joints:
+            if not hasattr(j, "child_joint"):
+                j.child_joint = j.child_joints  # the attribute 0.0.4's Skeleton.num_end_effectors reads
+        m.set_skeleton(skel)
+        if len(_LOADED) >= _LOADED_MAX:
+            _LOADED.pop(next(iter(_LOADED)))
+        _LOADED[key] = velocity.MotionWithVelocity.from_motion(m)
+    return copy.deepcopy(_LOADED[key])
+
+
 class FairmotionGraph:
     """fairmotion 0.0.4's motion graph behind the compare generator interface (see the module docstring).
 
@@ -304,25 +350,17 @@ class FairmotionGraph:
             raise ValueError(f"fairmotion native_fps {native:g} must be a whole multiple of the database's "
                              f"{fps:g} fps")
         up = int(round(up))
-        with tempfile.TemporaryDirectory(prefix="animsynth_fairmotion_") as tmp:
-            files = []
-            for i, c in enumerate(clips):
-                f = os.path.join(tmp, f"clip{i:03d}.bvh")
-                write_bvh(f, _bvh_ready(upsample(c, up)), scale=c.skeleton.length_to_m)
-                files.append(f)
-            loaded = [bvh.load(f) for f in files]
+        loaded = [_load_native(first, up, bvh, velocity)]
+        loaded += [_load_native(c, up, bvh, velocity, on=(first, loaded[0].skel)) for c in clips[1:]]
         for c, m in zip(clips, loaded):
             if not np.isclose(m.fps, native):
                 raise ValueError(f"fairmotion read clip {c.name!r} at {m.fps} fps, not {native:g} (its BVH loader "
                                  "rounds the frame rate to an integer)")
         skel = loaded[0].skel
-        for j in skel.joints:
-            if not hasattr(j, "child_joint"):
-                j.child_joint = j.child_joints  # the attribute 0.0.4's Skeleton.num_end_effectors reads
-        motions = []
         for m in loaded:
             m.set_skeleton(skel)
-            motions.append(velocity.MotionWithVelocity.from_motion(m))
+        motions = loaded
+        files = [f"clip{i:03d}.bvh" for i in range(len(clips))]  # names only: fairmotion keeps them, never reads them
         graph = motion_graph.MotionGraph(
             motions=motions, motion_files=files, skel=skel, fps=native,
             base_length=self._seconds(self.base * up, native), stride_length=self._seconds(stride * up, native),
