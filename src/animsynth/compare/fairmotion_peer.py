@@ -212,11 +212,10 @@ def _load_native(clip: Motion, up: int, bvh, velocity, on=None):
 
     Remembered for the rest of the process, keyed on the clip's values, rate and skeleton and the skeleton
     it is put on (the first clip's, equal in a database of one subject), and handed out as a deep copy: the
-    leave-one-out databases of a subset share their trials (each trial is in three of the four databases) and
-    the budget sweep loads the same clips again, so fairmotion's loading and velocities (most of a graph's
-    build) run once per trial and not once per database. The copy is what fairmotion would have computed
-    again: the same file, read and differentiated by the same
-    code (a test checks the graph and the walks equal those of a fresh load)."""
+    leave-one-out databases of a subset share their trials (each trial is in three of the four databases), so
+    fairmotion's loading and velocities (most of a graph's build) run once per trial and job, not once per
+    database. The copy is what fairmotion would have computed again: the same file, read and differentiated by
+    the same code (a test checks the graph and the walks equal those of a fresh load)."""
     import hashlib
 
     h = hashlib.sha256()
