@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["ROLES", "JointRoleError", "resolve_role", "resolve_roles", "check_role_overrides", "normalise_name"]
+__all__ = ["ROLES", "FOOT_ROLES", "JointRoleError", "resolve_role", "resolve_roles", "check_role_overrides", "normalise_name"]
 
 
 class JointRoleError(ValueError):
@@ -74,6 +74,10 @@ ROLES: dict[str, tuple[str, ...]] = dict((k, tuple(v)) for k, v in _CENTRE.items
 for _part, _pats in _SIDED.items():
     for _s, _side in (("l", "left"), ("r", "right")):
         ROLES[f"{_side}_{_part}"] = tuple(p.format(s=_s, side=_side) for p in _pats)
+
+#: The roles every foot metric tracks (re-sequencing's foot skate, compare's skating and contacts), in this
+#: order: the end of the ankle's segment is the ball of the foot, the end of the toe's the toe tip.
+FOOT_ROLES = ("left_ankle", "left_toe", "right_ankle", "right_toe")
 
 
 def normalise_name(name: str) -> str:

@@ -197,8 +197,14 @@ def bone_lengths(skeleton: Skeleton, values) -> np.ndarray:
     return np.linalg.norm(ends - starts, axis=-1)[:, 1:]
 
 
-def _wrap(a):
+def wrap_degrees(a):
+    """Angles in degrees wrapped to [-180, 180): ``(a + 180) % 360 - 180``, elementwise (any shape)."""
     return (a + 180.0) % 360.0 - 180.0
+
+
+def wrap_radians(a):
+    """Angles in radians wrapped to [-pi, pi): ``(a + pi) % 2 pi - pi``, elementwise (any shape)."""
+    return (np.asarray(a, float) + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def _continuous_euler(ang: np.ndarray) -> np.ndarray:
@@ -209,11 +215,11 @@ def _continuous_euler(ang: np.ndarray) -> np.ndarray:
     A motion whose middle angle crosses 90 degrees (e.g. a CMU root yaw) is
     continuous only if we switch to the other branch, as the original data did.
     """
-    alt = _wrap(np.stack([ang[:, 0] + 180.0, 180.0 - ang[:, 1], ang[:, 2] + 180.0], axis=1))
+    alt = wrap_degrees(np.stack([ang[:, 0] + 180.0, 180.0 - ang[:, 1], ang[:, 2] + 180.0], axis=1))
     out = ang.copy()
     for t in range(1, len(ang)):
-        d0 = np.abs(_wrap(ang[t] - out[t - 1])).sum()
-        d1 = np.abs(_wrap(alt[t] - out[t - 1])).sum()
+        d0 = np.abs(wrap_degrees(ang[t] - out[t - 1])).sum()
+        d1 = np.abs(wrap_degrees(alt[t] - out[t - 1])).sum()
         if d1 < d0:
             out[t] = alt[t]
     return out
@@ -255,6 +261,46 @@ def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t:
                     block[:, k] = translations[:, i, a] - j.offset[a]
         values[:, sl[j.name]] = block
     return values
+
+
+def set_root(skeleton: Skeleton, values, R: Rotation, pos: np.ndarray) -> np.ndarray:
+    """``values`` with the root's DOF set from world rotations and positions (the other joints unchanged).
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    values : array (frames, n_dof)
+    R : Rotation of length ``frames``, the root's world rotation per frame
+    pos : array (frames, 3), the root's world position per frame (skeleton units)
+
+    Returns
+    -------
+    array (frames, n_dof), a new array. The root's rotational DOF come from ``C^-1 R C`` in the root's own
+    Euler order (degrees), its translation DOF from ``pos`` minus the root offset.
+
+    Raises
+    ------
+    ValueError
+        ``R`` is to be written to a root with one or two rotational DOF (no Euler triple fits).
+    """
+    out = np.array(values, float, copy=True)
+    root = skeleton.joints[0]
+    sl = skeleton.dof_slices()[root.name]
+    rd = [d for d in root.dofs if d in ROT_DOFS]
+    if rd:
+        if len(rd) < 3:
+            raise ValueError(f"skeleton {skeleton.name!r}: setting the root rotation needs a root with three "
+                             f"rotational DOF, {root.name!r} has {len(rd)}")
+        C = root.axis_rotation()
+        ang = (C.inv() * R * C).as_euler("".join(d[1] for d in rd), degrees=True)
+        for k, d in enumerate(root.dofs):
+            if d in ROT_DOFS:
+                out[:, sl.start + k] = ang[:, rd.index(d)]
+    for k, d in enumerate(root.dofs):
+        if d in TRANS_DOFS:
+            a = TRANS_DOFS.index(d)
+            out[:, sl.start + k] = pos[:, a] - root.offset[a]
+    return out
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -393,7 +439,16 @@ def heading(skeleton: Skeleton, values, overrides: dict | None = None) -> np.nda
     if _role_index(skeleton, ("left_hip", "right_hip"), overrides) is not None:
         f = facing(skeleton, values, overrides)
         return np.arctan2(f[:, 0], f[:, 1])
-    f = root_rotation(skeleton, values).apply(np.array([0.0, 0.0, 1.0]))
+    return rotation_heading(root_rotation(skeleton, values))
+
+
+def rotation_heading(R: Rotation) -> np.ndarray:
+    """Heading (radians about +y, 0 = +z) of the local +z axis turned by ``R``, shape ``(len(R),)``.
+
+    The root's own forward axis, not the body's (:func:`heading` reads the hips where it can): the right
+    measure of how much a root *turns* between two frames, whatever its rest pose.
+    """
+    f = R.apply(np.array([0.0, 0.0, 1.0]))
     return np.arctan2(f[:, 0], f[:, 2])
 
 

@@ -1,8 +1,9 @@
 """The common interface of the compare family's generators: :class:`Generator` (``fit`` / ``generate``), the
-:class:`Database` of clips they are fitted on, and the root helpers that place a generated motion where the start
-stands. The generators themselves and the factory are in :mod:`animsynth.compare.generators` (which re-exports
-these names); the modern generators (:mod:`.motionmatching`, :mod:`.genmm`) build on this module alone, so the
-factory can import them without an import cycle.
+:class:`Database` of clips they are fitted on, and the root helper that places a generated motion where the start
+stands (on :func:`animsynth.kinematics.heading` and :func:`animsynth.kinematics.set_root`). The generators
+themselves and the factory are in :mod:`animsynth.compare.generators` (which re-exports these names); the modern
+generators (:mod:`.motionmatching`, :mod:`.genmm`) build on this module alone, so the factory can import them
+without an import cycle.
 """
 
 from __future__ import annotations
@@ -10,42 +11,13 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import heading as _heading
-from ..kinematics import root_rotation, root_translation
+from ..kinematics import heading, root_rotation, root_translation, set_root
 from ..motion import Motion
-from ..skeleton import ROT_DOFS, TRANS_DOFS
 
-__all__ = ["Database", "Generator", "heading", "align_root", "check_generated"]
+__all__ = ["Database", "Generator", "align_root", "check_generated"]
 
 
 # ----------------------------------------------------------------------------- root helpers
-
-
-def heading(skeleton, values) -> np.ndarray:
-    """Heading (radians about +Y) per frame, shape ``(frames,)``: the facing from the hips
-    (:func:`animsynth.kinematics.heading`; the root's local +Z axis when the skeleton has no hip roles)."""
-    return _heading(skeleton, values)
-
-
-def _set_root(skeleton, values: np.ndarray, R: Rotation, pos: np.ndarray) -> np.ndarray:
-    """``values`` with the root's DOF set from world rotations ``R`` and positions ``pos`` (skeleton units)."""
-    out = np.array(values, float, copy=True)
-    root = skeleton.joints[0]
-    sl = skeleton.dof_slices()[root.name]
-    rd = [d for d in root.dofs if d in ROT_DOFS]
-    if rd:
-        if len(rd) < 3:
-            raise ValueError("moving the root needs a root with three rotational DOF")
-        C = root.axis_rotation()
-        ang = (C.inv() * R * C).as_euler("".join(d[1] for d in rd), degrees=True)
-        for k, d in enumerate(root.dofs):
-            if d in ROT_DOFS:
-                out[:, sl.start + k] = ang[:, rd.index(d)]
-    for k, d in enumerate(root.dofs):
-        if d in TRANS_DOFS:
-            a = TRANS_DOFS.index(d)
-            out[:, sl.start + k] = pos[:, a] - root.offset[a]
-    return out
 
 
 def align_root(skeleton, values, anchor, index: int = 0) -> np.ndarray:
@@ -65,7 +37,7 @@ def align_root(skeleton, values, anchor, index: int = 0) -> np.ndarray:
     q[:, 0] += pa[0]
     q[:, 2] += pa[2]
     q[:, 1] = p[:, 1]
-    return _set_root(skeleton, values, Ry * R, q)
+    return set_root(skeleton, values, Ry * R, q)
 
 
 def check_generated(motion: Motion, length: int, skeleton, name: str = "generator") -> Motion:

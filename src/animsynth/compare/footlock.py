@@ -43,7 +43,7 @@ from scipy.ndimage import median_filter
 from scipy.spatial.transform import Rotation
 
 from ..joints import resolve_roles
-from ..kinematics import forward_kinematics
+from ..kinematics import forward_kinematics, wrap_degrees
 from ..skeleton import ROT_DOFS
 
 __all__ = ["leg_chains", "contact_points", "contact_labels", "lock_contacts", "two_bone_ik", "place_feet"]
@@ -167,7 +167,7 @@ def _joint_euler(skeleton, j: int, L: Rotation, old: np.ndarray) -> np.ndarray:
     alt[:, 1] = 180.0 - ang[:, 1]
     best = None
     for cand in (ang, alt):
-        c = old + ((cand - old + 180.0) % 360.0 - 180.0)
+        c = old + wrap_degrees(cand - old)
         d = np.abs(c - old).sum(axis=1)
         best = (c, d) if best is None else (np.where((d < best[1])[:, None], c, best[0]), np.minimum(d, best[1]))
     return best[0]
@@ -193,7 +193,7 @@ def _write_rotation(skeleton, j: int, L: Rotation, values: np.ndarray) -> None:
     C = joint.axis_rotation()
     ang = (C.inv() * L * C).as_euler("".join(axes + [a for a in "xyz" if a not in axes]), degrees=True)[:, :len(rd)]
     old = values[:, cols]
-    values[:, cols] = old + ((ang - old + 180.0) % 360.0 - 180.0)
+    values[:, cols] = old + wrap_degrees(ang - old)
 
 
 def place_feet(skeleton, values, chain, targets, max_length_buffer_m: float = 0.015, fk=None) -> np.ndarray:

@@ -63,14 +63,14 @@ import logging
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..kinematics import root_rotation, root_translation
+from ..kinematics import root_rotation, root_translation, set_root
 from ..motion import Motion
-from .base import Database, Generator, _set_root, align_root, check_generated, heading
+from .base import Database, Generator, align_root, check_generated
 
 log = logging.getLogger("animsynth.compare.generators")
 
 __all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINISTIC", "Database", "Generator",
-           "FieldFollower", "Resequencer", "Replay", "Concat", "make_generator", "heading", "align_root",
+           "FieldFollower", "Resequencer", "Replay", "Concat", "make_generator", "align_root",
            "check_generated"]
 
 #: every generator name, in the order of the tables
@@ -164,16 +164,6 @@ class FieldFollower(Generator):
 # ----------------------------------------------------------------------------- re-sequencers
 
 
-def st_parameters(st: dict, fps: float) -> dict:
-    """ST-Isomap keyword arguments (frames) from the re-sequencing study's ``stisomap`` block (seconds)."""
-    tw = int(st["temporal_window"])
-    return {"temporal_window": tw, "c_atn": float(st["c_atn"]), "c_ctn": float(st["c_ctn"]),
-            "ctn_neighbors": int(st["ctn_neighbors"]),
-            "ctn_min_gap": max(tw, int(round(float(st["ctn_min_gap_s"]) * fps))),
-            "ctn_tolerance": int(st["ctn_tolerance"]),
-            "ctn_reach": max(1, int(round(float(st["ctn_reach_s"]) * fps)))}
-
-
 class Resequencer(Generator):
     """Isomap / ST-Isomap re-sequencing: Dijkstra paths on the neighbourhood graph between seeded targets.
 
@@ -206,6 +196,7 @@ class Resequencer(Generator):
     def fit(self, database) -> "Resequencer":
         from ..resequencing import sparse as sp
         from ..resequencing.features import motion_features
+        from ..resequencing.settings import st_parameters
 
         if self.method not in ("isomap", "stisomap"):
             raise ValueError(f"re-sequencing method must be isomap or stisomap, got {self.method!r}")
@@ -346,7 +337,7 @@ class Concat(Generator):
             p = root_translation(sk, seg)
             target = root_translation(sk, last[None, :])[0]
             shift = np.array([target[0] - p[0, 0], 0.0, target[2] - p[0, 2]])
-            seg = _set_root(sk, seg, root_rotation(sk, seg), p + shift)
+            seg = set_root(sk, seg, root_rotation(sk, seg), p + shift)
             parts.append(seg)
             seams.append(t)
             sources.append(np.stack([np.full(size, c), np.arange(f0, f0 + size)], 1))

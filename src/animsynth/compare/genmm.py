@@ -42,9 +42,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..kinematics import wrap_radians
 from ..motion import Motion
 from .base import Database, Generator
-from .poses import decode, encode, rest_forward, from_rot6d, rot6d, rotation_yaw, wrap_angle, yaw_rotation
+from .poses import decode, encode, rest_forward, from_rot6d, rot6d, rotation_yaw, yaw_rotation
 
 __all__ = ["GenMM", "make_genmm", "extract_patches", "match_patches", "vote", "resample_rows", "level_scales"]
 
@@ -197,7 +198,7 @@ class GenMM(Generator):
         yaw0 = rotation_yaw(sk, root_rotation(sk, anchor[None, :]), self.forward_)[0]
         yaw = rotation_yaw(sk, R, self.forward_)
         prev = np.concatenate([[yaw0], yaw[:-1]])
-        turn = wrap_angle(yaw - prev)
+        turn = wrap_radians(yaw - prev)
         disp = r[:, 7:9] / (m * fps)
         local = yaw_rotation(-prev).apply(np.column_stack([disp[:, 0], np.zeros(T), disp[:, 1]]))[:, [0, 2]]
         tilt = (yaw_rotation(-yaw) * R).as_quat()

@@ -30,14 +30,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..joints import resolve_roles
+from ..joints import FOOT_ROLES, resolve_roles
 from ..kinematics import HORIZONTAL as _KIN_HORIZONTAL
 from ..kinematics import UP as _KIN_UP
 from ..kinematics import facing as _hip_facing
 from ..kinematics import forward_kinematics
 
 __all__ = [
-    "UP", "FOOT_ROLES", "positions", "foot_indices", "facing", "body_frame", "pose_features",
+    "UP", "positions", "foot_indices", "facing", "body_frame", "pose_features",
     "global_quaternions", "align_quaternions", "floor_height", "foot_skating", "skating_ratio", "JumpReference",
     "jump_reference", "seam_jumps", "frame_jumps", "capture_max_jumps", "speed_profile", "ldlj", "sparc",
     "position_stats", "l2p", "l2q", "npss", "window_nearest",
@@ -48,9 +48,6 @@ __all__ = [
 UP = _KIN_UP
 #: Indices of the horizontal axes (x, z).
 _HORIZONTAL = list(_KIN_HORIZONTAL)
-#: Joint roles tracked by the foot metrics (:mod:`animsynth.joints`): the end of the ankle's segment is the
-#: ball of the foot, the end of the toe's the toe tip.
-FOOT_ROLES = ("left_ankle", "left_toe", "right_ankle", "right_toe")
 _NAN = float("nan")
 
 
@@ -76,7 +73,7 @@ def positions(motion) -> np.ndarray:
 
 
 def foot_indices(skeleton, overrides: dict | None = None) -> np.ndarray:
-    """Indices of the :data:`FOOT_ROLES` joints (left ankle, left toe, right ankle, right toe).
+    """Indices of the :data:`animsynth.joints.FOOT_ROLES` joints (left ankle, left toe, right ankle, right toe).
 
     Parameters
     ----------

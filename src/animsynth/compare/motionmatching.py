@@ -76,11 +76,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..joints import resolve_roles
-from ..kinematics import forward_kinematics
+from ..kinematics import forward_kinematics, wrap_radians
 from ..motion import Motion
 from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
 from .base import Database, Generator
-from .poses import Track, decode, encode, qexp, qinv, qlog, qmul, rest_forward, wrap_angle, yaw_rotation
+from .poses import Track, decode, encode, qexp, qinv, qlog, qmul, rest_forward, yaw_rotation
 
 __all__ = ["MotionMatching", "make_motion_matching", "decay_spring", "spring_position", "spring_angle",
            "halflife_to_damping", "pose_features", "trajectory_features"]
@@ -128,7 +128,7 @@ def spring_angle(x, v, goal, halflife: float, dt):
     (the shortest way round)."""
     y = halflife_to_damping(halflife) / 2.0
     dt = np.asarray(dt, float)
-    j0 = wrap_angle(x - goal)
+    j0 = wrap_radians(x - goal)
     j1 = v + j0 * y
     return np.exp(-y * dt) * (j0 + j1 * dt) + x - j0
 
@@ -371,7 +371,7 @@ class MotionMatching(Generator):
         v = (ground[-1] - ground[-2]) * fps
         pos = spring_position(ground[-1][None, :], v[None, :], np.zeros((1, 2)), goal_v[None, :],
                               float(self.trajectory_halflife_s), dt[:, None])
-        rate = float(wrap_angle(yaw[-1] - yaw[-2])) * fps
+        rate = float(wrap_radians(yaw[-1] - yaw[-2])) * fps
         ang = spring_angle(float(yaw[-1]), rate, goal_yaw, float(self.trajectory_halflife_s), dt)
         return pos, ang
 

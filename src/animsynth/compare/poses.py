@@ -25,18 +25,14 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..joints import resolve_roles
-from ..kinematics import forward_kinematics, local_rotations, root_rotation, root_translation
+from ..kinematics import (forward_kinematics, local_rotations, root_rotation, root_translation, wrap_degrees,
+                          wrap_radians)
 from ..motion import Motion
 from ..skeleton import ROT_DOFS, TRANS_DOFS
 
 __all__ = ["Track", "encode", "decode", "facing_yaw", "rotation_yaw", "rest_forward", "rotating_joints", "yaw_rotation",
-           "wrap_angle", "rot6d", "from_rot6d", "qmul", "qinv", "qlog", "qexp",
+           "rot6d", "from_rot6d", "qmul", "qinv", "qlog", "qexp",
            "dof_values"]
-
-
-def wrap_angle(a):
-    """Angles (radians) wrapped to [-pi, pi)."""
-    return (np.asarray(a, float) + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def yaw_rotation(yaw) -> Rotation:
@@ -188,7 +184,7 @@ def encode(motion: Motion, forward: np.ndarray | None = None) -> Track:
     d = np.diff(p, axis=0)
     local = yaw_rotation(-yaw[:-1]).apply(d)[:, [0, 2]]
     step = np.vstack([local[:1], local])
-    turn = wrap_angle(np.diff(yaw))
+    turn = wrap_radians(np.diff(yaw))
     turn = np.concatenate([turn[:1], turn])
     return Track(joints, _continuous_sign(rot), _continuous_sign(tilt[:, None, :])[:, 0], p[:, 1].copy(), step,
                  turn, yaw, ground)
@@ -203,9 +199,9 @@ def _euler_from(anchor, ang: np.ndarray) -> np.ndarray:
     for t, (a, b, c) in enumerate(ang.tolist()):
         best = None
         for x, y, z in ((a, b, c), (a + 180.0, 180.0 - b, c + 180.0)):
-            x = pa + ((x - pa + 180.0) % 360.0 - 180.0)
-            y = pb + ((y - pb + 180.0) % 360.0 - 180.0)
-            z = pc + ((z - pc + 180.0) % 360.0 - 180.0)
+            x = pa + wrap_degrees(x - pa)
+            y = pb + wrap_degrees(y - pb)
+            z = pc + wrap_degrees(z - pc)
             d = abs(x - pa) + abs(y - pb) + abs(z - pc)
             if best is None or d < best[0]:
                 best = (d, x, y, z)
@@ -240,7 +236,7 @@ def dof_values(skeleton, rotations: list, root_t: np.ndarray, anchor) -> np.ndar
                 ang = _euler_from(anchor[cols], ang)
             else:
                 ang = ang[:, :len(axes)]
-                ang = anchor[cols] + ((ang - anchor[cols] + 180.0) % 360.0 - 180.0)
+                ang = anchor[cols] + wrap_degrees(ang - anchor[cols])
                 ang = np.rad2deg(np.unwrap(np.deg2rad(np.vstack([anchor[cols][None, :], ang])), axis=0))[1:]
             values[:, cols] = ang
         for k, d in enumerate(j.dofs):

@@ -38,6 +38,7 @@ from .features import SIGN_MODES, matrix_naive_quaternions, motion_features, sig
 from .metrics import (Reference, TransitionReference, classify_path, jerk_magnitude, joint_quats, pass_jumps,
                       transition_measures)
 from .paths import pad_path, play_path, resolve_frame, shortest_path_frames
+from .settings import st_parameters
 
 log = logging.getLogger("animsynth.resequencing")
 
@@ -101,20 +102,6 @@ def prepare_motion(motion: Motion, max_frames: int | None = None, frame_step: in
     return Motion(v, motion.skeleton, motion.fps / frame_step, motion.name, dict(motion.meta))
 
 
-def st_kwargs(st: dict, fps: float) -> dict:
-    """Keyword arguments of :func:`spatio_temporal_distances` from the config block."""
-    tw = int(st["temporal_window"])
-    return {
-        "temporal_window": tw,
-        "c_atn": float(st["c_atn"]),
-        "c_ctn": float(st["c_ctn"]),
-        "ctn_neighbors": int(st["ctn_neighbors"]),
-        "ctn_min_gap": max(tw, int(round(float(st["ctn_min_gap_s"]) * fps))),
-        "ctn_tolerance": int(st["ctn_tolerance"]),
-        "ctn_reach": max(1, int(round(float(st["ctn_reach_s"]) * fps))),
-    }
-
-
 def sign_mode_of(cfg: dict) -> str:
     mode = cfg["linearisation"]["sign_mode"]
     if mode not in SIGN_MODES:
@@ -147,7 +134,7 @@ def method_distances(D: np.ndarray, method: str, cfg: dict, fps: float):
     if method == "isomap":
         return D, None, 0
     if method == "stisomap":
-        Dst, atn, ctn = spatio_temporal_distances(D, **st_kwargs(cfg["stisomap"], fps))
+        Dst, atn, ctn = spatio_temporal_distances(D, **st_parameters(cfg["stisomap"], fps))
         return Dst, atn, int(np.count_nonzero(np.triu(ctn)))
     raise ValueError(f"unknown method {method!r} (expected one of {METHODS})")
 
@@ -228,7 +215,7 @@ def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg:
     check_distance_budget(motion.n_frames, trial, budget_gib)
     feats = motion_features(motion)
     n = feats.n_frames
-    gap = st_kwargs(cfg["stisomap"], motion.fps)["ctn_min_gap"]
+    gap = st_parameters(cfg["stisomap"], motion.fps)["ctn_min_gap"]
     mode = sign_mode_of(cfg)
     rows, rv_rows, t_rows, emb = [], [], [], {}
     max_dim = min(int(cfg["max_dim"]), n - 2)
@@ -437,7 +424,7 @@ def resequence(motion: Motion, include_global: bool, method: str, metric: str, k
     tref = TransitionReference(motion, float(sm["contact_height_m"]))
     context = int(round(float(pc["context_s"]) * motion.fps))
     window = max(1, int(round(float(pc["transition_window_s"]) * motion.fps)))
-    same_pass = st_kwargs(cfg["stisomap"], motion.fps)["ctn_min_gap"]  # frames closer in time: the same pass
+    same_pass = st_parameters(cfg["stisomap"], motion.fps)["ctn_min_gap"]  # frames closer in time: the same pass
     paths, rows, trows = [], [], []
     for p, (a, b) in enumerate(path_pairs(n, pc, seed)):
         path, cost = shortest_path_frames(G, a, b)

@@ -37,10 +37,7 @@ log = logging.getLogger("animsynth.resequencing")
 __all__ = ["joint_quats", "transitions", "pass_jumps", "classify_path", "TransitionReference", "transition_measures",
            "pose_steps", "jerk_magnitude", "root_reversals", "foot_ground", "foot_skate", "Reference", "smoothness"]
 
-#: Joint roles of the foot metrics (:mod:`animsynth.joints`): the end of the
-#: ankle's segment is the ball of the foot, the end of the toe's the toe tip.
-FOOT_ROLES = ("left_ankle", "left_toe", "right_ankle", "right_toe")
-#: The CMU joints of :data:`FOOT_ROLES`.
+#: The CMU joints of :data:`animsynth.joints.FOOT_ROLES` (the roles of the foot metrics).
 FOOT_JOINTS = ("lfoot", "ltoes", "rfoot", "rtoes")
 
 
@@ -88,8 +85,9 @@ def root_reversals(motion, speed_threshold: float = 0.1) -> int:
 
 
 def foot_joints(skeleton) -> tuple[str, ...]:
-    """The joints of :data:`FOOT_ROLES` in ``skeleton`` (raises JointRoleError naming a missing role)."""
-    from ..joints import resolve_roles
+    """The joints of :data:`animsynth.joints.FOOT_ROLES` in ``skeleton`` (raises JointRoleError naming a missing
+    role)."""
+    from ..joints import FOOT_ROLES, resolve_roles
 
     return tuple(resolve_roles(skeleton, FOOT_ROLES))
 

@@ -7,8 +7,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
-from ..kinematics import local_rotations, root_translation
-from ..skeleton import ROT_DOFS, TRANS_DOFS
+from ..kinematics import local_rotations, root_translation, rotation_heading, set_root, wrap_radians
 from .embedding import DisconnectedGraphError
 
 __all__ = ["shortest_path_frames", "pad_path", "play_path", "resolve_frame"]
@@ -77,16 +76,6 @@ def pad_path(path, length: int | None, mode: str = "hold") -> np.ndarray:
     raise ValueError(f"unknown padding mode {mode!r} (hold, reverse)")
 
 
-def _yaw(R: Rotation) -> np.ndarray:
-    """Heading angle (radians, about +Y) of the rotated local +Z axis, per frame."""
-    f = R.apply(np.array([0.0, 0.0, 1.0]))
-    return np.arctan2(f[:, 0], f[:, 2])
-
-
-def _wrap(a):
-    return (a + np.pi) % (2 * np.pi) - np.pi
-
-
 def play_path(motion: Motion, path, root: str = "integrate", name: str | None = None, same_pass: int = 1) -> Motion:
     """The motion a frame-index path plays.
 
@@ -117,7 +106,7 @@ def play_path(motion: Motion, path, root: str = "integrate", name: str | None = 
     if root == "integrate" and path.size > 1:
         R0 = local_rotations(sk, vals)[0]
         p = root_translation(sk, vals)
-        yaw = _yaw(R0)
+        yaw = rotation_heading(R0)
         m = path.size
         new_yaw = np.empty(m)
         new_p = np.empty((m, 3))
@@ -131,7 +120,7 @@ def play_path(motion: Motion, path, root: str = "integrate", name: str | None = 
                 src, dst = b - 1, b
             else:
                 src, dst = b, b  # first frame reached by a jump: no step information
-            dyaw = _wrap(yaw[dst] - yaw[src])
+            dyaw = wrap_radians(yaw[dst] - yaw[src])
             d = p[dst] - p[src]
             c, s = np.cos(-yaw[src]), np.sin(-yaw[src])
             local = np.array([c * d[0] + s * d[2], -s * d[0] + c * d[2]])  # R_y(-yaw) on (x, z)
@@ -142,21 +131,5 @@ def play_path(motion: Motion, path, root: str = "integrate", name: str | None = 
             new_yaw[t] = new_yaw[t - 1] + dyaw
         # new root rotation = R_y(new_yaw - yaw[b]) * R[b]
         Ry = Rotation.from_euler("y", (new_yaw - yaw[path])[:, None])
-        Rnew = Ry * R0[path]
-        root = sk.joints[0]
-        C = root.axis_rotation()
-        M = C.inv() * Rnew * C
-        sl = sk.dof_slices()[root.name]
-        rd = [d for d in root.dofs if d in ROT_DOFS]
-        if rd:
-            ang = M.as_euler("".join(d[1] for d in rd), degrees=True)
-            if len(rd) < 3:
-                raise ValueError("root re-integration needs a root with three rotational DOF")
-            for k, d in enumerate(root.dofs):
-                if d in ROT_DOFS:
-                    out[:, sl.start + k] = ang[:, rd.index(d)]
-        for k, d in enumerate(root.dofs):
-            if d in TRANS_DOFS:
-                a = TRANS_DOFS.index(d)
-                out[:, sl.start + k] = new_p[:, a] - root.offset[a]
+        out = set_root(sk, out, Ry * R0[path], new_p)
     return Motion(out, sk, motion.fps, name or f"{motion.name}_reseq", dict(motion.meta))

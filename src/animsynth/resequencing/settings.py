@@ -1,10 +1,11 @@
-"""Cross-key checks of the ``resequencing`` config block (beyond the JSON Schema, which holds the defaults)."""
+"""The ``resequencing`` config block: cross-key checks (beyond the JSON Schema, which holds the defaults) and the
+adapters that turn its keys into the methods' arguments."""
 
 from __future__ import annotations
 
 from ..config import ConfigError
 
-__all__ = ["check"]
+__all__ = ["check", "st_parameters"]
 
 
 def check(config: dict) -> None:
@@ -28,3 +29,22 @@ def check(config: dict) -> None:
     if rs["linearisation"]["sign_mode"] not in rs["explanations"]["sign_modes"]:
         raise ConfigError(f"config key 'resequencing.explanations.sign_modes' {rs['explanations']['sign_modes']} "
                           f"must include resequencing.linearisation.sign_mode ({rs['linearisation']['sign_mode']!r})")
+
+
+def st_parameters(st: dict, fps: float) -> dict:
+    """Keyword arguments of ST-Isomap (:func:`~animsynth.resequencing.embedding.spatio_temporal_distances`,
+    :func:`~animsynth.resequencing.sparse.st_neighbours`; counts in frames) from the ``stisomap`` config block
+    (durations in seconds) at ``fps`` frames per second.
+
+    ``ctn_min_gap`` is at least ``temporal_window`` and ``ctn_reach`` at least one frame.
+    """
+    tw = int(st["temporal_window"])
+    return {
+        "temporal_window": tw,
+        "c_atn": float(st["c_atn"]),
+        "c_ctn": float(st["c_ctn"]),
+        "ctn_neighbors": int(st["ctn_neighbors"]),
+        "ctn_min_gap": max(tw, int(round(float(st["ctn_min_gap_s"]) * fps))),
+        "ctn_tolerance": int(st["ctn_tolerance"]),
+        "ctn_reach": max(1, int(round(float(st["ctn_reach_s"]) * fps))),
+    }
