@@ -24,8 +24,8 @@ from animsynth.resequencing.metrics import (Reference, TransitionReference, clas
                                             jerk_magnitude, pose_steps, root_reversals, smoothness,
                                             transition_measures, transitions)
 from animsynth.resequencing.paths import pad_path, play_path, resolve_frame, shortest_path_frames
-from animsynth.resequencing.jobs import (analyse, explain, min_k_table, path_pairs, prepare_motion, published_table2,
-                                         resequence, splice, summarise_paths)
+from animsynth.resequencing.jobs import analyse, explain, path_pairs, prepare_motion, resequence, splice, summarise_paths
+from animsynth.resequencing.tables import min_k_table, published_table2
 from animsynth.resequencing.verdicts import (explanation_verdicts, global_dof_verdict, lee_vs_l2_verdict,
                                              st_smoother_verdict)
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
@@ -498,7 +498,7 @@ def test_min_k_table_fills_published_values(tmp_path):
 
 def test_lee_weights_beside_the_paper_and_malformed_published_files(tmp_path):
     from animsynth.published import PublishedError
-    from animsynth.resequencing.jobs import lee_weights_table
+    from animsynth.resequencing.tables import lee_weights_table
 
     f = tmp_path / "lee.csv"
     f.write_text("joint_pair,weight\nhips,1.0000\nknees,0.0900\n")

@@ -171,7 +171,7 @@ def _tiny_config(wd) -> dict:
 @pytest.mark.workflow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_resequencing_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow, seed):
-    from animsynth.resequencing.jobs import published_table2
+    from animsynth.resequencing.tables import published_table2
     from animsynth.resequencing.verdicts import all_verdicts
 
     out = tiny_workflow / "results" / "resequencing"

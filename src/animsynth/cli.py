@@ -306,7 +306,7 @@ def cmd_generate(a) -> None:
 
 
 def cmd_resequence(a) -> None:
-    from .resequencing.jobs import resequence_motion
+    from .resequencing.quick import resequence_motion
 
     files, a.out = _split_motion_args(a.files, a.out, MOTION_OUTPUTS)
     m, a.amc = _load_any(a, files)

@@ -3,7 +3,8 @@ import numpy as np
 
 from animsynth.motion import Motion
 from animsynth.atomic import atomic_path
-from animsynth.resequencing.jobs import analyse, gdof_flag, prepare_motion
+from animsynth.resequencing.jobs import analyse, prepare_motion
+from animsynth.resequencing.settings import gdof_flag
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)

@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 
 from animsynth.resequencing.plots import embedding_figure, residual_variance_figure
-from animsynth.resequencing.jobs import METHOD_LABEL, METRIC_LABEL
+from animsynth.resequencing.settings import METHOD_LABEL, METRIC_LABEL
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)

@@ -3,7 +3,8 @@ import pandas as pd
 
 from animsynth.motion import Motion
 from animsynth.atomic import atomic_path
-from animsynth.resequencing.jobs import gdof_flag, prepare_motion, resequence
+from animsynth.resequencing.jobs import prepare_motion, resequence
+from animsynth.resequencing.settings import gdof_flag
 from animsynth.viz import motion_previews
 from animsynth.workflow_utils import setup_logging
 

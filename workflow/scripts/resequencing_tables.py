@@ -2,7 +2,8 @@
 import pandas as pd
 
 from animsynth.atomic import atomic_path
-from animsynth.resequencing.jobs import lee_weights_table, min_k_table, published_table2, summarise_paths
+from animsynth.resequencing.jobs import summarise_paths
+from animsynth.resequencing.tables import lee_weights_table, min_k_table, published_table2
 from animsynth.resequencing.verdicts import all_verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging

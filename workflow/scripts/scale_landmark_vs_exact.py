@@ -1,5 +1,5 @@
 """Landmark vs exact Isomap on one database size (dense pipeline cross-checked too)."""
-from animsynth.resequencing.jobs import landmark_vs_exact
+from animsynth.resequencing.cost import landmark_vs_exact
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 

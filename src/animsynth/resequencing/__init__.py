@@ -11,9 +11,11 @@ paths       Dijkstra re-sequencing, padding, playing a path as a motion
 metrics     transitions, path classes, per-transition and whole-path smoothness
 landmark    Landmark Isomap (geodesics from a few frames) for large databases
 sparse      the sparse (k-NN candidate) pipeline of large databases
-jobs        the workflow steps (analyse, explain, resequence, tables, published values), the one-call
-            :func:`~.jobs.resequence_motion`, the scale study's measured steps
-settings    config checks beyond the schema
+jobs        the workflow steps (analyse, explain, resequence, summarise the paths)
+settings    config checks beyond the schema and the config adapters (names, wildcards, ST-Isomap parameters)
+tables      the paper's Table 2 and Lee weights in our names, beside ours
+quick       the one-call :func:`~.quick.resequence_motion` (CLI, notebooks)
+cost        the scale study's measured steps and Landmark vs exact Isomap
 verdicts    the paper's claims in the common verdict format
 plots       Fig. 2 (embeddings with edges) and Fig. 3 (residual variance)
 """

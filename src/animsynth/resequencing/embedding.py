@@ -52,7 +52,7 @@ log = logging.getLogger("animsynth.resequencing")
 __all__ = ["DisconnectedGraphError", "neighbor_ranks", "knn_graph", "graph_components", "min_connected_k",
            "temporal_adjacency",
            "PrecomputedIsomap", "STIsomap", "spatio_temporal_distances", "nontrivial_neighbors",
-           "residual_variance"]
+           "residual_variance", "checked_graph"]
 
 
 class DisconnectedGraphError(ValueError):
@@ -462,3 +462,12 @@ def residual_variance(geodesic, embedding, dims=None) -> np.ndarray:
         r = np.corrcoef(g, e)[0, 1]
         out.append(1.0 - r * r)
     return np.asarray(out)
+
+
+def checked_graph(Dm, k: int, always=None, what: str = ""):
+    """The ``k``-NN graph of ``Dm`` (plus the ``always`` edges), refused when it is disconnected."""
+    ncomp = graph_components(Dm, k, always=always)
+    if ncomp > 1:
+        raise DisconnectedGraphError(f"{what}: the {k}-NN graph has {ncomp} components "
+                                     f"(the smallest connected k is {min_connected_k(Dm, always=always)})")
+    return knn_graph(Dm, k, always=always)

@@ -7,15 +7,22 @@ configuration's exact minimum connected k -- (distances, Isomap / ST-Isomap
 fit, residual variance, 2-D embedding) plus the labelled fixed-k sweep;
 :func:`explain` computes the minimum k over the candidate explanations of the
 paper's Table 2 (sign mode x frame rate x global DOF) and the quaternion sign
-flips; :func:`resequence` makes and measures the re-sequenced motions;
-:func:`min_k_table` and :mod:`.verdicts` aggregate; :func:`read_published_table2`
-and :func:`lee_weights_table` put the paper's published values beside ours.
+flips; :func:`resequence` makes and measures the re-sequenced motions and
+:func:`summarise_paths` sums them up per configuration.
 
 The configuration dictionary ``cfg`` is the ``resequencing`` block of the
 workflow config as validated by ``config/schema.yaml`` (every key present; the
 schema holds the defaults, ``docs/config_resequencing.md`` the meanings).
-:func:`resequence_motion` is the one-call library route (CLI, notebooks) with
-explicit keyword arguments instead.
+
+The family's other concerns live beside this module: the config adapters
+(method and metric names, global-DOF wildcards, sign mode, ST-Isomap
+parameters) in :mod:`.settings`; the paper's Table 2 and Lee weights beside
+ours (:func:`~.tables.published_table2`, :func:`~.tables.lee_weights_table`,
+:func:`~.tables.min_k_table`) in :mod:`.tables`; the one-call library route
+with explicit keyword arguments (CLI, notebooks),
+:func:`~.quick.resequence_motion`, in :mod:`.quick`; the cost curves of
+:mod:`animsynth.scale` in :mod:`.cost` (:func:`scale_steps` is named here too,
+where the scale harness reads every family's measured steps).
 """
 
 from __future__ import annotations
@@ -28,25 +35,18 @@ import pandas as pd
 
 from ..limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
 from ..motion import Motion
-from ..published import PublishedError, read_table
-from ..tables import add_paper_differences
+from .cost import scale_steps  # noqa: F401  (animsynth.scale reads each family's measured steps from its jobs)
 from .distances import l2_distances, lee_distances
-from .embedding import (DisconnectedGraphError, PrecomputedIsomap, graph_components, knn_graph,
-                        min_connected_k, neighbor_ranks, residual_variance, spatio_temporal_distances)
+from .embedding import (PrecomputedIsomap, checked_graph, graph_components, knn_graph, min_connected_k,
+                        neighbor_ranks, residual_variance, spatio_temporal_distances)
 from .landmark import EMBED_METHODS, embed
-from .features import SIGN_MODES, matrix_naive_quaternions, motion_features, sign_flips
+from .features import matrix_naive_quaternions, motion_features, sign_flips
 from .metrics import (Reference, TransitionReference, classify_path, jerk_magnitude, joint_quats, pass_jumps,
                       transition_measures)
 from .paths import pad_path, play_path, resolve_frame, shortest_path_frames
-from .settings import st_parameters
+from .settings import METHODS, METRICS, gdof_name, sign_mode_of, st_parameters
 
 log = logging.getLogger("animsynth.resequencing")
-
-METHODS = ("isomap", "stisomap")
-METRICS = ("l2", "lee")
-GDOF = {"noglobal": False, "global": True}
-METHOD_LABEL = {"isomap": "Isomap", "stisomap": "ST-Isomap"}
-METRIC_LABEL = {"l2": "L2", "lee": "Lee"}
 
 #: N x N float64 arrays the distance steps hold at once (base distances,
 #: method distances, geodesics, the centred kernel / path graph).
@@ -78,17 +78,6 @@ def check_distance_budget(n_frames: int, trial: str, budget_gib: float | None = 
                  DEFAULT_MEMORY_BUDGET_GIB if budget_gib is None else float(budget_gib))
 
 
-def gdof_flag(name: str) -> bool:
-    try:
-        return GDOF[name]
-    except KeyError:
-        raise ValueError(f"global-DOF wildcard must be one of {sorted(GDOF)}, got {name!r}") from None
-
-
-def gdof_name(flag: bool) -> str:
-    return "global" if flag else "noglobal"
-
-
 def prepare_motion(motion: Motion, max_frames: int | None = None, frame_step: int = 1) -> Motion:
     """Keep every ``frame_step``-th frame of the first ``max_frames`` frames (fps adjusted)."""
     if frame_step < 1:
@@ -100,13 +89,6 @@ def prepare_motion(motion: Motion, max_frames: int | None = None, frame_step: in
     if v.shape[0] < 12:
         raise ValueError(f"trial {motion.name!r}: {v.shape[0]} frames after max_frames/frame_step; need >= 12")
     return Motion(v, motion.skeleton, motion.fps / frame_step, motion.name, dict(motion.meta))
-
-
-def sign_mode_of(cfg: dict) -> str:
-    mode = cfg["linearisation"]["sign_mode"]
-    if mode not in SIGN_MODES:
-        raise ValueError(f"config key 'resequencing.linearisation.sign_mode': {mode!r} is not one of {SIGN_MODES}")
-    return mode
 
 
 def base_distances(features, metric: str, include_global: bool, cfg: dict, sign_mode: str | None = None) -> np.ndarray:
@@ -364,15 +346,6 @@ def splice(path, n: int, context: int) -> np.ndarray:
     return np.concatenate([pre, path, post])
 
 
-def checked_graph(Dm, k: int, always=None, what: str = ""):
-    """The ``k``-NN graph of ``Dm`` (plus the ``always`` edges), refused when it is disconnected."""
-    ncomp = graph_components(Dm, k, always=always)
-    if ncomp > 1:
-        raise DisconnectedGraphError(f"{what}: the {k}-NN graph has {ncomp} components "
-                                     f"(the smallest connected k is {min_connected_k(Dm, always=always)})")
-    return knn_graph(Dm, k, always=always)
-
-
 def config_graph(motion: Motion, include_global: bool, method: str, metric: str, k: int, cfg: dict):
     """The weighted neighbourhood graph a configuration's paths run on (k checked)."""
     feats = motion_features(motion)
@@ -498,273 +471,3 @@ def summarise_paths(per_path: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-#: The paper's Table 2 names -> ours.
-PAPER_GLOBAL_DOF = {"included": True, "excluded": False}
-PAPER_METHODS = {"isomap": "isomap", "st-isomap": "stisomap", "stisomap": "stisomap"}
-TABLE2_COLUMNS = ("motion", "frames", "global_dof", "method", "metric", "min_k")
-
-
-def published_table2(path) -> pd.DataFrame | None:
-    """The paper's Table 2 (CSV: motion, frames, global_dof, method, metric, min_k) in our names.
-
-    Read with :func:`animsynth.published.read_table`: ``None`` (and a WARNING) when ``path`` is None or
-    absent. Returns columns ``dataset, paper_frames, global_dof (bool), method, metric, min_k_paper``.
-
-    Raises
-    ------
-    animsynth.published.PublishedError
-        A missing column, a non-number, an empty count, or a global_dof / method / metric the table's
-        layout does not have (the message names the file and line).
-    """
-    df = read_table(path, TABLE2_COLUMNS, numeric=("frames", "min_k"), what="re-sequencing paper Table 2",
-                    config_key="published.resequencing.table2")
-    if df is None:
-        return None
-    bad = ~df["global_dof"].isin(PAPER_GLOBAL_DOF) | ~df["method"].isin(PAPER_METHODS) | ~df["metric"].isin(METRICS)
-    bad |= df["frames"].isna() | df["min_k"].isna()
-    if bad.any():
-        i = int(bad.to_numpy().nonzero()[0][0])
-        raise PublishedError(f"{path}, line {i + 2}: unknown global_dof/method/metric or an empty count "
-                             f"{df.iloc[i][list(TABLE2_COLUMNS[1:])].tolist()}")
-    return pd.DataFrame({"dataset": df["motion"], "paper_frames": df["frames"].astype(int),
-                         "global_dof": df["global_dof"].map(PAPER_GLOBAL_DOF), "method": df["method"].map(PAPER_METHODS),
-                         "metric": df["metric"], "min_k_paper": df["min_k"].astype(int)})
-
-
-def lee_weights_table(path, weights: dict) -> pd.DataFrame | None:
-    """Our Lee weights beside the paper's (CSV: joint_pair, weight); ``None`` without the file.
-
-    Columns: ``group, weight_paper, weight_ours, weight_minus_paper, match`` (equal to the paper's four
-    printed decimals)."""
-    df = read_table(path, ("joint_pair", "weight"), numeric=("weight",), what="re-sequencing paper Lee weights",
-                    config_key="published.resequencing.lee_weights")
-    if df is None:
-        return None
-    df = df.rename(columns={"joint_pair": "group", "weight": "weight_paper"})
-    df["weight_ours"] = df["group"].map(lambda g: float(weights.get(g, 0.0)))
-    df["weight_minus_paper"] = df["weight_ours"] - df["weight_paper"]
-    df["match"] = np.isclose(df["weight_ours"], df["weight_paper"], rtol=0, atol=5e-5)
-    return df
-
-
-def min_k_table(grid: pd.DataFrame, published: pd.DataFrame | None, frame_step: int) -> pd.DataFrame:
-    """The paper's Table 2 layout (long form): our min k in both sign modes at the
-    workflow's ``frame_step``, with the paper's value beside the matching rows
-    (the paper's global-DOF setting per motion; other rows empty)."""
-    df = grid[grid["frame_step"] == int(frame_step)].copy()
-    df["min_k_paper"] = np.nan
-    df["paper_frames"] = np.nan
-    if published is not None:
-        for rec in published.itertuples():
-            m = ((df["dataset"] == rec.dataset) & (df["global_dof"] == bool(rec.global_dof))
-                 & (df["method"] == rec.method) & (df["metric"] == rec.metric))
-            df.loc[m, "min_k_paper"] = rec.min_k_paper
-            df.loc[m, "paper_frames"] = rec.paper_frames
-    order = {"walk": 0, "run": 1, "dance": 2}
-    df["_o"] = df["dataset"].map(lambda d: order.get(d, 9))
-    df["_s"] = df["sign_mode"].map(lambda x: SIGN_MODES.index(x) if x in SIGN_MODES else 9)
-    df = df.sort_values(["_o", "dataset", "global_dof", "_s", "method", "metric"], kind="stable")
-    cols = ["dataset", "trial", "frames", "fps", "global_dof", "sign_mode", "method", "metric", "min_k",
-            "min_k_paper", "paper_frames", "components_at_min_k_minus_1", "components_at_min_k"]
-    out = add_paper_differences(df[cols].reset_index(drop=True), {"min_k": "min_k_paper", "frames": "paper_frames"})
-    for c in ("min_k_paper", "paper_frames", "min_k_minus_paper", "frames_minus_paper"):
-        out[c] = out[c].astype("Int64")
-    return out
-
-
-def resequence_motion(motion: Motion, start: int, end: int, method: str = "stisomap", metric: str = "l2",
-                      k: int | None = None, global_dof: bool = False, length: int | None = None, *,
-                      sign_mode: str = "continuous", lee: dict | None = None, st: dict | None = None,
-                      root_playback: str = "integrate") -> tuple[np.ndarray, Motion]:
-    """One-call re-sequencing (CLI, notebooks): Dijkstra from ``start`` to ``end``.
-
-    Parameters
-    ----------
-    motion : Motion
-        The capture, ``(frames, dof)`` values.
-    start, end : int
-        First and last frame of the path (negative counts from the end).
-    method : {"stisomap", "st-isomap", "isomap"}
-    metric : {"l2", "lee"}
-    k : int, optional
-        Neighbours; default the smallest k giving one connected component of the method's graph.
-    global_dof : bool
-        Include the root translation and orientation in the distances.
-    length : int, optional
-        Pad the path to this many frames (holding the last frame).
-    sign_mode : str
-        Quaternion linearisation of the L2 features (:func:`.features.linearize_quaternions`).
-    lee : dict, optional
-        Keyword arguments of :func:`.distances.lee_distances` (``weights``, ``nu``, ``sqrt``,
-        ``translation_scale``); its defaults (the paper's weights) otherwise.
-    st : dict, optional
-        Keyword arguments of :func:`.embedding.spatio_temporal_distances` (in frames); its defaults otherwise.
-    root_playback : {"integrate", "absolute"}
-        Root of the played motion (:func:`.paths.play_path`).
-
-    Returns
-    -------
-    path : int array (frames,)
-        The frame index path (padded to ``length`` if given).
-    played : Motion
-        The motion it plays.
-    """
-    method = {"st-isomap": "stisomap"}.get(method, method)
-    feats = motion_features(motion)
-    n = feats.n_frames
-    a, b = resolve_frame(start, n, "start"), resolve_frame(end, n, "end")
-    if metric == "l2":
-        D = l2_distances(feats.linearised(global_dof, sign_mode))
-    elif metric == "lee":
-        D = lee_distances(feats, include_global=global_dof, **(lee or {}))
-    else:
-        raise ValueError(f"unknown metric {metric!r} (expected one of {METRICS})")
-    if method == "isomap":
-        Dm, always = D, None
-    elif method == "stisomap":
-        Dm, always, _ = spatio_temporal_distances(D, **(st or {}))
-    else:
-        raise ValueError(f"unknown method {method!r} (expected one of {METHODS})")
-    if k is None:
-        k = min_connected_k(Dm, always=always)
-    G = checked_graph(Dm, int(k), always, f"{method}/{metric}")
-    path, _ = shortest_path_frames(G, a, b)
-    path = pad_path(path, length, "hold")
-    return path, play_path(motion, path, root=root_playback, name="resequenced")
-
-
-# ----------------------------------------------------------------------------- cost curves (animsynth.scale)
-
-
-def scale_steps(recorder, n: int, metric: str = "l2", method: str = "isomap", n_candidates: int = 20, k=None,
-                       embedding: str = "landmark", exact_max_frames: int = 4000, n_landmarks: int = 500,
-                       landmarks: str = "maxmin", n_components: int = 2, seed: int = 0, trial_frames: int = 1000,
-                       cmu_mirror: str | None = None, algorithm: str = "kd_tree", st: dict | None = None,
-                       lee: dict | None = None):
-    """Re-sequencing of an ``n``-frame database: neighbours, exact min k, embedding, one path."""
-    from ..io.cmu_mirror import read_mirror_motions
-    from ..synth.mocap import synthetic_motions
-    from . import landmark as lm
-    from . import sparse as sp
-    from .features import motion_features
-
-    motions = read_mirror_motions(cmu_mirror, n) if cmu_mirror else synthetic_motions(n, trial_frames, seed)
-    feats = [motion_features(m) for m in motions]
-    feats, seq = sp.concat_features(feats)
-    n = int(seq.size)
-    S = recorder("resequencing", n, metric=metric, method=method)
-    lee = lee or {}
-    with S.step("neighbours", candidates=n_candidates):
-        if metric == "l2":
-            X = np.vstack([f.linearised(False) for f in feats])
-            dist, idx = sp.l2_neighbours(X, n_candidates, algorithm=algorithm)
-            pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)  # noqa: E731
-        elif metric == "lee":
-            kw = {"weights": lee.get("weights"), "nu": float(lee.get("nu", 0.01)), "sqrt": bool(lee.get("sqrt", False))}
-            dist, idx = sp.lee_neighbours(feats, n_candidates, algorithm=algorithm, **kw)
-            parts = sp._lee_parts(feats, kw["weights"], kw["nu"], False)
-            pair = lambda i, j: sp.lee_pair_metric(parts, i, j, kw["sqrt"])  # noqa: E731
-        else:
-            raise ValueError(f"unknown metric {metric!r} (l2, lee)")
-        always = None
-        if method == "stisomap":
-            st = dict(st or {})
-            dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
-            always = sp.st_always_edges(seq, st.get("temporal_window", 1), st.get("c_atn", 10.0), pair)
-        elif method != "isomap":
-            raise ValueError(f"unknown method {method!r} (isomap, stisomap)")
-    with S.step("min_k") as info:
-        kmin = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
-        info["min_k"] = kmin
-    kk = max(kmin, int(k or kmin))
-    G = sp.sparse_knn_graph(dist, idx, kk, always=always)
-    with S.step("embedding") as info:
-        res = lm.embed(G, n_components, embedding, exact_max_frames, n_landmarks, landmarks, seed)
-        info.update(embedding_method=res.method, rv_d2=float(res.residual_variance[min(1, n_components - 1)]))
-    with S.step("path") as info:
-        path, cost = sp.shortest_path(G, 0, n - 1)
-        info.update(path_frames=int(path.size))
-    for r in S.rows:
-        r["k"] = kk
-    return S.rows
-
-
-def landmark_vs_exact(n: int, metric: str = "l2", method: str = "isomap", n_candidates: int = 20, k=10,
-                      n_landmarks=(50, 100, 200), seeds=(0, 1, 2), max_dim: int = 5, pairs: int = 10, seed: int = 0,
-                      trial_frames: int = 1000, cmu_mirror: str | None = None, st: dict | None = None):
-    """Landmark vs exact Isomap on an ``n``-frame database small enough for N x N.
-
-    * The graph uses ``max(k, minimum k)`` neighbours: at the minimum k itself
-      a database graph is often a chain, whose geodesics are 1-D, and a 2-D
-      Procrustes comparison would compare rounding noise.
-    * The dense pipeline (:mod:`.embedding`: full distance matrix,
-      exact min k) and the sparse one (:mod:`.sparse`) must give the
-      same minimum k and the same path costs (``pairs`` seeded start/end pairs).
-    * On the sparse graph, exact Isomap vs Landmark Isomap for each number of
-      landmarks x landmark seed: Procrustes disparity of the 2-D embeddings
-      (scipy; 0 = identical up to rotation, scale and reflection), residual
-      variance per dimension (exact: all frame pairs; landmark: landmark pairs).
-
-    Returns
-    -------
-    summary : DataFrame, one row per landmarks x seed
-    rv : DataFrame, residual-variance curves (long: dim, rv_exact, rv_landmark)
-    """
-    from scipy.spatial import procrustes
-
-    from ..io.cmu_mirror import read_mirror_motions
-    from ..synth.mocap import synthetic_motions
-    from . import landmark as lm
-    from . import sparse as sp
-    from .distances import l2_distances
-    from .embedding import knn_graph, min_connected_k, spatio_temporal_distances, temporal_adjacency
-    from .features import motion_features
-    from .paths import shortest_path_frames
-
-    motions = read_mirror_motions(cmu_mirror, n) if cmu_mirror else synthetic_motions(n, trial_frames, seed)
-    feats, seq = sp.concat_features([motion_features(m) for m in motions])
-    n = int(seq.size)
-    if metric != "l2":
-        raise ValueError("landmark_vs_exact compares on the L2 metric (the dense Lee metric of a multi-trial "
-                         "database would mix velocities across trial boundaries)")
-    X = np.vstack([f.linearised(False) for f in feats])
-    dist, idx = sp.l2_neighbours(X, n_candidates, algorithm="kd_tree")
-    D = l2_distances(X)
-    if method == "stisomap":
-        if len(feats) != 1:
-            raise ValueError("the dense ST-Isomap adjustment handles one sequence; use one trial for stisomap")
-        st = dict(st or {})
-        pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)  # noqa: E731
-        dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
-        always = sp.st_always_edges(seq, st.get("temporal_window", 1), st.get("c_atn", 10.0), pair)
-        D = spatio_temporal_distances(D, **st)[0]
-        always_dense = temporal_adjacency(n, st.get("temporal_window", 1))
-    else:
-        always, always_dense = None, None
-    kmin_sparse = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
-    kmin_dense = min_connected_k(D, always=always_dense)
-    kk = max(kmin_sparse, int(k or kmin_sparse))
-    G = sp.sparse_knn_graph(dist, idx, kk, always=always)
-    Gd = knn_graph(D, kk, always=always_dense)
-    rng = np.random.default_rng(seed)
-    ab = [tuple(int(x) for x in rng.choice(n, 2, replace=False)) for _ in range(int(pairs))]
-    cs = np.array([sp.shortest_path(G, a, b)[1] for a, b in ab])
-    cd = np.array([shortest_path_frames(Gd, a, b)[1] for a, b in ab])
-    exact = lm.embed(G, max_dim, "exact")
-    rows, rv_rows = [], []
-    for nl in n_landmarks:
-        for s in seeds:
-            res = lm.embed(G, max_dim, "landmark", n_landmarks=int(nl), seed=int(s))
-            disp = procrustes(exact.embedding[:, :2], res.embedding[:, :2])[2]
-            rows.append({"n": n, "metric": metric, "method": method, "k": kk, "min_k_dense": kmin_dense,
-                         "min_k_sparse": kmin_sparse, "n_landmarks": int(nl), "landmark_seed": int(s),
-                         "procrustes_2d": float(disp), "rv_exact_d2": float(exact.residual_variance[1]),
-                         "rv_landmark_d2": float(res.residual_variance[1]), "rv_landmark_on": res.rv_on,
-                         "path_pairs": len(ab), "path_cost_dense_mean": float(cd.mean()),
-                         "path_cost_sparse_mean": float(cs.mean()),
-                         "path_cost_max_rel_diff": float(np.max(np.abs(cs - cd) / np.maximum(cd, 1e-300)))})
-            for d in range(max_dim):
-                rv_rows.append({"n": n, "method": method, "n_landmarks": int(nl), "landmark_seed": int(s),
-                                "dim": d + 1, "rv_exact": float(exact.residual_variance[d]),
-                                "rv_landmark": float(res.residual_variance[d])})
-    return pd.DataFrame(rows), pd.DataFrame(rv_rows)

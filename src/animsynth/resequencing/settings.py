@@ -1,11 +1,22 @@
 """The ``resequencing`` config block: cross-key checks (beyond the JSON Schema, which holds the defaults) and the
-adapters that turn its keys into the methods' arguments."""
+adapters that turn its keys and the workflow's wildcards into the methods' arguments.
+
+Imported when the workflow is parsed (:func:`check`): nothing here loads the numeric modules at import time.
+"""
 
 from __future__ import annotations
 
 from ..config import ConfigError
 
-__all__ = ["check", "st_parameters"]
+__all__ = ["METHODS", "METRICS", "GDOF", "METHOD_LABEL", "METRIC_LABEL", "check", "gdof_flag", "gdof_name",
+           "sign_mode_of", "st_parameters"]
+
+#: The methods and metrics of the study, the global-DOF wildcard values and the figures' labels.
+METHODS = ("isomap", "stisomap")
+METRICS = ("l2", "lee")
+GDOF = {"noglobal": False, "global": True}
+METHOD_LABEL = {"isomap": "Isomap", "stisomap": "ST-Isomap"}
+METRIC_LABEL = {"l2": "L2", "lee": "Lee"}
 
 
 def check(config: dict) -> None:
@@ -48,3 +59,27 @@ def st_parameters(st: dict, fps: float) -> dict:
         "ctn_tolerance": int(st["ctn_tolerance"]),
         "ctn_reach": max(1, int(round(float(st["ctn_reach_s"]) * fps))),
     }
+
+
+def gdof_flag(name: str) -> bool:
+    """The global-DOF flag of a wildcard value (``noglobal``, ``global``)."""
+    try:
+        return GDOF[name]
+    except KeyError:
+        raise ValueError(f"global-DOF wildcard must be one of {sorted(GDOF)}, got {name!r}") from None
+
+
+def gdof_name(flag: bool) -> str:
+    """The wildcard value of a global-DOF flag (inverse of :func:`gdof_flag`)."""
+    return "global" if flag else "noglobal"
+
+
+def sign_mode_of(cfg: dict) -> str:
+    """The L2 features' quaternion sign mode (``linearisation.sign_mode``), checked against
+    :data:`~animsynth.resequencing.features.SIGN_MODES`."""
+    from .features import SIGN_MODES  # here: the config checks stay free of the numeric modules
+
+    mode = cfg["linearisation"]["sign_mode"]
+    if mode not in SIGN_MODES:
+        raise ValueError(f"config key 'resequencing.linearisation.sign_mode': {mode!r} is not one of {SIGN_MODES}")
+    return mode

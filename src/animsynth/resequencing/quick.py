@@ -1,0 +1,76 @@
+"""One call from a capture to a re-sequenced motion (CLI, notebooks): explicit keyword arguments instead of the
+workflow's config block, the same methods as the workflow steps (:mod:`.jobs`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..motion import Motion
+from .distances import l2_distances, lee_distances
+from .embedding import checked_graph, min_connected_k, spatio_temporal_distances
+from .features import motion_features
+from .paths import pad_path, play_path, resolve_frame, shortest_path_frames
+from .settings import METHODS, METRICS
+
+__all__ = ["resequence_motion"]
+
+
+def resequence_motion(motion: Motion, start: int, end: int, method: str = "stisomap", metric: str = "l2",
+                      k: int | None = None, global_dof: bool = False, length: int | None = None, *,
+                      sign_mode: str = "continuous", lee: dict | None = None, st: dict | None = None,
+                      root_playback: str = "integrate") -> tuple[np.ndarray, Motion]:
+    """One-call re-sequencing (CLI, notebooks): Dijkstra from ``start`` to ``end``.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture, ``(frames, dof)`` values.
+    start, end : int
+        First and last frame of the path (negative counts from the end).
+    method : {"stisomap", "st-isomap", "isomap"}
+    metric : {"l2", "lee"}
+    k : int, optional
+        Neighbours; default the smallest k giving one connected component of the method's graph.
+    global_dof : bool
+        Include the root translation and orientation in the distances.
+    length : int, optional
+        Pad the path to this many frames (holding the last frame).
+    sign_mode : str
+        Quaternion linearisation of the L2 features (:func:`.features.linearize_quaternions`).
+    lee : dict, optional
+        Keyword arguments of :func:`.distances.lee_distances` (``weights``, ``nu``, ``sqrt``,
+        ``translation_scale``); its defaults (the paper's weights) otherwise.
+    st : dict, optional
+        Keyword arguments of :func:`.embedding.spatio_temporal_distances` (in frames); its defaults otherwise.
+    root_playback : {"integrate", "absolute"}
+        Root of the played motion (:func:`.paths.play_path`).
+
+    Returns
+    -------
+    path : int array (frames,)
+        The frame index path (padded to ``length`` if given).
+    played : Motion
+        The motion it plays.
+    """
+    method = {"st-isomap": "stisomap"}.get(method, method)
+    feats = motion_features(motion)
+    n = feats.n_frames
+    a, b = resolve_frame(start, n, "start"), resolve_frame(end, n, "end")
+    if metric == "l2":
+        D = l2_distances(feats.linearised(global_dof, sign_mode))
+    elif metric == "lee":
+        D = lee_distances(feats, include_global=global_dof, **(lee or {}))
+    else:
+        raise ValueError(f"unknown metric {metric!r} (expected one of {METRICS})")
+    if method == "isomap":
+        Dm, always = D, None
+    elif method == "stisomap":
+        Dm, always, _ = spatio_temporal_distances(D, **(st or {}))
+    else:
+        raise ValueError(f"unknown method {method!r} (expected one of {METHODS})")
+    if k is None:
+        k = min_connected_k(Dm, always=always)
+    G = checked_graph(Dm, int(k), always, f"{method}/{metric}")
+    path, _ = shortest_path_frames(G, a, b)
+    path = pad_path(path, length, "hold")
+    return path, play_path(motion, path, root=root_playback, name="resequenced")
