@@ -286,7 +286,7 @@ def test_counting_clips_says_reproduced_where_counting_groups_says_within_noise(
     assert (h, f) == (17, 2) and h / (h + f) >= 0.75 and binomtest(h, h + f).pvalue < 0.05  # by clips: reproduced
     groups = CV.independent_groups(clips)
     assert len(set(groups.values())) == 7
-    v = CV.build(metrics, VC, "test data", {}, clips).set_index("claim")
+    v = CV.build_verdicts(metrics, VC, "test data", {}, clips).set_index("claim")
     assert v.loc[claim, "verdict"] == "within noise"
     ev = v.loc[claim, "evidence"]
     assert "7 independent groups" in ev and "holds in 5, opposite in 0, within noise in 2" in ev
@@ -294,7 +294,7 @@ def test_counting_clips_says_reproduced_where_counting_groups_says_within_noise(
     # every group holding: reproduced; two groups holding the opposite: partly
     def verdict(effects):
         m, c = _grouped(effects)
-        return CV.build(m, VC, "test data", {}, c).set_index("claim").loc[claim, "verdict"]
+        return CV.build_verdicts(m, VC, "test data", {}, c).set_index("claim").loc[claim, "verdict"]
 
     assert verdict([[0.05, 0.06, 0.05]] * 7) == "reproduced"
     assert verdict([[0.05, 0.06, 0.05]] * 5 + [[-0.05, -0.04]] * 2) == "partly"
@@ -313,7 +313,7 @@ def test_the_modern_rows_claims_are_decided_over_groups(claim, pair, metric, sig
         m, c = _grouped([[sign * e for e in g] for g in effects], pair=pair, metric=metric)
         if left_out:
             m = m[m["generator"] != left_out]
-        v = CV.build(m, dict(VC, **kw), "test data", {left_out: "not in this run"} if left_out else {}, c)
+        v = CV.build_verdicts(m, dict(VC, **kw), "test data", {left_out: "not in this run"} if left_out else {}, c)
         return v.set_index("claim").loc[claim]
 
     row = verdict([[0.05, 0.06, 0.05]] * 7)
@@ -377,7 +377,7 @@ def test_verdict_builder_on_known_outcomes():
     metrics = _metrics({"motion_graph": lo, "stisomap": hi, "isomap": [0.0] * n, "delaunay": hi, "knn": hi,
                         "concat": hi, "replay": [0.05] * n})
     vc = dict(VC, min_groups=2)
-    v = CV.build(metrics, vc, "test data", {"fairmotion": "not installed here"}).set_index("claim")
+    v = CV.build_verdicts(metrics, vc, "test data", {"fairmotion": "not installed here"}).set_index("claim")
     assert set(v["verdict"]) <= set(VOCABULARY)
     claim = "the classic motion graph skates less than ST-Isomap re-sequencing"
     assert v.loc[claim, "verdict"] == "reproduced"

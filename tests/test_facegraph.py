@@ -573,12 +573,12 @@ def test_table1_row_uniqueness_and_connectivity(db):
     # the verdicts of these tables: the common format, words of the common vocabulary
     from animsynth import verdicts as common
     from animsynth.facegraph.jobs import assemble_table1, baseline_table
-    from animsynth.facegraph.verdicts import verdicts
+    from animsynth.facegraph.verdicts import build_verdicts
 
     table1 = assemble_table1([row], [row["config"]])
     base, _ = baseline_table(db, model.graphs_, dict(cfg, baseline=dict(fg["baseline"], max_queries=3)), 4,
                              row["config"])
-    v = verdicts(table1, base, summary, "synthetic test")
+    v = build_verdicts(table1, base, summary, "synthetic test")
     assert tuple(v.columns) == common.COLUMNS and len(v) >= 8
     common.check(v)
     assert set(v.verdict) <= set(common.VOCABULARY)

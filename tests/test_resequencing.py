@@ -794,7 +794,7 @@ def test_config_cross_checks_name_the_key():
 def test_smoothness_decision_separates_clear_wins_leans_and_noise():
     from animsynth.resequencing.verdicts import _decide
 
-    assert _decide(60, 10, 1e-6, 0.75, 0.05) == "yes"          # 86 %, significant
+    assert _decide(60, 10, 1e-6, 0.75, 0.05) == "holds"         # 86 %, significant
     assert _decide(10, 60, 1e-6, 0.75, 0.05) == "opposite"
     assert _decide(49, 23, 0.003, 0.75, 0.05) == "lean"        # 68 %: significant, below the share
     assert _decide(23, 49, 0.003, 0.75, 0.05) == "lean_opposite"

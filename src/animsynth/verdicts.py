@@ -25,6 +25,16 @@ The vocabulary:
 * ``contradicted`` -- the opposite holds on every nudge;
 * ``within noise`` -- the outcome flips across nudges; the evidence gives the share.
 
+A beats B over units
+--------------------
+Every family that decides "A beats B" over independent units (pairs of paths, groups of clips) uses one rule,
+:func:`a_beats_b`: each unit votes for A, for B or for neither (:func:`unit_votes`: a unit votes only when it
+leans one way by at least the minimum effect); A *holds* when at least ``share`` of the units vote for it and a
+test of the votes gives ``p < alpha`` (the two-sided sign test, :func:`sign_test`, unless the family gives its own
+p -- compare passes a Holm-adjusted t-test of its group effects, and says why); *opposite* is the same for B; a
+significant test without the share *leans*; anything else is noise. Each family maps the outcome onto
+:data:`VOCABULARY` and says in its evidence how many units voted which way.
+
 Whether a row ran on real or synthetic data is not part of the row: the data layer records it
 per family (``FAMILY_REAL`` of the workflow) and the report joins it, so no word in a text decides it.
 """
@@ -37,11 +47,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-__all__ = ["COLUMNS", "VOCABULARY", "VerdictError", "row", "table", "read", "check", "fmt", "agreement_verdict",
-           "holm"]
+__all__ = ["COLUMNS", "VOCABULARY", "OUTCOMES", "VerdictError", "row", "table", "read", "check", "fmt",
+           "agreement_verdict", "holm", "unit_votes", "sign_test", "a_beats_b"]
 
 COLUMNS = ("claim", "paper_value", "ours", "data", "verdict", "evidence", "source")
 VOCABULARY = ("reproduced", "partly", "not reproduced", "contradicted", "within noise")
+#: What :func:`a_beats_b` decides (the families map these onto :data:`VOCABULARY`).
+OUTCOMES = ("holds", "opposite", "lean", "lean_opposite", "noise", "none")
 
 
 class VerdictError(ValueError):
@@ -144,3 +156,79 @@ def holm(pvalues) -> np.ndarray:
     adj = np.minimum(1.0, np.maximum.accumulate(p[order] * (m - np.arange(m))))
     out[order] = adj
     return out
+
+
+def unit_votes(lead, effect=None, min_effect: float = 0.0) -> np.ndarray:
+    """Each unit's vote: +1 for A, -1 for B, 0 for neither.
+
+    Parameters
+    ----------
+    lead : array (units,)
+        Which way the unit leans: positive towards A, negative towards B (a difference signed so that positive
+        favours A, or a count of sub-units for A minus those for B).
+    effect : array (units,), optional
+        The unit's effect in the claim's units, signed as ``lead``; ``None``: ``lead`` itself.
+    min_effect : float
+        A unit votes for A when it leans to A and ``effect >= min_effect``, for B when it leans to B and
+        ``effect <= -min_effect`` (a NaN effect never votes).
+
+    Returns
+    -------
+    ndarray of int (units,)
+    """
+    lead = np.asarray(lead, float)
+    effect = lead if effect is None else np.asarray(effect, float)
+    m = float(min_effect)
+    return np.where((lead > 0) & (effect >= m), 1, np.where((lead < 0) & (effect <= -m), -1, 0))
+
+
+def sign_test(wins: int, losses: int) -> float:
+    """Two-sided sign test of ``wins`` against ``losses`` (exact binomial, p = 1/2; units voting for neither are
+    not counted); 1.0 when no unit votes."""
+    wins, losses = int(wins), int(losses)
+    if not wins + losses:
+        return 1.0
+    from scipy.stats import binomtest  # here, not at import (scipy.stats is slow to import)
+
+    return float(binomtest(wins, wins + losses, 0.5).pvalue)
+
+
+def a_beats_b(wins: int, losses: int, undecided: int = 0, *, share: float, alpha: float, p: float | None = None,
+              min_units: int = 0) -> str:
+    """The one rule for "A beats B over units": a word of :data:`OUTCOMES`.
+
+    Parameters
+    ----------
+    wins, losses : int
+        Units voting for A and for B (:func:`unit_votes`).
+    undecided : int
+        Units voting for neither that still count in the share (a unit below the minimum effect); units a
+        family drops (exact ties) are not passed.
+    share : float
+        The share of the counted units (``wins + losses + undecided``) that must vote one way.
+    alpha : float
+        The test's level.
+    p : float, optional
+        The test's p; default the sign test of ``wins`` against ``losses`` (:func:`sign_test`). A NaN p is
+        never significant.
+    min_units : int
+        Fewer counted units than this are never significant.
+
+    Returns
+    -------
+    ``"holds"`` (A: share reached, p < alpha), ``"opposite"`` (the same for B), ``"lean"`` / ``"lean_opposite"``
+    (p < alpha, the share not reached; by which side has more votes), ``"noise"`` (otherwise), ``"none"`` (no
+    unit counted).
+    """
+    n = int(wins) + int(losses) + int(undecided)
+    if n == 0:
+        return "none"
+    p = sign_test(wins, losses) if p is None else float(p)
+    significant = n >= int(min_units) and bool(np.isfinite(p)) and p < float(alpha)
+    if significant and wins / n >= float(share):
+        return "holds"
+    if significant and losses / n >= float(share):
+        return "opposite"
+    if significant:
+        return "lean" if wins > losses else "lean_opposite"
+    return "noise"

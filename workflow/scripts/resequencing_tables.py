@@ -4,7 +4,7 @@ import pandas as pd
 from animsynth.atomic import atomic_path
 from animsynth.resequencing.jobs import summarise_paths
 from animsynth.resequencing.tables import lee_weights_table, min_k_table, published_table2
-from animsynth.resequencing.verdicts import all_verdicts
+from animsynth.resequencing.verdicts import build_verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
@@ -67,7 +67,7 @@ write_table(smooth, out.smooth, title="Re-sequenced motions: transitions and per
                  "docs/config_resequencing.md for definitions.")
 trial_txt = " ".join(f"{d} {t}" for d, t in trials.items())
 npairs = int(per_path.groupby(["dataset", "method", "metric", "global_dof"]).size().max()) if len(per_path) else 0
-v = all_verdicts(table2, grid, table2_paper, per_path, step, cfg, data_min_k=trial_txt,
+v = build_verdicts(table2, grid, table2_paper, per_path, step, cfg, data_min_k=trial_txt,
                  data_paths=f"{trial_txt} ({npairs} pairs per configuration)")
 write_table(v, out.verdicts, title="Re-sequencing: verdicts on the paper's claims")
 for r in v.itertuples():

@@ -242,7 +242,7 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     ``cost`` (+ ``cost_md``), ``verdicts`` (+ ``verdicts_md``), ``summary_md`` (the family's page)."""
     from ..atomic import atomic_write_text
     from ..tables import write_table
-    from .verdicts import build, independent_groups, sanity_checks
+    from .verdicts import build_verdicts, independent_groups, sanity_checks
 
     order = list(cfg["generators"])
     metrics = _read_metrics(inp["metrics"])
@@ -256,7 +256,7 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     clips_full = pd.read_csv(inp["clips"], dtype=str)
     n_groups = len(set(independent_groups(clips_full).values()))
     data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
-    verdicts = build(metrics, cfg["verdicts"], data, left_out, clips_full)
+    verdicts = build_verdicts(metrics, cfg["verdicts"], data, left_out, clips_full)
     sanity = sanity_checks(metrics, cfg["verdicts"], data, left_out, clips_full)
     write_table(metrics, out["metrics"], md=False)
     write_table(timing, out["metrics_timing"], md=False)

@@ -18,10 +18,12 @@ it is within noise (no vote).
 
 The verdict of a claim
 ----------------------
+By the common rule for "A beats B over units" (:func:`animsynth.verdicts.a_beats_b`, the groups the units):
+
 * ``reproduced`` -- at least ``compare.verdicts.share`` of the groups hold (a group within noise does not),
   there are at least ``compare.verdicts.min_groups`` groups, and a one-sample t-test of the group effects against zero gives
   a Holm-adjusted p below ``compare.verdicts.alpha`` (Holm over every finding of the family: the claims of
-  :func:`build`, not the sanity checks);
+  :func:`build_verdicts`, not the sanity checks);
 * ``contradicted`` -- the same for the opposite;
 * ``partly`` -- neither, but some groups hold and others hold the opposite;
 * ``within noise`` -- anything else (the evidence gives the group counts, the effects and both p);
@@ -46,7 +48,7 @@ from .. import verdicts as V
 from .generators import REFERENCES
 from .jobs import METRICS
 
-__all__ = ["independent_groups", "group_outcomes", "decide_groups", "pair_outcomes", "per_clip", "build",
+__all__ = ["independent_groups", "group_outcomes", "decide_groups", "pair_outcomes", "per_clip", "build_verdicts",
            "sanity_checks"]
 
 _UNITS = {m: u for m, u, _b in METRICS}
@@ -137,17 +139,15 @@ def per_clip(j: pd.DataFrame) -> pd.DataFrame:
 
 def group_outcomes(j: pd.DataFrame, groups: dict, min_effect: float) -> pd.DataFrame:
     """Per group: ``clips_for``, ``clips_against`` (clip outcomes, :func:`per_clip`), ``effect`` (median of its
-    clips' effects) and ``vote``: +1 (holds: more clips for than against and effect >= ``min_effect``), -1 (the
-    opposite), 0 (within noise)."""
+    clips' effects) and ``vote`` (:func:`animsynth.verdicts.unit_votes`): +1 (holds: more clips for than against
+    and effect >= ``min_effect``), -1 (the opposite), 0 (within noise)."""
     c = per_clip(j)
     c["unit"] = c["clip"].map(groups).fillna(c["clip"])
     g = c.groupby("unit", sort=False)
     out = pd.DataFrame({"clips": g.size(), "clips_for": g["outcome"].apply(lambda o: int((o > 0).sum())),
                         "clips_against": g["outcome"].apply(lambda o: int((o < 0).sum())),
                         "effect": g["effect"].median()})
-    lead = np.sign(out["clips_for"] - out["clips_against"])
-    m = float(min_effect)
-    out["vote"] = np.where((lead > 0) & (out["effect"] >= m), 1, np.where((lead < 0) & (out["effect"] <= -m), -1, 0))
+    out["vote"] = V.unit_votes(out["clips_for"] - out["clips_against"], out["effect"], min_effect)
     return out
 
 
@@ -166,16 +166,18 @@ def _t_p(effects: np.ndarray) -> float:
 
 
 def decide_groups(per: pd.DataFrame, p_adj: float, vc: dict) -> str:
-    """The verdict from the group votes (:func:`group_outcomes`) and the Holm-adjusted p: the share is over
-    every group with a value (a group within noise does not hold)."""
+    """The verdict from the group votes (:func:`group_outcomes`) and the Holm-adjusted p, by the common rule
+    :func:`animsynth.verdicts.a_beats_b`: the share is over every group with a value (a group within noise
+    counts and does not hold), at least ``min_groups`` groups."""
     n = len(per)
-    if not n:
-        return "not reproduced"
     h, f = int((per["vote"] > 0).sum()), int((per["vote"] < 0).sum())
-    enough = n >= int(vc["min_groups"]) and np.isfinite(p_adj) and p_adj < float(vc["alpha"])
-    if enough and h / n >= float(vc["share"]):
+    outcome = V.a_beats_b(h, f, n - h - f, share=float(vc["share"]), alpha=float(vc["alpha"]), p=p_adj,
+                          min_units=int(vc["min_groups"]))
+    if outcome == "none":
+        return "not reproduced"
+    if outcome == "holds":
         return "reproduced"
-    if enough and f / n >= float(vc["share"]):
+    if outcome == "opposite":
         return "contradicted"
     if h and f:
         return "partly"
@@ -299,7 +301,7 @@ def _capture_row(sub_rows: list, data: str) -> dict | None:
                  source="compare/metrics.csv")
 
 
-def build(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
+def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
           clips: pd.DataFrame | None = None) -> pd.DataFrame:
     """The findings of the comparison (the verdict table; the sanity checks: :func:`sanity_checks`).
 

@@ -31,7 +31,7 @@ def _rank_trend(x, y, samples: dict | None, order: list[str], n_boot: int = 200,
     return float(rho), float(p), share
 
 
-def verdicts(table1: pd.DataFrame, baseline: pd.DataFrame, uniqueness: pd.DataFrame, source: str,
+def build_verdicts(table1: pd.DataFrame, baseline: pd.DataFrame, uniqueness: pd.DataFrame, source: str,
              samples: dict | None = None) -> pd.DataFrame:
     """The paper's claims checked against our deterministic tables.
 

@@ -41,7 +41,7 @@ SKIN_NOTE = {
 }
 
 
-def verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame, gen: pd.DataFrame,
+def build_verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame, gen: pd.DataFrame,
              data: str, cv_rig: str = "per_fold") -> pd.DataFrame:
     """The verdict table (deterministic columns only); ``cv_rig`` as the config key
     ``meshdetail.cv_rig`` (says in the evidence whether the folds' skins saw their held-out frames)."""

@@ -19,9 +19,12 @@ verdict, evidence, source``; ``verdict`` a word of :data:`animsynth.verdicts.VOC
   the measure of a visible jerk; other measures in the evidence) with a
   two-sided sign test. For the global DOF, when that comparison is not clear,
   the pairs where only one arm re-sequences decide (losing the ability to
-  re-sequence is the plainest way to be hurt). A claim holds when the share is at least
-  ``share`` and the sign test gives p < ``alpha``; the opposite when the
-  share is at most ``1 - share`` with p < ``alpha``; otherwise "within noise".
+  re-sequence is the plainest way to be hurt). Both are decided by the common
+  rule for "A beats B over units" (:func:`animsynth.verdicts.a_beats_b`, the
+  pairs the units, tied pairs dropped): a claim holds when the share is at
+  least ``share`` and the sign test gives p < ``alpha``; the opposite when the
+  other arm's share is at least ``share`` with p < ``alpha``; otherwise
+  "within noise".
 """
 
 from __future__ import annotations
@@ -29,17 +32,17 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .. import verdicts as common
+from .. import verdicts as V
 
 __all__ = ["explanation_verdicts", "lee_vs_l2_verdict", "paired_share", "st_smoother_verdict",
-           "global_dof_verdict", "all_verdicts"]
+           "global_dof_verdict", "build_verdicts"]
 
 PRIMARY = "velocity_jump_ratio"
 SECONDARY = ["pose_jump_ratio", "accel_jump_ratio", "foot_skate_ratio"]
 
 
 def _row(claim, paper_value, ours, data, verdict, evidence, source):
-    return common.row(claim, verdict, evidence, paper_value=paper_value, ours=ours, data=data, source=source)
+    return V.row(claim, verdict, evidence, paper_value=paper_value, ours=ours, data=data, source=source)
 
 
 def _pick(grid, dataset, step, gdof, mode, method, metric):
@@ -155,29 +158,21 @@ def lee_vs_l2_verdict(table2: pd.DataFrame, factor: float = 3.16, data: str = ""
 
 
 def paired_share(a: pd.Series, b: pd.Series) -> tuple[int, int, int, float]:
-    """Pairs where ``b < a`` (b smoother), where ``b > a``, ties; two-sided sign-test p (ties dropped)."""
+    """Pairs where ``b < a`` (b smoother), where ``b > a``, ties; two-sided sign-test p (ties dropped).
+
+    Each pair is a unit voting by the sign of ``a - b`` (:func:`animsynth.verdicts.unit_votes`, no minimum
+    effect); the p is :func:`animsynth.verdicts.sign_test`."""
     ok = a.notna() & b.notna()
     a, b = a[ok].astype(float), b[ok].astype(float)
-    lo, hi = int((b < a).sum()), int((b > a).sum())
+    votes = V.unit_votes(a.to_numpy() - b.to_numpy())
+    lo, hi = int((votes > 0).sum()), int((votes < 0).sum())
     ties = int(len(a) - lo - hi)
-    from scipy.stats import binomtest  # here, not at import (scipy.stats is slow to import)
-
-    p = float(binomtest(lo, lo + hi, 0.5).pvalue) if lo + hi else 1.0
-    return lo, hi, ties, p
+    return lo, hi, ties, V.sign_test(lo, hi)
 
 
 def _decide(lo: int, hi: int, p: float, share: float, alpha: float) -> str:
-    n = lo + hi
-    if n == 0:
-        return "none"
-    s = lo / n
-    if s >= share and p < alpha:
-        return "yes"
-    if s <= 1 - share and p < alpha:
-        return "opposite"
-    if p < alpha:  # significant, but the share needed for a clear win is not reached
-        return "lean" if s > 0.5 else "lean_opposite"
-    return "noise"
+    """:func:`animsynth.verdicts.a_beats_b` over pairs (``lo`` for the claim, ``hi`` against; ties dropped)."""
+    return V.a_beats_b(lo, hi, share=share, alpha=alpha, p=p)
 
 
 def st_smoother_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: float = 0.05, data: str = "",
@@ -200,7 +195,7 @@ def st_smoother_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: floa
                     "no pair where both methods re-sequence, so smoothness cannot be compared; " + counts, source)
     lo, hi, ties, p = paired_share(iso.loc[both, PRIMARY], st.loc[both, PRIMARY])
     dec = _decide(lo, hi, p, share, alpha)
-    verdict = {"yes": "reproduced", "opposite": "contradicted", "lean": "partly", "lean_opposite": "not reproduced",
+    verdict = {"holds": "reproduced", "opposite": "contradicted", "lean": "partly", "lean_opposite": "not reproduced",
                "noise": "within noise", "none": "within noise"}[dec]
     others = []
     for c in SECONDARY:
@@ -251,13 +246,11 @@ def global_dof_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: float
         both = [i for i, a, b in zip(idx, rs_out, rs_in) if a and b]
         # smoothness: "lo" = pairs where the global arm is smoother
         lo, hi, _, p = paired_share(out.loc[both, PRIMARY], inn.loc[both, PRIMARY]) if both else (0, 0, 0, 1.0)
-        eff_s = {"yes": "help", "opposite": "hurt"}.get(_decide(lo, hi, p, share, alpha), "no clear effect")
+        eff_s = {"holds": "help", "opposite": "hurt"}.get(_decide(lo, hi, p, share, alpha), "no clear effect")
         only_in, only_out = int((rs_in & ~rs_out).sum()), int((rs_out & ~rs_in).sum())
-        from scipy.stats import binomtest
-
-        p_a = float(binomtest(only_in, only_in + only_out, 0.5).pvalue) if only_in + only_out else 1.0
-        eff_a = {"yes": "help", "opposite": "hurt"}.get(_decide(only_in, only_out, p_a, share, alpha),
-                                                        "no clear effect")
+        p_a = V.sign_test(only_in, only_out)
+        eff_a = {"holds": "help", "opposite": "hurt"}.get(_decide(only_in, only_out, p_a, share, alpha),
+                                                          "no clear effect")
         effect = eff_s if eff_s != "no clear effect" else eff_a
         expected = want.get(ds)
         if expected is not None and effect == expected:
@@ -287,7 +280,7 @@ def global_dof_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: float
     return _row(claim, paper_value, ours, data, verdict, ev, source)
 
 
-def all_verdicts(table2, grid, published, per_path, frame_step: int, cfg: dict, data_min_k: str = "",
+def build_verdicts(table2, grid, published, per_path, frame_step: int, cfg: dict, data_min_k: str = "",
                  data_paths: str = "") -> pd.DataFrame:
     """Every verdict row of the family (``cfg``: the resequencing block with defaults)."""
     ex = cfg["explanations"]
@@ -296,4 +289,4 @@ def all_verdicts(table2, grid, published, per_path, frame_step: int, cfg: dict, 
     rows.append(lee_vs_l2_verdict(table2, f, data_min_k))
     rows.append(st_smoother_verdict(per_path, float(cfg["verdict_share"]), float(cfg["verdict_alpha"]), data_paths))
     rows.append(global_dof_verdict(per_path, float(cfg["verdict_share"]), float(cfg["verdict_alpha"]), data_paths))
-    return common.table(rows)
+    return V.table(rows)
