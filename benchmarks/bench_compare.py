@@ -14,7 +14,8 @@ load average are in the row's ``baseline`` text):
   2-core build machine. Baseline, measured once in the same run: fairmotion 0.0.4's build on the same clips
   (:class:`animsynth.compare.fairmotion_peer.FairmotionGraph.fit`: BVH writing and fairmotion's BVH loading,
   its velocities, ``construct`` and ``reduce("scc")``), CPU including its worker process (fairmotion compares
-  node pairs in a ``multiprocessing`` pool, here of one process); ratio = fairmotion / ours. When fairmotion
+  node pairs in a ``multiprocessing`` pool, here of one process); ratio = fairmotion / ours (lower is better:
+  above 1, ours is faster; :func:`animsynth.tables.benchmark_row`). When fairmotion
   is not installed the row says why and has no baseline.
 * ``motion_graph_build_cpu_s_<data>_walk_run_dance_120fps`` (full size only, report only): the same build at
   the capture rate (1,648 frames), to show how the all-pairs step grows.
@@ -29,13 +30,13 @@ import os
 import time
 from pathlib import Path
 
-import numpy as np
 import yaml
 from threadpoolctl import threadpool_limits
 
 from animsynth.compare.fairmotion_peer import FairmotionGraph, FairmotionUnavailable
 from animsynth.compare.motiongraph import MotionGraph
 from animsynth.motion import Motion
+from animsynth.tables import benchmark_row
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 REPO = Path(__file__).resolve().parents[1]
@@ -98,24 +99,21 @@ def run(size: str = "full") -> list[dict]:
         except FairmotionUnavailable as e:
             base, fm_value = f"fairmotion not run: {e.reason}; wall ours {wall:.2f} s", None
         load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-        rows.append({
-            "family": "compare", "benchmark": f"motion_graph_build_cpu_s_{label}_walk_run_dance",
-            "value": round(cpu, 3), "unit": "s",
-            "baseline": f"{base}; {frames} frames at {FPS:g} fps; ours best of {p['repeat']}: {graph.n_nodes_} "
-                        f"frames in the graph, {len(graph.transitions_)} transitions; load average {load:.1f}",
-            "baseline_value": np.nan if fm_value is None else round(fm_value, 3),
-            "ratio": np.nan if fm_value is None else round(fm_value / cpu, 1),
-            "target": f"<= {TARGET_S:g} s CPU (2 cores)", "meets_target": bool(cpu <= TARGET_S)})
+        rows.append(benchmark_row(
+            "compare", f"motion_graph_build_cpu_s_{label}_walk_run_dance", round(cpu, 3), "s", better="lower",
+            baseline=f"{base}; {frames} frames at {FPS:g} fps; ours best of {p['repeat']}: {graph.n_nodes_} "
+                     f"frames in the graph, {len(graph.transitions_)} transitions; load average {load:.1f}",
+            baseline_value=None if fm_value is None else round(fm_value, 3), digits=1,
+            target=f"<= {TARGET_S:g} s CPU (2 cores)", meets_target=cpu <= TARGET_S))
         if p["capture_rate_row"]:
             full_rate, label = _clips(p["cmu"], 1, None)
             k = int(round(full_rate[0].fps / 3))  # the same 1/3 s window at the capture rate
             cpu, wall, graph = _best(lambda: MotionGraph(window=k).fit(full_rate), p["repeat"])
-            rows.append({
-                "family": "compare", "benchmark": f"motion_graph_build_cpu_s_{label}_walk_run_dance_120fps",
-                "value": round(cpu, 3), "unit": "s",
-                "baseline": f"none; {sum(c.n_frames for c in full_rate)} frames at {full_rate[0].fps:g} fps, "
-                            f"window {k}; wall {wall:.2f} s; {graph.n_nodes_} frames in the graph",
-                "baseline_value": np.nan, "ratio": np.nan, "target": "report only", "meets_target": np.nan})
+            rows.append(benchmark_row(
+                "compare", f"motion_graph_build_cpu_s_{label}_walk_run_dance_120fps", round(cpu, 3), "s",
+                better="lower", baseline=f"none; {sum(c.n_frames for c in full_rate)} frames at "
+                                         f"{full_rate[0].fps:g} fps, window {k}; wall {wall:.2f} s; "
+                                         f"{graph.n_nodes_} frames in the graph"))
     return rows
 
 

@@ -19,7 +19,9 @@
   (5,886^2 float32 weights) and path time extrapolated (O(N^2) Dijkstra on a
   complete graph) from a complete graph on 1,500 poses, against the paper's ~1.9 s.
 
-Timings are machine-dependent; they belong in benchmarks.csv, not in result tables.
+Every row's ratio is baseline / value (lower is better: above 1, the row's value beats its baseline;
+:func:`animsynth.tables.benchmark_row`). Timings are machine-dependent; they belong in benchmarks.csv, not in
+result tables.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from animsynth.facegraph import FaceGraphBaseline, FaceGraphModel, FacePreproces
 from animsynth.facegraph.evaluate import evaluate_resynthesis
 from animsynth.facegraph.jobs import face_graph_nbytes, subset_database
 from animsynth.synth.faces import generate_sequences
+from animsynth.tables import benchmark_row
 
 FAMILY = "facegraph"
 
@@ -63,11 +66,10 @@ CKPLUS = dict(n_subjects=123, n_sequences=327, total_frames=5886, n_unlabelled=2
 
 
 def _row(benchmark, value, unit, baseline, baseline_value, target, meets):
-    """One row; ``baseline_value`` and ``meets`` None for a report-only row (no ratio, no target)."""
-    bv = np.nan if baseline_value is None else float(baseline_value)
-    return {"family": FAMILY, "benchmark": benchmark, "value": float(value), "unit": unit, "baseline": baseline,
-            "baseline_value": bv, "ratio": float(value) / bv if baseline_value is not None else np.nan,
-            "target": target, "meets_target": np.nan if meets is None else bool(meets)}
+    """One row (every facegraph measure: lower is better); ``baseline_value`` and ``meets`` None for a report-only
+    row (no ratio, no target)."""
+    return benchmark_row(FAMILY, benchmark, value, unit, better="lower", baseline=baseline,
+                         baseline_value=baseline_value, target=target, meets_target=meets)
 
 
 def _jit_warmup() -> float:

@@ -1,6 +1,7 @@
 """resequencing benchmarks: geodesics + embedding, and the exact minimum k, each against what a user would otherwise run.
 
-Each row's ``ratio`` = baseline time / our time, both measured in this run
+Each row's ``ratio`` = baseline time / our time (lower is better: above 1, ours is faster;
+:func:`animsynth.tables.benchmark_row`), both measured in this run
 (best of three; both under the same single BLAS thread, the workflow's setting
 on a shared machine):
 
@@ -43,6 +44,7 @@ from animsynth.resequencing.distances import l2_distances, lee_distances
 from animsynth.resequencing.embedding import PrecomputedIsomap, STIsomap, min_connected_k
 from animsynth.resequencing.features import motion_features
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+from animsynth.tables import benchmark_row
 
 REPO = Path(__file__).resolve().parents[1]
 CMU = Path(os.environ.get("ANIMSYNTH_SHARED_DATA", REPO.parent / "shared" / "data")) / "cmu_mocap" / "subjects"
@@ -106,23 +108,23 @@ def run(size: str = "full") -> list[dict]:
                 "GEODESICS DIFFER" if name == "isomap" else
                 f"geodesics differ by design (ours keep the temporal chain at k={est.n_neighbors_}; "
                 f"scikit-learn needs k={k} to connect)")
-        rows.append({"family": "resequencing", "benchmark": f"geodesics_embedding_{n}_frames_{name}",
-                     "value": round(t, 3), "unit": "s",
-                     "baseline": f"scikit-learn Isomap defaults (path_method=auto, eigen_solver=auto), k={k}; {note}",
-                     "baseline_value": round(tb, 3), "ratio": round(tb / t, 2),
-                     "target": "<= 1.5 s and, for Isomap, identical geodesics",
-                     "meets_target": bool(t <= 1.5 and (same or name == "stisomap"))})
+        rows.append(benchmark_row(
+            "resequencing", f"geodesics_embedding_{n}_frames_{name}", round(t, 3), "s", better="lower",
+            baseline=f"scikit-learn Isomap defaults (path_method=auto, eigen_solver=auto), k={k}; {note}",
+            baseline_value=round(tb, 3), digits=2, target="<= 1.5 s and, for Isomap, identical geodesics",
+            meets_target=t <= 1.5 and (same or name == "stisomap")))
     feats, label = _walk_features(cmu)
     for mode in ("continuous", "matrix_naive"):
         Dk = l2_distances(feats.linearised(False, mode))
         t, k = _best(lambda: min_connected_k(Dk), repeat)
         tb, kb = _best(lambda: _scan_min_k(Dk), repeat)
         same = k == kb
-        rows.append({"family": "resequencing", "benchmark": f"min_k_exact_{label}_l2_{mode}", "value": round(t * 1e3, 1),
-                     "unit": "ms", "baseline": f"NearestNeighbors + connected_components scan over k = 1..{kb}"
+        rows.append(benchmark_row(
+            "resequencing", f"min_k_exact_{label}_l2_{mode}", round(t * 1e3, 1), "ms", better="lower",
+            baseline=f"NearestNeighbors + connected_components scan over k = 1..{kb}"
                      + ("; same k" if same else f"; K DIFFERS ({k} vs {kb})"),
-                     "baseline_value": round(tb * 1e3, 1), "ratio": round(tb / t, 2),
-                     "target": "the same k (speed: informational, see ratio)", "meets_target": bool(same)})
+            baseline_value=round(tb * 1e3, 1), digits=2, target="the same k (speed: informational, see ratio)",
+            meets_target=same))
     return rows
 
 

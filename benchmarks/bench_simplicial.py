@@ -52,6 +52,7 @@ from animsynth.simplicial.folds import fit_pca  # noqa: E402
 from animsynth.simplicial.field import FieldStack, VectorField, training_vectors  # noqa: E402
 from animsynth.simplicial.path import follow_batch  # noqa: E402
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion  # noqa: E402
+from animsynth.tables import benchmark_row  # noqa: E402
 
 K = 16
 # full size (the performance targets) and demo size (seconds, for the default and tiny runs)
@@ -105,13 +106,13 @@ def _best(fn, repeat=3):
 
 def _row(name, value, base, cpu, base_cpu, same, target_txt, target):
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    return {"family": "simplicial", "benchmark": name, "value": round(value, 1), "unit": "steps/s",
-            "baseline": f"{BASELINE}; CPU-time rates ours {cpu:.0f} vs baseline {base_cpu:.0f} steps/s "
-                        f"(wall {value:.0f} vs {base:.0f}; load average {load:.1f}; "
-                        f"{numba.get_num_threads()} numba thread(s)); "
-                        + ("same paths" if same else "PATHS DIFFER"),
-            "baseline_value": round(base, 1), "ratio": round(value / base, 2), "target": target_txt,
-            "meets_target": bool(target(value, base) and same)}
+    return benchmark_row("simplicial", name, round(value, 1), "steps/s", better="higher",
+                         baseline=f"{BASELINE}; CPU-time rates ours {cpu:.0f} vs baseline {base_cpu:.0f} steps/s "
+                                  f"(wall {value:.0f} vs {base:.0f}; load average {load:.1f}; "
+                                  f"{numba.get_num_threads()} numba thread(s)); "
+                                  + ("same paths" if same else "PATHS DIFFER"),
+                         baseline_value=round(base, 1), digits=2, target=target_txt,
+                         meets_target=target(value, base) and same)
 
 
 def run(size: str = "full") -> list[dict]:

@@ -32,14 +32,20 @@ def cost_table(per_family_csv) -> str:
 
 
 def benchmark_table(benchmarks_csv) -> str:
-    """The performance targets of a run's ``benchmarks.csv``: ours, the in-run baseline, ratio, target, met."""
+    """The performance targets of a run's ``benchmarks.csv``: ours, which direction is better, the in-run baseline,
+    ratio (above 1: ours is better; :func:`animsynth.tables.benchmark_row`), target, met."""
     df = pd.read_csv(benchmarks_csv)
-    lines = ["| family | benchmark | ours | baseline (same run) | ratio | target | met |", "|---|---|---:|---:|---:|---|---|"]
+    if "better" not in df:
+        raise ValueError(f"{benchmarks_csv}: no column 'better' (written before the one ratio convention; "
+                         "rerun the benchmarks)")
+    lines = ["| family | benchmark | ours | better | baseline (same run) | ratio (> 1: ours better) | target | met |",
+             "|---|---|---:|---|---:|---:|---|---|"]
     for r in df.itertuples():
         met = "" if pd.isna(r.meets_target) else ("yes" if str(r.meets_target).lower() == "true" else "**no**")
         base = "" if pd.isna(r.baseline_value) else f"{r.baseline_value:.4g}"
         ratio = "" if pd.isna(r.ratio) else f"{r.ratio:.3g}"
-        lines.append(f"| {r.family} | `{r.benchmark}` | {r.value:.4g} {r.unit} | {base} | {ratio} | {r.target} | {met} |")
+        lines.append(f"| {r.family} | `{r.benchmark}` | {r.value:.4g} {r.unit} | {r.better} | {base} | {ratio} | "
+                     f"{r.target} | {met} |")
     return "\n".join(lines)
 
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import sys
 
 from animsynth import scale
+from animsynth.tables import benchmark_row
 
 DEFAULT_CFG = {"trial_frames": 1000,
                "resequencing": {"metric": "l2", "method": "isomap", "n_candidates": 20, "k": 10, "n_landmarks": 500,
@@ -45,12 +46,10 @@ def run(frames: int = 100_000, cfg: dict | None = None, seed: int = 0, cmu_mirro
             "embedding_method": rows[2].get("embedding_method"), "steps": steps, "wall_s": round(wall, 2)}
     base = "dense N x N pipeline: not run (N^2 memory; ~28 GB at 22,000 frames)"
     return [
-        {"family": "resequencing", "benchmark": f"reseq_{tag}_frames_total_s", "value": round(cpu, 2), "unit": "s CPU",
-         "baseline": base, "baseline_value": float("nan"), "ratio": float("nan"), "target": f"<= {t_cpu:g}",
-         "meets_target": bool(cpu <= t_cpu), **info},
-        {"family": "resequencing", "benchmark": f"reseq_{tag}_frames_peak_mb", "value": round(peak, 1), "unit": "MB",
-         "baseline": base, "baseline_value": float("nan"), "ratio": float("nan"), "target": f"<= {t_mb:g}",
-         "meets_target": bool(peak <= t_mb), **info},
+        benchmark_row("resequencing", f"reseq_{tag}_frames_total_s", round(cpu, 2), "s CPU", better="lower",
+                      baseline=base, target=f"<= {t_cpu:g}", meets_target=cpu <= t_cpu, **info),
+        benchmark_row("resequencing", f"reseq_{tag}_frames_peak_mb", round(peak, 1), "MB", better="lower",
+                      baseline=base, target=f"<= {t_mb:g}", meets_target=peak <= t_mb, **info),
     ]
 
 

@@ -90,3 +90,44 @@ def test_cost_table_sums_families_and_names_date_and_machine(tmp_path):
     assert "| **total** | 11 | 170 | 44 | 420 |" in md and "| data | 3 | 8 | 3 | 107 |" in md
     line = cost_table.provenance_line(csv)
     assert "cores" in line and str(csv) in line and line.startswith("Measured 20")
+
+
+def test_benchmark_row_states_the_better_direction_and_one_ratio_convention():
+    from animsynth.tables import BENCHMARK_COLUMNS, benchmark_row
+
+    t = benchmark_row("f", "build_s", 2.0, "s", better="lower", baseline="theirs", baseline_value=10.0)
+    assert list(t) == list(BENCHMARK_COLUMNS) and (t["better"], t["ratio"]) == ("lower", 5.0)  # 5x faster
+    r = benchmark_row("f", "rate", 2.0, "steps/s", better="higher", baseline_value=10.0, digits=3)
+    assert r["ratio"] == 0.2  # a fifth of the baseline's rate: below 1, ours is worse
+    slow = benchmark_row("f", "build_s", 10.0, "s", better="lower", baseline_value=2.0)
+    assert slow["ratio"] == 0.2  # the same story for a time: below 1 always means worse
+    alone = benchmark_row("f", "only", 1.0, "s", better="lower", extra_column=3)
+    assert math.isnan(alone["ratio"]) and math.isnan(alone["baseline_value"]) and alone["extra_column"] == 3
+    assert math.isnan(alone["meets_target"]) and alone["target"] == "report only"
+    with pytest.raises(ValueError, match="better"):
+        benchmark_row("f", "x", 1.0, "s", better="faster")
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in (REPO / "benchmarks").glob("bench_*.py")) + ["scale_reseq.py"])
+def test_every_benchmark_builds_its_rows_with_the_one_row_builder(name):
+    src = (REPO / "benchmarks" / name).read_text()
+    assert "benchmark_row(" in src
+    assert '"ratio":' not in src and "'ratio':" not in src, f"{name} writes a ratio of its own"
+
+
+def test_the_benchmark_table_shows_the_direction(tmp_path):
+    sys.path.insert(0, str(REPO / "benchmarks"))
+    import cost_table
+
+    from animsynth.tables import benchmark_row
+
+    csv = tmp_path / "benchmarks.csv"
+    import pandas as pd
+
+    pd.DataFrame([benchmark_row("f", "build_s", 2.0, "s", better="lower", baseline_value=10.0, target="t",
+                                meets_target=True)]).to_csv(csv, index=False)
+    md = cost_table.benchmark_table(csv)
+    assert "| f | `build_s` | 2 s | lower | 10 | 5 | t | yes |" in md
+    pd.read_csv(csv).drop(columns="better").to_csv(csv, index=False)
+    with pytest.raises(ValueError, match="better"):
+        cost_table.benchmark_table(csv)

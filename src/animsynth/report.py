@@ -102,7 +102,9 @@ def run_benchmarks(files, size: str = "full") -> pd.DataFrame:
     and tiny runs). Demo rows keep their measured values and ratios but judge no
     target (``meets_target`` empty): a target holds or fails at full size only.
     Every row carries the machine it ran on and its size, so quoted figures say
-    where they came from.
+    where they came from. The rows come from :func:`animsynth.tables.benchmark_row`:
+    ``better`` says which direction is better, and ``ratio`` above 1 always means
+    the value beats its baseline.
     """
     if size not in BENCHMARK_SIZES:
         raise ValueError(f"benchmark size must be one of {BENCHMARK_SIZES}, got {size!r}")
@@ -123,8 +125,8 @@ def run_benchmarks(files, size: str = "full") -> pd.DataFrame:
             r["size"] = size
             r["machine"] = machine
             rows.append(r)
-    cols = ["family", "benchmark", "size", "value", "unit", "baseline", "baseline_value", "ratio", "target",
-            "meets_target", "machine"]
+    cols = ["family", "benchmark", "size", "value", "unit", "better", "baseline", "baseline_value", "ratio",
+            "target", "meets_target", "machine"]
     df = pd.DataFrame(rows)
     for c in cols:
         if c not in df:

@@ -79,3 +79,49 @@ def add_paper_differences(df: pd.DataFrame, pairs: dict[str, str], suffix: str =
             out = out.drop(columns=name)
         out.insert(out.columns.get_loc(paper) + 1, name, a - b)
     return out
+
+
+#: The columns of a benchmark row (``benchmarks.csv``), in order.
+BENCHMARK_COLUMNS = ("family", "benchmark", "value", "unit", "better", "baseline", "baseline_value", "ratio",
+                     "target", "meets_target")
+
+
+def benchmark_row(family: str, benchmark: str, value, unit: str, *, better: str, baseline: str = "none",
+                  baseline_value=None, target: str = "report only", meets_target=None,
+                  digits: int | None = None, **extra) -> dict:
+    """One benchmark row, with the one ratio convention of every benchmark table.
+
+    ``ratio`` is how many times better the row's value is than its baseline, so a ratio above 1 always means
+    the value beats the baseline: ``baseline_value / value`` when lower is better (times, memory, errors),
+    ``value / baseline_value`` when higher is better (rates). ``better`` says which, and is written in the row.
+
+    Parameters
+    ----------
+    family, benchmark, unit : str
+    value : float, the measured value (ours, unless the benchmark's name says otherwise)
+    better : {"lower", "higher"}
+    baseline : str, what the baseline is (measured in the same run, or published)
+    baseline_value : float or None; None: no baseline, no ratio
+    target : str; meets_target : bool or None (None: report only)
+    digits : int, optional, round the ratio to this many decimals (the value and baseline as the caller gives them)
+    **extra : further columns (after the common ones)
+
+    Raises
+    ------
+    ValueError
+        ``better`` is neither "lower" nor "higher".
+    """
+    if better not in ("lower", "higher"):
+        raise ValueError(f"benchmark {benchmark!r}: better must be 'lower' or 'higher', got {better!r}")
+    v = float(value)
+    if baseline_value is None or not np.isfinite(float(baseline_value)):
+        bv, ratio = np.nan, np.nan
+    else:
+        bv = float(baseline_value)
+        num, den = (bv, v) if better == "lower" else (v, bv)
+        ratio = num / den if den != 0 else np.nan
+        if digits is not None and np.isfinite(ratio):
+            ratio = round(ratio, digits)
+    return {"family": family, "benchmark": benchmark, "value": v, "unit": unit, "better": better,
+            "baseline": baseline, "baseline_value": bv, "ratio": ratio, "target": target,
+            "meets_target": np.nan if meets_target is None else bool(meets_target), **extra}
