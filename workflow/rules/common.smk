@@ -389,24 +389,19 @@ def compare_trial_npz(wildcards):
 
 
 def compare_job_cfg(wildcards):
-    """The config one generator job reads: the shared keys, the generator's own block, and for ST-Isomap the
-    re-sequencing study's stisomap block (a changed block reruns only the jobs that read it)."""
-    cfg = {k: CMP[k] for k in CMP_RUN_KEYS}
-    block = CMP_GEN_BLOCK.get(wildcards.cmpgen)
-    if block:
-        cfg[block] = CMP[block]
-    if wildcards.cmpgen == "stisomap":
-        cfg["stisomap"] = dict(config["resequencing"]["stisomap"])
-    return cfg
+    """The config one generator job reads (animsynth.compare.settings.job_cfg, as the tests build it: a changed
+    block reruns only the jobs that read it)."""
+    from animsynth.compare.settings import job_cfg
+
+    return job_cfg(config, wildcards.cmpgen)
 
 
 def compare_sweep_cfg(wildcards):
     """A budget-sweep job's config: the graph generator's as in the main run, at the wildcard's budget, with
     compare.budget_sweep_seeds seeds."""
-    cfg = compare_job_cfg(type("W", (), {"cmpgen": wildcards.cmpgraph})())
-    cfg["transitions_per_s"] = float(wildcards.budget)
-    cfg["seeds"] = min(int(CMP["seeds"]), int(CMP["budget_sweep_seeds"]))
-    return cfg
+    from animsynth.compare.settings import job_cfg
+
+    return job_cfg(config, wildcards.cmpgraph, budget=wildcards.budget)
 
 
 # Benchmark files of this family's jobs (inputs of rule_benchmarks).

@@ -33,7 +33,7 @@ _EXPORTS = {
     "Database": ".generators",
     "FieldFollower": ".generators",
     "GENERATORS": ".generators",
-    "METRICS": ".jobs",
+    "METRICS": ".metrics",
     "MotionGraph": ".motiongraph",
     "Replay": ".generators",
     "Resequencer": ".generators",

@@ -16,7 +16,9 @@ Protocol (docs/compare.md, "Protocol"):
   ``compare.seed``, ``c`` and ``i`` (the same for every generator, so generators are compared
   seed by seed).
 
-The tables of the family are assembled by :mod:`animsynth.compare.tables`.
+Every workflow step is a function here: :func:`run_job` (one generator over every clip), :func:`tables_job`
+(the family's tables, built by :mod:`animsynth.compare.tables` and :mod:`animsynth.compare.verdicts`) and
+:func:`sweep_job` (the transition budget sweep).
 
 Files between steps: ``compare/clips.npz`` (every clip's database, held-out clip and length:
 :func:`save_clips` / :func:`load_clips`), per generator ``compare/runs/<generator>.csv`` (metrics,
@@ -39,50 +41,10 @@ from ..config import derive_seed
 from ..motion import Motion
 from ..skeleton import Skeleton
 from .generators import make_generator
+from .metrics import METRIC_NAMES, SENSITIVITY_SPEEDS
 
 log = logging.getLogger("animsynth.compare.jobs")
 
-#: every metric column of metrics.csv: (column, unit, which way is better: "lower", "higher" or "" for
-#: a descriptive number)
-METRICS = (
-    ("contact_share", "share of foot joint-frames", ""),
-    ("skate_share", "share of contact joint-frames", "lower"),
-    ("skate_m_per_contact_frame", "m", "lower"),
-    ("transition_skate_share", "share of contact joint-frames near seams", "lower"),
-    ("skating_ratio_gmd", "share of foot steps (GMD)", "lower"),
-    *((f"skate_share_at_{v:g}", f"share of contact joint-frames, {v:g} m/s", "") for v in (0.15, 0.3, 0.5)),
-    *((f"skating_ratio_gmd_at_{v:g}", f"share of foot steps (GMD), {v:g} m/s", "") for v in (0.15, 0.3, 0.5)),
-    ("velocity_jump_p95", "m/s", "lower"),
-    ("velocity_jump_max", "m/s", "lower"),
-    ("velocity_jump_over_capture", "share of frames", "lower"),
-    ("accel_jump_p95", "m/s^2", "lower"),
-    ("accel_jump_max", "m/s^2", "lower"),
-    ("accel_jump_over_capture", "share of frames", "lower"),
-    ("n_seams", "seams", ""),
-    ("seams_per_s", "1/s", ""),
-    ("transitions_kept", "transitions before pruning", ""),
-    # at the seams a generator reports (secondary: they trust the generator's own seams)
-    ("velocity_jump", "m/s", ""),
-    ("velocity_jump_ratio", "x capture median", ""),
-    ("velocity_jump_pct", "percentile in capture", ""),
-    ("accel_jump", "m/s^2", ""),
-    ("accel_jump_ratio", "x capture median", ""),
-    ("accel_jump_pct", "percentile in capture", ""),
-    ("ldlj", "log dimensionless jerk", "higher"),
-    ("sparc", "spectral arc length", "higher"),
-    ("l2p", "LAFAN1 L2P (run statistics)", "lower"),
-    ("l2p_m", "m", "lower"),
-    ("l2q", "LAFAN1 L2Q", "lower"),
-    ("npss", "NPSS", "lower"),
-    ("coverage", "share of database windows", "higher"),
-    ("local_diversity_m", "m", ""),
-    ("seed_diversity_m", "m", "higher"),
-    ("novelty_median_m", "m", ""),
-    ("copy_share", "share of frames", ""),
-)
-METRIC_NAMES = [m for m, _u, _b in METRICS]
-#: the skating threshold sensitivity speeds (m/s) of the ``*_at_<speed>`` columns
-SENSITIVITY_SPEEDS = (0.15, 0.3, 0.5)
 KEY_COLUMNS = ["clip", "group", "protocol", "generator", "seed"]
 TIMING_COLUMNS = ["generator", "clip", "database_frames", "build_cpu_s", "build_wall_s", "generate_cpu_s",
                   "generate_wall_s", "frames_generated", "peak_rss_mb"]
@@ -535,3 +497,73 @@ def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict
     if "shown" in out:  # the budget sweep's jobs write metrics and timing only
         save_shown(out["shown"], shown)
         write_bvh(out["bvh"], shown)
+
+
+# ----------------------------------------------------------------------------- the family's tables
+
+
+def read_metrics(paths) -> pd.DataFrame:
+    """The generator jobs' metrics files as one table (``note``: '' where a row has none)."""
+    m = pd.concat([pd.read_csv(p, dtype={"note": str}, keep_default_na=False, na_values=[""]) for p in paths],
+                  ignore_index=True)
+    m["note"] = m["note"].fillna("")
+    return m
+
+
+def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, order) -> None:
+    """The sweep table and figure from the default run's graph-generator metrics (``inp["default"]``) and one
+    metrics file per budget and generator (``inp["sweep"]``, in the order of ``budgets`` x ``generators``)."""
+    from ..tables import write_table
+    from .plots import sweep_figure
+    from .tables import sweep_table
+
+    runs = {float(default_budget): read_metrics(inp["default"])}
+    runs[float(default_budget)] = runs[float(default_budget)][runs[float(default_budget)]["generator"]
+                                                              .isin(generators)]
+    paths = list(inp["sweep"])
+    k = 0
+    for b in budgets:
+        runs[float(b)] = read_metrics(paths[k:k + len(generators)])
+        k += len(generators)
+    table = sweep_table(runs, order)
+    write_table(table, out["table"], md=out["table_md"])
+    sweep_figure(table, out["figure"], float(default_budget))
+
+
+def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str) -> None:
+    """Assemble the family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``,
+    ``timing`` lists) into ``out``: ``metrics``, ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``),
+    ``cost`` (+ ``cost_md``), ``verdicts`` (+ ``verdicts_md``), ``summary_md`` (the family's page)."""
+    from ..atomic import atomic_write_text
+    from ..tables import write_table
+    from .tables import cost_table, data_label, sensitivity_table, summary_markdown, summary_table, winners_table
+    from .verdicts import build, independent_groups, sanity_checks
+
+    order = list(cfg["generators"])
+    metrics = read_metrics(inp["metrics"])
+    metrics["_g"] = metrics["generator"].map({g: i for i, g in enumerate(order)})
+    clips = pd.read_csv(inp["clips"], dtype={"held_out": str})
+    metrics["_c"] = metrics["clip"].map({c: i for i, c in enumerate(clips["clip"])})
+    metrics = metrics.sort_values(["_c", "_g", "seed"], kind="stable").drop(columns=["_g", "_c"])
+    timing = pd.concat([pd.read_csv(p) for p in inp["timing"]], ignore_index=True)
+    summary = summary_table(metrics, order)
+    winners = winners_table(metrics, summary, order)
+    clips_full = pd.read_csv(inp["clips"], dtype=str)
+    n_groups = len(set(independent_groups(clips_full).values()))
+    data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
+    verdicts = build(metrics, cfg["verdicts"], data, left_out, clips_full)
+    sanity = sanity_checks(metrics, cfg["verdicts"], data, left_out, clips_full)
+    write_table(metrics, out["metrics"], md=False)
+    write_table(timing, out["metrics_timing"], md=False)
+    write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below
+    write_table(winners, out["winners"], md=out["winners_md"])
+    write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
+    write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
+    write_table(sanity, out["sanity"], md=out["sanity_md"])
+    write_table(sensitivity_table(metrics, order), out["sensitivity"], md=out["sensitivity_md"])
+    not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
+    log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
+             metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
+             len(verdicts), ", ".join(verdicts["verdict"]))
+    atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg,
+                                                          not_built, sanity))
