@@ -289,3 +289,17 @@ COMPARE_SUMMARY = [
     },
 ]
 COMPARE_VERDICTS = [R("compare/verdicts.csv"), R("compare/sanity_checks.csv")]
+# Key figures for the summary and the report's home page, with what to see in them.
+COMPARE_FIGURES = [
+    {
+        "png": R("compare/metrics.png"),
+        "caption": "Every generator's values over held-out clips x seeds, one panel per metric (box: "
+        "interquartile range; grey: the realism bounds replay and concat): a generator whose box lies apart "
+        "from another's wins that metric beyond the spread.",
+    },
+    {
+        "png": R("compare/strips.png"),
+        "caption": "One skeleton strip per generator from the same start (seams in red): where each generator "
+        "breaks the motion, and whether its poses stay plausible.",
+    },
+]
