@@ -222,12 +222,44 @@ class Reference:
     capture_max: tuple = (np.nan, np.nan)
 
 
-def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> np.ndarray:
+class DatabaseKinematics:
+    """Positions (m, :func:`animsynth.compare.metrics.positions`) and facing (:func:`~animsynth.compare.metrics.facing`)
+    of each database motion, computed once per job for every clip and metric that reads them.
+
+    A database clip is shared by several held-out clips (leave one out) and read by the run's L2P statistics and
+    by each clip's reference: calling an instance with a motion returns its ``(positions, facing)``, computed on
+    the first call (keyed by the motion's name, checked by its values: two motions of one name and other values
+    are computed apart). The arrays are read-only (a metric that wrote into them would change the others').
+    """
+
+    def __init__(self, roles: dict | None = None):
+        self.roles = roles
+        self._memo: dict[str, tuple] = {}
+
+    def __call__(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+        from . import metrics as M
+
+        hit = self._memo.get(motion.name)
+        if hit is not None and (hit[0] is motion.values or np.array_equal(hit[0], motion.values)):
+            return hit[1], hit[2]
+        pos, fwd = M.positions(motion), M.facing(motion, self.roles)
+        pos.setflags(write=False)
+        fwd.setflags(write=False)
+        if hit is None:
+            self._memo[motion.name] = (motion.values, pos, fwd)
+        return pos, fwd
+
+
+def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None,
+              kin: DatabaseKinematics | None = None) -> np.ndarray:
     """LAFAN1's position statistics (std, (J, 3)) over the whole run's database: every distinct database clip
     of every held-out clip (by name), as LAFAN1 normalises by its whole training set. Windows of
     ``context + length`` frames (the longest of the run's clips; shorter if a database clip is shorter),
-    every ``compare.metrics.l2p_stride`` frames, aligned at the last context frame."""
+    every ``compare.metrics.l2p_stride`` frames, aligned at the last context frame (``kin``: the job's
+    :class:`DatabaseKinematics`, made here if not given)."""
     from . import metrics as M
+
+    kin = kin or DatabaseKinematics(roles)
 
     seen = {}
     for c in clips:
@@ -240,8 +272,7 @@ def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> np.nd
                          "statistics")
     window = min(max(c.context + c.length for c in clips), min(d.n_frames for d in db))
     context = min(min(c.context for c in clips), window)
-    pos = [M.positions(d) for d in db]
-    fwd = [M.facing(d, roles) for d in db]
+    pos, fwd = zip(*(kin(d) for d in db))
     return M.position_stats(pos, fwd, window, int(mcfg["l2p_stride"]), context)[1]
 
 
@@ -249,7 +280,8 @@ def _joint_count(clip: Clip) -> int:
     return len(clip.held_out.skeleton.joints)
 
 
-def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> dict:
+def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = None,
+                          kin: DatabaseKinematics | None = None) -> dict:
     """:func:`run_stats` per skeleton: {joint count: std (J, 3)}. A run of one skeleton (CMU, the demo) has one
     entry, the whole run's database; a run mixing skeletons (a user's BVH files of several sources) normalises
     each clip's L2P by the database clips of its own skeleton, logged (positions of different joint sets have no
@@ -260,31 +292,42 @@ def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = No
     if len(groups) > 1:
         log.warning("the run mixes skeletons of %s joints: each clip's L2P is normalised by the database clips of "
                     "its own skeleton", sorted(groups))
-    return {n: run_stats(cs, mcfg, roles) for n, cs in groups.items()}
+    kin = kin or DatabaseKinematics(roles)
+    return {n: run_stats(cs, mcfg, roles, kin) for n, cs in groups.items()}
 
 
-def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray | None = None) -> Reference:
+def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray | None = None,
+              kin: DatabaseKinematics | None = None) -> Reference:
     """The database side of every metric of ``clip`` (``mcfg``: the ``compare.metrics`` block; ``std``: the
-    run's L2P statistics, :func:`run_stats`; ``None``: this clip's database only)."""
+    run's L2P statistics, :func:`run_stats`; ``None``: this clip's database only; ``kin``: the job's
+    :class:`DatabaseKinematics`, made here if not given).
+
+    Forward kinematics runs once per database motion of the job (``kin``) and once for the held-out clip
+    (positions and the ground truth's world rotations from one pass)."""
     from . import metrics as M
 
+    from ..kinematics import forward_kinematics
+
+    kin = kin or DatabaseKinematics(roles)
     sk = clip.held_out.skeleton
     fps = clip.held_out.fps
     foot = M.foot_indices(sk, roles)
-    db_pos = [M.positions(d) for d in clip.database]
-    db_fwd = [M.facing(d, roles) for d in clip.database]
+    db_pos, db_fwd = (list(x) for x in zip(*(kin(d) for d in clip.database)))
     floor = (M.floor_height(db_pos, foot, float(mcfg["floor_percentile"])) if mcfg["floor_m"] is None
              else float(mcfg["floor_m"]))
     if std is None:
         window = min(clip.context + clip.length, max(p.shape[0] for p in db_pos))
         std = M.position_stats(db_pos, db_fwd, window, int(mcfg["l2p_stride"]), min(clip.context, window))[1]
-    held_pos = M.positions(clip.held_out)
+    # one pass over the held-out clip: its positions (M.positions) and the ground truth's world rotations
+    # (M.global_quaternions of the frames after the start)
+    held_pos, W = forward_kinematics(sk, clip.held_out.values, ends=True, world_rotations=True)
+    held_pos = held_pos * float(sk.length_to_m)
+    truth = slice(clip.context, clip.context + clip.length)
+    truth_q = M.align_quaternions(np.stack([r.as_quat() for r in W], axis=1)[truth])
     held_fwd = M.facing(clip.held_out, roles)
-    truth = clip.truth
     return Reference(foot, floor, M.jump_reference(db_pos, fps), std,
                      [M.pose_features(p, f) for p, f in zip(db_pos, db_fwd)],
-                     held_pos[clip.context:clip.context + clip.length], M.global_quaternions(truth),
-                     held_fwd[clip.context - 1], M.capture_max_jumps(held_pos, fps))
+                     held_pos[truth], truth_q, held_fwd[clip.context - 1], M.capture_max_jumps(held_pos, fps))
 
 
 def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict,
@@ -404,7 +447,8 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     """
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
-    std = run_stats_by_skeleton(clips, mcfg, roles)
+    kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
+    std = run_stats_by_skeleton(clips, mcfg, roles, kin)
     for clip in clips:
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
@@ -426,7 +470,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
             continue
         build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
         start = clip.start
-        ref = reference(clip, mcfg, roles, std[_joint_count(clip)])
+        ref = reference(clip, mcfg, roles, std[_joint_count(clip)], kin)
         gen_cpu = gen_wall = 0.0
         feats = []
         for i, s in enumerate(seeds):
