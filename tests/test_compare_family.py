@@ -556,3 +556,26 @@ def test_the_job_config_holds_the_generators_block_and_nothing_of_the_others():
     sweep = settings.job_cfg(dict(config, compare=dict(config["compare"], seeds=5, budget_sweep_seeds=2)),
                              "motion_graph", budget="12.5")
     assert sweep["transitions_per_s"] == 12.5 and sweep["seeds"] == 2
+
+
+def test_the_jobs_shared_kinematics_give_the_references_of_separate_computations(walks, cfg):
+    from animsynth.compare import metrics as M
+
+    trials = {f"t{i}": Motion(w.values, w.skeleton, 30.0, f"t{i}") for i, w in enumerate(walks)}
+    cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
+    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
+    mcfg = cfg["metrics"]
+    kin = jobs.DatabaseKinematics()
+    std = jobs.run_stats(clips, mcfg, None, kin)
+    assert np.array_equal(std, jobs.run_stats(clips, mcfg))
+    for c in clips:
+        shared, alone = jobs.reference(c, mcfg, None, std, kin), jobs.reference(c, mcfg, None, std)
+        for name in ("floor", "std", "truth_pos", "truth_q", "truth_forward", "capture_max"):
+            assert np.array_equal(getattr(shared, name), getattr(alone, name)), (c.clip, name)
+        assert all(np.array_equal(a, b) for a, b in zip(shared.features, alone.features))
+        # the ground truth's rotations from the held-out clip's one pass are those of the truth on its own
+        assert np.array_equal(shared.truth_q, M.global_quaternions(c.truth))
+    pos, fwd = kin(clips[0].database[0])
+    assert not pos.flags.writeable and not fwd.flags.writeable  # shared by every clip: read-only
+    other = Motion(clips[0].database[0].values[::-1].copy(), walks[0].skeleton, 15.0, clips[0].database[0].name)
+    assert np.array_equal(kin(other)[0], M.positions(other))  # same name, other values: computed apart
