@@ -158,6 +158,10 @@ def test_every_family_of_the_registry_is_a_package_with_a_rule_file_and_nothing_
     for fam in registry.FAMILIES:
         assert (SRC / fam.name / "settings.py").is_file() and (rules / f"{fam.name}.smk").is_file(), fam.name
         assert TOP[fam.name] == fam.layer
+        text = (rules / f"{fam.name}.smk").read_text()
+        for part in ("TARGETS", "SUMMARY", "VERDICTS", "FIGURES"):  # what the workflow collects of every family
+            assert f"\n{fam.name.upper()}_{part} " in text, f"{fam.name}.smk defines no {fam.name.upper()}_{part}"
+        assert f"def {fam.name}_benchmarks(" in (rules / "common.smk").read_text(), fam.name
     packages = {p.parent.name for p in SRC.glob("*/__init__.py")}
     assert packages - {"io", "synth"} == set(registry.names())
     shared = {"common", "data", "report", "scale"}

@@ -3,8 +3,9 @@ the layers test all read.
 
 A family is a package ``animsynth.<name>`` (``settings.py`` with ``check(config)``, ``jobs.py``, ``verdicts.py``,
 ``plots.py``) and a rule file ``workflow/rules/<name>.smk``. Adding one is that package, that rule file and one
-:class:`Family` line in :data:`FAMILIES`; nothing else names the families. The rule file defines, by this naming
-convention (``<NAME>`` is the name in upper case):
+:class:`Family` line in :data:`FAMILIES`; nothing else names the families (``tests/test_layers.py`` checks that
+every family of the registry has both and that no other package or rule file is one). The rule file defines, by
+this naming convention (``<NAME>`` is the name in upper case):
 
 ``<NAME>_TARGETS``
     every output of the family (``rule all`` asks for them when the family runs);
@@ -15,8 +16,13 @@ convention (``<NAME>`` is the name in upper case):
     its ``verdicts.csv`` (and ``sanity_checks.csv``) files;
 ``<NAME>_FIGURES``
     its key figures for the summary and the report's home page (dicts ``png``, ``caption``);
+
+and, with the family's input functions in ``workflow/rules/common.smk`` (Snakemake's lint keeps functions out of
+the rule files):
+
 ``<name>_benchmarks()``
-    the benchmark files of its jobs in this run (the inputs of the benchmark aggregation).
+    the benchmark files of its jobs in this run (the inputs of the benchmark aggregation), called only when the
+    family runs.
 
 The workflow may import this module; this module imports nothing of the package (layer 0 of the import graph).
 """
