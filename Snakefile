@@ -31,11 +31,14 @@ report: "workflow/report/workflow.rst"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/data.smk"
-include: "workflow/rules/simplicial.smk"
-include: "workflow/rules/resequencing.smk"
-include: "workflow/rules/facegraph.smk"
-include: "workflow/rules/meshdetail.smk"
-include: "workflow/rules/compare.smk"
+
+
+# One rule file per family of the registry (animsynth.families), in its order.
+for _family in FAMILIES:
+
+    include: f"workflow/rules/{_family.name}.smk"
+
+
 include: "workflow/rules/report.smk"
 
 

@@ -34,7 +34,9 @@ def _config() -> dict:
 
 @pytest.fixture(scope="module")
 def cfg():
-    return dict(settings.generator_cfg(_config()), seeds=2)
+    config = _config()
+    # the generator jobs' config (the workflow's, every generator at once) plus the clips job's keys
+    return dict(settings.job_cfg(config), **settings.clips_cfg(config), seeds=2)
 
 
 @pytest.fixture(scope="module")
@@ -200,7 +202,7 @@ def test_run_generator_scores_every_clip_and_seed_and_writes_a_bvh_our_reader_re
     from animsynth.kinematics import forward_kinematics
 
     trials = {f"t{i}": w for i, w in enumerate(walks)}
-    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
+    cc = {k: cfg[k] for k in settings.CLIP_KEYS}
     clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
     jobs.save_clips(tmp_path / "clips.npz", clips)
     out = {k: str(tmp_path / f"{k}{ext}") for k, ext in
@@ -349,7 +351,7 @@ def test_the_modern_rows_from_the_config(cfg):
 
 def test_motion_matching_rows_have_seed_diversity_zero_and_genmm_does_not(walks, cfg):
     trials = {f"t{i}": w for i, w in enumerate(walks)}
-    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
+    cc = {k: cfg[k] for k in settings.CLIP_KEYS}
     clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
     for name, zero in (("motion_matching", True), ("genmm", False)):
         metrics, timing, _ = jobs.run_generator(clips, name, cfg, 7)
@@ -465,7 +467,7 @@ def test_settings_lists_clips_and_showcase():
 
 def test_a_generator_not_built_on_a_clip_keeps_its_rows_with_the_reason(walks, cfg):
     trials = {"a": walks[0], "b": walks[1], "c": Motion(walks[2].values[:18], walks[2].skeleton, 30.0, "c")}
-    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
+    cc = {k: cfg[k] for k in settings.CLIP_KEYS}
     clips = jobs.prepare_clips(trials, {"w1": ["a", "b"], "w2": ["b", "c"]}, {}, dict(cc, length=10))
     # the w2/b clip's database is c alone: 18 frames, too short for windows of 20 frames
     mg = dict(cfg, motion_graph=dict(cfg["motion_graph"], window=20))
@@ -540,3 +542,40 @@ def test_a_subset_the_run_lacks_is_left_out_with_a_warning(caplog):
     assert "'compare.subsets': 'r1' is not a subset of this run" in caplog.text
     subsets, reseq = settings.groups(cfg)
     assert subsets == {} and reseq  # the re-sequencing clips still give the comparison its clips
+
+
+def test_the_job_config_holds_the_generators_block_and_nothing_of_the_others():
+    config = _config()
+    mg = settings.job_cfg(config, "motion_graph")
+    assert list(mg) == [*settings.RUN_KEYS, "motion_graph"] and mg["motion_graph"] == config["compare"]["motion_graph"]
+    st = settings.job_cfg(config, "stisomap")
+    assert st["stisomap"] == config["resequencing"]["stisomap"] and "resequencing_graph" in st and "field" not in st
+    assert list(settings.job_cfg(config, "replay")) == list(settings.RUN_KEYS)  # no block of its own
+    every = settings.job_cfg(config)
+    assert {*settings.GENERATOR_BLOCKS.values(), "stisomap"} <= set(every)
+    sweep = settings.job_cfg(dict(config, compare=dict(config["compare"], seeds=5, budget_sweep_seeds=2)),
+                             "motion_graph", budget="12.5")
+    assert sweep["transitions_per_s"] == 12.5 and sweep["seeds"] == 2
+
+
+def test_the_jobs_shared_kinematics_give_the_references_of_separate_computations(walks, cfg):
+    from animsynth.compare import metrics as M
+
+    trials = {f"t{i}": Motion(w.values, w.skeleton, 30.0, f"t{i}") for i, w in enumerate(walks)}
+    cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
+    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
+    mcfg = cfg["metrics"]
+    kin = jobs.DatabaseKinematics()
+    std = jobs.run_stats(clips, mcfg, None, kin)
+    assert np.array_equal(std, jobs.run_stats(clips, mcfg))
+    for c in clips:
+        shared, alone = jobs.reference(c, mcfg, None, std, kin), jobs.reference(c, mcfg, None, std)
+        for name in ("floor", "std", "truth_pos", "truth_q", "truth_forward", "capture_max"):
+            assert np.array_equal(getattr(shared, name), getattr(alone, name)), (c.clip, name)
+        assert all(np.array_equal(a, b) for a, b in zip(shared.features, alone.features))
+        # the ground truth's rotations from the held-out clip's one pass are those of the truth on its own
+        assert np.array_equal(shared.truth_q, M.global_quaternions(c.truth))
+    pos, fwd = kin(clips[0].database[0])
+    assert not pos.flags.writeable and not fwd.flags.writeable  # shared by every clip: read-only
+    other = Motion(clips[0].database[0].values[::-1].copy(), walks[0].skeleton, 15.0, clips[0].database[0].name)
+    assert np.array_equal(kin(other)[0], M.positions(other))  # same name, other values: computed apart

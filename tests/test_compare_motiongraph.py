@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from animsynth.compare.motiongraph import (MotionGraph, apply_floor_transform, floor_alignment, kovar_alpha,
-                                           _pair_terms, _window_clouds)
+                                           pair_terms, window_clouds)
 from animsynth.kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
@@ -84,7 +84,7 @@ def test_all_pairs_matrix_products_equal_the_closed_form_per_pair():
     Q = rng.normal(size=(4, 25, 3))
     w = rng.uniform(0.2, 1.0, 25)
     w /= w.sum()
-    d2, a, b, cp, cq = _pair_terms(P, Q, w)
+    d2, a, b, cp, cq = pair_terms(P, Q, w)
     for i in range(6):
         for j in range(4):
             th, _, _, ref = floor_alignment(P[i], Q[j], w)
@@ -94,7 +94,7 @@ def test_all_pairs_matrix_products_equal_the_closed_form_per_pair():
 
 def test_window_clouds_are_frame_major():
     pos = np.arange(5 * 2 * 3, dtype=float).reshape(5, 2, 3)
-    c = _window_clouds(pos, 3)
+    c = window_clouds(pos, 3)
     assert c.shape == (3, 6, 3)
     assert np.array_equal(c[1], pos[1:4].reshape(6, 3))
 

@@ -4,13 +4,14 @@ Every ``import`` statement of every module counts, also those inside functions (
 dependency). Layers, bottom to top:
 
 0. plain helpers with no animsynth import: atomic writes, file-format errors, limits, the verdict format,
-   the published-table reader, joint roles, the skeleton;
+   the published-table reader, joint roles, the skeleton, the family registry;
 1. config checks, tables, the Motion container, kinematics;
 2. io (file formats; knows no method);
 3. shared machinery on top of io: synthetic data, skinning, drawing (the scoreboard too), data sources, the data layer,
    workflow logging;
-4. the four families (simplicial, resequencing, facegraph, meshdetail), which never import each other;
+4. the four families of the papers, which never import each other;
 5. compare, which scores the families' generators side by side (the one package that imports them);
+(layers 4 and 5 as the family registry, :mod:`animsynth.families`, gives them: adding a family adds it here)
 6. report, scale (the measuring harness) and the command line.
 """
 
@@ -23,16 +24,18 @@ import pytest
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
+from animsynth import families as registry
+
 SRC = Path(__file__).resolve().parents[1] / "src" / "animsynth"
 PKG = "animsynth"
-FAMILIES = ("simplicial", "resequencing", "facegraph", "meshdetail")
+FAMILIES = registry.paper_families()
 LAYERS = {
-    0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton"],
+    0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton", "families"],
     1: ["config", "tables", "motion", "kinematics"],
     2: ["io"],
     3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "workflow_utils"],
     4: list(FAMILIES),
-    5: ["compare"],
+    5: [f.name for f in registry.FAMILIES if f.layer == 5],
     6: ["report", "scale", "cli"],
 }
 TOP = {name: layer for layer, names in LAYERS.items() for name in names}
@@ -138,7 +141,7 @@ def test_lazy_exports_point_down_or_inside_their_own_package():
     import importlib
 
     bad = []
-    for family in (*FAMILIES, "compare"):
+    for family in registry.names():
         pkg = importlib.import_module(f"animsynth.{family}")
         for name in getattr(pkg, "__all__", []):
             owner = getattr(getattr(pkg, name), "__module__", "") or ""
@@ -146,3 +149,20 @@ def test_lazy_exports_point_down_or_inside_their_own_package():
             if top is not None and top != family and (top in FAMILIES or TOP[top] >= TOP[family]):
                 bad.append(f"animsynth.{family}.{name} comes from {owner}")
     assert not bad, "\n".join(bad)
+
+
+def test_every_family_of_the_registry_is_a_package_with_a_rule_file_and_nothing_else_is_one():
+    """The registry is the one list of families: each has its package (with settings.check) and its rule file, and
+    every package beside the shared layers is a family of the registry."""
+    rules = SRC.parents[1] / "workflow" / "rules"
+    for fam in registry.FAMILIES:
+        assert (SRC / fam.name / "settings.py").is_file() and (rules / f"{fam.name}.smk").is_file(), fam.name
+        assert TOP[fam.name] == fam.layer
+        text = (rules / f"{fam.name}.smk").read_text()
+        for part in ("TARGETS", "SUMMARY", "VERDICTS", "FIGURES"):  # what the workflow collects of every family
+            assert f"\n{fam.name.upper()}_{part} " in text, f"{fam.name}.smk defines no {fam.name.upper()}_{part}"
+        assert f"def {fam.name}_benchmarks(" in (rules / "common.smk").read_text(), fam.name
+    packages = {p.parent.name for p in SRC.glob("*/__init__.py")}
+    assert packages - {"io", "synth"} == set(registry.names())
+    shared = {"common", "data", "report", "scale"}
+    assert {p.stem for p in rules.glob("*.smk")} - shared == set(registry.names())

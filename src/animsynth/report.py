@@ -11,21 +11,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from . import families
 from . import verdicts as verdict_format
 from .tables import to_markdown
 
 log = logging.getLogger("animsynth.report")
 
-# Which paper each family's verdicts speak for.
-FAMILY_PAPERS = {
-    "simplicial": "Gauch & Peters (simplicial complex)",
-    "resequencing": "Isomap / ST-Isomap re-sequencing",
-    "meshdetail": "Hybrid mesh animation",
-    "facegraph": "Serra et al. 2018 (facial motion graphs)",
-    "compare": "Beyond the papers: generators side by side",
-}
+#: which paper each family's verdicts speak for (from the family registry, :mod:`animsynth.families`)
+FAMILY_PAPERS = {f.name: f.paper for f in families.report_order()}
 #: the section of summary.md and of the report's home page that puts the generators side by side
-SIDE_BY_SIDE = "The generators side by side"
+SIDE_BY_SIDE = families.get("compare").section
 
 
 def aggregate_rule_benchmarks(paths, root: str = "benchmarks/rules") -> pd.DataFrame:
@@ -174,17 +169,11 @@ def run_banner(family_real: dict[str, bool] | None, demo: bool = True) -> str:
 
 
 #: the short name of each paper in the claims table (its full name heads the family's section)
-FAMILY_SHORT = {
-    "simplicial": "Gauch & Peters",
-    "resequencing": "ST-Isomap",
-    "meshdetail": "Hybrid mesh",
-    "facegraph": "Serra et al.",
-    "compare": "Side by side",
-}
+FAMILY_SHORT = {f.name: f.short for f in families.report_order()}
 #: the letter of each family's claim ids (S1, S2, ...: the id of a claim's cell in the scoreboard)
-FAMILY_LETTER = {"simplicial": "S", "resequencing": "R", "meshdetail": "M", "facegraph": "F", "compare": "C"}
+FAMILY_LETTER = {f.name: f.letter for f in families.report_order()}
 #: the heading of each family's section in summary.md and on the report's home page
-FAMILY_SECTION = {**FAMILY_PAPERS, "compare": SIDE_BY_SIDE}
+FAMILY_SECTION = {f.name: f.section for f in families.report_order()}
 #: no line of the summary's claims table is longer than this (characters)
 LINE_LIMIT = 400
 #: the longest text of each cell of the claims table (characters; a longer one is cut at a word, ending in '…',

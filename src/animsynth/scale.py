@@ -13,8 +13,9 @@ earlier steps still held). Where the reset is not possible the value is
 ``getrusage(RUSAGE_SELF).ru_maxrss`` of the child, the peak since it started
 (column ``peak_kind`` says which).
 
-Each family owns the steps it measures (``scale_steps`` in its workflow-step module, listed in
-:data:`STEP_FUNCTIONS`); this module only measures them:
+Each family owns the steps it measures (``scale_steps`` in its workflow-step module, named by its
+:class:`animsynth.families.ScaleStudy` in the family registry, with the config keys they read); this module only
+measures them:
 
 * simplicial: one fold (PCA, Delaunay complex, motion graph, vector field and a
   1,000-step generated path) on synthetic walking trials totalling ``n`` training frames.
@@ -36,10 +37,13 @@ from contextlib import contextmanager
 import numpy as np
 import pandas as pd
 
+from . import families as _families
+
 log = logging.getLogger("animsynth.scale")
 
 COLUMNS = ["family", "step", "n", "cpu_s", "wall_s", "peak_mb"]
-FAMILIES = ("simplicial", "resequencing", "facegraph", "meshdetail")
+#: the families the scale study measures (the registry's :func:`animsynth.families.scaled`)
+FAMILIES = tuple(f.name for f in _families.scaled())
 
 
 # ----------------------------------------------------------------------------- measuring
@@ -85,13 +89,8 @@ class Steps:
 
 #: measurement -> (module, function): each family owns its measured steps (a function
 #: ``scale_steps(recorder, n, **kwargs)`` that times its steps with ``recorder(family, n, **extra)``,
-#: a :class:`Steps`); this module only measures.
-STEP_FUNCTIONS = {
-    "simplicial_steps": ("animsynth.simplicial.jobs", "scale_steps"),
-    "resequencing_steps": ("animsynth.resequencing.jobs", "scale_steps"),
-    "facegraph_steps": ("animsynth.facegraph.jobs", "scale_steps"),
-    "meshdetail_steps": ("animsynth.meshdetail.jobs", "scale_steps"),
-}
+#: a :class:`Steps`), named in the family registry; this module only measures.
+STEP_FUNCTIONS = {f"{f.name}_steps": tuple(f.scale.steps.split(":")) for f in _families.scaled()}
 
 
 def _step_function(target: str):
@@ -99,6 +98,34 @@ def _step_function(target: str):
 
     module, name = STEP_FUNCTIONS[target]
     return getattr(importlib.import_module(module), name)
+
+
+def point_kwargs(family: str, cfg: dict, n: int, seed: int, resolution: float | None = None,
+                 mirror: str | None = None) -> tuple[str, dict]:
+    """The measurement (a key of :data:`STEP_FUNCTIONS`) and its keyword arguments for one point of a cost curve.
+
+    Parameters
+    ----------
+    family : a family the scale study measures (:data:`FAMILIES`)
+    cfg : the ``scale`` config block; the family's :class:`animsynth.families.ScaleStudy` names the keys read
+    n, seed : the size and the point's seed
+    resolution : the mesh resolution of the point (families measured over resolutions only)
+    mirror : the CMU mirror (``scale.source: cmu``; families that read it only)
+    """
+    study = _families.get(family).scale
+    if study is None:
+        raise ValueError(f"the scale study does not measure family {family!r}; it measures {list(FAMILIES)}")
+    kwargs = {"n": int(n), "seed": int(seed)}
+    for kw, key in study.kwargs.items():
+        value = cfg
+        for part in key.split("."):
+            value = value[part]
+        kwargs[kw] = value
+    if study.resolutions:
+        kwargs["resolution"] = float(resolution)
+    if study.mirror:
+        kwargs[study.mirror] = mirror
+    return f"{family}_steps", kwargs
 
 
 def _child_main():
@@ -183,8 +210,7 @@ def plot_curves(curves: pd.DataFrame, path) -> None:
             label = " ".join(str(k) for k in key if str(k) != "nan") + f" (n^{e:.2f})"
             ax.loglog(h["n"], h["cpu_s"], "o-", label=label)
         ax.set_title(fam)
-        ax.set_xlabel({"facegraph": "sequences", "meshdetail": "frames", "simplicial": "training frames"}
-                      .get(fam, "frames"))
+        ax.set_xlabel(_families.get(fam).scale.axis)
         ax.set_ylabel("CPU s")
         ax.legend(fontsize=7)
         ax.grid(True, which="both", alpha=0.3)

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from . import families
 from .atomic import atomic_path
 from .verdicts import VOCABULARY
 
@@ -38,9 +39,10 @@ VERDICT_COLOURS = {
 OTHER_COLOUR = "#bdbdbd"
 _DARK = {"reproduced", "contradicted"}  # white id text on these
 HATCH = "///"  # the cells of claims on synthetic data
-#: the order of the rows: the four papers as the project lists them, then the generators side by side;
-#: a family not named here follows in the order of ``claims.csv``
-ROW_ORDER = ("simplicial", "resequencing", "meshdetail", "facegraph", "compare")
+#: the order of the rows: the four papers as the project lists them, then the generators side by side (the family
+#: registry's report order, :func:`animsynth.families.report_order`); a family not named here follows in the order
+#: of ``claims.csv``
+ROW_ORDER = tuple(f.name for f in families.report_order())
 #: the words that mark a claim true by construction (a column value or a verdict)
 SANITY_WORDS = ("sanity check", "sanity-check", "sanity_check", "sanity checks", "sanity")
 _TRUE = ("true", "yes", "1", "y")

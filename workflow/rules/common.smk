@@ -7,12 +7,13 @@ from pathlib import Path
 from snakemake.io import is_flagged, strip_wildcard_constraints
 
 from animsynth.config import check_config, derive_seed, normalise_resequencing_trials, trial_setting
+from animsynth.families import FAMILIES, report_order
 from animsynth.meshdetail.settings import mesh_sequences
 from animsynth.sources import is_archive, is_url, mesh_source_name, probe_source
 
 
-# Config checks beyond the schema, in one place: the shared ones, then each family's
-# settings.check(config) (which names the offending config key).
+# Config checks beyond the schema, in one place: the shared ones, then the settings.check(config) of each family
+# of the registry (animsynth.families; it names the offending config key).
 # resequencing_trials may hold any subset of walk, run, dance: the studies without a trial of
 # this config are left out with a note (the default's trial ids are not a user's).
 import yaml as _yaml
@@ -20,8 +21,8 @@ import yaml as _yaml
 with open(Path(workflow.basedir) / "config" / "config.yaml") as _f:
     normalise_resequencing_trials(config, (_yaml.safe_load(_f) or {}).get("resequencing_trials") or {})
 check_config(config)
-for _family in ("simplicial", "resequencing", "facegraph", "meshdetail", "compare"):
-    importlib.import_module(f"animsynth.{_family}.settings").check(config)
+for _family in FAMILIES:
+    importlib.import_module(f"animsynth.{_family.name}.settings").check(config)
 
 TRIALS = {t["id"]: t for t in config["trials"]}
 SUBSETS = {k: v for k, v in config["subsets"].items() if v}  # null drops a subset
@@ -74,16 +75,18 @@ def job_benchmarks(rule_name, **wildcards):
     return files
 
 
+def family_part(family, part):
+    """What the .smk of a family defines by the naming convention of the registry (animsynth.families), that is
+    <FAMILY>_<part> (TARGETS, SUMMARY, VERDICTS, FIGURES), or the function <family>_<part> (benchmarks)."""
+    name = f"{family}_{part}" if part == "benchmarks" else f"{family.upper()}_{part}"
+    if name not in globals():
+        raise NameError(f"workflow/rules/{family}.smk defines no {name} (every family of animsynth.families does)")
+    return globals()[name]
+
+
 def family_targets():
-    """Targets of every family that runs (a family whose data are unavailable is left out)."""
-    targets = {
-        "data": DATA_TARGETS,
-        "simplicial": SIMPLICIAL_TARGETS,
-        "resequencing": RESEQUENCING_TARGETS,
-        "facegraph": FACEGRAPH_TARGETS,
-        "meshdetail": MESHDETAIL_TARGETS,
-        "compare": COMPARE_TARGETS,
-    }
+    """Targets of the data layer and of every family that runs (a family whose data are unavailable is left out)."""
+    targets = {"data": DATA_TARGETS, **{f.name: family_part(f.name, "TARGETS") for f in FAMILIES}}
     return [t for fam, ts in targets.items() if FAMILY_RAN[fam] for t in ts]
 
 
@@ -158,8 +161,9 @@ def _family_status():
         mesh = ("mesh sequences " + ", ".join(f"{n} ({s['mesh_dir']})" for n, s in MD_SEQS.items()), True, "")
     ck = config["facegraph"]["ckplus_dir"]
     faces = _status(f"CK+ from {ck}", ck) if ck else _status("synthetic CK+-layout database (not real CK+)")
-    status = {"data": mocap, "simplicial": mocap, "resequencing": mocap, "meshdetail": mesh, "facegraph": faces,
-              "compare": mocap}
+    # each family's data source, by the kind of data the registry gives it (the report's order)
+    sources = {"mocap": mocap, "mesh": mesh, "faces": faces}
+    status = {"data": mocap, **{f.name: sources[f.data] for f in report_order()}}
     if not config["resequencing"]["datasets"]:  # resequencing_trials all null (or none of them in the run)
         status["resequencing"] = (mocap[0], False, "no trial in resequencing_trials")
     skipped = {}
@@ -172,15 +176,14 @@ def _family_status():
 
 
 FAMILY_STATUS, FAMILY_RAN = _family_status()
-# Real or synthetic data per family, from the data sources themselves (never from words in a table).
-FAMILY_REAL = {
-    "data": SOURCE != "synthetic",
-    "simplicial": SOURCE != "synthetic",
-    "resequencing": SOURCE != "synthetic",
-    "meshdetail": all(s["mesh_dir"] for s in MD_SEQS.values()),  # every sequence of the run is real
-    "facegraph": bool(config["facegraph"]["ckplus_dir"]),
-    "compare": SOURCE != "synthetic",  # real when its mocap is real
+# Real or synthetic data per family, from the data sources themselves (never from words in a table), by the kind
+# of data the registry gives each family (the report's order).
+_REAL = {
+    "mocap": SOURCE != "synthetic",
+    "mesh": all(s["mesh_dir"] for s in MD_SEQS.values()),  # every sequence of the run is real
+    "faces": bool(config["facegraph"]["ckplus_dir"]),
 }
+FAMILY_REAL = {"data": _REAL["mocap"], **{f.name: _REAL[f.data] for f in report_order()}}
 
 
 def provenance_rows():
@@ -389,24 +392,19 @@ def compare_trial_npz(wildcards):
 
 
 def compare_job_cfg(wildcards):
-    """The config one generator job reads: the shared keys, the generator's own block, and for ST-Isomap the
-    re-sequencing study's stisomap block (a changed block reruns only the jobs that read it)."""
-    cfg = {k: CMP[k] for k in CMP_RUN_KEYS}
-    block = CMP_GEN_BLOCK.get(wildcards.cmpgen)
-    if block:
-        cfg[block] = CMP[block]
-    if wildcards.cmpgen == "stisomap":
-        cfg["stisomap"] = dict(config["resequencing"]["stisomap"])
-    return cfg
+    """The config one generator job reads (animsynth.compare.settings.job_cfg, as the tests build it: a changed
+    block reruns only the jobs that read it)."""
+    from animsynth.compare.settings import job_cfg
+
+    return job_cfg(config, wildcards.cmpgen)
 
 
 def compare_sweep_cfg(wildcards):
     """A budget-sweep job's config: the graph generator's as in the main run, at the wildcard's budget, with
     compare.budget_sweep_seeds seeds."""
-    cfg = compare_job_cfg(type("W", (), {"cmpgen": wildcards.cmpgraph})())
-    cfg["transitions_per_s"] = float(wildcards.budget)
-    cfg["seeds"] = min(int(CMP["seeds"]), int(CMP["budget_sweep_seeds"]))
-    return cfg
+    from animsynth.compare.settings import job_cfg
+
+    return job_cfg(config, wildcards.cmpgraph, budget=wildcards.budget)
 
 
 # Benchmark files of this family's jobs (inputs of rule_benchmarks).
@@ -424,14 +422,7 @@ def compare_benchmarks():
 
 def run_benchmark_files(wildcards=None):
     """The benchmark file of every job of this run (the families that run, the summary and the benchmarks)."""
-    family_benchmarks = {
-        "data": data_benchmarks,
-        "simplicial": simplicial_benchmarks,
-        "resequencing": resequencing_benchmarks,
-        "facegraph": facegraph_benchmarks,
-        "meshdetail": meshdetail_benchmarks,
-        "compare": compare_benchmarks,
-    }
+    family_benchmarks = {"data": data_benchmarks, **{f.name: family_part(f.name, "benchmarks") for f in FAMILIES}}
     files = [f for fam, fn in family_benchmarks.items() if FAMILY_RAN[fam] for f in fn()]
     return files + [f for r in ("claims", "scoreboard", "summary", "benchmarks") for f in job_benchmarks(r)]
 

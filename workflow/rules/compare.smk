@@ -6,7 +6,7 @@
 # compare_figures gather them. A generator that cannot run here (fairmotion without its package) is left
 # out at parse time with one line, and the tables and docs say why. Every job gets only the config keys it
 # uses. Resources: measured on CMU (the paper run) with headroom.
-from animsynth.compare.settings import clip_ids, groups, run_generators, showcase
+from animsynth.compare.settings import clip_ids, clips_cfg, groups, run_generators, showcase
 
 CMP = config["compare"]
 CMP_SUBSETS, CMP_RESEQ = groups(config)
@@ -15,13 +15,6 @@ for _gen, _why in CMP_LEFT_OUT.items():
     print(f"animsynth: compare: generator {_gen} left out ({_why})", file=sys.stderr)
 CMP_SHOWCASE = list(showcase(config))
 CMP_TRIALS = list(dict.fromkeys([t for ids in CMP_SUBSETS.values() for t in ids] + list(CMP_RESEQ.values())))
-CMP_CLIP_KEYS = ("fps", "context", "length", "min_length", "holdout_fraction")
-CMP_RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
-# each generator's own config block (a changed block reruns only that generator's job)
-CMP_GEN_BLOCK = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph", "stisomap": "resequencing_graph",
-                 "motion_graph": "motion_graph", "fairmotion": "fairmotion",
-                 "fairmotion_fixed": "fairmotion", "motion_matching": "motion_matching",
-                 "motion_matching_pose": "motion_matching", "genmm": "genmm", "concat": "concat"}
 # the transition budget sweep: our motion graph and fairmotion with upstream's walk fixes (the peer's method; the
 # as-released row builds the same graph) at every further budget of compare.budget_sweep, budget_sweep_seeds seeds
 CMP_GRAPHS = [g for g in ("motion_graph", "fairmotion_fixed") if g in CMP_RUN]
@@ -57,7 +50,7 @@ rule compare_clips:
         trials=CMP_TRIALS,
         subsets=CMP_SUBSETS,
         resequencing=CMP_RESEQ,
-        cfg={k: CMP[k] for k in CMP_CLIP_KEYS},
+        cfg=clips_cfg(config),
     threads: 1
     resources:
         mem_mb=1000,
@@ -296,3 +289,17 @@ COMPARE_SUMMARY = [
     },
 ]
 COMPARE_VERDICTS = [R("compare/verdicts.csv"), R("compare/sanity_checks.csv")]
+# Key figures for the summary and the report's home page, with what to see in them.
+COMPARE_FIGURES = [
+    {
+        "png": R("compare/metrics.png"),
+        "caption": "Every generator's values over held-out clips x seeds, one panel per metric (box: "
+        "interquartile range; grey: the realism bounds replay and concat): a generator whose box lies apart "
+        "from another's wins that metric beyond the spread.",
+    },
+    {
+        "png": R("compare/strips.png"),
+        "caption": "One skeleton strip per generator from the same start (seams in red): where each generator "
+        "breaks the motion, and whether its poses stay plausible.",
+    },
+]

@@ -1,7 +1,7 @@
 # One summary for all four systems, the report's home page, benchmark aggregation.
-# Each family's .smk defines <FAMILY>_SUMMARY (tables for summary.md) and
-# <FAMILY>_VERDICTS (its verdicts.csv files); they are collected here for the
-# families that run (see FAMILY_RAN in common.smk).
+# Each family of the registry (animsynth.families) has a .smk that defines <FAMILY>_SUMMARY
+# (tables for summary.md), <FAMILY>_VERDICTS (its verdicts.csv files) and <FAMILY>_FIGURES
+# (its key figures); they are collected here for the families that run (see FAMILY_RAN in common.smk).
 import os
 import re
 
@@ -12,21 +12,8 @@ DATA_SUMMARY = [
         "note": "Subsets, pose dimension (56 = 62 DOF minus the root), lengths and total nodes.",
     }
 ]
-FAMILY_SUMMARIES = {
-    "data": DATA_SUMMARY,
-    "simplicial": SIMPLICIAL_SUMMARY,
-    "resequencing": RESEQUENCING_SUMMARY,
-    "facegraph": FACEGRAPH_SUMMARY,
-    "meshdetail": MESHDETAIL_SUMMARY,
-    "compare": COMPARE_SUMMARY,
-}
-FAMILY_VERDICTS = {
-    "simplicial": SIMPLICIAL_VERDICTS,
-    "resequencing": RESEQUENCING_VERDICTS,
-    "facegraph": FACEGRAPH_VERDICTS,
-    "meshdetail": MESHDETAIL_VERDICTS,
-    "compare": COMPARE_VERDICTS,
-}
+FAMILY_SUMMARIES = {"data": DATA_SUMMARY, **{f.name: family_part(f.name, "SUMMARY") for f in FAMILIES}}
+FAMILY_VERDICTS = {f.name: family_part(f.name, "VERDICTS") for f in FAMILIES}
 # Every table of the summary, in order, with its family; the first table of each family (the data layer's
 # aside) is its key table, shown in the family's section beside its key figures; the others go to the
 # summary's detailed tables.
@@ -41,55 +28,9 @@ SUMMARY_SECTIONS = [
 # is byte-identical between two runs of one config.
 SUMMARY_TIMING = [s["csv"] for s in SUMMARY_SECTIONS if re.search(r"(^|_)timing\.csv$", os.path.basename(s["csv"]))]
 VERDICT_FILES = [v for fam, vs in FAMILY_VERDICTS.items() if FAMILY_RAN[fam] for v in vs]
-# Each family's key figures, shown in its section of summary.md and of the report's home page, with what to
-# see in them (the first dataset or sequence of the run where a family draws one per dataset).
-FAMILY_FIGURES = {
-    "simplicial": [
-        {
-            "png": R("simplicial/figures/fig6_paths_delaunay.png"),
-            "caption": "Held-out (black) against generated (red) latent paths of the Delaunay field, one panel per "
-            "fold: the closer the red path ends to the black one's final square, the smaller Error F; the panel "
-            "titles give the Error A and F that Table II takes the median of.",
-        }
-    ],
-    "resequencing": [
-        {
-            "png": R(f"resequencing/figures/fig3_residual_variance_{RESEQ_DATASETS[0]}.png"),
-            "caption": f"Residual variance against embedding dimension ({RESEQ_DATASETS[0]}): red (ST-Isomap) "
-            "below blue (Isomap) means the spatio-temporal embedding explains the motion's geodesic distances "
-            "with fewer dimensions, the paper's Fig. 3 claim; solid = L2, dashed = Lee metric.",
-        }
-    ] if RESEQ_DATASETS else [],
-    "meshdetail": [
-        {
-            "png": R(f"meshdetail/{MD_NAMES[0]}/fig5c.png"),
-            "caption": f"Per-frame mean vertex error on held-out frames ({MD_NAMES[0]}, blocked cross-validation): "
-            "the hybrid below linear blend skinning alone is the paper's claim that the learned detail helps on "
-            "frames it never saw; the plain GP and ridge lines are the baselines it must beat.",
-        }
-    ] if MD_NAMES else [],
-    "facegraph": [
-        {
-            "png": R("facegraph/trajectories.png"),
-            "caption": "Landmark trajectories of original sequences (blue) and their re-synthesis through the region "
-            "graphs (red): the same shape and timing is the Table 1 claim that synthesis keeps the original "
-            "durations and displacements.",
-        }
-    ],
-    "compare": [
-        {
-            "png": R("compare/metrics.png"),
-            "caption": "Every generator's values over held-out clips x seeds, one panel per metric (box: "
-            "interquartile range; grey: the realism bounds replay and concat): a generator whose box lies apart "
-            "from another's wins that metric beyond the spread.",
-        },
-        {
-            "png": R("compare/strips.png"),
-            "caption": "One skeleton strip per generator from the same start (seams in red): where each generator "
-            "breaks the motion, and whether its poses stay plausible.",
-        },
-    ],
-}
+# Each family's key figures (<FAMILY>_FIGURES of its .smk), shown in its section of summary.md and of the report's
+# home page, with what to see in them; in the report's order.
+FAMILY_FIGURES = {f.name: family_part(f.name, "FIGURES") for f in report_order()}
 KEY_FIGURES = {fam: figs for fam, figs in FAMILY_FIGURES.items() if FAMILY_RAN[fam]}
 BENCH_SCRIPTS = sorted(glob_wildcards("benchmarks/bench_{name}.py").name)
 # With the scale study on, its 100,000-frame re-sequencing rows join benchmarks.csv.

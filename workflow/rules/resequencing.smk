@@ -279,3 +279,12 @@ RESEQUENCING_SUMMARY = [
     },
 ]
 RESEQUENCING_VERDICTS = [R("resequencing/verdicts.csv")]
+# Key figures for the summary and the report's home page, with what to see in them.
+RESEQUENCING_FIGURES = [
+    {
+        "png": R(f"resequencing/figures/fig3_residual_variance_{RESEQ_DATASETS[0]}.png"),
+        "caption": f"Residual variance against embedding dimension ({RESEQ_DATASETS[0]}): red (ST-Isomap) "
+        "below blue (Isomap) means the spatio-temporal embedding explains the motion's geodesic distances "
+        "with fewer dimensions, the paper's Fig. 3 claim; solid = L2, dashed = Lee metric.",
+    }
+] if RESEQ_DATASETS else []

@@ -2,6 +2,8 @@
 # landmark-vs-exact size, the 100,000-frame re-sequencing benchmark, and the
 # aggregation (cost_curves.csv, exponents, log-log plot). Included only when
 # config key scale.enabled is true (config/scale.yaml).
+from animsynth.families import scaled as scaled_families
+
 SCALE = config["scale"]
 SCALE_SOURCE = SCALE["source"]
 if SCALE_SOURCE == "cmu" and not os.path.isdir(os.path.join(str(config["cmu_mirror"]), "subjects")):
@@ -11,13 +13,15 @@ if SCALE_SOURCE == "cmu" and not os.path.isdir(os.path.join(str(config["cmu_mirr
 SCALE_MIRROR = config["cmu_mirror"] if SCALE_SOURCE == "cmu" else None
 
 
-# (family, point) of every cost-curve job; meshdetail points are frames x resolution.
-SCALE_POINTS = (
-    [("resequencing", f"n{n}") for n in SCALE["resequencing"]["sizes"]]
-    + [("simplicial", f"n{n}") for n in SCALE["simplicial"]["sizes"]]
-    + [("facegraph", f"n{n}") for n in SCALE["facegraph"]["sizes"]]
-    + [("meshdetail", f"n{n}_r{r}") for n in SCALE["meshdetail"]["sizes"] for r in SCALE["meshdetail"]["resolutions"]]
-)
+# (family, point) of every cost-curve job, for every family the registry says the scale study measures
+# (animsynth.families: its sizes from scale.<family>.sizes; points of a family measured over mesh resolutions are
+# frames x resolution).
+SCALE_POINTS = [
+    (f.name, f"n{n}_r{r}" if f.scale.resolutions else f"n{n}")
+    for f in scaled_families()
+    for n in SCALE[f.name]["sizes"]
+    for r in (SCALE[f.name]["resolutions"] if f.scale.resolutions else [None])
+]
 SCALE_TARGETS = [
     R("scale/cost_curves.csv"),
     R("scale/cost_exponents.csv"),
@@ -30,7 +34,7 @@ SCALE_TARGETS = [
 
 
 wildcard_constraints:
-    scfamily="resequencing|simplicial|facegraph|meshdetail",
+    scfamily="|".join(f.name for f in scaled_families()),
     scpoint=r"n\d+(_r[0-9.]+)?",
     scn=r"\d+",
 

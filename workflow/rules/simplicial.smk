@@ -380,3 +380,12 @@ SIMPLICIAL_SUMMARY = [
     },
 ]
 SIMPLICIAL_VERDICTS = [R("simplicial/verdicts.csv")]
+# Key figures for the summary and the report's home page, with what to see in them.
+SIMPLICIAL_FIGURES = [
+    {
+        "png": R("simplicial/figures/fig6_paths_delaunay.png"),
+        "caption": "Held-out (black) against generated (red) latent paths of the Delaunay field, one panel per "
+        "fold: the closer the red path ends to the black one's final square, the smaller Error F; the panel "
+        "titles give the Error A and F that Table II takes the median of.",
+    }
+]

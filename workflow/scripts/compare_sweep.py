@@ -1,5 +1,5 @@
 """budget_sweep.csv / .md / .png: the graph generators at every transition budget."""
-from animsynth.compare.tables import sweep_job
+from animsynth.compare.jobs import sweep_job
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)

@@ -1,5 +1,5 @@
 """metrics.csv, summary.csv, winners.csv, cost_timing.csv, verdicts.csv and summary.md of the comparison."""
-from animsynth.compare.tables import tables_job
+from animsynth.compare.jobs import tables_job
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)

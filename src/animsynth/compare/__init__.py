@@ -17,8 +17,9 @@ motionmatching  motion matching with inertialization and foot locking (Clavet 20
 genmm           generative motion matching (Li et al. 2023)
 poses           the pose representation the two share; footlock: motion matching's foot locking and leg IK
 fairmotion_peer fairmotion's motion graph on the same clips (the peer row), when it can be imported
-metrics         the metrics (pure numpy; metres, m/s)
-jobs            the protocol (held-out clips, starts, seeds), one generator over every clip, scored
+metrics         the metric list (``METRICS``) and the metrics (pure numpy; metres, m/s)
+jobs            every workflow step: the protocol (held-out clips, starts, seeds), one generator over every
+                clip, scored; the family's tables; the budget sweep
 tables          medians and spreads, which generator wins which metric, cost, the family's summary page
 verdicts        the side-by-side claims, decided over clips x seeds
 plots           metrics per generator with spreads, one skeleton strip per generator
@@ -33,7 +34,7 @@ _EXPORTS = {
     "Database": ".generators",
     "FieldFollower": ".generators",
     "GENERATORS": ".generators",
-    "METRICS": ".jobs",
+    "METRICS": ".metrics",
     "MotionGraph": ".motiongraph",
     "Replay": ".generators",
     "Resequencer": ".generators",

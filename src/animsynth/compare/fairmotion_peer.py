@@ -98,7 +98,7 @@ from ..kinematics import dof_values_from_local
 from ..motion import Motion
 from ..skeleton import Skeleton
 from ..kinematics import local_rotations, root_translation
-from .motiongraph import (_pair_terms, _positions_m, _transform_from_terms, _window_clouds, apply_floor_transform,
+from .motiongraph import (pair_terms, positions_m, transform_from_terms, window_clouds, apply_floor_transform,
                           budget_keep)
 
 __all__ = ["FairmotionGraph", "FairmotionUnavailable", "INSTALL_COMMAND", "FAIRMOTION_VERSION", "FIXES", "NATIVE_FPS",
@@ -408,7 +408,7 @@ class FairmotionGraph:
         self._graph_ = graph
         self._loaded_ = copy.deepcopy(graph.motions)
         self._names_ = [j.name for j in skel.joints]
-        self._pos_ = [_positions_m(c) for c in clips]
+        self._pos_ = [positions_m(c) for c in clips]
         self.fairmotion_version_ = found
         self.skeleton_ = first.skeleton
         self.fps_ = fps
@@ -425,7 +425,7 @@ class FairmotionGraph:
             raise ValueError("start must be a Motion with at least one frame")
         if not np.isclose(start.fps, self.fps_):
             raise ValueError(f"start {start.name!r} is at {start.fps:g} fps, the database at {self.fps_:g} fps")
-        q = _positions_m(start)
+        q = positions_m(start)
         m = min(self.blend, start.n_frames)
         nodes = self._graph_.graph.nodes
         up = self.upsample_
@@ -436,9 +436,9 @@ class FairmotionGraph:
             lo = max(f - m, 0)
             clouds.append(self._pos_[c][lo:lo + m])
         w = np.full(m * q.shape[1], 1.0 / (m * q.shape[1]))
-        d2, a, b, cp, cq = _pair_terms(_window_clouds(q[-m:], m), np.stack(clouds).reshape(len(ids), -1, 3), w)
+        d2, a, b, cp, cq = pair_terms(window_clouds(q[-m:], m), np.stack(clouds).reshape(len(ids), -1, 3), w)
         best = int(np.argmin(d2[0]))
-        place = _transform_from_terms(a[0, best], b[0, best], (cp[0][0], cp[1][0]), (cq[0][best], cq[1][best]))
+        place = transform_from_terms(a[0, best], b[0, best], (cp[0][0], cp[1][0]), (cq[0][best], cq[1][best]))
         return ids[best], tuple(float(x) for x in place)
 
     def _fixes(self) -> tuple:

@@ -16,7 +16,9 @@ Protocol (docs/compare.md, "Protocol"):
   ``compare.seed``, ``c`` and ``i`` (the same for every generator, so generators are compared
   seed by seed).
 
-The tables of the family are assembled by :mod:`animsynth.compare.tables`.
+Every workflow step is a function here: :func:`run_job` (one generator over every clip), :func:`tables_job`
+(the family's tables, built by :mod:`animsynth.compare.tables` and :mod:`animsynth.compare.verdicts`) and
+:func:`sweep_job` (the transition budget sweep).
 
 Files between steps: ``compare/clips.npz`` (every clip's database, held-out clip and length:
 :func:`save_clips` / :func:`load_clips`), per generator ``compare/runs/<generator>.csv`` (metrics,
@@ -39,50 +41,10 @@ from ..config import derive_seed
 from ..motion import Motion
 from ..skeleton import Skeleton
 from .generators import make_generator
+from .metrics import METRIC_NAMES, SENSITIVITY_SPEEDS
 
 log = logging.getLogger("animsynth.compare.jobs")
 
-#: every metric column of metrics.csv: (column, unit, which way is better: "lower", "higher" or "" for
-#: a descriptive number)
-METRICS = (
-    ("contact_share", "share of foot joint-frames", ""),
-    ("skate_share", "share of contact joint-frames", "lower"),
-    ("skate_m_per_contact_frame", "m", "lower"),
-    ("transition_skate_share", "share of contact joint-frames near seams", "lower"),
-    ("skating_ratio_gmd", "share of foot steps (GMD)", "lower"),
-    *((f"skate_share_at_{v:g}", f"share of contact joint-frames, {v:g} m/s", "") for v in (0.15, 0.3, 0.5)),
-    *((f"skating_ratio_gmd_at_{v:g}", f"share of foot steps (GMD), {v:g} m/s", "") for v in (0.15, 0.3, 0.5)),
-    ("velocity_jump_p95", "m/s", "lower"),
-    ("velocity_jump_max", "m/s", "lower"),
-    ("velocity_jump_over_capture", "share of frames", "lower"),
-    ("accel_jump_p95", "m/s^2", "lower"),
-    ("accel_jump_max", "m/s^2", "lower"),
-    ("accel_jump_over_capture", "share of frames", "lower"),
-    ("n_seams", "seams", ""),
-    ("seams_per_s", "1/s", ""),
-    ("transitions_kept", "transitions before pruning", ""),
-    # at the seams a generator reports (secondary: they trust the generator's own seams)
-    ("velocity_jump", "m/s", ""),
-    ("velocity_jump_ratio", "x capture median", ""),
-    ("velocity_jump_pct", "percentile in capture", ""),
-    ("accel_jump", "m/s^2", ""),
-    ("accel_jump_ratio", "x capture median", ""),
-    ("accel_jump_pct", "percentile in capture", ""),
-    ("ldlj", "log dimensionless jerk", "higher"),
-    ("sparc", "spectral arc length", "higher"),
-    ("l2p", "LAFAN1 L2P (run statistics)", "lower"),
-    ("l2p_m", "m", "lower"),
-    ("l2q", "LAFAN1 L2Q", "lower"),
-    ("npss", "NPSS", "lower"),
-    ("coverage", "share of database windows", "higher"),
-    ("local_diversity_m", "m", ""),
-    ("seed_diversity_m", "m", "higher"),
-    ("novelty_median_m", "m", ""),
-    ("copy_share", "share of frames", ""),
-)
-METRIC_NAMES = [m for m, _u, _b in METRICS]
-#: the skating threshold sensitivity speeds (m/s) of the ``*_at_<speed>`` columns
-SENSITIVITY_SPEEDS = (0.15, 0.3, 0.5)
 KEY_COLUMNS = ["clip", "group", "protocol", "generator", "seed"]
 TIMING_COLUMNS = ["generator", "clip", "database_frames", "build_cpu_s", "build_wall_s", "generate_cpu_s",
                   "generate_wall_s", "frames_generated", "peak_rss_mb"]
@@ -260,12 +222,44 @@ class Reference:
     capture_max: tuple = (np.nan, np.nan)
 
 
-def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> np.ndarray:
+class DatabaseKinematics:
+    """Positions (m, :func:`animsynth.compare.metrics.positions`) and facing (:func:`~animsynth.compare.metrics.facing`)
+    of each database motion, computed once per job for every clip and metric that reads them.
+
+    A database clip is shared by several held-out clips (leave one out) and read by the run's L2P statistics and
+    by each clip's reference: calling an instance with a motion returns its ``(positions, facing)``, computed on
+    the first call (keyed by the motion's name, checked by its values: two motions of one name and other values
+    are computed apart). The arrays are read-only (a metric that wrote into them would change the others').
+    """
+
+    def __init__(self, roles: dict | None = None):
+        self.roles = roles
+        self._memo: dict[str, tuple] = {}
+
+    def __call__(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+        from . import metrics as M
+
+        hit = self._memo.get(motion.name)
+        if hit is not None and (hit[0] is motion.values or np.array_equal(hit[0], motion.values)):
+            return hit[1], hit[2]
+        pos, fwd = M.positions(motion), M.facing(motion, self.roles)
+        pos.setflags(write=False)
+        fwd.setflags(write=False)
+        if hit is None:
+            self._memo[motion.name] = (motion.values, pos, fwd)
+        return pos, fwd
+
+
+def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None,
+              kin: DatabaseKinematics | None = None) -> np.ndarray:
     """LAFAN1's position statistics (std, (J, 3)) over the whole run's database: every distinct database clip
     of every held-out clip (by name), as LAFAN1 normalises by its whole training set. Windows of
     ``context + length`` frames (the longest of the run's clips; shorter if a database clip is shorter),
-    every ``compare.metrics.l2p_stride`` frames, aligned at the last context frame."""
+    every ``compare.metrics.l2p_stride`` frames, aligned at the last context frame (``kin``: the job's
+    :class:`DatabaseKinematics`, made here if not given)."""
     from . import metrics as M
+
+    kin = kin or DatabaseKinematics(roles)
 
     seen = {}
     for c in clips:
@@ -278,8 +272,7 @@ def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> np.nd
                          "statistics")
     window = min(max(c.context + c.length for c in clips), min(d.n_frames for d in db))
     context = min(min(c.context for c in clips), window)
-    pos = [M.positions(d) for d in db]
-    fwd = [M.facing(d, roles) for d in db]
+    pos, fwd = zip(*(kin(d) for d in db))
     return M.position_stats(pos, fwd, window, int(mcfg["l2p_stride"]), context)[1]
 
 
@@ -287,7 +280,8 @@ def _joint_count(clip: Clip) -> int:
     return len(clip.held_out.skeleton.joints)
 
 
-def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = None) -> dict:
+def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = None,
+                          kin: DatabaseKinematics | None = None) -> dict:
     """:func:`run_stats` per skeleton: {joint count: std (J, 3)}. A run of one skeleton (CMU, the demo) has one
     entry, the whole run's database; a run mixing skeletons (a user's BVH files of several sources) normalises
     each clip's L2P by the database clips of its own skeleton, logged (positions of different joint sets have no
@@ -298,31 +292,42 @@ def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = No
     if len(groups) > 1:
         log.warning("the run mixes skeletons of %s joints: each clip's L2P is normalised by the database clips of "
                     "its own skeleton", sorted(groups))
-    return {n: run_stats(cs, mcfg, roles) for n, cs in groups.items()}
+    kin = kin or DatabaseKinematics(roles)
+    return {n: run_stats(cs, mcfg, roles, kin) for n, cs in groups.items()}
 
 
-def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray | None = None) -> Reference:
+def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray | None = None,
+              kin: DatabaseKinematics | None = None) -> Reference:
     """The database side of every metric of ``clip`` (``mcfg``: the ``compare.metrics`` block; ``std``: the
-    run's L2P statistics, :func:`run_stats`; ``None``: this clip's database only)."""
+    run's L2P statistics, :func:`run_stats`; ``None``: this clip's database only; ``kin``: the job's
+    :class:`DatabaseKinematics`, made here if not given).
+
+    Forward kinematics runs once per database motion of the job (``kin``) and once for the held-out clip
+    (positions and the ground truth's world rotations from one pass)."""
     from . import metrics as M
 
+    from ..kinematics import forward_kinematics
+
+    kin = kin or DatabaseKinematics(roles)
     sk = clip.held_out.skeleton
     fps = clip.held_out.fps
     foot = M.foot_indices(sk, roles)
-    db_pos = [M.positions(d) for d in clip.database]
-    db_fwd = [M.facing(d, roles) for d in clip.database]
+    db_pos, db_fwd = (list(x) for x in zip(*(kin(d) for d in clip.database)))
     floor = (M.floor_height(db_pos, foot, float(mcfg["floor_percentile"])) if mcfg["floor_m"] is None
              else float(mcfg["floor_m"]))
     if std is None:
         window = min(clip.context + clip.length, max(p.shape[0] for p in db_pos))
         std = M.position_stats(db_pos, db_fwd, window, int(mcfg["l2p_stride"]), min(clip.context, window))[1]
-    held_pos = M.positions(clip.held_out)
+    # one pass over the held-out clip: its positions (M.positions) and the ground truth's world rotations
+    # (M.global_quaternions of the frames after the start)
+    held_pos, W = forward_kinematics(sk, clip.held_out.values, ends=True, world_rotations=True)
+    held_pos = held_pos * float(sk.length_to_m)
+    truth = slice(clip.context, clip.context + clip.length)
+    truth_q = M.align_quaternions(np.stack([r.as_quat() for r in W], axis=1)[truth])
     held_fwd = M.facing(clip.held_out, roles)
-    truth = clip.truth
     return Reference(foot, floor, M.jump_reference(db_pos, fps), std,
                      [M.pose_features(p, f) for p, f in zip(db_pos, db_fwd)],
-                     held_pos[clip.context:clip.context + clip.length], M.global_quaternions(truth),
-                     held_fwd[clip.context - 1], M.capture_max_jumps(held_pos, fps))
+                     held_pos[truth], truth_q, held_fwd[clip.context - 1], M.capture_max_jumps(held_pos, fps))
 
 
 def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict,
@@ -442,7 +447,8 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     """
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
-    std = run_stats_by_skeleton(clips, mcfg, roles)
+    kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
+    std = run_stats_by_skeleton(clips, mcfg, roles, kin)
     for clip in clips:
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
@@ -464,7 +470,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
             continue
         build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
         start = clip.start
-        ref = reference(clip, mcfg, roles, std[_joint_count(clip)])
+        ref = reference(clip, mcfg, roles, std[_joint_count(clip)], kin)
         gen_cpu = gen_wall = 0.0
         feats = []
         for i, s in enumerate(seeds):
@@ -535,3 +541,73 @@ def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict
     if "shown" in out:  # the budget sweep's jobs write metrics and timing only
         save_shown(out["shown"], shown)
         write_bvh(out["bvh"], shown)
+
+
+# ----------------------------------------------------------------------------- the family's tables
+
+
+def read_metrics(paths) -> pd.DataFrame:
+    """The generator jobs' metrics files as one table (``note``: '' where a row has none)."""
+    m = pd.concat([pd.read_csv(p, dtype={"note": str}, keep_default_na=False, na_values=[""]) for p in paths],
+                  ignore_index=True)
+    m["note"] = m["note"].fillna("")
+    return m
+
+
+def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, order) -> None:
+    """The sweep table and figure from the default run's graph-generator metrics (``inp["default"]``) and one
+    metrics file per budget and generator (``inp["sweep"]``, in the order of ``budgets`` x ``generators``)."""
+    from ..tables import write_table
+    from .plots import sweep_figure
+    from .tables import sweep_table
+
+    runs = {float(default_budget): read_metrics(inp["default"])}
+    runs[float(default_budget)] = runs[float(default_budget)][runs[float(default_budget)]["generator"]
+                                                              .isin(generators)]
+    paths = list(inp["sweep"])
+    k = 0
+    for b in budgets:
+        runs[float(b)] = read_metrics(paths[k:k + len(generators)])
+        k += len(generators)
+    table = sweep_table(runs, order)
+    write_table(table, out["table"], md=out["table_md"])
+    sweep_figure(table, out["figure"], float(default_budget))
+
+
+def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str) -> None:
+    """Assemble the family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``,
+    ``timing`` lists) into ``out``: ``metrics``, ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``),
+    ``cost`` (+ ``cost_md``), ``verdicts`` (+ ``verdicts_md``), ``summary_md`` (the family's page)."""
+    from ..atomic import atomic_write_text
+    from ..tables import write_table
+    from .tables import cost_table, data_label, sensitivity_table, summary_markdown, summary_table, winners_table
+    from .verdicts import build_verdicts, independent_groups, sanity_checks
+
+    order = list(cfg["generators"])
+    metrics = read_metrics(inp["metrics"])
+    metrics["_g"] = metrics["generator"].map({g: i for i, g in enumerate(order)})
+    clips = pd.read_csv(inp["clips"], dtype={"held_out": str})
+    metrics["_c"] = metrics["clip"].map({c: i for i, c in enumerate(clips["clip"])})
+    metrics = metrics.sort_values(["_c", "_g", "seed"], kind="stable").drop(columns=["_g", "_c"])
+    timing = pd.concat([pd.read_csv(p) for p in inp["timing"]], ignore_index=True)
+    summary = summary_table(metrics, order)
+    winners = winners_table(metrics, summary, order)
+    clips_full = pd.read_csv(inp["clips"], dtype=str)
+    n_groups = len(set(independent_groups(clips_full).values()))
+    data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
+    verdicts = build_verdicts(metrics, cfg["verdicts"], data, left_out, clips_full)
+    sanity = sanity_checks(metrics, cfg["verdicts"], data, left_out, clips_full)
+    write_table(metrics, out["metrics"], md=False)
+    write_table(timing, out["metrics_timing"], md=False)
+    write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below
+    write_table(winners, out["winners"], md=out["winners_md"])
+    write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
+    write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
+    write_table(sanity, out["sanity"], md=out["sanity_md"])
+    write_table(sensitivity_table(metrics, order), out["sensitivity"], md=out["sensitivity_md"])
+    not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
+    log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
+             metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
+             len(verdicts), ", ".join(verdicts["verdict"]))
+    atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg,
+                                                          not_built, sanity))

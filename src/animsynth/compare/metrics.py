@@ -4,6 +4,11 @@ Pure numpy functions (scipy where it helps). Every length is in metres, every sp
 in m/s^2; the vertical axis is y (:data:`UP`), as in CMU ASF/AMC and BVH. ``docs/compare.md`` (section
 "Metrics") defines each metric, names its source and says where ours differs from it.
 
+The metric list
+    :data:`METRICS` (every column of ``metrics.csv`` with its unit and which way is better),
+    :data:`METRIC_NAMES`, :data:`SENSITIVITY_SPEEDS`: read by the scoring job, the tables, the verdicts and the
+    figures, which therefore never import the jobs (nor, through them, the generators)
+
 Positions and features
     :func:`positions` (forward kinematics in metres), :func:`foot_indices`, :func:`facing`,
     :func:`body_frame`, :func:`pose_features`, :func:`global_quaternions`, :func:`align_quaternions`
@@ -37,6 +42,7 @@ from ..kinematics import facing as _hip_facing
 from ..kinematics import forward_kinematics
 
 __all__ = [
+    "METRICS", "METRIC_NAMES", "SENSITIVITY_SPEEDS",
     "UP", "positions", "foot_indices", "facing", "body_frame", "pose_features",
     "global_quaternions", "align_quaternions", "floor_height", "foot_skating", "skating_ratio", "JumpReference",
     "jump_reference", "seam_jumps", "frame_jumps", "capture_max_jumps", "speed_profile", "ldlj", "sparc",
@@ -44,6 +50,47 @@ __all__ = [
     "window_scores", "coverage", "local_diversity", "seed_diversity", "novelty",
 ]
 
+#: the skating threshold sensitivity speeds (m/s) of the ``*_at_<speed>`` columns
+SENSITIVITY_SPEEDS = (0.15, 0.3, 0.5)
+#: every metric column of metrics.csv: (column, unit, which way is better: "lower", "higher" or "" for
+#: a descriptive number)
+METRICS = (
+    ("contact_share", "share of foot joint-frames", ""),
+    ("skate_share", "share of contact joint-frames", "lower"),
+    ("skate_m_per_contact_frame", "m", "lower"),
+    ("transition_skate_share", "share of contact joint-frames near seams", "lower"),
+    ("skating_ratio_gmd", "share of foot steps (GMD)", "lower"),
+    *((f"skate_share_at_{v:g}", f"share of contact joint-frames, {v:g} m/s", "") for v in SENSITIVITY_SPEEDS),
+    *((f"skating_ratio_gmd_at_{v:g}", f"share of foot steps (GMD), {v:g} m/s", "") for v in SENSITIVITY_SPEEDS),
+    ("velocity_jump_p95", "m/s", "lower"),
+    ("velocity_jump_max", "m/s", "lower"),
+    ("velocity_jump_over_capture", "share of frames", "lower"),
+    ("accel_jump_p95", "m/s^2", "lower"),
+    ("accel_jump_max", "m/s^2", "lower"),
+    ("accel_jump_over_capture", "share of frames", "lower"),
+    ("n_seams", "seams", ""),
+    ("seams_per_s", "1/s", ""),
+    ("transitions_kept", "transitions before pruning", ""),
+    # at the seams a generator reports (secondary: they trust the generator's own seams)
+    ("velocity_jump", "m/s", ""),
+    ("velocity_jump_ratio", "x capture median", ""),
+    ("velocity_jump_pct", "percentile in capture", ""),
+    ("accel_jump", "m/s^2", ""),
+    ("accel_jump_ratio", "x capture median", ""),
+    ("accel_jump_pct", "percentile in capture", ""),
+    ("ldlj", "log dimensionless jerk", "higher"),
+    ("sparc", "spectral arc length", "higher"),
+    ("l2p", "LAFAN1 L2P (run statistics)", "lower"),
+    ("l2p_m", "m", "lower"),
+    ("l2q", "LAFAN1 L2Q", "lower"),
+    ("npss", "NPSS", "lower"),
+    ("coverage", "share of database windows", "higher"),
+    ("local_diversity_m", "m", ""),
+    ("seed_diversity_m", "m", "higher"),
+    ("novelty_median_m", "m", ""),
+    ("copy_share", "share of frames", ""),
+)
+METRIC_NAMES = [m for m, _u, _b in METRICS]
 #: Index of the vertical axis (y up: the canonical frame of :mod:`animsynth.kinematics`).
 UP = _KIN_UP
 #: Indices of the horizontal axes (x, z).

@@ -71,7 +71,8 @@ from scipy.spatial.transform import Rotation
 from ..kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation
 from ..motion import Motion
 
-__all__ = ["MotionGraph", "apply_floor_transform", "floor_alignment", "kovar_alpha", "compose_floor_transforms"]
+__all__ = ["MotionGraph", "apply_floor_transform", "floor_alignment", "kovar_alpha", "compose_floor_transforms",
+           "budget_count", "budget_keep", "positions_m", "window_clouds", "pair_terms", "transform_from_terms"]
 
 
 # --------------------------------------------------------------------------------------------------
@@ -194,19 +195,40 @@ def kovar_alpha(n: int) -> np.ndarray:
     return 2.0 * u**3 - 3.0 * u**2 + 1.0
 
 
-def _window_clouds(pos: np.ndarray, k: int) -> np.ndarray:
-    """(T, J, 3) -> (T-k+1, k*J, 3): the point cloud of every window of ``k`` frames, frame-major."""
+def window_clouds(pos: np.ndarray, k: int) -> np.ndarray:
+    """The point cloud of every window of ``k`` frames, frame-major (the points of the window's first frame,
+    then its second's, ...).
+
+    Parameters
+    ----------
+    pos : array (T, J, 3), joint positions of ``T`` frames
+    k : int, frames per window (``1 <= k <= T``)
+
+    Returns
+    -------
+    array (T-k+1, k*J, 3); row ``t`` is the window ``pos[t:t+k]``
+    """
     v = np.lib.stride_tricks.sliding_window_view(pos, k, axis=0)  # (T-k+1, J, 3, k)
     return np.ascontiguousarray(np.moveaxis(v, -1, 1)).reshape(v.shape[0], k * pos.shape[1], 3)
 
 
-def _pair_terms(P: np.ndarray, Q: np.ndarray, w: np.ndarray):
-    """Closed-form terms for every pair (row of P, row of Q) of point clouds, as matrix products.
+def pair_terms(P: np.ndarray, Q: np.ndarray, w: np.ndarray):
+    """Closed-form terms of the floor alignment (:func:`floor_alignment`) for every pair (row of P, row of Q) of
+    point clouds, as matrix products.
 
-    P (m, n, 3), Q (l, n, 3), w (n,) summing to 1. Returns ``d2`` (m, l) = the aligned weighted mean squared
-    distance, ``a``, ``b`` (m, l) with ``theta = atan2(b, a)`` (Q onto P), and the xz centroids of P and Q.
     Centring x and z per cloud first (the optimal translation removes them anyway) keeps the differences of
     large numbers out of the products.
+
+    Parameters
+    ----------
+    P : array (m, n, 3), Q : array (l, n, 3), point clouds of ``n`` corresponding points (y up)
+    w : array (n,), point weights summing to 1
+
+    Returns
+    -------
+    d2 : array (m, l), the aligned weighted mean squared distance (Q moved onto P)
+    a, b : arrays (m, l), ``theta = atan2(b, a)`` is the aligning rotation about y (:func:`transform_from_terms`)
+    cp, cq : ``(x, z)`` weighted centroids of P (two arrays (m,)) and of Q (two arrays (l,))
     """
     xp, yp, zp = P[..., 0], P[..., 1], P[..., 2]
     xq, yq, zq = Q[..., 0], Q[..., 1], Q[..., 2]
@@ -223,16 +245,18 @@ def _pair_terms(P: np.ndarray, Q: np.ndarray, w: np.ndarray):
     return np.maximum(d2, 0.0), a, b, (xpb, zpb), (xqb, zqb)
 
 
-def _transform_from_terms(a, b, cp, cq):
-    """``(theta, x0, z0)`` mapping Q onto P from the terms of :func:`_pair_terms` (arrays of equal shape)."""
+def transform_from_terms(a, b, cp, cq):
+    """The floor transform ``(theta, x0, z0)`` moving Q onto P (:func:`apply_floor_transform`), from the terms of
+    :func:`pair_terms`: ``a``, ``b`` and the centroids ``cp = (x, z)``, ``cq = (x, z)`` of the pairs wanted
+    (arrays of one shape, or scalars); returns three arrays of that shape."""
     theta = np.arctan2(b, a)
     c, s = np.cos(theta), np.sin(theta)
     (xpb, zpb), (xqb, zqb) = cp, cq
     return theta, xpb - xqb * c - zqb * s, zpb + xqb * s - zqb * c
 
 
-def _positions_m(motion: Motion) -> np.ndarray:
-    """World joint positions (segment ends) in metres, (T, J, 3)."""
+def positions_m(motion: Motion) -> np.ndarray:
+    """World joint positions (segment ends, forward kinematics) of ``motion`` in metres: array (T, J, 3)."""
     return forward_kinematics(motion.skeleton, motion.values, ends=True) * motion.skeleton.length_to_m
 
 
@@ -321,8 +345,35 @@ class MotionGraph:
         compared through their own forward kinematics; the output is on the first clip's skeleton: frames of
         another subject's clip are played with that subject's joint rotations and root translation on the
         first subject's bones (feet may then float or sink by the difference in leg length).
+
+        The paper's steps, one method each: :meth:`_check_database`, :meth:`_candidates` (point-cloud distances
+        of every pair of windows and their local minima), :meth:`_threshold` (the transitions kept),
+        :meth:`_prune` (the largest strongly connected component of the frame-level graph) and
+        :meth:`_store_frames` (what the output is assembled from).
         """
         k, b, r = self._check_params()
+        clips = self._check_database(database, k)
+        pos = [positions_m(c) for c in clips]
+        n_joints = pos[0].shape[1]
+        if any(p.shape[1] != n_joints for p in pos):
+            raise ValueError("motion graph: the clips' skeletons have different joint counts")
+        jw = _normalised_weights(self.joint_weights, n_joints)
+        lengths = np.array([c.n_frames for c in clips])
+        rows, cols, cand, terms = self._candidates(pos, lengths, np.tile(jw, k) / k, k, r)
+        keep = self._threshold(cand, float(lengths.sum()) / float(clips[0].fps))
+        rows, cols, cand = rows[keep], cols[keep], cand[keep]
+        a, bb, cen = terms
+        theta, x0, z0 = transform_from_terms(a[rows, cols], bb[rows, cols],
+                                             (cen[0][rows], cen[1][rows]), (cen[0][cols], cen[1][cols]))
+        del terms, a, bb
+        self._prune(lengths, rows, cols, cand, (theta, x0, z0), k, b)
+        self._store_frames(clips, pos, jw, k, b)
+        return self
+
+    @staticmethod
+    def _check_database(database, k: int) -> list:
+        """The clips of ``database`` as a list, checked: not empty, one DOF layout, one frame rate, each at least
+        ``k + 2`` frames."""
         clips = list(database)
         if not clips:
             raise ValueError("motion graph: the database is empty")
@@ -336,26 +387,37 @@ class MotionGraph:
             if c.n_frames < k + 2:
                 raise ValueError(f"motion graph: clip {c.name!r} has {c.n_frames} frames, fewer than "
                                  f"window + 2 = {k + 2}")
-        pos = [_positions_m(c) for c in clips]
-        n_joints = pos[0].shape[1]
-        if any(p.shape[1] != n_joints for p in pos):
-            raise ValueError("motion graph: the clips' skeletons have different joint counts")
-        jw = _normalised_weights(self.joint_weights, n_joints)
-        w = np.tile(jw, k) / k
+        return clips
 
-        lengths = np.array([c.n_frames for c in clips])
-        offsets = np.concatenate([[0], np.cumsum(lengths)])
+    @staticmethod
+    def _candidates(pos: list, lengths: np.ndarray, w: np.ndarray, k: int, r: int):
+        """Candidate transitions: the local minima of the aligned window distance inside each pair of clips.
+
+        Parameters
+        ----------
+        pos : list of arrays (frames, J, 3), every clip's joint positions (m)
+        lengths : int array (clips,)
+        w : array (k * J,), the point weights of a window (summing to 1)
+        k, r : the window and the local-minimum radius
+
+        Returns
+        -------
+        rows, cols : int arrays (candidates,), the windows (indices into all clips' windows, clip by clip) of A
+            (starting at A_i) and of B (ending at B_j)
+        cand : array (candidates,), their RMS distance (m)
+        terms : ``(a, b, centroids)`` of :func:`pair_terms` for every pair of windows (the transforms of the
+            kept candidates come from them)
+        """
         n_win = lengths - k + 1
         win_off = np.concatenate([[0], np.cumsum(n_win)])
-        clouds = np.concatenate([_window_clouds(p, k) for p in pos])
-        d2, a, bb, cen, _ = _pair_terms(clouds, clouds, w)
+        clouds = np.concatenate([window_clouds(p, k) for p in pos])
+        d2, a, bb, cen, _ = pair_terms(clouds, clouds, w)
         dist = np.sqrt(d2)
-
-        # local minima inside each pair of clips, then the validity rules
+        del d2
         rows, cols = [], []
-        for ca in range(len(clips)):
+        for ca in range(len(lengths)):
             ra = slice(win_off[ca], win_off[ca + 1])
-            for cb in range(len(clips)):
+            for cb in range(len(lengths)):
                 rb = slice(win_off[cb], win_off[cb + 1])
                 block = dist[ra, rb]
                 is_min = block <= minimum_filter(block, size=2 * r + 1, mode="nearest")
@@ -367,24 +429,35 @@ class MotionGraph:
                 cols.append(s[ok] + win_off[cb])
         rows = np.concatenate(rows)
         cols = np.concatenate(cols)
-        cand = dist[rows, cols]
+        return rows, cols, dist[rows, cols], (a, bb, cen)
+
+    def _threshold(self, cand: np.ndarray, database_seconds: float) -> np.ndarray:
+        """Which candidates become transitions (bool (candidates,)): the transition budget's smallest, else those
+        at or below the threshold (given, or the ``threshold_quantile`` quantile of the candidates). Sets
+        ``n_candidates_``, ``threshold_`` and ``n_below_threshold_``."""
         self.n_candidates_ = int(cand.size)
         if cand.size == 0:
             raise ValueError("motion graph: no candidate transitions (local minima) in the database")
         if self.transitions_per_s is not None:
-            keep = budget_keep(cand, float(self.transitions_per_s), float(lengths.sum()) / float(first.fps))
+            keep = budget_keep(cand, float(self.transitions_per_s), database_seconds)
             self.threshold_ = float(cand[keep].max())
         else:
             self.threshold_ = (float(self.threshold) if self.threshold is not None
                                else float(np.quantile(cand, float(self.threshold_quantile))))
             keep = cand <= self.threshold_
         self.n_below_threshold_ = int(keep.sum())
-        rows, cols, cand = rows[keep], cols[keep], cand[keep]
-        theta, x0, z0 = _transform_from_terms(a[rows, cols], bb[rows, cols],
-                                              (cen[0][rows], cen[1][rows]), (cen[0][cols], cen[1][cols]))
-        del d2, a, bb, dist
+        return keep
 
-        win_clip = np.repeat(np.arange(len(clips)), n_win)
+    def _prune(self, lengths: np.ndarray, rows: np.ndarray, cols: np.ndarray, cand: np.ndarray, transforms,
+               k: int, b: int) -> None:
+        """The frame-level graph (every frame to the next of its clip, the kept transitions from their first
+        blended frame of A to B_{j+1}) pruned to its largest strongly connected component. Sets
+        ``n_nodes_``, ``largest_scc_share_``, ``in_graph_``, ``transitions_`` and the walk's arrays."""
+        theta, x0, z0 = transforms
+        offsets = np.concatenate([[0], np.cumsum(lengths)])
+        n_win = lengths - k + 1
+        win_off = np.concatenate([[0], np.cumsum(n_win)])
+        win_clip = np.repeat(np.arange(len(lengths)), n_win)
         win_start = np.arange(win_off[-1]) - win_off[win_clip]
         ca, i = win_clip[rows], win_start[rows]
         cb, s = win_clip[cols], win_start[cols]
@@ -393,7 +466,7 @@ class MotionGraph:
 
         # frame-level graph: next frame of the same clip, and the transitions
         n = int(offsets[-1])
-        clip_of = np.repeat(np.arange(len(clips)), lengths)
+        clip_of = np.repeat(np.arange(len(lengths)), lengths)
         has_next = np.ones(n, bool)
         has_next[offsets[1:] - 1] = False
         nat_from = np.nonzero(has_next)[0]
@@ -421,7 +494,7 @@ class MotionGraph:
         self._has_next_ = has_next
         self._nat_ok_ = has_next & in_scc & np.concatenate([in_scc[1:], [False]])
         self._in_scc_ = in_scc
-        self.in_graph_ = [in_scc[offsets[c]:offsets[c + 1]].copy() for c in range(len(clips))]
+        self.in_graph_ = [in_scc[offsets[c]:offsets[c + 1]].copy() for c in range(len(lengths))]
         self._clip_of_ = clip_of
         self._frame_of_ = np.arange(n) - offsets[clip_of]
         self._offsets_ = offsets
@@ -432,7 +505,10 @@ class MotionGraph:
         keep_edges = np.concatenate([self._nat_ok_[nat_from], tr])
         self._graph_ = csr_matrix((wts[keep_edges], (src[keep_edges], dst[keep_edges])), shape=(n, n))
 
-        # per-frame data for the output: local rotations, root translation (m), positions (m)
+    def _store_frames(self, clips: list, pos: list, jw: np.ndarray, k: int, b: int) -> None:
+        """Per-frame data for the output (local rotations, root translation and positions in metres) and the
+        fitted attributes that describe it."""
+        first = clips[0]
         self._quat_ = np.concatenate([np.stack([r.as_quat() for r in local_rotations(c.skeleton, c.values)], 1)
                                       for c in clips])
         self._root_ = np.concatenate([root_translation(c.skeleton, c.values) * c.skeleton.length_to_m
@@ -443,7 +519,6 @@ class MotionGraph:
         self.fps_ = float(first.fps)
         self.window_, self.blend_ = k, b
         self.clip_names_ = [c.name for c in clips]
-        return self
 
     # ---------------------------------------------------------------- queries
     def _check_fitted(self):
@@ -461,7 +536,7 @@ class MotionGraph:
             raise ValueError("start must be a Motion with at least one frame")
         if not np.isclose(start.fps, self.fps_):
             raise ValueError(f"start {start.name!r} is at {start.fps:g} fps, the database at {self.fps_:g} fps")
-        q = _positions_m(start)
+        q = positions_m(start)
         if q.shape[1] != self._pos_.shape[1]:
             raise ValueError(f"start {start.name!r} has {q.shape[1]} joints, the database {self._pos_.shape[1]}")
         m = min(self.window_, start.n_frames)
@@ -469,7 +544,7 @@ class MotionGraph:
         ends, clouds = [], []
         for c in range(len(self._offsets_) - 1):
             lo, hi = self._offsets_[c], self._offsets_[c + 1]
-            clouds.append(_window_clouds(self._pos_[lo:hi], m))
+            clouds.append(window_clouds(self._pos_[lo:hi], m))
             ends.append(np.arange(lo + m - 1, hi))
         ends = np.concatenate(ends)
         clouds = np.concatenate(clouds)
@@ -477,14 +552,35 @@ class MotionGraph:
         ok = self._has_next_[ends] & self._in_scc_[np.minimum(ends + 1, n - 1)]
         if not ok.any():
             raise ValueError("motion graph: no graph node follows a database window")
-        d2, a, b, cp, cq = _pair_terms(_window_clouds(q[-m:], m), clouds[ok], w)
+        d2, a, b, cp, cq = pair_terms(window_clouds(q[-m:], m), clouds[ok], w)
         best = int(np.argmin(d2[0]))
-        theta, x0, z0 = _transform_from_terms(a[0, best], b[0, best], (cp[0][0], cp[1][0]),
+        theta, x0, z0 = transform_from_terms(a[0, best], b[0, best], (cp[0][0], cp[1][0]),
                                               (cq[0][best], cq[1][best]))
         return int(ends[ok][best]) + 1, (float(theta), float(x0), float(z0))
 
     def _out_transitions(self, g: int) -> np.ndarray:
         return np.arange(self._tr_ptr_[g], self._tr_ptr_[g + 1])
+
+    def _play_on(self, g: int, steps: list, n_out: int, length: int, choose) -> tuple[list, int]:
+        """The walk from node ``g`` until ``length`` output frames (the one play-on loop of :meth:`generate` and
+        :meth:`search`).
+
+        At every node ``choose(nat, transitions)`` picks the out-edge: ``nat`` (bool) says whether the next frame
+        of the clip is in the graph, ``transitions`` (int array) are the indices of the transitions that leave
+        there; it returns ``None`` to play on, else the index of the transition taken. Appends to ``steps``
+        (database frames >= 0, transitions as ``-1 - index``) and returns ``(steps, output frames)``.
+        """
+        while n_out < length:
+            t = choose(bool(self._nat_ok_[g]), self._out_transitions(g))
+            if t is None:
+                steps.append(g)
+                n_out += 1
+                g += 1
+            else:
+                steps.append(-1 - t)
+                n_out += self.blend_
+                g = int(self._land_[t])
+        return steps, n_out
 
     def generate(self, start: Motion, length: int, seed: int) -> Motion:
         """A seeded random walk of ``length`` frames from the node nearest the end of ``start``.
@@ -502,20 +598,12 @@ class MotionGraph:
         length = self._check_length(length)
         node, place = self._start_node(start)
         rng = np.random.default_rng(seed)
-        steps, n_out, g = [], 0, node
-        while n_out < length:
-            trs = self._out_transitions(g)
-            nat = bool(self._nat_ok_[g])
+
+        def uniform(nat: bool, trs: np.ndarray):
             pick = int(rng.integers(nat + trs.size))
-            if nat and pick == 0:
-                steps.append(g)
-                n_out += 1
-                g += 1
-            else:
-                t = int(trs[pick - nat])
-                steps.append(-1 - t)
-                n_out += self.blend_
-                g = int(self._land_[t])
+            return None if nat and pick == 0 else int(trs[pick - nat])
+
+        steps, _ = self._play_on(node, [], 0, length, uniform)
         return self._assemble(steps, place, length, f"motion_graph_walk_seed{seed}",
                               {"start_node": self._source(node)})
 
@@ -548,7 +636,7 @@ class MotionGraph:
                              f"{np.shape(target)}")
         tp = forward_kinematics(self.skeleton_, tgt[None], ends=True) * self.skeleton_.length_to_m
         nodes = np.nonzero(self._in_scc_)[0]
-        d2, *_ = _pair_terms(tp, self._pos_[nodes], self._jw_)
+        d2, *_ = pair_terms(tp, self._pos_[nodes], self._jw_)
         goal = int(nodes[int(np.argmin(d2[0]))])
         _, pred = dijkstra(self._graph_, indices=node, return_predecessors=True)
         path = [goal]
@@ -571,18 +659,11 @@ class MotionGraph:
                 n_out += self.blend_
         target_frame = n_out if n_out < length else -1
         path_frames = n_out + 1
-        g = goal
-        while n_out < length:
-            if self._nat_ok_[g]:
-                steps.append(g)
-                n_out += 1
-                g += 1
-            else:
-                trs = self._out_transitions(g)
-                t = int(trs[np.argmin(self._tr_dist_[trs])])
-                steps.append(-1 - t)
-                n_out += self.blend_
-                g = int(self._land_[t])
+
+        def nearest(nat: bool, trs: np.ndarray):
+            return None if nat else int(trs[np.argmin(self._tr_dist_[trs])])
+
+        steps, n_out = self._play_on(goal, steps, n_out, length, nearest)
         return self._assemble(steps, place, length, "motion_graph_search",
                               {"start_node": self._source(node), "target_node": self._source(goal),
                                "target_frame": target_frame, "path_frames": path_frames})

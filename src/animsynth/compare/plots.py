@@ -7,7 +7,7 @@ import pandas as pd
 
 from ..atomic import atomic_path
 from .generators import REFERENCES
-from .jobs import METRICS
+from .metrics import METRICS
 
 __all__ = ["FIGURE_METRICS", "metrics_figure", "strips_figure", "sweep_figure"]
 

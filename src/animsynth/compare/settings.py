@@ -12,7 +12,8 @@ from ..config import ConfigError
 
 log = logging.getLogger("animsynth.compare")
 
-__all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "generator_cfg", "unavailable"]
+__all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "clips_cfg", "job_cfg", "unavailable",
+           "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
 def groups(config: dict) -> tuple[dict, dict]:
@@ -68,10 +69,52 @@ def run_generators(config: dict) -> tuple[list[str], dict]:
     return run, left
 
 
-def generator_cfg(config: dict) -> dict:
-    """The config a generator job reads: the ``compare`` block plus the re-sequencing study's ST-Isomap
-    parameters (``resequencing.stisomap``: the compare family runs that study's method)."""
-    return dict(config["compare"], stisomap=dict(config["resequencing"]["stisomap"]))
+#: the ``compare`` keys the clips job reads (the protocol: rate, start, lengths, temporal split)
+CLIP_KEYS = ("fps", "context", "length", "min_length", "holdout_fraction")
+#: the ``compare`` keys every generator job reads
+RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
+#: each generator's own ``compare`` block (a changed block reruns only the jobs of the generators that read it)
+GENERATOR_BLOCKS = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph",
+                    "stisomap": "resequencing_graph", "motion_graph": "motion_graph", "fairmotion": "fairmotion",
+                    "fairmotion_fixed": "fairmotion", "motion_matching": "motion_matching",
+                    "motion_matching_pose": "motion_matching", "genmm": "genmm", "concat": "concat"}
+
+
+def clips_cfg(config: dict) -> dict:
+    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block)."""
+    return {k: config["compare"][k] for k in CLIP_KEYS}
+
+
+def job_cfg(config: dict, generator: str | None = None, budget: float | None = None) -> dict:
+    """The config one generator job reads, built the same way for the workflow and the tests.
+
+    Parameters
+    ----------
+    config : the whole (validated) config
+    generator : a generator name: :data:`RUN_KEYS`, the generator's own block (:data:`GENERATOR_BLOCKS`) and,
+        for ``stisomap``, the re-sequencing study's ST-Isomap parameters (``resequencing.stisomap``: the compare
+        family runs that study's method); ``None``: the config of every generator at once (each block and
+        ``stisomap``), for a caller that fits several generators from one config
+    budget : a transition budget of the budget sweep (``compare.budget_sweep``): ``transitions_per_s`` set to it
+        and ``compare.budget_sweep_seeds`` seeds (at most ``compare.seeds``)
+
+    Returns
+    -------
+    dict, the keys in that order (the workflow hands it to the job as a param: the same dict reruns nothing)
+    """
+    cmp = config["compare"]
+    cfg = {k: cmp[k] for k in RUN_KEYS}
+    names = list(GENERATOR_BLOCKS) if generator is None else [generator]
+    for name in names:
+        block = GENERATOR_BLOCKS.get(name)
+        if block:
+            cfg[block] = cmp[block]
+    if "stisomap" in names:
+        cfg["stisomap"] = dict(config["resequencing"]["stisomap"])
+    if budget is not None:
+        cfg["transitions_per_s"] = float(budget)
+        cfg["seeds"] = min(int(cmp["seeds"]), int(cmp["budget_sweep_seeds"]))
+    return cfg
 
 
 def check(config: dict) -> None:

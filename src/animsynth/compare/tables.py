@@ -9,12 +9,13 @@ import numpy as np
 import pandas as pd
 
 from .generators import REFERENCES
-from .jobs import METRIC_NAMES, METRICS
+from .metrics import METRIC_NAMES, METRICS, SENSITIVITY_SPEEDS
+from .verdicts import pair_outcomes
 
 log = logging.getLogger("animsynth.compare.tables")
 
-__all__ = ["summary_table", "paired_share", "winners_table", "cost_table", "data_label", "summary_markdown",
-           "tables_job", "sensitivity_table", "sweep_table", "sweep_job", "results_markdown"]
+__all__ = ["summary_table", "winners_table", "cost_table", "data_label", "summary_markdown", "sensitivity_table",
+           "sweep_table", "results_markdown"]
 
 #: the columns of the budget sweep table (medians over clips x seeds)
 SWEEP_METRICS = ("transitions_kept", "skate_share", "transition_skate_share", "skating_ratio_gmd", "velocity_jump_p95",
@@ -49,19 +50,6 @@ def summary_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
                                       "p95"])
 
 
-def paired_share(metrics: pd.DataFrame, a: str, b: str, metric: str, better: str = "lower"):
-    """Over the clip x seed pairs where both generators have a value: (a better, b better, ties)."""
-    key = ["clip", "seed"]
-    A = metrics[metrics["generator"] == a].set_index(key)[metric]
-    B = metrics[metrics["generator"] == b].set_index(key)[metric]
-    j = pd.concat([A.rename("a"), B.rename("b")], axis=1, join="inner").apply(pd.to_numeric, errors="coerce")
-    j = j[np.isfinite(j["a"]) & np.isfinite(j["b"])]
-    d = (j["a"] - j["b"]).to_numpy(float)
-    if better == "higher":
-        d = -d
-    return int(np.sum(d < 0)), int(np.sum(d > 0)), int(np.sum(d == 0))
-
-
 def winners_table(metrics: pd.DataFrame, summary: pd.DataFrame, order) -> pd.DataFrame:
     """Per metric with a direction: the best and the second-best generator (reference rows aside) by
     median, the margin, whether the IQRs are apart ("beyond the spread"), the share of clip x seed pairs
@@ -77,7 +65,8 @@ def winners_table(metrics: pd.DataFrame, summary: pd.DataFrame, order) -> pd.Dat
         s = s.sort_values("median", ascending=(better == "lower"), kind="stable")
         a, b = s.iloc[0], s.iloc[1]
         apart = (a["q75"] < b["q25"]) if better == "lower" else (a["q25"] > b["q75"])
-        wins, losses, ties = paired_share(metrics, a["generator"], b["generator"], m, better)
+        outcome = pair_outcomes(metrics, a["generator"], b["generator"], m, better)["outcome"]
+        wins, losses, ties = int((outcome > 0).sum()), int((outcome < 0).sum()), int((outcome == 0).sum())
         ref = {g: summary[(summary["metric"] == m) & (summary["generator"] == g)]["median"] for g in REFERENCES}
         rows.append({"metric": m, "unit": _unit(m), "better": better, "best": a["generator"],
                      "best_median": a["median"], "best_q25": a["q25"], "best_q75": a["q75"],
@@ -114,11 +103,9 @@ def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
 
 
 def sensitivity_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
-    """Skating against its speed threshold: per generator and speed (:data:`animsynth.compare.jobs.SENSITIVITY_SPEEDS`)
+    """Skating against its speed threshold: per generator and speed (:data:`animsynth.compare.metrics.SENSITIVITY_SPEEDS`)
     the median skate share (ours) and GMD-style skating ratio over clips x seeds, and each generator's rank
     (1 = skates least, reference rows aside) by each, so a reader sees whether the order holds."""
-    from .jobs import SENSITIVITY_SPEEDS
-
     rows = []
     gens = order_generators(metrics["generator"].unique(), order)
     for v in SENSITIVITY_SPEEDS:
@@ -153,32 +140,6 @@ def sweep_table(runs: dict, order) -> pd.DataFrame:
                 row[f"{k}_median"] = float(x.median()) if x.notna().any() else np.nan
             rows.append(row)
     return pd.DataFrame(rows)
-
-
-def _read_metrics(paths) -> pd.DataFrame:
-    m = pd.concat([pd.read_csv(p, dtype={"note": str}, keep_default_na=False, na_values=[""]) for p in paths],
-                  ignore_index=True)
-    m["note"] = m["note"].fillna("")
-    return m
-
-
-def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, order) -> None:
-    """The sweep table and figure from the default run's graph-generator metrics (``inp["default"]``) and one
-    metrics file per budget and generator (``inp["sweep"]``, in the order of ``budgets`` x ``generators``)."""
-    from ..tables import write_table
-    from .plots import sweep_figure
-
-    runs = {float(default_budget): _read_metrics(inp["default"])}
-    runs[float(default_budget)] = runs[float(default_budget)][runs[float(default_budget)]["generator"]
-                                                              .isin(generators)]
-    paths = list(inp["sweep"])
-    k = 0
-    for b in budgets:
-        runs[float(b)] = _read_metrics(paths[k:k + len(generators)])
-        k += len(generators)
-    table = sweep_table(runs, order)
-    write_table(table, out["table"], md=out["table_md"])
-    sweep_figure(table, out["figure"], float(default_budget))
 
 
 # ----------------------------------------------------------------------------- the family's summary
@@ -234,44 +195,6 @@ def _num(x) -> str:
     from ..verdicts import fmt
 
     return fmt(x, 4)
-
-
-def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str) -> None:
-    """Assemble the family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``,
-    ``timing`` lists) into ``out``: ``metrics``, ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``),
-    ``cost`` (+ ``cost_md``), ``verdicts`` (+ ``verdicts_md``), ``summary_md`` (the family's page)."""
-    from ..atomic import atomic_write_text
-    from ..tables import write_table
-    from .verdicts import build_verdicts, independent_groups, sanity_checks
-
-    order = list(cfg["generators"])
-    metrics = _read_metrics(inp["metrics"])
-    metrics["_g"] = metrics["generator"].map({g: i for i, g in enumerate(order)})
-    clips = pd.read_csv(inp["clips"], dtype={"held_out": str})
-    metrics["_c"] = metrics["clip"].map({c: i for i, c in enumerate(clips["clip"])})
-    metrics = metrics.sort_values(["_c", "_g", "seed"], kind="stable").drop(columns=["_g", "_c"])
-    timing = pd.concat([pd.read_csv(p) for p in inp["timing"]], ignore_index=True)
-    summary = summary_table(metrics, order)
-    winners = winners_table(metrics, summary, order)
-    clips_full = pd.read_csv(inp["clips"], dtype=str)
-    n_groups = len(set(independent_groups(clips_full).values()))
-    data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
-    verdicts = build_verdicts(metrics, cfg["verdicts"], data, left_out, clips_full)
-    sanity = sanity_checks(metrics, cfg["verdicts"], data, left_out, clips_full)
-    write_table(metrics, out["metrics"], md=False)
-    write_table(timing, out["metrics_timing"], md=False)
-    write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below
-    write_table(winners, out["winners"], md=out["winners_md"])
-    write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
-    write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
-    write_table(sanity, out["sanity"], md=out["sanity_md"])
-    write_table(sensitivity_table(metrics, order), out["sensitivity"], md=out["sensitivity_md"])
-    not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
-    log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
-             metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
-             len(verdicts), ", ".join(verdicts["verdict"]))
-    atomic_write_text(out["summary_md"], summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg,
-                                                          not_built, sanity))
 
 
 #: the columns of the results section of docs/compare.md (metric, heading)

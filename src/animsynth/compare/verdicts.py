@@ -46,7 +46,7 @@ import pandas as pd
 
 from .. import verdicts as V
 from .generators import REFERENCES
-from .jobs import METRICS
+from .metrics import METRICS
 
 __all__ = ["independent_groups", "group_outcomes", "decide_groups", "pair_outcomes", "per_clip", "build_verdicts",
            "sanity_checks"]
