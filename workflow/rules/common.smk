@@ -397,6 +397,8 @@ def compare_job_cfg(wildcards):
         cfg[block] = CMP[block]
     if wildcards.cmpgen == "stisomap":
         cfg["stisomap"] = dict(config["resequencing"]["stisomap"])
+    if wildcards.cmpgen in CMP_USER:  # a user generator: its spec and its file's hash (a changed file reruns it)
+        cfg.update(user_job_cfg(config, wildcards.cmpgen))
     return cfg
 
 

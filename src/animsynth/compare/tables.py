@@ -8,7 +8,7 @@ import logging
 import numpy as np
 import pandas as pd
 
-from .generators import REFERENCES
+from .generators import GENERATORS, REFERENCES
 from .jobs import METRIC_NAMES, METRICS
 
 log = logging.getLogger("animsynth.compare.tables")
@@ -204,9 +204,20 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
     if left_out:
         out += ["Left out: " + "; ".join(f"**{g}**: {why}" for g, why in left_out.items()) + ".", ""]
     if not_built is not None and len(not_built):
+        failed = not_built[not_built["note"].str.startswith("failed: ")].drop_duplicates("generator")
+        not_built = not_built[~not_built["note"].str.startswith("failed: ")]
+        if len(failed):  # a user generator that could not run: one line each, its rows empty
+            out += ["Failed (no values at all): " + "; ".join(
+                f"**{r.generator}**: {r.note.removeprefix('failed: ')}" for r in failed.itertuples()) + ".", ""]
+    if not_built is not None and len(not_built):
         out += ["Not built (no values for these clips): " + "; ".join(
             f"**{r.generator}** on {r.clip} ({r.note.removeprefix('not built: ')})"
             for r in not_built.itertuples()) + ".", ""]
+    user = [g for g in generators if g not in GENERATORS]
+    if user:
+        out += ["Your own generators (compare.user_generators): " + ", ".join(f"**{g}**" for g in user) + ". They "
+                "run on the same clips, seeds and metrics and are in every table and figure; the verdicts and sanity "
+                "checks below are the family's own claims, decided without them.", ""]
     out += ["## Which generator wins which metric", "",
             "Best and second-best by median over clips x seeds (the reference rows replay and concat aside); "
             "`beyond_spread`: the two IQRs do not overlap; `best_wins_share`: share of clip x seed pairs in "
@@ -256,8 +267,10 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     clips_full = pd.read_csv(inp["clips"], dtype=str)
     n_groups = len(set(independent_groups(clips_full).values()))
     data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
-    verdicts = build(metrics, cfg["verdicts"], data, left_out, clips_full)
-    sanity = sanity_checks(metrics, cfg["verdicts"], data, left_out, clips_full)
+    # the claims are the family's own: a user generator (compare.user_generators) is in every table, not in them
+    own = metrics[metrics["generator"].isin(GENERATORS)]
+    verdicts = build(own, cfg["verdicts"], data, left_out, clips_full)
+    sanity = sanity_checks(own, cfg["verdicts"], data, left_out, clips_full)
     write_table(metrics, out["metrics"], md=False)
     write_table(timing, out["metrics_timing"], md=False)
     write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below
