@@ -128,6 +128,8 @@ class Hold:
 FAILURES += [
     ("generate raises", HOLD.format(body="        raise RuntimeError('no luck')"), "Hold",
      "generate(start, length, seed) raised RuntimeError at mine.py:11: no luck"),
+    ("exits", HOLD.format(body="        raise SystemExit(3)"), "Hold",
+     "generate(start, length, seed) raised SystemExit at mine.py:11: 3"),
     ("too few frames", HOLD.format(body="        return Motion(v[:-1], start.skeleton, start.fps)"), "Hold",
      "returned values of shape (11, "),
     ("wrong DOF", HOLD.format(body="        return Motion(v[:, 1:], start.skeleton, start.fps)"), "Hold",

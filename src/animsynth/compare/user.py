@@ -121,7 +121,7 @@ def load_class(name: str, spec: str):
         sys.path.insert(0, folder)
         try:
             ispec.loader.exec_module(module)
-        except Exception as exc:  # noqa: BLE001 - the user's code: any failure is reported as one line
+        except (Exception, SystemExit) as exc:  # noqa: BLE001 - the user's code: any failure is reported as one line
             raise UserGeneratorError(f"{head}: importing the file {_raised(exc, 'it', path).removeprefix('it ')}") \
                 from None
         finally:
@@ -185,12 +185,12 @@ class UserGenerator(Generator):
         self.db_ = Database(clips)
         try:
             model = cls()
-        except Exception as exc:  # noqa: BLE001 - the user's code
+        except (Exception, SystemExit) as exc:  # noqa: BLE001 - the user's code
             raise UserGeneratorError(f"{self._head()}: {_raised(exc, cls.__name__ + '()', self._path())}") from None
         # the user's class sees its own copy of the clips (Database: .clips, .skeleton, .fps)
         try:
             model.fit(Database([Motion(np.array(c.values, float), c.skeleton, c.fps, c.name) for c in clips]))
-        except Exception as exc:  # noqa: BLE001
+        except (Exception, SystemExit) as exc:  # noqa: BLE001
             raise UserGeneratorError(f"{self._head()}: {_raised(exc, 'fit(database)', self._path())}") from None
         self.model_ = model
         return self
@@ -201,7 +201,7 @@ class UserGenerator(Generator):
         given = Motion(np.array(start.values, float), start.skeleton, start.fps, start.name)
         try:
             out = self.model_.generate(given, length, int(seed))
-        except Exception as exc:  # noqa: BLE001
+        except (Exception, SystemExit) as exc:  # noqa: BLE001
             raise UserGeneratorError(f"{self._head()}: {_raised(exc, 'generate(start, length, seed)', self._path())}") \
                 from None
         head = f"{self._head()}: generate(start, {length}, {int(seed)})"
