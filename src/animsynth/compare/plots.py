@@ -119,8 +119,11 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
             ax.text(k * height * 0.9, pos[:, :, 1].min() - 0.08 * height, str(f - c), ha="center", fontsize=6)
         ax.set_aspect("equal")
         ax.axis("off")
-        ax.set_title(g + (f" -- no motion ({m.meta['note']})" if m.meta.get("note") else ""), fontsize=8.5,
-                     loc="left")
+        note = str(m.meta.get("note") or "")
+        if note:  # a generator that failed: its start frame at the left, the reason beside its name
+            ax.set_xlim(-0.6 * height, (n_panels - 0.4) * height * 0.9)
+            note = " -- no motion: " + (note if len(note) <= 110 else note[:107] + "...")
+        ax.set_title(g + note, fontsize=8.5, loc="left")
     _save(fig, path, title)
 
 
