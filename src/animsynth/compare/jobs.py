@@ -462,19 +462,26 @@ def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase:
     print(f"animsynth: ERROR: {line}", file=sys.stderr)
     rows, trows, shown = [], [], None
     for clip in clips:
-        key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
-        rows += [{**key, "seed": i, **{m: np.nan for m in METRIC_NAMES}, "note": f"failed: {line}"}
-                 for i in range(int(cfg["seeds"]))]
-        trows.append({"generator": generator, "clip": clip.clip, "database_frames": int(sum(d.n_frames for d in
-                                                                                             clip.database)),
-                      "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan,
-                      "generate_wall_s": np.nan, "frames_generated": 0, "peak_rss_mb": peak_rss_mb()})
+        r, t = _empty_rows(clip, generator, int(cfg["seeds"]), f"failed: {line}")
+        rows += r
+        trows.append(t)
         if showcase is not None and clip.clip == showcase[0]:
             start = clip.start
             shown = Motion(np.asarray(start.values, float), start.skeleton, start.fps, f"{generator} {clip.clip}",
                            {"context": clip.context, "seams": np.zeros(0, np.int64), "note": f"failed: {line}"})
     return (pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"]), pd.DataFrame(trows, columns=TIMING_COLUMNS),
             shown)
+
+
+def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> tuple[list, dict]:
+    """The metric rows (one per seed, no values, ``note``) and the timing row (no times) of a clip a generator
+    has no motion for."""
+    key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
+    rows = [{**key, "seed": i, **{m: np.nan for m in METRIC_NAMES}, "note": note} for i in range(n_seeds)]
+    timing = {"generator": generator, "clip": clip.clip, "database_frames": int(sum(d.n_frames for d in clip.database)),
+              "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan, "generate_wall_s": np.nan,
+              "frames_generated": 0, "peak_rss_mb": peak_rss_mb()}
+    return rows, timing
 
 
 def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
@@ -494,11 +501,9 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
                 raise ValueError(f"{generator} cannot be built on the showcase clip {clip.clip} ({exc}); choose "
                                  "another with config key 'compare.showcase.clip'") from exc
             log.warning("%s cannot be built on %s: %s", generator, clip.clip, exc)
-            rows += [{**key, "seed": i, **{m: np.nan for m in METRIC_NAMES}, "note": f"not built: {exc}"}
-                     for i in range(len(seeds))]
-            trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
-                          "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan,
-                          "generate_wall_s": np.nan, "frames_generated": 0, "peak_rss_mb": peak_rss_mb()})
+            r, t = _empty_rows(clip, generator, len(seeds), f"not built: {exc}")
+            rows += r
+            trows.append(t)
             continue
         build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
         start = clip.start
