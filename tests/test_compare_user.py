@@ -137,6 +137,8 @@ FAILURES += [
     ("not a Motion", HOLD.format(body="        return v"), "Hold", "returned a ndarray, not an animsynth.motion.Motion"),
     ("not finite", HOLD.format(body="        v[3, 7] = np.nan\n        return Motion(v, start.skeleton, start.fps)"),
      "Hold", "non-finite values"),
+    ("no skeleton", HOLD.format(body="        return Motion(v, None, start.fps)"), "Hold",
+     "returned a motion on another skeleton"),
     ("wrong rate", HOLD.format(body="        return Motion(v, start.skeleton, 2 * start.fps)"), "Hold",
      "returned 60 fps, the database runs at 30 fps"),
     ("seams outside", HOLD.format(body="        return Motion(v, start.skeleton, start.fps, '', {'seams': [40]})"),

@@ -215,12 +215,19 @@ class UserGenerator(Generator):
         if values.shape != want:
             raise UserGeneratorError(f"{head} returned values of shape {values.shape}, expected {want} ({length} "
                                      f"frames x the start's {start.skeleton.n_dof} DOF)")
-        if out.skeleton is not start.skeleton and out.skeleton.columns() != start.skeleton.columns():
+        try:
+            columns = out.skeleton.columns()
+        except (AttributeError, TypeError, ValueError):
+            columns = None
+        if columns != start.skeleton.columns():
             raise UserGeneratorError(f"{head} returned a motion on another skeleton (its DOF columns differ from "
                                      "the start's)")
-        if not np.isclose(float(out.fps), float(start.fps)):
-            raise UserGeneratorError(f"{head} returned {float(out.fps):g} fps, the database runs at "
-                                     f"{float(start.fps):g} fps")
+        try:
+            fps = float(out.fps)
+        except (TypeError, ValueError):
+            fps = float("nan")
+        if not np.isclose(fps, float(start.fps)):
+            raise UserGeneratorError(f"{head} returned {fps:g} fps, the database runs at {float(start.fps):g} fps")
         meta = out.meta if isinstance(out.meta, dict) else {}
         m = Motion(values.copy(), self.db_.skeleton, self.db_.fps, self.name,
                    {"seams": meta.get("seams", []), "source_frames": None})
