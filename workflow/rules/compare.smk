@@ -159,7 +159,8 @@ rule compare_tables:
     params:
         generators=CMP_RUN,
         left_out=CMP_LEFT_OUT,
-        cfg={k: CMP_ORDER if k == "generators" else CMP[k] for k in ("generators", "seeds", "fps", "context", "length", "verdicts")},
+        cfg={k: CMP_ORDER if k == "generators" else CMP[k]
+             for k in ("generators", "seeds", "fps", "context", "length", "verdicts")},
         source=SOURCE,
     threads: 1
     resources:
