@@ -57,3 +57,76 @@ def test_compare_outputs(tiny_workflow):
     assert len(ours) == len(v) + len(sanity)  # the findings, then the sanity checks marked as such
     assert ours["sanity_check"].astype(bool).sum() == len(sanity)
     assert "The generators side by side" in (tiny_workflow / "results" / "claims.rst").read_text()
+
+
+def _docs_toy() -> str:
+    """The toy generator shown in docs/compare.md (run here as a user would copy it)."""
+    from conftest import REPO
+
+    text = (REPO / "docs" / "compare.md").read_text()
+    start = text.index("```python\n# mine/toy.py") + len("```python\n")
+    return text[start:text.index("```", start)]
+
+
+@pytest.mark.workflow
+def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp_path_factory):
+    """The docs' toy generator and a broken one added to a copy of the finished tiny run: only their two jobs run,
+    the broken one is one error line and empty rows, the toy is in every table, figure and the BVH folder, the
+    family's rows and claims are byte for byte the same; then animsynth score reads the toy's BVH file back."""
+    import numpy as np
+
+    from animsynth import cli
+    from animsynth.compare import jobs
+    from animsynth.compare.scoring import DATABASE_METRICS
+    from animsynth.io.bvh import read_bvh
+    from conftest import copy_finished_run, run_snakemake
+
+    wd = copy_finished_run(tiny_workflow, tmp_path_factory.mktemp("tiny_user") / "run")
+    r = wd / "results" / "compare"
+    before = {f: (r / f).read_text() for f in ("metrics.csv", "verdicts.csv", "sanity_checks.csv")}
+    (wd / "mine").mkdir()
+    (wd / "mine" / "toy.py").write_text(_docs_toy())
+    (wd / "config" / "mine.yaml").write_text("compare:\n  user_generators:\n    toy: mine/toy.py:RandomSegments\n"
+                                             "    broken: mine/toy.py:NoSuchClass\n")
+    summary_before = (wd / "results" / "summary.md").stat().st_mtime_ns
+    res = run_snakemake(wd, "results/compare/summary.md", "results/compare/metrics.png", "results/compare/strips.png",
+                        "results/compare/bvh/toy.bvh", "results/compare/bvh/broken.bvh", "results/summary.md",
+                        "--configfile", "config/test.yaml", "config/mine.yaml")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-6000:]
+    broken = [line for line in out.splitlines() if "user generator 'broken'" in line]
+    assert len(broken) == 1 and "(mine/toy.py:NoSuchClass): the file has no class 'NoSuchClass'" in broken[0], broken
+    assert "Traceback" not in out
+    ran = {line.split("cmpgen=")[1].split(",")[0].strip() for line in out.splitlines() if "cmpgen=" in line}
+    assert ran == {"toy", "broken"}  # the family's generator jobs did not run again
+    m = pd.read_csv(r / "metrics.csv")
+    assert list(dict.fromkeys(m["generator"]))[-2:] == ["toy", "broken"]
+    ours = [row for row in (r / "metrics.csv").read_text().splitlines() if ",toy," not in row and ",broken," not in row]
+    assert ours == before["metrics.csv"].splitlines()  # the family's rows byte for byte
+    for f in ("verdicts.csv", "sanity_checks.csv"):
+        assert (r / f).read_text() == before[f], f  # the claims are the family's alone
+    toy = m[m["generator"] == "toy"]
+    assert len(toy) == len(m[m["generator"] == "replay"]) and toy[["skate_share", "l2p", "coverage"]].notna().all().all()
+    assert (toy["n_seams"] >= 1).all() and toy["note"].isna().all()
+    bad = m[m["generator"] == "broken"]
+    assert bad[METRIC_NAMES].isna().all().all() and bad["note"].str.startswith("failed: user generator 'broken'").all()
+    for f in ("summary.csv", "cost_timing.csv", "skating_sensitivity.csv"):
+        assert {"toy", "broken"} <= set(pd.read_csv(r / f)["generator"]), f
+    page = (r / "summary.md").read_text()
+    assert "Your own generators (compare.user_generators): **toy**, **broken**" in page and "**broken**: user generator" in page
+    assert (wd / "results" / "summary.md").stat().st_mtime_ns > summary_before  # the report is rebuilt with them
+    clips = jobs.load_clips(r / "clips.npz")
+    show = clips[0]
+    assert read_bvh(r / "bvh" / "toy.bvh").n_frames == show.context + show.length
+    assert read_bvh(r / "bvh" / "broken.bvh").n_frames == show.context  # the start alone
+
+    # animsynth score on the run's own files: the toy's motion against the held-out start and continuation
+    unit = str(show.held_out.skeleton.length_to_m)
+    assert cli.main(["score", str(r / "bvh" / "toy.bvh"), "--reference", str(r / "bvh" / "replay.bvh"), "--config",
+                     str(wd / "config" / "test.yaml"), "--length-to-m", unit, "--out", str(wd / "scores.csv")]) == 0
+    s = pd.read_csv(wd / "scores.csv").iloc[0]
+    row = toy[(toy["clip"] == show.clip) & (toy["seed"] == 0)].iloc[0]
+    for c in ("l2p_m", "l2q", "npss", "ldlj", "sparc", "velocity_jump_p95", "velocity_jump_max", "accel_jump_p95",
+              "accel_jump_max"):
+        assert np.isclose(s[c], row[c], rtol=1e-4, atol=1e-6), (c, s[c], row[c])
+    assert all(np.isnan(s[c]) for c in DATABASE_METRICS)  # no --database

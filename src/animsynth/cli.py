@@ -6,6 +6,7 @@
     animsynth generate A.bvh B.bvh OUT.bvh
     animsynth resequence SKEL.asf MOTION.amc --start 10 --end 300 OUT.bvh   (or: resequence WALK.bvh ...)
     animsynth face --labels fear,surprise,happy OUT.gif
+    animsynth score GENERATED.bvh ... --reference HELD_OUT.bvh [--database DB.bvh ...] --out scores.csv
 
 Every command that reads a motion takes a BVH file as well as an ASF/AMC
 pair. A BVH file is read as the workflow reads a trial
@@ -338,6 +339,76 @@ def cmd_face(a) -> None:
     print(f"wrote {a.out} ({out})")
 
 
+def _project_file(rel: str) -> str:
+    """A file of the project folder (``config/...``): beside the installed sources (``pip install -e``), else
+    in the working directory."""
+    from pathlib import Path
+
+    for root in (Path(__file__).resolve().parents[2], Path.cwd()):
+        if (root / rel).is_file():
+            return str(root / rel)
+    raise UsageError("--config", f"the project's {rel} is not beside the animsynth sources nor in the working "
+                                 "directory; run from the project folder")
+
+
+def _compare_settings(configs) -> dict:
+    """The ``compare`` block a run with ``--configfile`` ``configs`` would use: config/config.yaml, then each
+    file merged over it in order (as Snakemake merges them), validated by config/schema.yaml (which fills every
+    default)."""
+    import yaml
+    from snakemake.utils import update_config
+
+    from .config import ConfigError, validate_config
+
+    cfg: dict = {}
+    for path in [_project_file("config/config.yaml")] + list(configs or []):
+        with open(path, encoding="utf-8") as fh:
+            try:
+                data = yaml.safe_load(fh) or {}
+            except yaml.YAMLError as exc:
+                raise UsageError("--config", f"{path}: not YAML ({' '.join(str(exc).split())})") from None
+        if not isinstance(data, dict):
+            raise UsageError("--config", f"{path}: expected a mapping of config keys")
+        update_config(cfg, data)
+    try:
+        validate_config(cfg, _project_file("config/schema.yaml"))
+    except ConfigError as exc:
+        raise UsageError("--config", " ".join(str(exc).split())) from None
+    return cfg["compare"]
+
+
+def cmd_score(a) -> None:
+    """Score BVH files against the held-out capture with the compare family's metrics
+    (:func:`animsynth.compare.scoring.score_motions`)."""
+    from .compare.scoring import score_motions
+    from .tables import write_table
+
+    for f in a.generated:
+        if not f.lower().endswith(".bvh"):
+            raise UsageError("GENERATED", f"expected .bvh files, got {f!r}")
+        if not os.path.isfile(f):
+            raise UsageError("GENERATED", f"no such file {f!r}")
+    for f in a.database or []:
+        if not f.lower().endswith(".bvh"):
+            raise UsageError("--database", f"expected .bvh files, got {f!r}")
+    cmp = _compare_settings(a.config)
+    mcfg = dict(cmp["metrics"])
+    if a.floor_m is not None:
+        mcfg["floor_m"] = a.floor_m
+    context = int(cmp["context"]) if a.context is None else a.context
+    motions = {}
+    for f in dict.fromkeys([a.reference] + a.generated + list(a.database or [])):
+        motions[f] = _load_bvh(a, f)
+        _check_frames(a, motions[f].n_frames, len(motions[f].skeleton.joints), "frames of " + f)
+    ref = motions[a.reference]
+    generated = {f: motions[f] for f in a.generated}
+    database = {f: motions[f] for f in a.database} if a.database else None
+    table = score_motions(generated, ref, database, context, mcfg, reference_name=a.reference)
+    write_table(table, a.out, md=False)
+    print(f"wrote {a.out}: {len(table)} scored file(s) against {a.reference}, {context} start frames"
+          + ("" if database else "; no --database: the metrics that read it are empty"))
+
+
 def _write_motion(path: str, motion) -> None:
     kind = path.lower()  # the same rule as the --out check (OUT.BVH is a BVH file)
     if kind.endswith(".bvh"):
@@ -409,7 +480,28 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=seed_int, default=0)
     s.add_argument("out", type=_out_with((".gif", ".csv")), help="output .gif (or .csv of landmarks)")
     s.set_defaults(func=cmd_face)
-    for name in ("preview", "generate", "resequence"):
+
+    s = sub.add_parser("score", help="score BVH files from any tool with the compare family's metrics",
+                       description="Score generated BVH files against the held-out capture they continue, with the "
+                       "metrics of compare/metrics.csv (docs/compare.md, Score motions made anywhere). The first "
+                       "--context frames of every file are the start; the frames after it are scored against the "
+                       "reference's. The generator's seams, transitions and seed spread are not in a BVH file: "
+                       "those columns stay empty, as do the metrics that read the database without --database.")
+    s.add_argument("generated", nargs="+", metavar="GENERATED.bvh", help="generated motions (one row each)")
+    s.add_argument("--reference", required=True, type=_existing_file, metavar="HELD_OUT.bvh",
+                   help="the held-out capture: the start, then the frames the generated ones are compared with")
+    s.add_argument("--database", nargs="+", action="extend", type=_existing_file, metavar="DB.bvh",
+                   help="the clips the generator learned from (floor, L2P statistics, coverage, novelty)")
+    s.add_argument("--out", required=True, type=_out_with((".csv",)), help="output .csv (columns of compare/metrics.csv)")
+    s.add_argument("--context", type=positive_int, default=None,
+                   help="start frames at the head of every file (default: compare.context of the config)")
+    s.add_argument("--config", action="append", type=_existing_file, metavar="CONFIG.yaml",
+                   help="config file(s) merged over config/config.yaml, as --configfile of a run: compare.metrics "
+                        "and compare.context are read from it (default: the project's defaults)")
+    s.add_argument("--floor-m", type=_finite, default=None,
+                   help="floor height in metres (default: compare.metrics.floor_m, else from the database's feet)")
+    s.set_defaults(func=cmd_score)
+    for name in ("preview", "generate", "resequence", "score"):
         s = sub.choices[name]
         s.add_argument("--length-to-m", action="append", metavar="[FILE=]M",
                        help="metres per length unit of BVH input (default 1; 0.01 centimetres, 0.05644 cgspeed's CMU "
@@ -434,6 +526,8 @@ def _inputs(a) -> list[str]:
     """The input files a command was given: ``--asf``/``amc``, the training files or the positional files."""
     names = [getattr(a, k, None) for k in ("asf", "amc")]
     names += list(getattr(a, "train", None) or []) + list(getattr(a, "files", None) or [])
+    names += list(getattr(a, "generated", None) or []) + [getattr(a, "reference", None)]
+    names += list(getattr(a, "database", None) or [])
     return [n for n in dict.fromkeys(names) if n]
 
 
@@ -444,7 +538,7 @@ def _check_out_is_not_an_input(a) -> None:
         return
     for inp in _inputs(a):
         if inp and os.path.exists(inp) and os.path.samefile(inp, out):
-            option = "--out" if a.command in ("generate", "resequence") else "out"
+            option = "--out" if a.command in ("generate", "resequence", "score") else "out"
             raise UsageError(option, f"{out!r} is the input file {inp!r}; writing it would replace the input")
 
 
@@ -466,7 +560,7 @@ def main(argv=None) -> int:
         # files may come after options too (resequence walk.bvh --start 10 --end 300 out.bvh): argparse leaves
         # the ones after an option over; they join the command's file list
         args, extra = parser.parse_known_args(argv)
-        listed = next((k for k in ("files", "train") if hasattr(args, k)), None)
+        listed = next((k for k in ("files", "train", "generated") if hasattr(args, k)), None)
         if extra and (listed is None or any(e.startswith("-") for e in extra)):
             parser.error(f"unrecognized arguments: {' '.join(extra)}")
         if extra:

@@ -6,11 +6,16 @@
 # compare_figures gather them. A generator that cannot run here (fairmotion without its package) is left
 # out at parse time with one line, and the tables and docs say why. Every job gets only the config keys it
 # uses. Resources: measured on CMU (the paper run) with headroom.
-from animsynth.compare.settings import clip_ids, clips_cfg, groups, run_generators, showcase
+from animsynth.compare.settings import (clip_ids, clips_cfg, generator_order, groups, run_generators, showcase,
+                                        user_generators)
 
 CMP = config["compare"]
 CMP_SUBSETS, CMP_RESEQ = groups(config)
 CMP_RUN, CMP_LEFT_OUT = run_generators(config)
+# the user's own generators (compare.user_generators), run after the family's; their job's rerun trigger is the
+# content of their file (compare_job_cfg), and they are in every table and figure, not in the verdicts
+CMP_USER = user_generators(config)
+CMP_ORDER = generator_order(config)
 for _gen, _why in CMP_LEFT_OUT.items():
     print(f"animsynth: compare: generator {_gen} left out ({_why})", file=sys.stderr)
 CMP_SHOWCASE = list(showcase(config))
@@ -147,7 +152,8 @@ rule compare_tables:
     params:
         generators=CMP_RUN,
         left_out=CMP_LEFT_OUT,
-        cfg={k: CMP[k] for k in ("generators", "seeds", "fps", "context", "length", "verdicts")},
+        cfg={k: CMP_ORDER if k == "generators" else CMP[k]
+             for k in ("generators", "seeds", "fps", "context", "length", "verdicts")},
         source=SOURCE,
     threads: 1
     resources:

@@ -24,6 +24,8 @@ tables          medians and spreads, which generator wins which metric, cost, th
 verdicts        the side-by-side claims, decided over clips x seeds
 plots           metrics per generator with spreads, one skeleton strip per generator
 settings        config checks and what the workflow reads of the ``compare`` block
+user            your own generator in the comparison (``compare.user_generators``: a file and a class)
+scoring         motion files from any tool scored with the metrics (``animsynth score``)
 """
 
 from .._lazy import lazy_exports

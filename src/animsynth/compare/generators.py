@@ -355,7 +355,8 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
 
     Parameters
     ----------
-    name : one of :data:`GENERATORS`
+    name : one of :data:`GENERATORS`, or a key of ``cfg["user_generators"]`` (a user's class:
+        :class:`animsynth.compare.user.UserGenerator`)
     cfg : dict, the ``compare`` block with ``stisomap`` (the re-sequencing study's block) added
     held_out : Motion, the held-out clip (``replay`` only)
     """
@@ -388,4 +389,9 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
         return Replay(held_out)
     if name == "concat":
         return Concat(**cfg["concat"])
+    user = cfg.get("user_generators") or {}
+    if name in user:  # a researcher's own class (compare.user_generators; animsynth.compare.user)
+        from .user import UserGenerator
+
+        return UserGenerator(name, user[name])
     raise ValueError(f"config key 'compare.generators': unknown generator {name!r} (one of {list(GENERATORS)})")

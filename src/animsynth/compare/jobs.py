@@ -444,7 +444,52 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
         memory so far (:func:`peak_rss_mb`)
     shown : Motion or None, the showcase clip's start and generated frames joined
         (``meta["context"]``: start frames)
+
+    A user generator (``compare.user_generators``) that fails in any way (:class:`UserGeneratorError`) stops at
+    its first failure: one error line, and every row of it empty (:func:`failed_run`).
     """
+    from .user import UserGeneratorError
+
+    try:
+        return _run_generator(clips, generator, cfg, master_seed, roles, showcase)
+    except UserGeneratorError as exc:
+        return failed_run(clips, generator, cfg, str(exc), showcase)
+
+
+def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase: tuple[str, int] | None = None):
+    """The files of a generator that could not run at all: ``why`` logged as one error line (and printed to
+    stderr, the run's console), every clip x seed row with no values and ``note`` = "failed: <why>", every timing
+    row empty, and as the showcase the showcase clip's start alone (no generated frame; ``meta["note"]``)."""
+    import sys
+
+    line = " ".join(why.split())
+    log.error("%s", line)
+    print(f"animsynth: ERROR: {line}", file=sys.stderr)
+    rows, trows, shown = [], [], None
+    for clip in clips:
+        r, t = _empty_rows(clip, generator, int(cfg["seeds"]), f"failed: {line}")
+        rows += r
+        trows.append(t)
+        if showcase is not None and clip.clip == showcase[0]:
+            start = clip.start
+            shown = Motion(np.asarray(start.values, float), start.skeleton, start.fps, f"{generator} {clip.clip}",
+                           {"context": clip.context, "seams": np.zeros(0, np.int64), "note": f"failed: {line}"})
+    return (pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"]), pd.DataFrame(trows, columns=TIMING_COLUMNS),
+            shown)
+
+
+def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> tuple[list, dict]:
+    """The metric rows (one per seed, no values, ``note``) and the timing row (no times) of a clip a generator
+    has no motion for."""
+    key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
+    rows = [{**key, "seed": i, **{m: np.nan for m in METRIC_NAMES}, "note": note} for i in range(n_seeds)]
+    timing = {"generator": generator, "clip": clip.clip, "database_frames": int(sum(d.n_frames for d in clip.database)),
+              "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan, "generate_wall_s": np.nan,
+              "frames_generated": 0, "peak_rss_mb": peak_rss_mb()}
+    return rows, timing
+
+
+def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
     kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
@@ -462,11 +507,9 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
                 raise ValueError(f"{generator} cannot be built on the showcase clip {clip.clip} ({exc}); choose "
                                  "another with config key 'compare.showcase.clip'") from exc
             log.warning("%s cannot be built on %s: %s", generator, clip.clip, exc)
-            rows += [{**key, "seed": i, **{m: np.nan for m in METRIC_NAMES}, "note": f"not built: {exc}"}
-                     for i in range(len(seeds))]
-            trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
-                          "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan,
-                          "generate_wall_s": np.nan, "frames_generated": 0, "peak_rss_mb": peak_rss_mb()})
+            r, t = _empty_rows(clip, generator, len(seeds), f"not built: {exc}")
+            rows += r
+            trows.append(t)
             continue
         build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
         start = clip.start
@@ -507,19 +550,24 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
 
 
 def save_shown(path, motion: Motion) -> None:
-    """Store the showcase motion (start + generated frames) with its start length and seams."""
+    """Store the showcase motion (start + generated frames) with its start length and seams (and ``meta["note"]``
+    when the generator failed: then the start alone)."""
+    note = {"note": np.array(motion.meta["note"])} if motion.meta.get("note") else {}  # a run that failed
     with atomic_path(path, suffix=".npz") as tmp:
         np.savez_compressed(tmp, values=np.asarray(motion.values, float), fps=np.float64(motion.fps),
                             name=np.array(motion.name), skeleton=np.array(motion.skeleton.to_json()),
                             context=np.int64(motion.meta["context"]),
-                            seams=np.asarray(motion.meta.get("seams", []), np.int64))
+                            seams=np.asarray(motion.meta.get("seams", []), np.int64), **note)
 
 
 def load_shown(path) -> Motion:
-    """The motion stored by :func:`save_shown` (``meta``: ``context``, ``seams``)."""
+    """The motion stored by :func:`save_shown` (``meta``: ``context``, ``seams``, ``note`` when stored)."""
     with np.load(path, allow_pickle=False) as z:
+        meta = {"context": int(z["context"]), "seams": np.array(z["seams"])}
+        if "note" in z.files:
+            meta["note"] = str(z["note"])
         return Motion(np.array(z["values"]), Skeleton.from_json(str(z["skeleton"])), float(z["fps"]), str(z["name"]),
-                      {"context": int(z["context"]), "seams": np.array(z["seams"])})
+                      meta)
 
 
 def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase, out: dict) -> None:
@@ -581,6 +629,7 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     from ..atomic import atomic_write_text
     from ..tables import write_table
     from .tables import cost_table, data_label, sensitivity_table, summary_markdown, summary_table, winners_table
+    from .generators import GENERATORS
     from .verdicts import build_verdicts, independent_groups, sanity_checks
 
     order = list(cfg["generators"])
@@ -595,8 +644,10 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     clips_full = pd.read_csv(inp["clips"], dtype=str)
     n_groups = len(set(independent_groups(clips_full).values()))
     data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
-    verdicts = build_verdicts(metrics, cfg["verdicts"], data, left_out, clips_full)
-    sanity = sanity_checks(metrics, cfg["verdicts"], data, left_out, clips_full)
+    # the claims are the family's own: a user generator (compare.user_generators) is in every table, not in them
+    own = metrics[metrics["generator"].isin(GENERATORS)]
+    verdicts = build_verdicts(own, cfg["verdicts"], data, left_out, clips_full)
+    sanity = sanity_checks(own, cfg["verdicts"], data, left_out, clips_full)
     write_table(metrics, out["metrics"], md=False)
     write_table(timing, out["metrics_timing"], md=False)
     write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below

@@ -86,7 +86,8 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
     Parameters
     ----------
     shown : {generator: Motion}, the start and generated frames joined (``meta["context"]``: start frames,
-        ``meta["seams"]``: seam frames of the joined motion)
+        ``meta["seams"]``: seam frames of the joined motion; ``meta["note"]``: why a generator that failed shows its
+        start alone)
     """
     import matplotlib.pyplot as plt
 
@@ -106,6 +107,7 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
         c = int(m.meta["context"])
         seams = set(int(s) for s in np.asarray(m.meta.get("seams", [])))
         idx = np.unique(np.concatenate([[c - 1], np.linspace(c, pos.shape[0] - 1, n_panels - 1).round().astype(int)]))
+        idx = idx[idx < pos.shape[0]]  # a generator that failed: its start alone
         parents = m.skeleton.parents()
         for k, f in enumerate(idx):
             q = pos[f] - pos[f, :1] * np.array([1.0, 0.0, 1.0])
@@ -117,7 +119,11 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
             ax.text(k * height * 0.9, pos[:, :, 1].min() - 0.08 * height, str(f - c), ha="center", fontsize=6)
         ax.set_aspect("equal")
         ax.axis("off")
-        ax.set_title(g, fontsize=8.5, loc="left")
+        note = str(m.meta.get("note") or "")
+        if note:  # a generator that failed: its start frame at the left, the reason beside its name
+            ax.set_xlim(-0.6 * height, (n_panels - 0.4) * height * 0.9)
+            note = " -- no motion: " + (note if len(note) <= 110 else note[:107] + "...")
+        ax.set_title(g + note, fontsize=8.5, loc="left")
     _save(fig, path, title)
 
 

@@ -13,7 +13,7 @@ from ..config import ConfigError
 log = logging.getLogger("animsynth.compare")
 
 __all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "clips_cfg", "job_cfg", "unavailable",
-           "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
+           "user_generators", "generator_order", "user_job_cfg", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
 def groups(config: dict) -> tuple[dict, dict]:
@@ -56,9 +56,21 @@ def unavailable(name: str) -> str:
     return ""
 
 
+def user_generators(config: dict) -> dict:
+    """``{row name: "path/to/file.py:ClassName"}`` of ``compare.user_generators`` (a researcher's own classes,
+    :mod:`animsynth.compare.user`), in config order."""
+    return dict(config["compare"].get("user_generators") or {})
+
+
+def generator_order(config: dict) -> list[str]:
+    """The order of the tables: ``compare.generators``, then the user generators."""
+    return list(config["compare"]["generators"]) + list(user_generators(config))
+
+
 def run_generators(config: dict) -> tuple[list[str], dict]:
     """``(generators that run, {generator left out: reason})``: fairmotion is left out when its package is
-    not installed here (:func:`unavailable`)."""
+    not installed here (:func:`unavailable`); the user generators run after the family's own (a user
+    generator that cannot run is found out by its job, which still writes its files: docs/compare.md)."""
     run, left = [], {}
     for g in config["compare"]["generators"]:
         why = unavailable(g)
@@ -66,7 +78,16 @@ def run_generators(config: dict) -> tuple[list[str], dict]:
             left[g] = why
         else:
             run.append(g)
-    return run, left
+    return run + list(user_generators(config)), left
+
+
+def user_job_cfg(config: dict, name: str) -> dict:
+    """What a user generator's job adds to the shared keys: its spec and, as the job's rerun trigger, the
+    SHA-256 of its file (:func:`animsynth.compare.user.file_sha256`: a changed file reruns that job alone)."""
+    from .user import file_sha256
+
+    spec = user_generators(config)[name]
+    return {"user_generators": {name: spec}, "user_file_sha256": file_sha256(spec)}
 
 
 #: the ``compare`` keys the clips job reads (the protocol: rate, start, lengths, temporal split)
@@ -111,6 +132,8 @@ def job_cfg(config: dict, generator: str | None = None, budget: float | None = N
             cfg[block] = cmp[block]
     if "stisomap" in names:
         cfg["stisomap"] = dict(config["resequencing"]["stisomap"])
+    if generator is not None and generator in user_generators(config):
+        cfg.update(user_job_cfg(config, generator))
     if budget is not None:
         cfg["transitions_per_s"] = float(budget)
         cfg["seeds"] = min(int(cmp["seeds"]), int(cmp["budget_sweep_seeds"]))
@@ -131,6 +154,20 @@ def check(config: dict) -> None:
         if d not in config["resequencing_trials"]:
             log.warning("config key 'compare.resequencing': %r is not a key of resequencing_trials (%s): left out "
                         "of the comparison", d, sorted(config["resequencing_trials"]))
+    from .generators import GENERATORS
+    from .user import parse_spec
+
+    for name, spec in user_generators(config).items():
+        if name in GENERATORS:
+            raise ConfigError(f"config key 'compare.user_generators.{name}': {name!r} is the name of one of the "
+                              "family's generators; give your generator another name")
+        if name.endswith(("_timing", "_showcase")):
+            raise ConfigError(f"config key 'compare.user_generators.{name}': a name may not end in _timing or "
+                              "_showcase (the names of a generator's other files)")
+        try:
+            parse_spec(spec)
+        except ValueError as exc:
+            raise ConfigError(f"config key 'compare.user_generators.{name}': {exc}") from None
     subsets, reseq = groups(config)
     if not subsets and not reseq:
         raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': no clip to compare")

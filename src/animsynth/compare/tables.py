@@ -8,7 +8,7 @@ import logging
 import numpy as np
 import pandas as pd
 
-from .generators import REFERENCES
+from .generators import GENERATORS, REFERENCES
 from .metrics import METRIC_NAMES, METRICS, SENSITIVITY_SPEEDS
 from .verdicts import pair_outcomes
 
@@ -165,9 +165,20 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
     if left_out:
         out += ["Left out: " + "; ".join(f"**{g}**: {why}" for g, why in left_out.items()) + ".", ""]
     if not_built is not None and len(not_built):
+        failed = not_built[not_built["note"].str.startswith("failed: ")].drop_duplicates("generator")
+        not_built = not_built[~not_built["note"].str.startswith("failed: ")]
+        if len(failed):  # a user generator that could not run: one line each, its rows empty
+            out += ["Failed (no values at all): " + "; ".join(
+                f"**{r.generator}**: {r.note.removeprefix('failed: ')}" for r in failed.itertuples()) + ".", ""]
+    if not_built is not None and len(not_built):
         out += ["Not built (no values for these clips): " + "; ".join(
             f"**{r.generator}** on {r.clip} ({r.note.removeprefix('not built: ')})"
             for r in not_built.itertuples()) + ".", ""]
+    user = [g for g in generators if g not in GENERATORS]
+    if user:
+        out += ["Your own generators (compare.user_generators): " + ", ".join(f"**{g}**" for g in user) + ". They "
+                "run on the same clips, seeds and metrics and are in every table and figure; the verdicts and sanity "
+                "checks below are the family's own claims, decided without them.", ""]
     out += ["## Which generator wins which metric", "",
             "Best and second-best by median over clips x seeds (the reference rows replay and concat aside); "
             "`beyond_spread`: the two IQRs do not overlap; `best_wins_share`: share of clip x seed pairs in "

@@ -1,0 +1,177 @@
+"""``animsynth score``: BVH files from anywhere scored with the compare family's metrics."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from animsynth import cli
+from animsynth.compare import jobs, settings
+from animsynth.compare.scoring import DATABASE_METRICS, SKATING_METRICS, UNSCORED
+from animsynth.config import validate_config
+from animsynth.io.bvh import read_bvh, write_bvh
+from animsynth.motion import Motion
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+from conftest import REPO
+
+SK = cmu_like_skeleton("cmp", 3)
+UNIT = str(SK.length_to_m)  # the synthetic skeleton's metres per unit, which a BVH file does not carry
+
+
+def _config() -> dict:
+    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
+    return cfg
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """A comparison of one clip (a temporal split of one walk, so the run's database is the clip's) with the
+    project's defaults: knn, replay and a user's generator run by the family's job, each writing its BVH."""
+    d = tmp_path_factory.mktemp("score_run")
+    (d / "mine.py").write_text("from animsynth.compare.generators import Concat\n\n\nclass Mine:\n"
+                               "    def fit(self, database):\n        self.g = Concat().fit(database.clips)\n"
+                               "        return self\n\n    def generate(self, start, length, seed):\n"
+                               "        return self.g.generate(start, length, seed)\n")
+    cfg = dict(settings.job_cfg(_config()), user_generators={"mine": f"{d / 'mine.py'}:Mine"})
+    walk = jobs.resample(generate_motion("walk_straight", 480, 0, SK, name="t0"), 30.0)
+    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
+    clips = jobs.prepare_clips({"t0": walk}, {}, {"walk": "t0"}, cc)
+    jobs.save_clips(d / "clips.npz", clips)
+    for g in ("knn", "replay", "mine"):
+        out = {k: str(d / f"{g}{ext}") for k, ext in (("metrics", ".csv"), ("timing", "_timing.csv"),
+                                                      ("shown", ".npz"), ("bvh", ".bvh"))}
+        jobs.run_job(d / "clips.npz", g, cfg, 7, None, ("walk/t0", 1), out)
+    write_bvh(d / "held_out.bvh", clips[0].held_out)
+    write_bvh(d / "database.bvh", clips[0].database[0])
+    return d, clips[0]
+
+
+def _score(*args) -> int:
+    return cli.main(["score", *map(str, args), "--length-to-m", UNIT])
+
+
+@pytest.mark.parametrize("generator", ["knn", "replay", "mine"])
+def test_scoring_the_comparisons_own_bvh_gives_its_metrics(run, tmp_path, generator):
+    d, clip = run
+    bvh = read_bvh(d / f"{generator}.bvh")
+    # what the showcase BVH holds: the start (the held-out clip's first context frames), then the generated frames
+    shown = jobs.load_shown(d / f"{generator}.npz")
+    assert bvh.n_frames == clip.context + clip.length == shown.n_frames and shown.meta["context"] == clip.context
+    assert np.allclose(shown.values[:clip.context], clip.held_out.values[:clip.context])
+    assert _score(d / f"{generator}.bvh", "--reference", d / "held_out.bvh", "--database", d / "database.bvh",
+                  "--out", tmp_path / "s.csv") == 0
+    s = pd.read_csv(tmp_path / "s.csv")
+    m = pd.read_csv(d / f"{generator}.csv")
+    assert list(s.columns) == list(m.columns)
+    row = m[m["seed"] == 1].iloc[0]  # the showcase seed
+    scored = [c for c in jobs.METRIC_NAMES if c not in UNSCORED]
+    assert set(UNSCORED) < set(jobs.METRIC_NAMES) and len(scored) == len(jobs.METRIC_NAMES) - len(UNSCORED)
+    for c in scored:  # every metric a file gives equals the run's (BVH keeps 6 decimals)
+        assert np.isclose(s[c].iloc[0], row[c], rtol=1e-4, atol=1e-6, equal_nan=True), (c, s[c].iloc[0], row[c])
+        assert np.isfinite(s[c].iloc[0]) or not np.isfinite(row[c]), c
+    assert s[list(UNSCORED)].isna().all().all()  # the generator's seams, transitions and seeds: not in a file
+    assert s["generator"].iloc[0] == str(d / f"{generator}.bvh") and s["clip"].iloc[0] == str(d / "held_out.bvh")
+
+
+def test_the_held_out_capture_against_itself_scores_zero(run, tmp_path):
+    d, _clip = run
+    held = d / "held_out.bvh"
+    assert _score(held, "--reference", held, "--out", tmp_path / "a.csv") == 0
+    a = pd.read_csv(tmp_path / "a.csv")
+    assert (a[["l2p_m", "l2q", "npss"]] == 0).all().all()
+    assert a[list(DATABASE_METRICS) + list(SKATING_METRICS)].isna().all().all()  # no database: left empty
+    assert a["ldlj"].notna().all() and a["note"].str.startswith("no database").all()
+    assert _score(held, "--reference", held, "--database", d / "database.bvh", "--out", tmp_path / "b.csv") == 0
+    b = pd.read_csv(tmp_path / "b.csv")
+    assert (b[["l2p", "l2p_m", "l2q", "npss"]] == 0).all().all() and b["skate_share"].notna().all()
+
+
+def test_a_floor_height_scores_skating_without_a_database_and_one_row_per_file(run, tmp_path):
+    d, _clip = run
+    files = [d / "knn.bvh", d / "mine.bvh", d / "replay.bvh"]
+    assert _score(*files, "--reference", d / "held_out.bvh", "--floor-m", "0", "--out", tmp_path / "s.csv") == 0
+    s = pd.read_csv(tmp_path / "s.csv")
+    assert list(s["generator"]) == [str(f) for f in files]
+    assert s["skate_share"].notna().all() and s[list(DATABASE_METRICS)].isna().all().all()
+
+
+def test_the_config_gives_the_start_and_the_metric_settings(run, tmp_path):
+    d, clip = run
+    (tmp_path / "c.yaml").write_text("compare: {context: 4, metrics: {window: 3}}\n")
+    assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--database", d / "database.bvh",
+                  "--config", tmp_path / "c.yaml", "--out", tmp_path / "a.csv") == 0
+    assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--database", d / "database.bvh",
+                  "--context", "4", "--out", tmp_path / "b.csv") == 0
+    a, b = pd.read_csv(tmp_path / "a.csv"), pd.read_csv(tmp_path / "b.csv")
+    assert a["l2p_m"].iloc[0] == b["l2p_m"].iloc[0]  # the same 4 start frames
+    assert a["coverage"].iloc[0] != b["coverage"].iloc[0] or a["local_diversity_m"].iloc[0] != b["local_diversity_m"].iloc[0]
+
+
+def _other_rate(d, tmp_path):
+    m = read_bvh(d / "knn.bvh")
+    write_bvh(tmp_path / "fast.bvh", Motion(m.values, m.skeleton, 2 * m.fps, "fast"))
+    return tmp_path / "fast.bvh"
+
+
+def _long(d, tmp_path):
+    m = read_bvh(d / "held_out.bvh")
+    write_bvh(tmp_path / "long.bvh", Motion(np.vstack([m.values, m.values]), m.skeleton, m.fps, "long"))
+    return tmp_path / "long.bvh"
+
+
+def _renamed(path, dest, old="ltoes", new="zeh_links"):
+    dest.write_text(path.read_text().replace(f"JOINT {old}\n", f"JOINT {new}\n"))
+    return dest
+
+
+def _other_joints(d, tmp_path):
+    return _renamed(d / "knn.bvh", tmp_path / "other.bvh")
+
+
+@pytest.mark.parametrize("make, args, says", [
+    (_other_rate, (), "fps, the reference"),
+    (_long, (), "has 36 frames to compare them with"),
+    (_other_joints, (), "its joints differ from the reference's"),
+    (None, ("--context", "36"), "none after the 36 start frames"),
+    (None, ("--database", "NODB.bvh"), "no such file"),
+    (None, ("--config", "BAD.yaml"), "compare.context"),
+])
+def test_bad_input_is_one_line_naming_it_and_writes_nothing(run, tmp_path, capsys, make, args, says):
+    d, clip = run
+    assert clip.held_out.n_frames == 36
+    gen = make(d, tmp_path) if make else d / "knn.bvh"
+    (tmp_path / "BAD.yaml").write_text("compare: {context: -1}\n")
+    args = [str(tmp_path / a) if a.endswith((".bvh", ".yaml")) else a for a in args]
+    capsys.readouterr()
+    assert _score(gen, "--reference", d / "held_out.bvh", *args, "--out", tmp_path / "s.csv") == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and says in err[0], err
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_the_output_must_be_a_csv_file(run, tmp_path, capsys):
+    d, _clip = run
+    assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--out", tmp_path / "s.txt") == 2
+    assert "use a .csv file name" in capsys.readouterr().err
+    assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh") == 2
+    assert "--out" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+def test_joint_roles_are_resolved_as_everywhere_else(run, tmp_path, capsys):
+    """A toe joint no name rule knows: one line naming the role without --role, the same numbers with it."""
+    d, _clip = run
+    files = [_renamed(d / f, tmp_path / f) for f in ("knn.bvh", "held_out.bvh", "database.bvh")]
+    args = [files[0], "--reference", files[1], "--database", files[2]]
+    assert _score(*args, "--out", tmp_path / "a.csv") == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "left_toe" in err[0], err
+    assert _score(*args, "--role", "left_toe=zeh_links", "--out", tmp_path / "a.csv") == 0
+    assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--database", d / "database.bvh",
+                  "--out", tmp_path / "b.csv") == 0
+    a, b = pd.read_csv(tmp_path / "a.csv"), pd.read_csv(tmp_path / "b.csv")
+    pd.testing.assert_frame_equal(a[jobs.METRIC_NAMES], b[jobs.METRIC_NAMES])
