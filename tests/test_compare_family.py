@@ -293,6 +293,7 @@ def test_counting_clips_says_reproduced_where_counting_groups_says_within_noise(
     ev = v.loc[claim, "evidence"]
     assert "7 independent groups" in ev and "holds in 5, opposite in 0, within noise in 2" in ev
     assert "Holm-adjusted" in ev and "minimum effect 0.02" in ev and "17 of 19 untied clips" in ev
+    assert ev.startswith("tested: motion_graph lower than stisomap; ")  # the hypothesis, not the finding
     # every group holding: reproduced; two groups holding the opposite: partly
     def verdict(effects):
         m, c = _grouped(effects)

@@ -38,7 +38,7 @@ def run(tmp_path_factory):
                                "        return self.g.generate(start, length, seed)\n")
     cfg = dict(settings.job_cfg(_config()), user_generators={"mine": f"{d / 'mine.py'}:Mine"})
     walk = jobs.resample(generate_motion("walk_straight", 480, 0, SK, name="t0"), 30.0)
-    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
+    cc = settings.clips_cfg(_config())
     clips = jobs.prepare_clips({"t0": walk}, {}, {"walk": "t0"}, cc)
     jobs.save_clips(d / "clips.npz", clips)
     for g in ("knn", "replay", "mine"):

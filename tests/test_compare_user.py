@@ -12,7 +12,6 @@ import pytest
 import yaml
 
 from animsynth.compare import jobs, settings
-from animsynth.compare import tables
 from animsynth.config import ConfigError, validate_config
 from animsynth.io.bvh import read_bvh
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
@@ -248,7 +247,7 @@ def test_tables_show_a_user_row_and_leave_the_claims_unchanged(tmp_path, clips_f
             ("cost", "csv"), ("cost_md", "md"), ("verdicts", "csv"), ("verdicts_md", "md"), ("sanity", "csv"),
             ("sanity_md", "md"), ("sensitivity", "csv"), ("sensitivity_md", "md"), ("summary_md", "md"))}
         users = [g for g in gens if g not in own]
-        tables.tables_job({"clips": str(tmp_path / "clips.csv"), "metrics": [runs[g]["metrics"] for g in gens],
+        jobs.tables_job({"clips": str(tmp_path / "clips.csv"), "metrics": [runs[g]["metrics"] for g in gens],
                            "timing": [runs[g]["timing"] for g in gens]}, out, gens, {},
                           dict(tcfg, generators=tcfg["generators"] + users), "synthetic")
         return out

@@ -237,7 +237,8 @@ def _pair(metrics, groups, claim, a, b, metric, better, vc, data, left_out, pape
     per = group_outcomes(j, groups, me)
     ours = (f"{metric} ({_UNITS[metric]}) median {a} {_spread(metrics, a, metric)} vs {b} "
             f"{_spread(metrics, b, metric)}")
-    lead = f"{a} {'lower' if better == 'lower' else 'higher'}; "
+    # the hypothesis under test (what "holds" means below), not the finding
+    lead = f"tested: {a} {'lower' if better == 'lower' else 'higher'} than {b}; "
     return _Claim(claim, data, paper_value=paper_value, ours=ours, per=per, j=j, metric=metric, min_effect=me,
                   lead=lead, caveat=caveat)
 
