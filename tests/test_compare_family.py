@@ -580,3 +580,18 @@ def test_the_jobs_shared_kinematics_give_the_references_of_separate_computations
     assert not pos.flags.writeable and not fwd.flags.writeable  # shared by every clip: read-only
     other = Motion(clips[0].database[0].values[::-1].copy(), walks[0].skeleton, 15.0, clips[0].database[0].name)
     assert np.array_equal(kin(other)[0], M.positions(other))  # same name, other values: computed apart
+
+
+def test_budget_sweep_compares_the_graphs_on_the_clips_both_were_built_on():
+    """A peer that cannot be built on one clip: the sweep's medians leave that clip out for every graph."""
+    rows = []
+    for g, kept in (("motion_graph", {"a": 10, "b": 20, "c": 90}), ("fairmotion_fixed", {"a": 10, "b": 20, "c": None})):
+        for clip, k in kept.items():
+            for seed in range(2):
+                note = "" if k is not None else "not built: too short"
+                rows.append({"clip": clip, "generator": g, "seed": seed, "note": note,
+                             **{m: (np.nan if k is None else float(k)) for m in tables.SWEEP_METRICS}})
+    t = tables.sweep_table({4.0: pd.DataFrame(rows)}, ["motion_graph", "fairmotion_fixed"]).set_index("generator")
+    assert list(t["clips_compared"]) == [2, 2] and list(t["clips_not_built"]) == [0, 1]
+    # counted over every clip it was built on, the motion graph's median would be 20; over the shared clips, 15
+    assert t.loc["motion_graph", "transitions_kept_median"] == t.loc["fairmotion_fixed", "transitions_kept_median"] == 15

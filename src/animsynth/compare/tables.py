@@ -126,15 +126,19 @@ def sensitivity_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
 
 def sweep_table(runs: dict, order) -> pd.DataFrame:
     """The transition budget sweep: ``runs`` = {budget (transitions per second of database): metrics of the
-    graph generators at that budget}; per generator and budget the median of :data:`SWEEP_METRICS` over clips
-    x seeds and the clips it could not be built on."""
+    graph generators at that budget}; per generator and budget the clips it could not be built on and the
+    median of :data:`SWEEP_METRICS` over the seeds of the clips that every graph generator was built on at that
+    budget (``clips_compared``), so that the generators are compared on the same clips."""
     rows = []
     for budget in sorted(runs):
         m = runs[budget]
+        failed = set(m.loc[m["note"].fillna("") != "", "clip"])
+        common = m[~m["clip"].isin(failed)]
         for g in order_generators(m["generator"].unique(), order):
-            sub = m[m["generator"] == g]
+            sub = common[common["generator"] == g]
             row = {"transitions_per_s": float(budget), "generator": g,
-                   "clips_not_built": int(sub.loc[sub["note"].fillna("") != "", "clip"].nunique())}
+                   "clips_not_built": int(m.loc[(m["generator"] == g) & (m["note"].fillna("") != ""), "clip"].nunique()),
+                   "clips_compared": int(sub["clip"].nunique())}
             for k in SWEEP_METRICS:
                 x = pd.to_numeric(sub[k], errors="coerce")
                 row[f"{k}_median"] = float(x.median()) if x.notna().any() else np.nan
