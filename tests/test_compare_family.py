@@ -369,9 +369,18 @@ def test_clips_sharing_a_trial_or_a_subject_in_a_subset_are_one_group():
         {"clip": "run/35_17", "group": "run", "held_out": "35_17[26:42]", "database": "35_17 frames 0-25"},
         {"clip": "dance/05_02", "group": "dance", "held_out": "05_02[197:281]", "database": "05_02 frames 0-196"},
     ])
-    g = CV.independent_groups(clips)
+    g = CV.independent_groups(clips, "subset_subject")
     assert g["r1/35_17"] == g["r1/35_22"] == g["run/35_17"] == "r1 + run"
     assert g["w1/35_16"] == "w1" and g["dance/05_02"] == "dance"
+    # by subject (the default): every clip of subject 35 is one group, whatever its subset
+    g = CV.independent_groups(clips)
+    assert g["r1/35_17"] == g["r1/35_22"] == g["run/35_17"] == g["w1/35_16"] == "subject 35 (r1, w1, run)"
+    assert g["dance/05_02"] == "subject 05 (dance)"
+    # a clip without a subject id keeps its subset as its group
+    other = pd.concat([clips, pd.DataFrame([{"clip": "x/walkA", "group": "x", "held_out": "walkA", "database": "walkB"}])])
+    assert CV.independent_groups(other)["x/walkA"] == "x"
+    with pytest.raises(ValueError, match="compare.verdicts.grouping"):
+        CV.independent_groups(clips, "trial")
 
 
 def test_verdict_builder_on_known_outcomes():
@@ -393,8 +402,17 @@ def test_verdict_builder_on_known_outcomes():
     capture = v.loc["the held-out capture skates less than every generator (the realism upper bound holds for "
                     "this metric)"]
     # isomap skates less than the capture: the claim holds for some generators and the opposite for isomap
-    assert capture["verdict"] == "partly" and "isomap: contradicted" in capture["evidence"]
-    assert "motion_graph: reproduced" in capture["evidence"]
+    assert capture["verdict"] == "partly" and "isomap: 0/2/0, p = 0, contradicted" in capture["evidence"]
+    # one intersection-union test: its p is the largest of its parts' and it is one finding in Holm
+    import re
+
+    ev = capture["evidence"]
+    parts = [float(x) for x in re.findall(r": \d+/\d+/\d+, p = ([0-9.e-]+),", ev)]
+    assert len(parts) == 5 and float(re.search(r"p = ([0-9.e-]+), and it is one finding", ev).group(1)) == max(parts)
+    n_findings = {int(x) for x in re.findall(r"Holm-adjusted over the (\d+) findings", " ".join(v["evidence"]))}
+    tested = sum("t-test of the group effects p = " in e and "p = nan" not in e for e in v["evidence"])
+    assert n_findings == {tested + 1}  # the pair claims with a test, and the capture claim once
+    assert re.search(r"motion_graph: 2/0/0, p = [0-9.e-]+, reproduced", capture["evidence"])
     # sanity checks: true by construction, not among the findings
     s = CV.sanity_checks(metrics, vc, "test data", {}).set_index("claim")
     assert any(c.startswith("re-sequencers copy database frames") for c in s.index)

@@ -642,7 +642,7 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     summary = summary_table(metrics, order)
     winners = winners_table(metrics, summary, order)
     clips_full = pd.read_csv(inp["clips"], dtype=str)
-    n_groups = len(set(independent_groups(clips_full).values()))
+    n_groups = len(set(independent_groups(clips_full, cfg["verdicts"].get("grouping", "subject")).values()))
     data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
     # the claims are the family's own: a user generator (compare.user_generators) is in every table, not in them
     own = metrics[metrics["generator"].isin(GENERATORS)]
