@@ -298,14 +298,24 @@ def _claims_rows_md(df: pd.DataFrame) -> str:
     return "\n".join(head + [claim_line_md(r, i) for i, (_, r) in zip(_ids(df), df.iterrows())]) + "\n"
 
 
-def _verdict_counts(part: pd.DataFrame) -> str:
-    """'3 reproduced, 1 partly, ...': the verdicts from best to worst, then any other word."""
-    from .scoreboard import VERDICT_COLOURS
+def verdict_counts_md(part: pd.DataFrame) -> str:
+    """The counts of some claims in words, counted as the scoreboard counts them
+    (:func:`animsynth.scoreboard.scoreboard_counts`): the findings by verdict, from best to worst (then any other
+    word), and the sanity checks apart and named as such, e.g. '2 partly, 6 within noise; 2 sanity checks.'
 
-    counts = part["verdict"].value_counts()
-    order = [v for v in VERDICT_COLOURS if v in counts.index] + sorted(v for v in counts.index
-                                                                      if v not in VERDICT_COLOURS)
-    return ", ".join(f"{counts[v]} {v}" for v in order) + "."
+    Parameters
+    ----------
+    part : DataFrame, rows of ``claims.csv`` (one family, or every claim on real or on synthetic data)
+    """
+    from .scoreboard import scoreboard_counts
+
+    counts = scoreboard_counts(part)
+    words = [c for c in counts.columns if c not in ("family", "paper", "data", "claims", "sanity_checks")]
+    text = ", ".join(f"{int(counts[w].sum())} {w}" for w in words if int(counts[w].sum()))
+    n_sanity = int(counts["sanity_checks"].sum())
+    if n_sanity:
+        text += ("; " if text else "") + f"{n_sanity} sanity check{'s' if n_sanity != 1 else ''}"
+    return text + "."
 
 
 def claims_markdown(claims: pd.DataFrame) -> str:
@@ -323,8 +333,9 @@ def claims_markdown(claims: pd.DataFrame) -> str:
         if part.empty and checks.empty:
             out += ["(none in this run)", ""]
             continue
+        out += [verdict_counts_md(claims[mask]), ""]
         if not part.empty:
-            out += [_verdict_counts(part), "", _claims_rows_md(part).rstrip("\n"), ""]
+            out += [_claims_rows_md(part).rstrip("\n"), ""]
         if not checks.empty:
             out += ["Sanity checks (true by construction, not counted among the findings):", "",
                     _claims_rows_md(checks).rstrip("\n"), ""]
@@ -627,7 +638,7 @@ def build_summary(sections: list[dict], verdict_paths, source_note: str,
         if len(part):
             kind = "real data" if bool(part["real"].iloc[0]) else "synthetic data"
             out += [f"**Data:** {(family_data or {}).get(fam) or part['data'].iloc[0]} ({kind}). "
-                    f"Claims {_ids(part).iloc[0]} to {_ids(part).iloc[-1]}: {_verdict_counts(part)}", ""]
+                    f"Claims {_ids(part).iloc[0]} to {_ids(part).iloc[-1]}: {verdict_counts_md(part)}", ""]
         for fig in family_figures.get(fam, []):
             out += [f"![{fig.get('caption', '')}]({fig['src']})", "",
                     f"*{Path(fig['src']).name}:* {fig.get('caption', '')}", ""]
