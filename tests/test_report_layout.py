@@ -160,6 +160,8 @@ def test_shorten_cuts_at_a_word():
     assert len(s) <= 60 and s.endswith("…") and LONG_CLAIM.startswith(s[:-1])
 
 
+TIMING = [f"results/paper/meshdetail/{seq}/{name}_timing.csv" for seq in ("samba", "crane")
+          for name in ("dembones", "gplvm", "multires")] + ["results/paper/compare/timing.csv"]
 SOURCE_NOTE = ("Every number below is computed by the workflow on the data named above; paper values are quoted "
                "beside ours where the paper gives them.")
 
@@ -181,7 +183,7 @@ def _summary(tmp_path, demo=False, sanity=False):
                "compare": [{"src": "compare/metrics.png", "caption": "boxes apart"},
                            {"src": "compare/strips.png", "caption": "seams in red"}]}
     md = build_summary(sections, paths, SOURCE_NOTE, prov, data, real, demo,
-                       scoreboard_png="scoreboard.png", family_figures=figures)
+                       scoreboard_png="scoreboard.png", family_figures=figures, timing_tables=TIMING)
     return md, claims_table(paths, data, real)
 
 
@@ -306,6 +308,10 @@ def test_a_familys_sanity_checks_file_is_marked_apart_and_not_counted(tmp_path):
                                   without.drop(columns="sanity_checks").reset_index(drop=True))
 
 
+#: a line between the provenance table and the scoreboard is at most this long (a sentence, not a list of paths)
+SHORT_LINE = 200
+
+
 def _scoreboard_rows(md: str) -> dict[str, list[str]]:
     """The scoreboard's counts table as {paper: cells}, with its header's column names under ''."""
     sb = md[md.index("## Scoreboard"): md.index("## Claims of the four papers")]
@@ -353,3 +359,24 @@ def test_family_headers_count_as_the_scoreboard_does_sanity_checks_apart(tmp_pat
                     want[h] = want.get(h, 0) + int(v)
         assert _counts_in_words(block) == want, (title, block)
 
+
+def test_only_short_lines_between_provenance_and_scoreboard_and_every_timing_table_named_later(tmp_path):
+    md, _ = _summary(tmp_path)
+    lines = md.splitlines()
+    last_prov = max(i for i, ln in enumerate(lines[: lines.index("## Scoreboard")]) if ln.startswith("| "))
+    between = lines[last_prov + 1: lines.index("## Scoreboard")]
+    assert SOURCE_NOTE in between  # the sentence on what the numbers are computed on stays where it was
+    assert all(len(ln) <= SHORT_LINE for ln in between), [len(ln) for ln in between]
+    assert not any(t in "\n".join(between) for t in TIMING)
+    # every timing table is named, after the claims table and the families' sections: the summary's last section
+    tail = md[md.index("## Timing tables"):]
+    assert md.index("## Timing tables") > md.index("## Detailed tables") > md.index("## Claims of the four papers")
+    assert "\n## " not in tail[3:]
+    for t in TIMING:
+        assert f"- `{t}`" in tail.splitlines(), t
+        assert md.count(t) == 1, t
+    assert "(#timing-tables)" in "\n".join(between)  # and the short line above points there
+    # no timing table, no section and no pointer
+    paths, real, data, prov = _run(tmp_path)
+    plain = build_summary([], paths, SOURCE_NOTE, prov, data, real, False)
+    assert "Timing tables" not in plain and "timing" not in plain.lower()
