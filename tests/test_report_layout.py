@@ -13,12 +13,14 @@ import pytest
 from PIL import Image
 
 from animsynth.report import (
+    FAMILY_SECTION,
     LINE_LIMIT,
     build_summary,
     claim_anchor,
     claims_rst,
     claims_table,
     shorten,
+    verdict_counts_md,
 )
 from animsynth.scoreboard import draw_scoreboard, sanity_checks, scoreboard_counts, scoreboard_figure
 from animsynth.verdicts import VOCABULARY
@@ -158,8 +160,19 @@ def test_shorten_cuts_at_a_word():
     assert len(s) <= 60 and s.endswith("…") and LONG_CLAIM.startswith(s[:-1])
 
 
-def _summary(tmp_path, demo=False):
+TIMING = [f"results/paper/meshdetail/{seq}/{name}_timing.csv" for seq in ("samba", "crane")
+          for name in ("dembones", "gplvm", "multires")] + ["results/paper/compare/timing.csv"]
+SOURCE_NOTE = ("Every number below is computed by the workflow on the data named above; paper values are quoted "
+               "beside ours where the paper gives them.")
+
+
+def _summary(tmp_path, demo=False, sanity=False):
     paths, real, data, prov = _run(tmp_path)
+    if sanity:  # compare's claims true by construction, as compare/sanity_checks.csv gives them
+        check = tmp_path / "compare" / "sanity_checks.csv"
+        pd.DataFrame([{"claim": f"check {i}", "paper_value": "", "ours": "0", "data": "", "verdict": "reproduced",
+                       "evidence": "by construction", "source": ""} for i in range(2)]).to_csv(check, index=False)
+        paths = paths + [check]
     key = tmp_path / "table2.csv"
     pd.DataFrame({"subset": ["w1"], "error_a": [0.05]}).to_csv(key, index=False)
     other = tmp_path / "datasets.csv"
@@ -169,8 +182,8 @@ def _summary(tmp_path, demo=False):
     figures = {"simplicial": [{"src": "simplicial/figures/fig6_paths_delaunay.png", "caption": "red near black"}],
                "compare": [{"src": "compare/metrics.png", "caption": "boxes apart"},
                            {"src": "compare/strips.png", "caption": "seams in red"}]}
-    md = build_summary(sections, paths, "Every number below is computed on that data.", prov, data, real, demo,
-                       scoreboard_png="scoreboard.png", family_figures=figures)
+    md = build_summary(sections, paths, SOURCE_NOTE, prov, data, real, demo,
+                       scoreboard_png="scoreboard.png", family_figures=figures, timing_tables=TIMING)
     return md, claims_table(paths, data, real)
 
 
@@ -293,3 +306,77 @@ def test_a_familys_sanity_checks_file_is_marked_apart_and_not_counted(tmp_path):
     assert counts.set_index("family").loc["compare", "sanity_checks"] == 1
     pd.testing.assert_frame_equal(counts.drop(columns="sanity_checks").reset_index(drop=True),
                                   without.drop(columns="sanity_checks").reset_index(drop=True))
+
+
+#: a line between the provenance table and the scoreboard is at most this long (a sentence, not a list of paths)
+SHORT_LINE = 200
+
+
+def _scoreboard_rows(md: str) -> dict[str, list[str]]:
+    """The scoreboard's counts table as {paper: cells}, with its header's column names under ''."""
+    sb = md[md.index("## Scoreboard"): md.index("## Claims of the four papers")]
+    rows = [[c.strip() for c in ln.strip("|").split("|")] for ln in sb.splitlines() if ln.startswith("| ")]
+    return {"": rows[0], **{r[0]: r for r in rows[1:]}}
+
+
+def _counts_in_words(text: str) -> dict[str, int]:
+    """'2 partly, 6 within noise; 2 sanity checks.' -> {'partly': 2, 'within noise': 6, 'sanity checks': 2}"""
+    found = {w: int(n) for n, w in re.findall(r"(\d+) ([a-z][a-z ]*?)(?=[,;.]|$)", text)}
+    if "sanity check" in found:
+        found["sanity checks"] = found.pop("sanity check")
+    return found
+
+
+@pytest.mark.parametrize("sanity", [False, True])
+def test_family_headers_count_as_the_scoreboard_does_sanity_checks_apart(tmp_path, sanity):
+    md, claims = _summary(tmp_path, sanity=sanity)
+    board = _scoreboard_rows(md)
+    header = board[""]
+    for fam in claims["family"].unique():
+        section = md[md.index("## " + FAMILY_SECTION[fam]):]
+        line = next(ln for ln in section.splitlines() if ln.startswith("**Data:**"))
+        said = _counts_in_words(line[line.index("Claims "):].split(": ", 1)[1])
+        row = board[str(claims.loc[claims["family"] == fam, "paper"].iloc[0])]
+        table = {h: int(v) for h, v in zip(header, row) if h not in ("paper", "data", "claims") and int(v or 0)}
+        assert said == table, (fam, line, row)
+    comp = md[md.index("## " + FAMILY_SECTION["compare"]):]
+    line = next(ln for ln in comp.splitlines() if ln.startswith("**Data:**"))
+    if sanity:  # two findings reproduced, two sanity checks apart, never counted as reproduced
+        assert line.endswith("Claims C1 to C4: 2 reproduced; 2 sanity checks."), line
+        assert board[""][-1] == "sanity checks" and board[str(claims.loc[claims["family"] == "compare", "paper"]
+                                                            .iloc[0])][-1] == "2"
+    else:
+        assert line.endswith("Claims C1 to C2: 2 reproduced."), line
+    # the claims table's count lines, on real and on synthetic data, add up to the scoreboard's rows
+    for title, real in (("### On real data", True), ("### On synthetic data", False)):
+        block = md[md.index(title):].split("\n\n")[1]
+        assert block == verdict_counts_md(claims[claims["real"] == real])
+        want: dict[str, int] = {}
+        for _, c in claims[claims["real"] == real].drop_duplicates("family").iterrows():
+            row = board[str(c["paper"])]
+            for h, v in zip(header, row):
+                if h not in ("paper", "data", "claims") and int(v or 0):
+                    want[h] = want.get(h, 0) + int(v)
+        assert _counts_in_words(block) == want, (title, block)
+
+
+def test_only_short_lines_between_provenance_and_scoreboard_and_every_timing_table_named_later(tmp_path):
+    md, _ = _summary(tmp_path)
+    lines = md.splitlines()
+    last_prov = max(i for i, ln in enumerate(lines[: lines.index("## Scoreboard")]) if ln.startswith("| "))
+    between = lines[last_prov + 1: lines.index("## Scoreboard")]
+    assert SOURCE_NOTE in between  # the sentence on what the numbers are computed on stays where it was
+    assert all(len(ln) <= SHORT_LINE for ln in between), [len(ln) for ln in between]
+    assert not any(t in "\n".join(between) for t in TIMING)
+    # every timing table is named, after the claims table and the families' sections: the summary's last section
+    tail = md[md.index("## Timing tables"):]
+    assert md.index("## Timing tables") > md.index("## Detailed tables") > md.index("## Claims of the four papers")
+    assert "\n## " not in tail[3:]
+    for t in TIMING:
+        assert f"- `{t}`" in tail.splitlines(), t
+        assert md.count(t) == 1, t
+    assert "(#timing-tables)" in "\n".join(between)  # and the short line above points there
+    # no timing table, no section and no pointer
+    paths, real, data, prov = _run(tmp_path)
+    plain = build_summary([], paths, SOURCE_NOTE, prov, data, real, False)
+    assert "Timing tables" not in plain and "timing" not in plain.lower()

@@ -298,14 +298,24 @@ def _claims_rows_md(df: pd.DataFrame) -> str:
     return "\n".join(head + [claim_line_md(r, i) for i, (_, r) in zip(_ids(df), df.iterrows())]) + "\n"
 
 
-def _verdict_counts(part: pd.DataFrame) -> str:
-    """'3 reproduced, 1 partly, ...': the verdicts from best to worst, then any other word."""
-    from .scoreboard import VERDICT_COLOURS
+def verdict_counts_md(part: pd.DataFrame) -> str:
+    """The counts of some claims in words, counted as the scoreboard counts them
+    (:func:`animsynth.scoreboard.scoreboard_counts`): the findings by verdict, from best to worst (then any other
+    word), and the sanity checks apart and named as such, e.g. '2 partly, 6 within noise; 2 sanity checks.'
 
-    counts = part["verdict"].value_counts()
-    order = [v for v in VERDICT_COLOURS if v in counts.index] + sorted(v for v in counts.index
-                                                                      if v not in VERDICT_COLOURS)
-    return ", ".join(f"{counts[v]} {v}" for v in order) + "."
+    Parameters
+    ----------
+    part : DataFrame, rows of ``claims.csv`` (one family, or every claim on real or on synthetic data)
+    """
+    from .scoreboard import scoreboard_counts
+
+    counts = scoreboard_counts(part)
+    words = [c for c in counts.columns if c not in ("family", "paper", "data", "claims", "sanity_checks")]
+    text = ", ".join(f"{int(counts[w].sum())} {w}" for w in words if int(counts[w].sum()))
+    n_sanity = int(counts["sanity_checks"].sum())
+    if n_sanity:
+        text += ("; " if text else "") + f"{n_sanity} sanity check{'s' if n_sanity != 1 else ''}"
+    return text + "."
 
 
 def claims_markdown(claims: pd.DataFrame) -> str:
@@ -323,8 +333,9 @@ def claims_markdown(claims: pd.DataFrame) -> str:
         if part.empty and checks.empty:
             out += ["(none in this run)", ""]
             continue
+        out += [verdict_counts_md(claims[mask]), ""]
         if not part.empty:
-            out += [_verdict_counts(part), "", _claims_rows_md(part).rstrip("\n"), ""]
+            out += [_claims_rows_md(part).rstrip("\n"), ""]
         if not checks.empty:
             out += ["Sanity checks (true by construction, not counted among the findings):", "",
                     _claims_rows_md(checks).rstrip("\n"), ""]
@@ -580,9 +591,11 @@ def _provenance_md(provenance: pd.DataFrame, family_real: dict[str, bool] | None
 def build_summary(sections: list[dict], verdict_paths, source_note: str,
                   provenance: pd.DataFrame | None = None, family_data: dict[str, str] | None = None,
                   family_real: dict[str, bool] | None = None, demo: bool = True, *,
-                  scoreboard_png: str | None = None, family_figures: dict | None = None) -> str:
+                  scoreboard_png: str | None = None, family_figures: dict | None = None,
+                  timing_tables=()) -> str:
     """Markdown summary, read top-down: the banner and what each part ran on (once), the scoreboard, one line
-    per claim, one section per family (its key figures, its key table, its claims in full), the detailed tables.
+    per claim, one section per family (its key figures, its key table, its claims in full), the detailed tables,
+    then the machine-dependent timing tables it names but does not show.
 
     Parameters
     ----------
@@ -591,12 +604,15 @@ def build_summary(sections: list[dict], verdict_paths, source_note: str,
         ``group`` (a heading shared by several, e.g. "The generators side by side"), ``family`` and ``key``
         (true: the family's key table, shown in its section; every other table goes to the detailed tables).
     verdict_paths : the families' verdicts.csv
-    source_note : the sentence after the provenance table (what the numbers are computed on, timing tables)
+    source_note : the short sentence after the provenance table (what the numbers are computed on)
     provenance : DataFrame (family, data, status)
     family_data, family_real : what each family ran on, and whether that is real data
     demo : the run is a demo (config ``demo``)
     scoreboard_png : path of the scoreboard picture relative to the summary ('' or None: counts only)
     family_figures : {family: [{"src": path relative to the summary, "caption": what to see in it}]}
+    timing_tables : paths of the machine-dependent timing tables (wall and CPU time, different between runs):
+        named in a list of their own at the end (:data:`TIMING_HEADING`), not rendered, so that the summary is
+        byte-identical between two runs of one config; a short line after ``source_note`` points there
     """
     from .scoreboard import scoreboard_counts, scoreboard_rows
 
@@ -607,7 +623,7 @@ def build_summary(sections: list[dict], verdict_paths, source_note: str,
         out += [banner, ""]
     if provenance is not None and not provenance.empty:
         out += _provenance_md(provenance, family_real) + [""]
-    out += [source_note, ""]
+    out += [source_note] + ([TIMING_POINTER] if timing_tables else []) + [""]
     claims = claims_table(verdict_paths, family_data, family_real)
     if claims.empty:
         out += ["## Claims of the four papers", "", "(no verdicts were produced)", ""]
@@ -627,7 +643,7 @@ def build_summary(sections: list[dict], verdict_paths, source_note: str,
         if len(part):
             kind = "real data" if bool(part["real"].iloc[0]) else "synthetic data"
             out += [f"**Data:** {(family_data or {}).get(fam) or part['data'].iloc[0]} ({kind}). "
-                    f"Claims {_ids(part).iloc[0]} to {_ids(part).iloc[-1]}: {_verdict_counts(part)}", ""]
+                    f"Claims {_ids(part).iloc[0]} to {_ids(part).iloc[-1]}: {verdict_counts_md(part)}", ""]
         for fig in family_figures.get(fam, []):
             out += [f"![{fig.get('caption', '')}]({fig['src']})", "",
                     f"*{Path(fig['src']).name}:* {fig.get('caption', '')}", ""]
@@ -643,7 +659,23 @@ def build_summary(sections: list[dict], verdict_paths, source_note: str,
         for s in rest:
             title = f"{s['group']}: {s['title']}" if s.get("group") else s["title"]
             out += _summary_section({**s, "title": title}, "###") + [""]
+    if timing_tables:
+        out += timing_tables_md(timing_tables) + [""]
     return "\n".join(out).rstrip("\n") + "\n"
+
+
+#: The heading of the summary's last section: the timing tables it names but does not show.
+TIMING_HEADING = "Timing tables"
+#: The line after the sentence under the provenance table that points to that section.
+TIMING_POINTER = f"Machine-dependent timing tables are listed at the end ([{TIMING_HEADING}](#timing-tables))."
+
+
+def timing_tables_md(paths) -> list[str]:
+    """The summary's last section: the machine-dependent timing tables, one per line (not rendered: their wall
+    and CPU times differ between runs)."""
+    return [f"## {TIMING_HEADING}", "",
+            "Machine-dependent timing tables are not shown here (they differ between runs):", "",
+            *(f"- `{t}`" for t in paths)]
 
 
 def _summary_section(s: dict, level: str) -> list[str]:

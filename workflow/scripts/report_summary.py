@@ -16,9 +16,6 @@ verdicts = list(snakemake.input.verdicts)
 provenance = pd.DataFrame(p.provenance, columns=["family", "data", "status"])
 note = ("Every number below is computed by the workflow on the data named above; paper values are quoted beside "
         "ours where the paper gives them.")
-if p.timing:
-    note += (" Machine-dependent timing tables are not shown here (they differ between runs): "
-             + ", ".join(f"`{t}`" for t in p.timing) + ".")
 here = os.path.dirname(out.summary)
 # key figures: the path on disk (embedded in the home page) and below the results folder (summary.md's links)
 figures = {fam: [{**f, "src": os.path.relpath(f["png"], here)} for f in figs] for fam, figs in p.figures.items()}
@@ -35,5 +32,6 @@ atomic_write_text(out.home, claims_rst(
     family_data=p.family_data, family_tables=tables))
 atomic_write_text(out.summary, build_summary(
     p.sections, verdicts, note, provenance, p.family_data, p.family_real, p.demo,
-    scoreboard_png=os.path.relpath(snakemake.input.scoreboard, here), family_figures=figures))
+    scoreboard_png=os.path.relpath(snakemake.input.scoreboard, here), family_figures=figures,
+    timing_tables=p.timing))
 log.info("summary with %d tables, %d claims (%d on real data)", len(p.sections), len(claims), int(claims["real"].sum()))
