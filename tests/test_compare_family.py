@@ -613,3 +613,22 @@ def test_budget_sweep_compares_the_graphs_on_the_clips_both_were_built_on():
     assert list(t["clips_compared"]) == [2, 2] and list(t["clips_not_built"]) == [0, 1]
     # counted over every clip it was built on, the motion graph's median would be 20; over the shared clips, 15
     assert t.loc["motion_graph", "transitions_kept_median"] == t.loc["fairmotion_fixed", "transitions_kept_median"] == 15
+
+
+def test_the_claims_against_the_peer_quote_the_budget_sweep():
+    n = 16
+    lo, hi = list(np.linspace(0.1, 0.2, n)), list(np.linspace(0.3, 0.4, n))
+    metrics = _metrics({"motion_graph": lo, "fairmotion_fixed": hi, "fairmotion": hi})
+    sweep = pd.DataFrame([{"transitions_per_s": b, "generator": g, "transition_skate_share_median": v}
+                          for b, g, v in ((2.0, "motion_graph", 0.2), (2.0, "fairmotion_fixed", 0.3),
+                                          (4.0, "motion_graph", 0.25), (4.0, "fairmotion_fixed", 0.2),
+                                          (8.0, "motion_graph", 0.3), (8.0, "fairmotion_fixed", 0.5))])
+    fixed = "our motion graph's transitions skate less than fairmotion's with upstream's walk fixes"
+    released = "our motion graph's transitions skate less than fairmotion 0.0.4's as released (at its native 60 fps)"
+    v = CV.build_verdicts(metrics, dict(VC, min_groups=2), "test data", {}, sweep=sweep).set_index("claim")
+    ev = v.loc[fixed, "evidence"]
+    assert "0.2 vs 0.3 at 2/s; 0.25 vs 0.2 at 4/s; 0.3 vs 0.5 at 8/s; motion_graph lower at 2 of 3 budgets" in ev
+    assert "the budget sweep runs the fixed row" in v.loc[released, "evidence"]
+    without = CV.build_verdicts(metrics, dict(VC, min_groups=2), "test data", {}).set_index("claim")
+    assert "budget sweep" not in without.loc[fixed, "evidence"]
+    assert (v["verdict"] == without["verdict"]).all()  # evidence, not a vote: decided at the default budget

@@ -602,6 +602,22 @@ def read_metrics(paths) -> pd.DataFrame:
     return m
 
 
+def sweep_runs(default: pd.DataFrame, paths, default_budget: float, budgets, generators) -> dict:
+    """``{budget: metrics of the graph generators}``: the default run's rows of ``generators`` at
+    ``default_budget`` and one metrics file per further budget and generator (``paths``, in the order of
+    ``budgets`` x ``generators``)."""
+    runs = {float(default_budget): default[default["generator"].isin(generators)]}
+    paths = list(paths)
+    if len(paths) != len(list(budgets)) * len(list(generators)):
+        raise ValueError(f"budget sweep: {len(paths)} metrics files for {len(list(budgets))} budgets x "
+                         f"{len(list(generators))} generators")
+    k = 0
+    for b in budgets:
+        runs[float(b)] = read_metrics(paths[k:k + len(generators)])
+        k += len(generators)
+    return runs
+
+
 def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, order) -> None:
     """The sweep table and figure from the default run's graph-generator metrics (``inp["default"]``) and one
     metrics file per budget and generator (``inp["sweep"]``, in the order of ``budgets`` x ``generators``)."""
@@ -609,27 +625,25 @@ def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, 
     from .plots import sweep_figure
     from .tables import sweep_table
 
-    runs = {float(default_budget): read_metrics(inp["default"])}
-    runs[float(default_budget)] = runs[float(default_budget)][runs[float(default_budget)]["generator"]
-                                                              .isin(generators)]
-    paths = list(inp["sweep"])
-    k = 0
-    for b in budgets:
-        runs[float(b)] = read_metrics(paths[k:k + len(generators)])
-        k += len(generators)
-    table = sweep_table(runs, order)
+    table = sweep_table(sweep_runs(read_metrics(inp["default"]), inp["sweep"], default_budget, budgets, generators),
+                        order)
     write_table(table, out["table"], md=out["table_md"])
     sweep_figure(table, out["figure"], float(default_budget))
 
 
-def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str) -> None:
+def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str, sweep: dict | None = None) -> None:
     """Assemble the family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``,
-    ``timing`` lists) into ``out``: ``metrics``, ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``),
-    ``cost`` (+ ``cost_md``), ``verdicts`` (+ ``verdicts_md``), ``summary_md`` (the family's page)."""
+    ``timing`` lists; optional ``sweep``: the budget sweep's metrics files) into ``out``: ``metrics``,
+    ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``), ``cost`` (+ ``cost_md``), ``verdicts``
+    (+ ``verdicts_md``), ``summary_md`` (the family's page).
+
+    ``sweep``: ``{"default": transitions_per_s, "budgets": [...], "generators": [...]}`` describing
+    ``inp["sweep"]`` (:func:`sweep_runs`); the claims against the peer quote the sweep as evidence."""
     from ..atomic import atomic_write_text
     from ..tables import write_table
-    from .tables import cost_table, data_label, sensitivity_table, summary_markdown, summary_table, winners_table
     from .generators import GENERATORS
+    from .tables import (cost_table, data_label, sensitivity_table, summary_markdown, summary_table, sweep_table,
+                         winners_table)
     from .verdicts import build_verdicts, independent_groups, sanity_checks
 
     order = list(cfg["generators"])
@@ -646,7 +660,11 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
     # the claims are the family's own: a user generator (compare.user_generators) is in every table, not in them
     own = metrics[metrics["generator"].isin(GENERATORS)]
-    verdicts = build_verdicts(own, cfg["verdicts"], data, left_out, clips_full)
+    sweep_tab = None
+    if sweep and sweep.get("budgets") and inp.get("sweep"):
+        sweep_tab = sweep_table(sweep_runs(metrics, inp["sweep"], sweep["default"], sweep["budgets"],
+                                           sweep["generators"]), order)
+    verdicts = build_verdicts(own, cfg["verdicts"], data, left_out, clips_full, sweep=sweep_tab)
     sanity = sanity_checks(own, cfg["verdicts"], data, left_out, clips_full)
     write_table(metrics, out["metrics"], md=False)
     write_table(timing, out["metrics_timing"], md=False)

@@ -31,7 +31,8 @@ By the common rule for "A beats B over units" (:func:`animsynth.verdicts.a_beats
 * ``reproduced`` -- at least ``compare.verdicts.share`` of the groups hold (a group within noise does not),
   there are at least ``compare.verdicts.min_groups`` groups, and a one-sample t-test of the group effects against zero gives
   a Holm-adjusted p below ``compare.verdicts.alpha`` (Holm over every finding of the family: the claims of
-  :func:`build_verdicts`, not the sanity checks);
+  :func:`build_verdicts`, not the sanity checks; the capture bound over every generator is one finding, an
+  intersection-union test whose p is the largest of its parts');
 * ``contradicted`` -- the same for the opposite;
 * ``partly`` -- neither, but some groups hold and others hold the opposite;
 * ``within noise`` -- anything else (the evidence gives the group counts, the effects and both p);
@@ -356,8 +357,29 @@ def _capture_rows(capture: list, p_adj: float, vc: dict, data: str, metrics: pd.
     return V.row(claim, verdict, evidence, ours=ours, data=data, source="compare/metrics.csv")
 
 
+def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> str:
+    """What the transition budget sweep (``compare/budget_sweep.csv``) says of ``a`` vs ``b`` on ``metric``
+    (lower is better): the medians at every budget, over the clips both graphs were built on."""
+    if sweep is None or not len(sweep):
+        return ""
+    col = f"{metric}_median"
+    parts, lower = [], 0
+    budgets = sorted(sweep["transitions_per_s"].unique())
+    for bud in budgets:
+        s = sweep[sweep["transitions_per_s"] == bud].set_index("generator")
+        if a not in s.index or b not in s.index:
+            continue
+        va, vb = float(s.loc[a, col]), float(s.loc[b, col])
+        lower += int(va < vb)
+        parts.append(f"{V.fmt(va)} vs {V.fmt(vb)} at {V.fmt(bud)}/s")
+    if not parts:
+        return ""
+    return (f"the budget sweep (budget_sweep.csv; medians over the clips both graphs were built on): {a} vs {b} "
+            f"{'; '.join(parts)}; {a} lower at {lower} of {len(parts)} budgets")
+
+
 def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
-          clips: pd.DataFrame | None = None) -> pd.DataFrame:
+                   clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None) -> pd.DataFrame:
     """The findings of the comparison (the verdict table; the sanity checks: :func:`sanity_checks`).
 
     Parameters
@@ -368,6 +390,8 @@ def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | 
     data : what the numbers ran on (e.g. "CMU: 19 held-out clips x 5 seeds")
     left_out : {generator: why it did not run}
     clips : DataFrame, ``compare/clips.csv`` (for :func:`independent_groups`; ``None``: each subset one group)
+    sweep : DataFrame or None, the budget sweep table (:func:`animsynth.compare.tables.sweep_table`): quoted as
+        evidence in the claims against the peer (decided at the default budget)
     """
     groups = _groups(metrics, clips, vc)
     present = set(metrics["generator"])
@@ -384,11 +408,14 @@ def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | 
     pair("our motion graph's transitions skate less than fairmotion 0.0.4's as released (at its native 60 fps)",
          "motion_graph", "fairmotion", "transition_skate_share",
          caveat="fairmotion as released: its walk blends from a held pose and turns an appended piece without "
-                "its path (animsynth.compare.fairmotion_peer); both graphs keep the same transition budget")
+                "its path (animsynth.compare.fairmotion_peer); both graphs keep the same transition budget"
+                + ("; the budget sweep runs the fixed row (the released row builds the same graph)"
+                   if sweep is not None and len(sweep) else ""))
     pair("our motion graph's transitions skate less than fairmotion's with upstream's walk fixes",
          "motion_graph", "fairmotion_fixed", "transition_skate_share",
          caveat="fairmotion with the fixes output_rate, blend_source, rigid_turn; both graphs keep the same "
-                "transition budget")
+                "transition budget" + (f"; {ev}" if (ev := _sweep_evidence(sweep, "motion_graph", "fairmotion_fixed",
+                                                                          "transition_skate_share")) else ""))
     pair("ST-Isomap re-sequencing jumps less than Isomap re-sequencing (95th percentile of the per-frame velocity "
          "jump)", "stisomap", "isomap", "velocity_jump_p95",
          paper_value="ST-Isomap re-sequences more smoothly than Isomap (the re-sequencing paper)")
