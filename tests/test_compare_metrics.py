@@ -374,23 +374,39 @@ def test_per_frame_jumps_find_a_discontinuity_between_reported_seams():
     assert M.frame_jumps(pos, FPS, 40, cmax)["velocity_jump_max"] == pytest.approx(0.0, abs=1e-9)
 
 
-def test_gmd_skating_ratio_counts_both_frames_in_contact_and_the_mean_speed_over_all_steps():
-    feet = np.concatenate([_sliding_foot(0.9, 0.0)[:, 1:], _sliding_foot(0.9, 0.5)[:, 1:]], axis=1)  # one lifted
-    T = feet.shape[0]
-    r = M.skating_ratio(feet, FPS, [0, 1], height_m=0.02, speed_m_s=0.5, floor_m=0.0, window=5)
-    # the sliding foot skates on every step (the zero-padded 5-frame mean at the ends is 0.9 * 3/5 = 0.54 > 0.5):
-    # all T - 1 steps of one of the two feet, over all 2 (T - 1) joint-steps
-    assert r == pytest.approx(0.5)
+def test_gmd_skating_ratio_counts_frame_steps_where_either_foot_skates_over_all_frame_steps():
+    # GMD's definition: a frame step skates when either foot skates on it; the ratio is over all T - 1 steps
+    slide, lifted = _sliding_foot(0.9, 0.0)[:, 1:], _sliding_foot(0.9, 0.5)[:, 1:]
+    T = slide.shape[0]
+    assert T == 60
+    # one foot skates on every step (the zero-padded 5-step mean at the ends is 0.9 * 3/5 = 0.54 > 0.5), the
+    # other is lifted and never does: every frame step skates (joint-steps over all joint-steps would give 1/2)
+    one_skates = np.concatenate([slide, lifted], axis=1)
+    assert M.skating_ratio(one_skates, FPS, [0, 1], height_m=0.02, speed_m_s=0.5, floor_m=0.0, window=5) == 1.0
+    # both feet skating on the same steps count once
+    assert M.skating_ratio(np.concatenate([slide, slide], axis=1), FPS, [0, 1], 0.02, 0.5, 0.0) == 1.0
+    # the feet take turns: foot 0 on the floor in frames 0..29, foot 1 in frames 30..59, both sliding. Foot 0 is
+    # in contact (both frames of the step) on steps 0..28, foot 1 on steps 30..58; step 29 has neither, and
+    # counts in the denominator: 58 of 59 frame steps (joint-steps: 58 of 118; contact steps only: 58 of 58)
+    turns = np.concatenate([slide, slide], axis=1)
+    turns[30:, 0, 1] = 0.5
+    turns[:30, 1, 1] = 0.5
+    assert M.skating_ratio(turns, FPS, [0, 1], 0.02, 0.5, 0.0) == pytest.approx(58 / 59, rel=1e-12)
     # a foot in contact in one frame only of a step does not skate there
-    one = _sliding_foot(0.9, 0.0)[:, 1:].copy()
+    one = slide.copy()
     one[::2, 0, 1] = 0.05
     assert M.skating_ratio(one, FPS, [0], 0.02, 0.5, 0.0) == 0.0
-    # a short burst of speed is removed by the 5-frame mean
+    # a short burst of speed is removed by the 5-step mean
     burst = _sliding_foot(0.0, 0.0)[:, 1:].copy()
     burst[31:, 0, 0] += 0.6 / FPS  # one step at 0.6 m/s
     assert M.foot_skating(burst, FPS, [0], 0.02, 0.5, 0.0)["skate_share"] > 0
     assert M.skating_ratio(burst, FPS, [0], 0.02, 0.5, 0.0) == 0.0
-    assert T == 60
+    # a slide on the floor from frame 40 on skates on steps 40..58 (the 5-step mean there is at least
+    # 0.9 * 3/5), the other foot lifted: 19 of 59 frame steps (joint-steps: 19 of 118)
+    late = _sliding_foot(0.0, 0.0)[:, 1:].copy()
+    late[41:, 0, 0] += 0.9 / FPS * np.arange(1, T - 40)
+    assert M.skating_ratio(np.concatenate([late, lifted], axis=1), FPS, [0, 1], 0.02, 0.5, 0.0) == \
+        pytest.approx(19 / 59, rel=1e-12)
 
 
 def test_the_robust_floor_ignores_a_few_frames_through_the_floor():

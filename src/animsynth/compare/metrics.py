@@ -59,9 +59,9 @@ METRICS = (
     ("skate_share", "share of contact joint-frames", "lower"),
     ("skate_m_per_contact_frame", "m", "lower"),
     ("transition_skate_share", "share of contact joint-frames near seams", "lower"),
-    ("skating_ratio_gmd", "share of foot steps (GMD)", "lower"),
+    ("skating_ratio_gmd", "share of frame steps (GMD)", "lower"),
     *((f"skate_share_at_{v:g}", f"share of contact joint-frames, {v:g} m/s", "") for v in SENSITIVITY_SPEEDS),
-    *((f"skating_ratio_gmd_at_{v:g}", f"share of foot steps (GMD), {v:g} m/s", "") for v in SENSITIVITY_SPEEDS),
+    *((f"skating_ratio_gmd_at_{v:g}", f"share of frame steps (GMD), {v:g} m/s", "") for v in SENSITIVITY_SPEEDS),
     ("velocity_jump_p95", "m/s", "lower"),
     ("velocity_jump_max", "m/s", "lower"),
     ("velocity_jump_over_capture", "share of frames", "lower"),
@@ -288,15 +288,25 @@ def floor_height(pos_list, foot_idx, percentile: float = 0.0) -> float:
 
 def skating_ratio(pos, fps: float, foot_idx, height_m: float = 0.05, speed_m_s: float = 0.5,
                   floor_m: float | None = None, window: int = 5) -> float:
-    """GMD's skating ratio (Karunratanakul et al. 2023, Guided Motion Diffusion; after its evaluation code).
+    """GMD's skating ratio (Karunratanakul et al. 2023, Guided Motion Diffusion; after its evaluation code,
+    ``calculate_skating_ratio`` in ``data_loaders/humanml/utils/metrics.py`` of korrawe/guided-motion-diffusion).
 
-    Two foot joints (GMD: SMPL's left and right foot, the ball of each foot; here the ``left_ankle`` and
-    ``right_ankle`` roles, whose segment ends are the balls of the feet). Per joint and pair of adjacent frames
-    ``(t-1, t)``: *contact* when the height above the floor is below ``height_m`` in both frames; *skating*
-    when, in contact, both the horizontal speed of the step and its mean over a centred ``window``-frame box
-    (zeros beyond the ends, as ``scipy.ndimage.uniform_filter1d(mode="constant")``) exceed ``speed_m_s``.
-    The ratio is the skating joint-steps over **all** joint-steps (not over contact steps as
-    :func:`foot_skating`'s share).
+    Two foot joints (GMD: SMPL's left and right foot, joints 10 and 11, at the ball of each foot; here the
+    ``left_ankle`` and ``right_ankle`` roles, whose segment ends are the balls of the feet). Per foot and frame
+    step ``(t-1, t)``: *contact* when the height above the floor is below ``height_m`` in **both** frames;
+    the foot *skates* on the step when, in contact, both the step's horizontal speed and that speed's mean over
+    a centred ``window``-step box (zeros beyond the ends, as ``scipy.ndimage.uniform_filter1d(mode="constant")``)
+    exceed ``speed_m_s``. A frame step skates when **either** foot skates on it; the ratio is the skating
+    frame steps over **all** ``T - 1`` frame steps (not over contact steps as :func:`foot_skating`'s share, and
+    not over joint-steps: one foot skating on every step gives 1, not 1/2).
+
+    Where ours still differs from GMD's (unavoidable; ``docs/compare.md``, "Foot skating"): the steps are at
+    the motion's own rate (the compare family's working rate, 30 fps on CMU) where GMD's are at HumanML3D's
+    20 fps, so a step's speed is over 1/30 s and the 5-step mean spans 1/6 s instead of 1/4 s (the thresholds
+    are m/s, so they carry over); the floor is the caller's (the compare family: the database's, as for
+    :func:`foot_skating`) where GMD's samples stand on HumanML3D's floor (y = 0: each training clip shifted so
+    that its lowest joint is at 0); and GMD scores every sample at its padded length of 196 frames, we the
+    frames given.
 
     Parameters
     ----------
@@ -304,16 +314,18 @@ def skating_ratio(pos, fps: float, foot_idx, height_m: float = 0.05, speed_m_s: 
         Metres, ``T >= 2``.
     fps : float
     foot_idx : array of int, shape (2,)
+        The two feet (any number of foot joints is accepted; a step skates when any of them skates).
     height_m, speed_m_s : float
         GMD: 0.05 m, 0.5 m/s.
     floor_m : float, optional
         Floor height (m); ``None``: 0 (GMD's data stand on y = 0).
     window : int
-        GMD: 5 frames.
+        GMD: 5 steps.
 
     Returns
     -------
     float
+        Skating frame steps / ``T - 1``.
     """
     from scipy.ndimage import uniform_filter1d
 
@@ -322,10 +334,10 @@ def skating_ratio(pos, fps: float, foot_idx, height_m: float = 0.05, speed_m_s: 
         raise ValueError(f"pos must have shape (T >= 2, J, 3), got {pos.shape}")
     P = pos[:, np.asarray(foot_idx, dtype=np.int64)]
     h = P[:, :, UP] - (0.0 if floor_m is None else float(floor_m))
-    speed = np.linalg.norm(np.diff(P[:, :, _HORIZONTAL], axis=0), axis=-1) * fps  # (T-1, 2)
+    speed = np.linalg.norm(np.diff(P[:, :, _HORIZONTAL], axis=0), axis=-1) * fps  # (T-1, feet)
     mean = uniform_filter1d(speed, size=int(window), axis=0, mode="constant")
     contact = (h[:-1] < height_m) & (h[1:] < height_m)
-    skate = contact & (speed > speed_m_s) & (mean > speed_m_s)
+    skate = (contact & (speed > speed_m_s) & (mean > speed_m_s)).any(axis=1)  # either foot, (T-1,)
     return float(skate.sum()) / skate.size
 
 
