@@ -341,11 +341,10 @@ def _capture_rows(capture: list, p_adj: float, vc: dict, data: str, metrics: pd.
     else:
         verdict = "within noise"
     me = float(vc["min_effect"].get("skate_share", 0.0))
-    n_groups = len(capture[0].per) if capture[0].per is not None else 0
     evidence = (f"one intersection-union test over the {len(capture)} generators (the claim holds only if it holds "
                 f"against each, so its p is the largest of theirs, p = {V.fmt(p_iut, 2)}, and it is one finding of "
-                f"the Holm correction: adjusted p = {V.fmt(p_adj, 2)}); each generator decided over {n_groups} "
-                f"independent groups ({GROUPINGS[vc.get('grouping', 'subject')]}, minimum effect {V.fmt(me)} "
+                f"the Holm correction: adjusted p = {V.fmt(p_adj, 2)}); each generator decided over the independent "
+                f"groups in which both have values ({GROUPINGS[vc.get('grouping', 'subject')]}, minimum effect {V.fmt(me)} "
                 f"{_UNITS['skate_share']}), its t-test p scaled by the claim's Holm factor; per generator (groups "
                 "holding / opposite / within noise, t-test p, verdict): " + "; ".join(parts))
     med = (metrics[metrics["generator"] != "replay"].assign(x=pd.to_numeric(metrics["skate_share"], errors="coerce"))
