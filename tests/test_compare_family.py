@@ -358,7 +358,7 @@ def test_motion_matching_rows_have_seed_diversity_zero_and_genmm_does_not(walks,
         metrics, timing, _ = jobs.run_generator(clips, name, cfg, 7)
         assert len(metrics) == 3 * cfg["seeds"] and (metrics["note"] == "").all()
         assert ((metrics["seed_diversity_m"] == 0).all() if zero else (metrics["seed_diversity_m"] > 0).all()), name
-        assert (timing["generate_cpu_s"] >= 0).all() and (timing["frames_generated"] == 20 * cfg["seeds"]).all()
+        assert np.isfinite(timing["generate_cpu_s"]).all() and (timing["frames_generated"] == 20 * cfg["seeds"]).all()
 
 
 def test_clips_sharing_a_trial_or_a_subject_in_a_subset_are_one_group():

@@ -297,11 +297,20 @@ def _capture_claims(metrics, groups, vc, data):
                   "lower", vc, data, {}) for g in gens]
 
 
-def _holm_rows(claims: list, vc: dict, correction_name: str) -> list:
-    ps = [c.p for c in claims]
+def _iut_p(capture: list) -> float:
+    """The intersection-union test's p of the capture claim: the largest of its parts' (NaN if one has none)."""
+    ps = np.array([c.p for c in capture], float)
+    return float(np.max(ps)) if ps.size and np.all(np.isfinite(ps)) else float("nan")
+
+
+def _holm_rows(claims: list, vc: dict, correction_name: str, extra: list = ()) -> tuple[list, list]:
+    """Every claim's row with its Holm-adjusted p, Holm run over the claims' p and the ``extra`` p (findings
+    written elsewhere, e.g. the capture claim's); returns (rows, the extra p adjusted)."""
+    ps = [c.p for c in claims] + list(extra)
     adj = V.holm(ps)
     n = int(np.sum(np.isfinite(ps)))
-    return [c.row(a, vc, f"Holm-adjusted over the {n} {correction_name}") for c, a in zip(claims, adj)]
+    rows = [c.row(a, vc, f"Holm-adjusted over the {n} {correction_name}") for c, a in zip(claims, adj)]
+    return rows, [float(a) for a in adj[len(claims):]]
 
 
 def _capture_rows(capture: list, p_adj: float, vc: dict, data: str, metrics: pd.DataFrame) -> dict | None:
@@ -317,8 +326,7 @@ def _capture_rows(capture: list, p_adj: float, vc: dict, data: str, metrics: pd.
     if not capture:
         return None
     claim = "the held-out capture skates less than every generator (the realism upper bound holds for this metric)"
-    ps = np.array([c.p for c in capture], float)
-    p_iut = float(np.max(ps)) if np.all(np.isfinite(ps)) else float("nan")
+    p_iut = _iut_p(capture)
     factor = p_adj / p_iut if np.isfinite(p_iut) and p_iut > 0 and np.isfinite(p_adj) else 1.0
     parts, words = [], []
     for c in capture:
@@ -430,14 +438,8 @@ def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | 
     if "replay" in configured and "replay" in present:
         capture = _capture_claims(metrics, groups, vc, data)
     # the capture claim is one finding (an intersection-union test over the generators: its p the largest)
-    ps = [c.p for c in claims]
-    if capture:
-        cps = np.array([c.p for c in capture], float)
-        ps.append(float(np.max(cps)) if np.all(np.isfinite(cps)) else float("nan"))
-    adj = V.holm(ps)
-    name = f"Holm-adjusted over the {int(np.sum(np.isfinite(ps)))} findings of this table"
-    out = [c.row(a, vc, name) for c, a in zip(claims, adj)]
-    cap = _capture_rows(capture, float(adj[-1]), vc, data, metrics) if capture else None
+    out, cap_adj = _holm_rows(claims, vc, "findings of this table", [_iut_p(capture)] if capture else [])
+    cap = _capture_rows(capture, cap_adj[0], vc, data, metrics) if capture else None
     if cap is not None:
         out.append(cap)
     elif "replay" in configured:
@@ -459,7 +461,7 @@ def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
         claims.append(_pair(metrics, groups, "the motion graph's blended transitions jump less than random "
                             "concatenation's unblended seams (95th percentile of the per-frame velocity jump)",
                             "motion_graph", "concat", "velocity_jump_p95", "lower", vc, data, left_out))
-    return V.table(_holm_rows(claims, vc, "sanity checks"))
+    return V.table(_holm_rows(claims, vc, "sanity checks")[0])
 
 
 def _groups(metrics: pd.DataFrame, clips: pd.DataFrame | None, vc: dict) -> dict:
