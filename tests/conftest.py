@@ -39,6 +39,17 @@ PAPERS = REPO / "tests" / "papers"
 SAFETY_TIMEOUT = 3 * 3600
 
 
+def default_config() -> dict:
+    """The embedded default config (config/config.yaml), validated against the schema (defaults filled in)."""
+    import yaml
+
+    from animsynth.config import validate_config
+
+    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
+    return cfg
+
+
 def need(path: Path):
     """Skip (with the reason) when a real-data folder is absent."""
     if not path.exists():

@@ -7,29 +7,25 @@ import copy
 import numpy as np
 import pandas as pd
 import pytest
-import yaml
 
 from animsynth.compare import generators as G
 from animsynth.compare import jobs
 from animsynth.compare import tables
 from animsynth.compare import settings
 from animsynth.compare import verdicts as CV
-from animsynth.config import ConfigError, validate_config
+from animsynth.config import ConfigError
 from animsynth.kinematics import heading, root_translation
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 from animsynth.verdicts import VOCABULARY, VerdictError
 
-from conftest import REPO
+from conftest import default_config
 
 ST = {"temporal_window": 1, "c_atn": 10.0, "c_ctn": 10.0, "ctn_neighbors": 4, "ctn_min_gap_s": 0.25,
       "ctn_tolerance": 2, "ctn_reach_s": 0.05}
 
 
-def _config() -> dict:
-    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
-    return cfg
+_config = default_config
 
 
 @pytest.fixture(scope="module")

@@ -5,26 +5,21 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-import yaml
 
 from animsynth import cli
 from animsynth.compare import jobs, settings
 from animsynth.compare.scoring import DATABASE_METRICS, SKATING_METRICS, UNSCORED
-from animsynth.config import validate_config
 from animsynth.io.bvh import read_bvh, write_bvh
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
-from conftest import REPO
+from conftest import default_config
 
 SK = cmu_like_skeleton("cmp", 3)
 UNIT = str(SK.length_to_m)  # the synthetic skeleton's metres per unit, which a BVH file does not carry
 
 
-def _config() -> dict:
-    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
-    return cfg
+_config = default_config
 
 
 @pytest.fixture(scope="module")

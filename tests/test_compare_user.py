@@ -16,15 +16,12 @@ from animsynth.config import ConfigError, validate_config
 from animsynth.io.bvh import read_bvh
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
-from conftest import REPO
+from conftest import REPO, default_config
 
 SHOWCASE = ("w1/t1", 1)
 
 
-def _config() -> dict:
-    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
-    return cfg
+_config = default_config
 
 
 @pytest.fixture(scope="module")
