@@ -218,20 +218,25 @@ class PoseFitter:
             cost = np.sum(c * res**2, axis=1)
             wx = wk[None, :, :, None] * X  # (F, V, K, 3)
             Y = np.einsum("fvka,vkj->fvja", wx, descK, optimize=True) - m[None, :, :, None] * S[:, None]  # (F, V, J, 3)
-            Yc = np.ascontiguousarray(Y * np.sqrt(c)[..., None, None]).reshape(F, V, 3 * J)
+            sc = np.sqrt(c)
+            Yc = np.ascontiguousarray(Y * sc[..., None, None]).reshape(F, V, 3 * J)
             G = np.stack([Yc[f].T @ Yc[f] for f in range(F)]).reshape(F, J, 3, J, 3)
             tr = np.einsum("fkala->fkl", G)
             H = np.zeros((F, 3 + 3 * J, 3 + 3 * J))
             blk = tr[:, :, None, :, None] * np.eye(3)[None, None, :, None, :] - np.swapaxes(G, 2, 4)
             H[:, 3:, 3:] = blk.reshape(F, 3 * J, 3 * J)
-            sy = np.einsum("fv,fvka->fka", c, Y)
+            sy = np.matmul(sc[:, None, :], Yc)[:, 0].reshape(F, J, 3)  # sum_v c Y
             cross = -_skew(sy)  # (F, J, 3, 3): d t-residual / d w_k
             H[:, :3, 3:] = np.moveaxis(cross, 1, 2).reshape(F, 3, 3 * J)
             H[:, 3:, :3] = np.swapaxes(H[:, :3, 3:], 1, 2)
             H[:, :3, :3] = c.sum(axis=1)[:, None, None] * np.eye(3)
             g = np.zeros((F, 3 + 3 * J))
             g[:, :3] = np.einsum("fv,fva->fa", c, r)
-            g[:, 3:] = np.einsum("fv,fvka->fka", c, np.cross(Y, r[:, :, None, :])).reshape(F, 3 * J)
+            # sum_v c (Y x r), from the products M[f, (k, b), e] = sum_v c Y[f, v, k, b] r[f, v, e] (one batched
+            # matrix product instead of a cross product of every vertex and joint)
+            M = np.matmul(np.swapaxes(Yc, 1, 2), sc[..., None] * r).reshape(F, J, 3, 3)
+            g[:, 3:] = np.stack([M[..., 1, 2] - M[..., 2, 1], M[..., 2, 0] - M[..., 0, 2],
+                                 M[..., 0, 1] - M[..., 1, 0]], axis=-1).reshape(F, 3 * J)
             diag = np.einsum("fii->fi", H)
             Hd = H + (lam[:, None] * np.maximum(diag, 1e-9))[:, :, None] * np.eye(3 + 3 * J)[None]
             step = -np.linalg.solve(Hd, g[..., None])[..., 0]
@@ -249,7 +254,11 @@ class PoseFitter:
             lam = np.where(ok, lam * 0.3, lam * 10.0)
             L = np.where(ok[:, None, None, None], Lnew, L)
             root_t = np.where(ok[:, None], tnew, root_t)
-            W, S, X, pred = evaluate(L, root_t)
+            # each frame is evaluated alone: the accepted frames' evaluation is the candidate's
+            W = np.where(ok[:, None, None, None], W2, W)
+            S = np.where(ok[:, None, None], S2, S)
+            X = np.where(ok[:, None, None, None], X2, X)
+            pred = np.where(ok[:, None, None], pred2, pred)
             if np.all(np.abs(cost2 - cost) <= self.tol * np.maximum(cost, 1e-30)):
                 break
         log.info("pose fit LM: mean residual %.3f mm", 1000 * np.linalg.norm(pred - P, axis=-1).mean())
