@@ -449,3 +449,40 @@ def test_fairmotion_loads_a_shared_trial_once_and_builds_what_a_fresh_load_build
     assert len(fp._LOADED) == 3  # a, b, c: b was loaded once
     assert np.array_equal(cold_tr, warm_tr)
     assert all(np.array_equal(x, y) for x, y in zip(cold_walks, warm_walks))
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_reuses_its_construction_across_rows_and_budgets(sk):
+    """The as-released row, the fixed row and another budget on one database: the second and third fits reuse
+    the first's construction and give what a cold build gives (transitions, threshold, walks)."""
+    from animsynth.compare import fairmotion_peer as fp
+
+    a, b = (generate_motion("walk_straight", 48, s, sk, fps=FPS) for s in (1, 8))
+    start = Motion(a.values[:10], sk, FPS, "start")
+
+    def build(budget, fixes):
+        g = fp.FairmotionGraph(base=8, blend=4, compare=4, transitions_per_s=budget, native_fps=60.0,
+                               fixes=fixes).fit([a, b])
+        return g, g.transitions_.to_numpy(), [g.generate(start, 30, seed=s).values for s in (1, 2)]
+
+    cold = {}
+    for budget, fixes in ((2.0, ()), (2.0, fp.FIXES), (4.0, fp.FIXES)):
+        fp._CONSTRUCTED.clear()
+        fp._LOADED.clear()
+        g, tr, walks = build(budget, fixes)
+        assert not g.construct_reused_
+        cold[budget, fixes] = (g.threshold_, g.n_nodes_, tr, walks)
+    fp._CONSTRUCTED.clear()
+    reused = []
+    for budget, fixes in ((2.0, ()), (2.0, fp.FIXES), (4.0, fp.FIXES)):
+        g, tr, walks = build(budget, fixes)
+        reused.append(g.construct_reused_)
+        t, n, tr0, w0 = cold[budget, fixes]
+        assert (g.threshold_, g.n_nodes_) == (t, n)
+        assert np.array_equal(tr, tr0)
+        assert all(np.array_equal(x, y) for x, y in zip(walks, w0))
+    assert reused == [False, True, True]
+    assert len(fp._CONSTRUCTED) == 1
+    # another comparison count is another graph
+    fp.FairmotionGraph(base=8, blend=4, compare=4, transitions_per_s=2.0, native_fps=60.0, num_comparison=2).fit([a, b])
+    assert len(fp._CONSTRUCTED) == 2

@@ -411,11 +411,12 @@ def compare_sweep_cfg(wildcards):
 def compare_benchmarks():
     return (
         job_benchmarks("compare_clips")
-        + job_benchmarks("compare_run", cmpgen=CMP_RUN)
+        + job_benchmarks("compare_run", cmpgen=CMP_OWN_JOB)
+        + (job_benchmarks("compare_run_fairmotion") if CMP_FM else [])
         + job_benchmarks("compare_tables")
         + job_benchmarks("compare_figures")
-        + (job_benchmarks("compare_sweep_run", cmpgraph=[g for b in CMP_SWEEP for g in CMP_GRAPHS],
-                          budget=[b for b in CMP_SWEEP for g in CMP_GRAPHS])
+        + (job_benchmarks("compare_sweep_run", cmpgraph=[g for b in CMP_SWEEP for g in CMP_GRAPHS if g not in CMP_FM],
+                          budget=[b for b in CMP_SWEEP for g in CMP_GRAPHS if g not in CMP_FM])
            + job_benchmarks("compare_sweep") if CMP_SWEEP and CMP_GRAPHS else [])
     )
 

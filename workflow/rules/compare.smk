@@ -6,8 +6,9 @@
 # compare_figures gather them. A generator that cannot run here (fairmotion without its package) is left
 # out at parse time with one line, and the tables and docs say why. Every job gets only the config keys it
 # uses. Resources: measured on CMU (the paper run) with headroom.
-from animsynth.compare.settings import (clip_ids, clips_cfg, generator_order, groups, run_generators, showcase,
-                                        user_generators)
+from animsynth.compare.generators import FAIRMOTION_ROWS
+from animsynth.compare.settings import (clip_ids, clips_cfg, generator_order, groups, job_cfg, run_generators,
+                                        showcase, user_generators)
 
 CMP = config["compare"]
 CMP_SUBSETS, CMP_RESEQ = groups(config)
@@ -31,6 +32,12 @@ CMP_OUT = {
     "timing": R("compare/runs/{cmpgen}_timing.csv"),
     "shown": R("compare/runs/{cmpgen}_showcase.npz"),
 }
+# fairmotion's rows and its budget sweep run in one job (compare_run_fairmotion): they build the same graphs, so
+# fairmotion's loading of every trial and its graph construction run once; each row and budget keeps its own
+# threshold and walks (animsynth.compare.fairmotion_peer)
+CMP_FM = [g for g in FAIRMOTION_ROWS if g in CMP_RUN]
+CMP_FM_SWEEP = [(g, b) for b in CMP_SWEEP for g in CMP_GRAPHS if g in CMP_FM]
+CMP_OWN_JOB = [g for g in CMP_RUN if g not in CMP_FM]
 
 
 wildcard_constraints:
@@ -71,6 +78,8 @@ rule compare_clips:
 
 
 rule compare_run:
+    wildcard_constraints:
+        cmpgen="|".join(CMP_OWN_JOB) or "none",
     input:
         CMP_CLIPS,
     output:
@@ -172,7 +181,42 @@ rule compare_tables:
         "../scripts/compare_tables.py"
 
 
+if CMP_FM:
+
+    rule compare_run_fairmotion:
+        input:
+            CMP_CLIPS,
+        output:
+            **{f"{k}_{g}": (CMP_OUT[k].format(cmpgen=g) if k in CMP_OUT else R(f"compare/bvh/{g}.bvh"))
+               for g in CMP_FM for k in ("metrics", "timing", "shown", "bvh")},
+            **{f"sweep{i}{k}": R(f"compare/sweep/{g}_{b}{k}.csv") for i, (g, b) in enumerate(CMP_FM_SWEEP)
+               for k in ("", "_timing")},
+        params:
+            # each row's and budget's config as compare_run's and compare_sweep_run's (compare_job_cfg,
+            # compare_sweep_cfg): a changed block reruns this job only if one of them reads it
+            rows=[(g, job_cfg(config, g)) for g in CMP_FM],
+            sweep=[(g, b, job_cfg(config, g, budget=b)) for g, b in CMP_FM_SWEEP],
+            seed=config["seed"],
+            roles={},  # as compare_run's
+            sweep_roles=config["joint_roles"],  # as compare_sweep_run's
+            showcase=CMP_SHOWCASE,
+        threads: 1
+        resources:
+            mem_mb=2500,
+            runtime=60,
+        log:
+            L("compare/run/fairmotion_rows_and_sweep.log"),
+        benchmark:
+            B("compare/run/fairmotion_rows_and_sweep.tsv")
+        conda:
+            "../envs/animsynth.yaml"
+        script:
+            "../scripts/compare_run_fairmotion.py"
+
+
 rule compare_sweep_run:
+    wildcard_constraints:
+        cmpgraph="|".join(g for g in CMP_GRAPHS if g not in CMP_FM) or "none",
     input:
         CMP_CLIPS,
     output:

@@ -31,6 +31,9 @@ given to its ``MotionGraph`` (``construct``, ``reduce("scc")``, ``create_random_
   as the ``threshold_quantile`` quantile of the differences (here of the node pairs that are not one clip
   playing on). With a transition budget (``transitions_per_s``, :func:`animsynth.compare.motiongraph.budget_count`)
   the threshold is the difference of the budget's last kept pair instead: the same rule as our motion graph's.
+  Since that graph does not depend on the threshold, it is built once per database and process and reused
+  (the nodes and weighted edges in ``construct``'s order): both rows and every budget of the sweep run in one
+  workflow job (``compare_run_fairmotion``) and pay fairmotion's loading and construction once.
 
 The output is observed, not altered, apart from the named fixes: while ``create_random_motion`` runs, fairmotion's
 ``ops.motion.append_and_blend`` is wrapped by a recorder that calls it unchanged and notes where each
@@ -202,6 +205,29 @@ _LOADED: dict = {}
 _LOADED_MAX = 64
 
 
+def _native_key(clip: Motion, up: int, on=None) -> str:
+    """The key of :func:`_load_native`'s memo: the clip's values, rate and skeleton, ``up`` and the skeleton
+    it is put on."""
+    import hashlib
+
+    h = hashlib.sha256()
+    parts = [np.ascontiguousarray(clip.values, np.float64).tobytes(), repr(float(clip.fps)).encode(),
+             str(int(up)).encode(), clip.skeleton.to_json().encode(), repr(clip.skeleton.length_to_m).encode()]
+    put_on = clip if on is None else on[0]  # the skeleton the velocities are computed on (a first clip: its own)
+    parts += [put_on.skeleton.to_json().encode(), repr(put_on.skeleton.length_to_m).encode()]
+    for part in parts:
+        h.update(part)
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+#: fairmotion's constructed graph of a database (:meth:`FairmotionGraph.fit`), kept for the rest of the
+#: process: ``{key: (nodes, edges)}``, the nodes' attributes and the ``(u, v, weights)`` edges in the order
+#: ``construct`` added them.
+_CONSTRUCTED: dict = {}
+_CONSTRUCTED_MAX = 64
+
+
 def _load_native(clip: Motion, up: int, bvh, velocity, on=None):
     """fairmotion's ``MotionWithVelocity`` of ``clip`` at ``up`` times its rate: the clip upsampled
     (:func:`upsample`), written to BVH, read by fairmotion's loader, put on the skeleton ``on`` and given
@@ -216,17 +242,7 @@ def _load_native(clip: Motion, up: int, bvh, velocity, on=None):
     fairmotion's loading and velocities (most of a graph's build) run once per trial and job, not once per
     database. The copy is what fairmotion would have computed again: the same file, read and differentiated by
     the same code (a test checks the graph and the walks equal those of a fresh load)."""
-    import hashlib
-
-    h = hashlib.sha256()
-    parts = [np.ascontiguousarray(clip.values, np.float64).tobytes(), repr(float(clip.fps)).encode(),
-             str(int(up)).encode(), clip.skeleton.to_json().encode(), repr(clip.skeleton.length_to_m).encode()]
-    put_on = clip if on is None else on[0]  # the skeleton the velocities are computed on (a first clip: its own)
-    parts += [put_on.skeleton.to_json().encode(), repr(put_on.skeleton.length_to_m).encode()]
-    for part in parts:
-        h.update(part)
-        h.update(b"\0")
-    key = h.hexdigest()
+    key = _native_key(clip, up, on)
     if key not in _LOADED:
         with tempfile.TemporaryDirectory(prefix="animsynth_fairmotion_") as tmp:
             f = os.path.join(tmp, "clip.bvh")
@@ -288,6 +304,9 @@ class FairmotionGraph:
     native_fps_ : float
         The rate fairmotion ran at; ``upsample_`` = native_fps_ / fps_.
     fixes_ : tuple of str
+    construct_reused_ : bool
+        Whether ``construct`` ran in this fit or its graph came from the process's memo (an earlier fit on the
+        same clips with the same lengths, weights and comparison count: the other row, another budget).
     last_walk_ : dict
         Of the last :meth:`generate`: ``out_fps`` (the rate of fairmotion's output motion), ``pieces``
         (first output frame, frames of each appended piece, at that rate), ``blend_sources`` (root position of
@@ -366,11 +385,32 @@ class FairmotionGraph:
             base_length=self._seconds(self.base * up, native), stride_length=self._seconds(stride * up, native),
             blend_length=self._seconds(self.blend * up, native), compare_length=self._seconds(self.compare * up, native),
             verbose=False)
-        with contextlib.redirect_stderr(io.StringIO()):  # its tqdm progress bars
-            graph.construct(w_joints=None, w_joint_pos=self.w_joint_pos, w_joint_vel=self.w_joint_vel,
-                            w_root_pos=self.w_root_pos, w_root_vel=self.w_root_vel, w_ee_pos=self.w_ee_pos,
-                            w_ee_vel=self.w_ee_vel, w_trajectory=self.w_trajectory, diff_threshold=np.inf,
-                            num_comparison=self.num_comparison, num_workers=1)
+        weights = dict(w_joint_pos=self.w_joint_pos, w_joint_vel=self.w_joint_vel, w_root_pos=self.w_root_pos,
+                       w_root_vel=self.w_root_vel, w_ee_pos=self.w_ee_pos, w_ee_vel=self.w_ee_vel,
+                       w_trajectory=self.w_trajectory)
+        # the graph at an infinite threshold depends on the loaded clips, the lengths, the weights and the comparison
+        # count, not on the threshold, the budget or the walk's fixes: both rows and every budget of the sweep build
+        # it once per process (the edges kept are then chosen per threshold below)
+        key = repr(([_native_key(c, up, None if i == 0 else (first, None)) for i, c in enumerate(clips)], native,
+                    graph.base_length, graph.stride_length, graph.blend_length, graph.compare_length,
+                    sorted(weights.items()), int(self.num_comparison)))
+        if key in _CONSTRUCTED:
+            node_list, edge_list = _CONSTRUCTED[key]
+            graph.skel = skel
+            graph.graph.add_nodes_from(node_list)
+            graph.graph.add_edges_from((u, v, {"weights": w}) for u, v, w in edge_list)
+            for name, value in dict(w_joints=None, **weights).items():
+                setattr(graph, name, value)
+            self.construct_reused_ = True
+        else:
+            with contextlib.redirect_stderr(io.StringIO()):  # its tqdm progress bars
+                graph.construct(w_joints=None, **weights, diff_threshold=np.inf, num_comparison=self.num_comparison,
+                                num_workers=1)
+            if len(_CONSTRUCTED) >= _CONSTRUCTED_MAX:
+                _CONSTRUCTED.pop(next(iter(_CONSTRUCTED)))
+            _CONSTRUCTED[key] = ([(n, dict(a)) for n, a in graph.graph.nodes(data=True)],
+                                 [(u, v, d["weights"]) for u, v, d in graph.graph.edges(data=True)])
+            self.construct_reused_ = False
         nodes = graph.graph.nodes
         n_before = graph.graph.number_of_nodes()
         if n_before == 0:

@@ -56,9 +56,18 @@ def fit_ssdr(rest: np.ndarray, frames: np.ndarray, faces: np.ndarray, bones: int
 
 
 def blend(W: np.ndarray, rest: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """Linear blend skinning: vertices (F, V, 3) of weights ``W`` (V, B) and transforms ``T`` (F, B, 3, 4)."""
-    Rv = np.einsum("vb,fbij,vj->fvi", W, T[..., :3], rest, optimize=True)
-    return Rv + np.einsum("vb,fbi->fvi", W, T[..., 3], optimize=True)
+    """Linear blend skinning: vertices (F, V, 3) of weights ``W`` (V, B) and transforms ``T`` (F, B, 3, 4).
+
+    One matrix product for all frames: ``[W[v, b] * (rest_v, 1)]`` (V, 4 B) times the transforms stacked as
+    (4 B, 3 F); a three-operand einsum over (vertex, bone, frame) cost about 10 times as much at 40 bones.
+    """
+    T = np.asarray(T, float)
+    F, B = T.shape[:2]
+    rest = np.asarray(rest, float)
+    V = len(rest)
+    M = (np.asarray(W, float)[:, :, None] * np.c_[rest, np.ones(V)][:, None, :]).reshape(V, 4 * B)
+    A = T.transpose(1, 3, 0, 2).reshape(4 * B, 3 * F)  # A[(b, j), (f, i)] = T[f, b, i, j]
+    return (M @ A).reshape(V, F, 3).transpose(1, 0, 2)
 
 
 def _nearest_rotation(M: np.ndarray) -> np.ndarray:
