@@ -65,7 +65,8 @@ from scipy.spatial import cKDTree
 
 from ..kinematics import root_rotation, root_translation, set_root
 from ..motion import Motion
-from .base import Database, Generator, align_root, check_generated
+from ..generator import Database, Generator, align_root, check_generated
+from ..simplicial.generator import FieldFollower
 
 log = logging.getLogger("animsynth.compare.generators")
 
@@ -84,81 +85,6 @@ FAIRMOTION_ROWS = ("fairmotion", "fairmotion_fixed")
 REFERENCES = ("replay", "concat")
 #: the generators whose motion the seed does not change (seed diversity 0)
 DETERMINISTIC = ("motion_matching", "motion_matching_pose", "replay")
-
-
-# ----------------------------------------------------------------------------- field followers
-
-
-class FieldFollower(Generator):
-    """Gauch & Peters field following, decoded to poses, the root from the nearest database frame.
-
-    Parameters
-    ----------
-    method : {"delaunay", "knn"}
-    latent_dim : int, PCA dimension of the joint angles (paper: 2)
-    k : int, k-NN neighbours (and Delaunay's outside-hull fallback; paper: 16)
-    derivative : {"half", "forward", "central"}, training vectors; ``half`` moves half a frame per
-        step, so two steps make one output frame, the others one step per frame
-    jitter : float, the start's latent point moves by this fraction of the latent bounding-box
-        diagonal in a seeded random direction (the field is deterministic: seeds differ by this)
-
-    Attributes
-    ----------
-    db_ : Database
-    pca_ : sklearn PCA
-    field_ : animsynth.simplicial.VectorField
-    latent_ : ndarray (N, latent_dim), the database frames in latent space
-    scale_ : float, latent bounding-box diagonal
-    steps_per_frame_ : int
-    """
-
-    def __init__(self, method: str = "delaunay", latent_dim: int = 2, k: int = 16, derivative: str = "half",
-                 jitter: float = 0.01):
-        self.method = method
-        self.latent_dim = latent_dim
-        self.k = k
-        self.derivative = derivative
-        self.jitter = jitter
-        self.name = method
-
-    def fit(self, database) -> "FieldFollower":
-        from sklearn.decomposition import PCA
-
-        from ..simplicial.field import VectorField, training_vectors
-        from ..simplicial.geometry import bbox_diagonal
-
-        if self.method not in ("delaunay", "knn"):
-            raise ValueError(f"field follower method must be delaunay or knn, got {self.method!r}")
-        self.db_ = db = Database(database)
-        angles = db.values[:, db.n_root:]
-        d = int(self.latent_dim)
-        if not 1 <= d <= min(angles.shape):
-            raise ValueError(f"latent_dim {d} outside 1..{min(angles.shape)} for {angles.shape[0]} frames x "
-                             f"{angles.shape[1]} angles")
-        self.pca_ = PCA(n_components=d, svd_solver="full").fit(angles)
-        latent = [self.pca_.transform(np.asarray(c.values, float)[:, db.n_root:]) for c in db.clips]
-        self.latent_ = np.vstack(latent)
-        self.field_ = VectorField(self.method, int(self.k)).fit(self.latent_, training_vectors(latent, self.derivative))
-        self.tree_ = cKDTree(self.latent_)
-        self.scale_ = float(bbox_diagonal(self.latent_))
-        self.steps_per_frame_ = 2 if self.derivative == "half" else 1
-        return self
-
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
-        from ..simplicial.path import follow_field
-
-        self._check_start(start, length)
-        db, spf, length = self.db_, self.steps_per_frame_, int(length)
-        x0 = self.pca_.transform(np.asarray(start.values, float)[-1:, db.n_root:])[0]
-        u = np.random.default_rng(seed).normal(size=x0.size)
-        x0 = x0 + float(self.jitter) * self.scale_ * u / max(float(np.linalg.norm(u)), 1e-300)
-        path = follow_field(self.field_, x0, length * spf)
-        pts = path.points[spf::spf]
-        _, near = self.tree_.query(np.vstack([x0[None, :], pts]))
-        values = db.play(near, start.values[-1])[1:]
-        values[:, db.n_root:] = self.pca_.inverse_transform(pts)
-        return self._motion(values, length, [], np.full((length, 2), -1),
-                            fallback_share=float(path.fallback.mean()) if path.fallback.size else 0.0)
 
 
 # ----------------------------------------------------------------------------- re-sequencers
