@@ -32,16 +32,15 @@ scoring         motion files from any tool scored with the metrics (``animsynth 
 
 from .._lazy import lazy_exports
 
-# name -> module; imported on first use
+# name -> module; imported on first use (the families' estimators, FieldFollower and Resequencer, are exported by
+# their families: animsynth.simplicial, animsynth.resequencing)
 _EXPORTS = {
     "Concat": ".references",
     "Database": ".generators",
-    "FieldFollower": ".generators",
     "GENERATORS": ".generators",
     "METRICS": ".metrics",
     "MotionGraph": ".motiongraph",
     "Replay": ".references",
-    "Resequencer": ".generators",
     "make_generator": ".generators",
     "prepare_clips": ".jobs",
     "run_generator": ".jobs",
