@@ -203,7 +203,7 @@ def test_resequencing_over_the_memory_budget_is_refused_before_the_distances(wal
         raise AssertionError("distance matrices built before the budget check")
 
     monkeypatch.setattr(jobs, "base_distances", no_distances)
-    monkeypatch.setattr(jobs, "config_graph", no_distances)
+    monkeypatch.setattr(jobs, "config_resequencer", no_distances)
     cfg = config_block("resequencing", {"explanations": {"frame_steps": [4, 1]}})
     n = walk.n_frames
     msg = rf"re-sequencing trial 'syn_walk': {n} frames .*{n} x {n}.*needs about .* GiB.*memory budget of 1e-05 GiB"

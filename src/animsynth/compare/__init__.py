@@ -8,10 +8,12 @@ sits above the four families: it imports their public functions to score them; n
 Modules
 -------
 base            the one interface (``fit(database)``, ``generate(start, length, seed)``: Generator, Database,
-                root placement), which every generator builds on
-generators      the factory (``make_generator``) and the adapters:
-                delaunay, knn, isomap, stisomap, motion_graph, fairmotion, fairmotion_fixed, motion_matching,
+                root placement), re-exported from :mod:`animsynth.generator`, where every generator builds on it
+generators      the registry: names -> estimators and their settings (``make_generator``), no method code:
+                delaunay, knn (the simplicial family's FieldFollower), isomap, stisomap (the resequencing
+                family's Resequencer), motion_graph, fairmotion, fairmotion_fixed, motion_matching,
                 motion_matching_pose, genmm, replay, concat
+references      the two reference rows: replay (the held-out capture) and concat (random segments)
 motiongraph     the classic motion graph (Kovar, Gleicher & Pighin 2002)
 motionmatching  motion matching with inertialization and foot locking (Clavet 2016; Holden et al. 2020)
 genmm           generative motion matching (Li et al. 2023)
@@ -30,16 +32,15 @@ scoring         motion files from any tool scored with the metrics (``animsynth 
 
 from .._lazy import lazy_exports
 
-# name -> module; imported on first use
+# name -> module; imported on first use (the families' estimators, FieldFollower and Resequencer, are exported by
+# their families: animsynth.simplicial, animsynth.resequencing)
 _EXPORTS = {
-    "Concat": ".generators",
+    "Concat": ".references",
     "Database": ".generators",
-    "FieldFollower": ".generators",
     "GENERATORS": ".generators",
     "METRICS": ".metrics",
     "MotionGraph": ".motiongraph",
-    "Replay": ".generators",
-    "Resequencer": ".generators",
+    "Replay": ".references",
     "make_generator": ".generators",
     "prepare_clips": ".jobs",
     "run_generator": ".jobs",

@@ -1,6 +1,9 @@
-"""Every motion generator of the side-by-side comparison, behind one interface.
+"""The registry of the side-by-side comparison: generator names -> estimators and their settings.
 
-Each generator is a scikit-learn-style estimator::
+This module holds no method code. Every generator is a scikit-learn-style estimator on the one interface
+(:mod:`animsynth.generator`), defined where its method lives: the families' own estimators (the same ones their
+paper steps and the command line call) and this package's modules. :func:`make_generator` builds one from the
+``compare`` config block::
 
     gen = make_generator(name, cfg).fit(database)   # database: list of Motion, one skeleton, one fps
     motion = gen.generate(start, length, seed)      # start: Motion of >= 2 frames (the context)
@@ -17,13 +20,13 @@ generated frames is scored as a seam by the family for every generator but ``rep
 Generators (``GENERATORS``):
 
 ``delaunay``, ``knn``
-    Gauch & Peters field following (:mod:`animsynth.simplicial`): PCA of the database's joint
+    Gauch & Peters field following (:class:`animsynth.simplicial.generator.FieldFollower`): PCA of the database's joint
     angles, the training vectors, the interpolated vector field and Euler steps from the start's
     latent point (moved by a seeded jitter, so seeds differ), decoded to joint angles. Root motion
     (an extension: the paper has no root) is the capture's own root step of the database frame
     nearest in latent space, integrated from the start (:func:`animsynth.resequencing.play_path`).
 ``isomap``, ``stisomap``
-    re-sequencing on the neighbourhood graph (:mod:`animsynth.resequencing`): L2 between
+    re-sequencing on the neighbourhood graph (:class:`animsynth.resequencing.generator.Resequencer`): L2 between
     linearised joint rotations, the smallest k that connects the graph (ST-Isomap: with the
     spatio-temporal adjustment and the adjacent temporal neighbours always in), Dijkstra paths
     from the database frame nearest the start to seeded random targets, chained until ``length``
@@ -50,9 +53,9 @@ The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare
     generative motion matching (Li et al. 2023; :mod:`animsynth.compare.genmm`) in keyframe mode from the
     start; seeds differ by the initial noise.
 ``replay``
-    the held-out capture itself (upper bound for realism; the same for every seed).
+    the held-out capture itself (upper bound for realism; the same for every seed; :mod:`.references`).
 ``concat``
-    random database segments appended (lower bound): root position made continuous, no blending,
+    random database segments appended (lower bound; :mod:`.references`): root position made continuous, no blending,
     no alignment of heading.
 """
 
@@ -60,12 +63,11 @@ from __future__ import annotations
 
 import logging
 
-import numpy as np
-from scipy.spatial import cKDTree
-
-from ..kinematics import root_rotation, root_translation, set_root
+from ..generator import Database, Generator, align_root, check_generated
 from ..motion import Motion
-from .base import Database, Generator, align_root, check_generated
+from ..resequencing.generator import Resequencer
+from ..simplicial.generator import FieldFollower
+from .references import Concat, Replay
 
 log = logging.getLogger("animsynth.compare.generators")
 
@@ -84,267 +86,6 @@ FAIRMOTION_ROWS = ("fairmotion", "fairmotion_fixed")
 REFERENCES = ("replay", "concat")
 #: the generators whose motion the seed does not change (seed diversity 0)
 DETERMINISTIC = ("motion_matching", "motion_matching_pose", "replay")
-
-
-# ----------------------------------------------------------------------------- field followers
-
-
-class FieldFollower(Generator):
-    """Gauch & Peters field following, decoded to poses, the root from the nearest database frame.
-
-    Parameters
-    ----------
-    method : {"delaunay", "knn"}
-    latent_dim : int, PCA dimension of the joint angles (paper: 2)
-    k : int, k-NN neighbours (and Delaunay's outside-hull fallback; paper: 16)
-    derivative : {"half", "forward", "central"}, training vectors; ``half`` moves half a frame per
-        step, so two steps make one output frame, the others one step per frame
-    jitter : float, the start's latent point moves by this fraction of the latent bounding-box
-        diagonal in a seeded random direction (the field is deterministic: seeds differ by this)
-
-    Attributes
-    ----------
-    db_ : Database
-    pca_ : sklearn PCA
-    field_ : animsynth.simplicial.VectorField
-    latent_ : ndarray (N, latent_dim), the database frames in latent space
-    scale_ : float, latent bounding-box diagonal
-    steps_per_frame_ : int
-    """
-
-    def __init__(self, method: str = "delaunay", latent_dim: int = 2, k: int = 16, derivative: str = "half",
-                 jitter: float = 0.01):
-        self.method = method
-        self.latent_dim = latent_dim
-        self.k = k
-        self.derivative = derivative
-        self.jitter = jitter
-        self.name = method
-
-    def fit(self, database) -> "FieldFollower":
-        from sklearn.decomposition import PCA
-
-        from ..simplicial.field import VectorField, training_vectors
-        from ..simplicial.geometry import bbox_diagonal
-
-        if self.method not in ("delaunay", "knn"):
-            raise ValueError(f"field follower method must be delaunay or knn, got {self.method!r}")
-        self.db_ = db = Database(database)
-        angles = db.values[:, db.n_root:]
-        d = int(self.latent_dim)
-        if not 1 <= d <= min(angles.shape):
-            raise ValueError(f"latent_dim {d} outside 1..{min(angles.shape)} for {angles.shape[0]} frames x "
-                             f"{angles.shape[1]} angles")
-        self.pca_ = PCA(n_components=d, svd_solver="full").fit(angles)
-        latent = [self.pca_.transform(np.asarray(c.values, float)[:, db.n_root:]) for c in db.clips]
-        self.latent_ = np.vstack(latent)
-        self.field_ = VectorField(self.method, int(self.k)).fit(self.latent_, training_vectors(latent, self.derivative))
-        self.tree_ = cKDTree(self.latent_)
-        self.scale_ = float(bbox_diagonal(self.latent_))
-        self.steps_per_frame_ = 2 if self.derivative == "half" else 1
-        return self
-
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
-        from ..simplicial.path import follow_field
-
-        self._check_start(start, length)
-        db, spf, length = self.db_, self.steps_per_frame_, int(length)
-        x0 = self.pca_.transform(np.asarray(start.values, float)[-1:, db.n_root:])[0]
-        u = np.random.default_rng(seed).normal(size=x0.size)
-        x0 = x0 + float(self.jitter) * self.scale_ * u / max(float(np.linalg.norm(u)), 1e-300)
-        path = follow_field(self.field_, x0, length * spf)
-        pts = path.points[spf::spf]
-        _, near = self.tree_.query(np.vstack([x0[None, :], pts]))
-        values = db.play(near, start.values[-1])[1:]
-        values[:, db.n_root:] = self.pca_.inverse_transform(pts)
-        return self._motion(values, length, [], np.full((length, 2), -1),
-                            fallback_share=float(path.fallback.mean()) if path.fallback.size else 0.0)
-
-
-# ----------------------------------------------------------------------------- re-sequencers
-
-
-class Resequencer(Generator):
-    """Isomap / ST-Isomap re-sequencing: Dijkstra paths on the neighbourhood graph between seeded targets.
-
-    Parameters
-    ----------
-    method : {"isomap", "stisomap"}
-    n_candidates : int, neighbours listed per frame (doubled until the smallest connecting k fits)
-    k : int or None, neighbours of the graph; None or smaller than the smallest k that connects the
-        graph: that k (as the re-sequencing study)
-    min_target_gap_s : float, a random target lies at least this far (seconds of database) from the
-        current frame in the same clip
-    stisomap : dict, the re-sequencing study's ``stisomap`` block (seconds; ST-Isomap only)
-
-    Attributes
-    ----------
-    db_ : Database
-    graph_ : scipy.sparse csr matrix (N, N), the weighted neighbourhood graph
-    k_ : int, neighbours used; min_k_ : the smallest connecting k
-    """
-
-    def __init__(self, method: str = "isomap", n_candidates: int = 20, k=None, min_target_gap_s: float = 0.5,
-                 stisomap: dict | None = None):
-        self.method = method
-        self.n_candidates = n_candidates
-        self.k = k
-        self.min_target_gap_s = min_target_gap_s
-        self.stisomap = stisomap
-        self.name = method
-
-    def fit(self, database) -> "Resequencer":
-        from ..resequencing import sparse as sp
-        from ..resequencing.features import motion_features
-        from ..resequencing.settings import st_parameters
-
-        if self.method not in ("isomap", "stisomap"):
-            raise ValueError(f"re-sequencing method must be isomap or stisomap, got {self.method!r}")
-        if self.method == "stisomap" and not self.stisomap:
-            raise ValueError("stisomap needs its parameters (the re-sequencing study's stisomap block)")
-        self.db_ = db = Database(database)
-        feats, seq = sp.concat_features([motion_features(c) for c in db.clips])
-        X = np.vstack([f.linearised(False) for f in feats])
-        n = X.shape[0]
-
-        def pair(i, j):
-            return np.linalg.norm(X[i] - X[j], axis=1)
-
-        m = min(int(self.n_candidates), n - 1)
-        while True:
-            dist, idx = sp.l2_neighbours(X, m)
-            always = None
-            if self.method == "stisomap":
-                st = st_parameters(self.stisomap, db.fps)
-                dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
-                always = sp.st_always_edges(seq, st["temporal_window"], st["c_atn"], pair)
-            try:
-                kmin = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
-                break
-            except sp.CandidateCountError:
-                if m >= n - 1:
-                    raise
-                m = min(2 * m, n - 1)
-        self.min_k_ = int(kmin)
-        self.k_ = max(self.min_k_, int(self.k or 0))
-        if self.k_ > idx.shape[1]:
-            dist, idx = sp.l2_neighbours(X, min(self.k_, n - 1))
-            if self.method == "stisomap":
-                dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
-        self.graph_ = sp.sparse_knn_graph(dist, idx, self.k_, always=always)
-        self.features_ = X
-        self.tree_ = cKDTree(X)
-        return self
-
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
-        from ..resequencing.features import motion_features
-        from ..resequencing.paths import shortest_path_frames
-
-        self._check_start(start, length)
-        db, length = self.db_, int(length)
-        x = motion_features(start).linearised(False)[-1]
-        path = [int(self.tree_.query(x)[1])]
-        rng = np.random.default_rng(seed)
-        gap = max(1, int(round(float(self.min_target_gap_s) * db.fps)))
-        n = db.n_frames
-        while len(path) < length + 1:
-            cur = path[-1]
-            far = (db.clip != db.clip[cur]) | (np.abs(db.frame - db.frame[cur]) >= gap)
-            choices = np.flatnonzero(far)
-            target = int(rng.choice(choices)) if choices.size else int((cur + 1 + rng.integers(n - 1)) % n)
-            p, _ = shortest_path_frames(self.graph_, cur, target)
-            path.extend(int(f) for f in p[1:])
-        path = np.asarray(path[:length + 1], np.int64)
-        values = db.play(path, start.values[-1])[1:]
-        seams = db.seams(path)  # positions in path; output frame t = path position t + 1
-        seams = seams[seams >= 2] - 1
-        return self._motion(values, length, seams, db.sources(path[1:]))
-
-
-# ----------------------------------------------------------------------------- references
-
-
-class Replay(Generator):
-    """The held-out capture itself: the frames that follow the start (the same for every seed).
-
-    Parameters
-    ----------
-    held_out : Motion, the held-out clip whose first frames are the start
-    """
-
-    def __init__(self, held_out: Motion | None = None):
-        self.held_out = held_out
-        self.name = "replay"
-
-    def fit(self, database) -> "Replay":
-        if self.held_out is None:
-            raise ValueError("replay needs the held-out clip (Replay(held_out=...))")
-        self.db_ = Database(database)
-        return self
-
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
-        self._check_start(start, length)
-        h = np.asarray(self.held_out.values, float)
-        c, length = start.n_frames, int(length)
-        if not np.array_equal(h[:c], np.asarray(start.values, float)):
-            raise ValueError("replay: the start is not the held-out clip's first frames")
-        if c + length > h.shape[0]:
-            raise ValueError(f"replay: the held-out clip has {h.shape[0]} frames, {c} + {length} asked for")
-        return self._motion(h[c:c + length], length, [], np.full((length, 2), -1))
-
-
-class Concat(Generator):
-    """Random database segments appended without blending (the lower bound).
-
-    Each segment (a random clip, weighted by its frames, a random first frame, a length drawn
-    uniformly between ``min_segment_s`` and ``max_segment_s``) keeps its own poses and heading;
-    only its root is shifted on the ground so that its first frame stands where the previous frame
-    stood (the first segment: where the start's last frame stands).
-
-    Attributes
-    ----------
-    db_ : Database
-    """
-
-    def __init__(self, min_segment_s: float = 0.5, max_segment_s: float = 1.5):
-        self.min_segment_s = min_segment_s
-        self.max_segment_s = max_segment_s
-        self.name = "concat"
-
-    def fit(self, database) -> "Concat":
-        if not 0 < float(self.min_segment_s) <= float(self.max_segment_s):
-            raise ValueError(f"concat segments: need 0 < min_segment_s <= max_segment_s, got "
-                             f"{self.min_segment_s}, {self.max_segment_s}")
-        self.db_ = Database(database)
-        return self
-
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
-        self._check_start(start, length)
-        db, length = self.db_, int(length)
-        sk = db.skeleton
-        rng = np.random.default_rng(seed)
-        lo = max(1, int(round(float(self.min_segment_s) * db.fps)))
-        hi = max(lo, int(round(float(self.max_segment_s) * db.fps)))
-        sizes = np.array([c.n_frames for c in db.clips], float)
-        last = np.asarray(start.values, float)[-1]
-        parts, seams, sources, t = [], [], [], 0
-        while t < length:
-            c = int(rng.choice(len(db.clips), p=sizes / sizes.sum()))
-            n_c = db.clips[c].n_frames
-            size = int(min(rng.integers(lo, hi + 1), n_c, length - t))
-            f0 = int(rng.integers(0, n_c - size + 1))
-            seg = np.asarray(db.clips[c].values[f0:f0 + size], float)
-            p = root_translation(sk, seg)
-            target = root_translation(sk, last[None, :])[0]
-            shift = np.array([target[0] - p[0, 0], 0.0, target[2] - p[0, 2]])
-            seg = set_root(sk, seg, root_rotation(sk, seg), p + shift)
-            parts.append(seg)
-            seams.append(t)
-            sources.append(np.stack([np.full(size, c), np.arange(f0, f0 + size)], 1))
-            last = seg[-1]
-            t += size
-        seams = [s for s in seams if s > 0]
-        return self._motion(np.vstack(parts), length, seams, np.vstack(sources))
 
 
 # ----------------------------------------------------------------------------- the factory

@@ -44,7 +44,7 @@ from scipy.spatial.transform import Rotation
 
 from ..kinematics import wrap_radians
 from ..motion import Motion
-from .base import Database, Generator
+from ..generator import Database, Generator
 from .poses import decode, encode, rest_forward, from_rot6d, rot6d, rotation_yaw, yaw_rotation
 
 __all__ = ["GenMM", "make_genmm", "extract_patches", "match_patches", "vote", "resample_rows", "level_scales"]

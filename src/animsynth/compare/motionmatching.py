@@ -79,7 +79,7 @@ from ..joints import resolve_roles
 from ..kinematics import forward_kinematics, wrap_radians
 from ..motion import Motion
 from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
-from .base import Database, Generator
+from ..generator import Database, Generator
 from .poses import Track, decode, encode, qexp, qinv, qlog, qmul, rest_forward, yaw_rotation
 
 __all__ = ["MotionMatching", "make_motion_matching", "decay_spring", "spring_position", "spring_angle",

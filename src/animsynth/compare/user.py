@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..motion import Motion
-from .base import Database, Generator, check_generated
+from ..generator import Database, Generator, check_generated
 
 __all__ = ["UserGeneratorError", "UserGenerator", "parse_spec", "resolve_path", "file_sha256", "load_class"]
 

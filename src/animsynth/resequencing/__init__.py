@@ -8,6 +8,8 @@ distances   L2 between linearised frames, Lee et al. metric with the paper's wei
 embedding   k-NN graphs (optionally with always-present edges), exact minimum connected k,
             Isomap (no silent graph joining), ST-Isomap (Jenkins & Mataric 2004), residual variance
 paths       Dijkstra re-sequencing, padding, playing a path as a motion
+generator   the method as one estimator (Resequencer: the neighbourhood graph, sparse or dense, its Dijkstra
+            paths, generate), called by the study's paths, the one-call route and the comparison
 metrics     transitions, path classes, per-transition and whole-path smoothness
 landmark    Landmark Isomap (geodesics from a few frames) for large databases
 sparse      the sparse (k-NN candidate) pipeline of large databases
@@ -27,6 +29,7 @@ _EXPORTS = {
     "DisconnectedGraphError": ".embedding",
     "PAPER_WEIGHTS": ".distances",
     "PrecomputedIsomap": ".embedding",
+    "Resequencer": ".generator",
     "SIGN_MODES": ".features",
     "STIsomap": ".embedding",
     "classify_path": ".metrics",

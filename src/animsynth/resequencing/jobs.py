@@ -18,9 +18,12 @@ The family's other concerns live beside this module: the config adapters
 (method and metric names, global-DOF wildcards, sign mode, ST-Isomap
 parameters) in :mod:`.settings`; the paper's Table 2 and Lee weights beside
 ours (:func:`~.tables.published_table2`, :func:`~.tables.lee_weights_table`,
-:func:`~.tables.min_k_table`) in :mod:`.tables`; the one-call library route
-with explicit keyword arguments (CLI, notebooks),
-:func:`~.quick.resequence_motion`, in :mod:`.quick`; the cost curves of
+:func:`~.tables.min_k_table`) in :mod:`.tables`; the method as one estimator (the graph and its Dijkstra
+paths), :class:`~.generator.Resequencer`, in :mod:`.generator`: :func:`resequence` fits it per configuration
+(:func:`config_resequencer`), as do the one-call route with explicit keyword arguments (CLI, notebooks),
+:func:`~.quick.resequence_motion` in :mod:`.quick`, and the comparison's rows. The minimum-k scans and
+embeddings of :func:`analyse` and :func:`explain` read the same distances (:func:`base_distances`,
+:func:`method_distances`) and stay here: no generator scans k or embeds. The cost curves of
 :mod:`animsynth.scale` in :mod:`.cost` (:func:`scale_steps` is named here too,
 where the scale harness reads every family's measured steps).
 """
@@ -36,14 +39,14 @@ import pandas as pd
 from ..limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
 from ..motion import Motion
 from .cost import scale_steps  # noqa: F401  (animsynth.scale reads each family's measured steps from its jobs)
-from .distances import l2_distances, lee_distances
-from .embedding import (PrecomputedIsomap, checked_graph, graph_components, knn_graph, min_connected_k,
-                        neighbor_ranks, residual_variance, spatio_temporal_distances)
+from .embedding import (PrecomputedIsomap, graph_components, knn_graph, min_connected_k, neighbor_ranks,
+                        residual_variance)
+from .generator import Resequencer, frame_distances, method_matrix
 from .landmark import EMBED_METHODS, embed
 from .features import matrix_naive_quaternions, motion_features, sign_flips
 from .metrics import (Reference, TransitionReference, classify_path, jerk_magnitude, joint_quats, pass_jumps,
                       transition_measures)
-from .paths import pad_path, play_path, resolve_frame, shortest_path_frames
+from .paths import pad_path, play_path, resolve_frame
 from .settings import METHODS, METRICS, gdof_name, sign_mode_of, st_parameters
 
 log = logging.getLogger("animsynth.resequencing")
@@ -92,23 +95,28 @@ def prepare_motion(motion: Motion, max_frames: int | None = None, frame_step: in
 
 
 def base_distances(features, metric: str, include_global: bool, cfg: dict, sign_mode: str | None = None) -> np.ndarray:
-    """The frame distance matrix of one metric (``cfg``: the resequencing block, with defaults).
+    """The frame distance matrix of one metric (``cfg``: the resequencing block, with defaults):
+    :func:`.generator.frame_distances`, the distances the study's :class:`~.generator.Resequencer` builds its
+    graph on.
 
     ``sign_mode`` (default: ``linearisation.sign_mode``) applies to the L2
     features only; the Lee metric is sign-invariant."""
-    lin = cfg["linearisation"]
-    scale = float(lin["translation_scale"])
-    if metric == "l2":
-        mode = sign_mode_of(cfg) if sign_mode is None else sign_mode
-        return l2_distances(features.linearised(include_global, mode, scale))
-    if metric == "lee":
-        lee = cfg["lee"]
-        return lee_distances(features, lee["weights"], float(lee["nu"]), include_global, bool(lee["sqrt"]), scale)
-    raise ValueError(f"unknown metric {metric!r} (expected one of {METRICS})")
+    if metric not in METRICS:
+        raise ValueError(f"unknown metric {metric!r} (expected one of {METRICS})")
+    scale = float(cfg["linearisation"]["translation_scale"])
+    mode = (sign_mode_of(cfg) if sign_mode is None else sign_mode) if metric == "l2" else "continuous"  # Lee: unused
+    return frame_distances(features, metric, include_global, mode, scale, lee_kwargs(cfg))
+
+
+def lee_kwargs(cfg: dict) -> dict:
+    """Keyword arguments of :func:`.distances.lee_distances` from the ``lee`` block."""
+    lee = cfg["lee"]
+    return {"weights": lee["weights"], "nu": float(lee["nu"]), "sqrt": bool(lee["sqrt"])}
 
 
 def method_distances(D: np.ndarray, method: str, cfg: dict, fps: float):
-    """The matrix a method builds its k-NN graph on, and the edges it always keeps.
+    """The matrix a method builds its k-NN graph on, and the edges it always keeps
+    (:func:`.generator.method_matrix` with the config's ST-Isomap block at ``fps``).
 
     Isomap: ``(D, None, 0)``. ST-Isomap: the spatio-temporally adjusted ``D``,
     the adjacent-temporal-neighbour matrix (always in the neighbourhood) and
@@ -116,7 +124,7 @@ def method_distances(D: np.ndarray, method: str, cfg: dict, fps: float):
     if method == "isomap":
         return D, None, 0
     if method == "stisomap":
-        Dst, atn, ctn = spatio_temporal_distances(D, **st_parameters(cfg["stisomap"], fps))
+        Dst, atn, ctn = method_matrix(D, method, st_parameters(cfg["stisomap"], fps))
         return Dst, atn, int(np.count_nonzero(np.triu(ctn)))
     raise ValueError(f"unknown method {method!r} (expected one of {METHODS})")
 
@@ -346,12 +354,14 @@ def splice(path, n: int, context: int) -> np.ndarray:
     return np.concatenate([pre, path, post])
 
 
-def config_graph(motion: Motion, include_global: bool, method: str, metric: str, k: int, cfg: dict):
-    """The weighted neighbourhood graph a configuration's paths run on (k checked)."""
-    feats = motion_features(motion)
-    D = base_distances(feats, metric, include_global, cfg)
-    Dm, always, _ = method_distances(D, method, cfg, motion.fps)
-    return checked_graph(Dm, k, always, f"{method}/{metric}")
+def config_resequencer(motion: Motion, include_global: bool, method: str, metric: str, k: int,
+                       cfg: dict) -> Resequencer:
+    """The fitted :class:`~.generator.Resequencer` of a configuration: the dense graph of ``motion`` under its
+    metric, global DOF, sign mode and ST-Isomap block, at ``k`` (checked: the graph must connect)."""
+    return Resequencer(method, k=int(k), stisomap=cfg["stisomap"] if method == "stisomap" else None,
+                       neighbours="dense", metric=metric, global_dof=include_global, sign_mode=sign_mode_of(cfg),
+                       translation_scale=float(cfg["linearisation"]["translation_scale"]),
+                       lee=lee_kwargs(cfg)).fit([motion])
 
 
 #: Per-transition measures (ratios to the capture; 1 = an ordinary step of the capture, larger = rougher).
@@ -387,7 +397,7 @@ def resequence(motion: Motion, include_global: bool, method: str, metric: str, k
     """
     n = motion.n_frames
     check_distance_budget(n, motion.name, budget_gib)
-    G = config_graph(motion, include_global, method, metric, k, cfg)
+    est = config_resequencer(motion, include_global, method, metric, k, cfg)
     pc = cfg["path"]
     mode = pc["root_playback"]
     if mode not in ("absolute", "integrate"):
@@ -400,7 +410,7 @@ def resequence(motion: Motion, include_global: bool, method: str, metric: str, k
     same_pass = st_parameters(cfg["stisomap"], motion.fps)["ctn_min_gap"]  # frames closer in time: the same pass
     paths, rows, trows = [], [], []
     for p, (a, b) in enumerate(path_pairs(n, pc, seed)):
-        path, cost = shortest_path_frames(G, a, b)
+        path, cost = est.path(a, b, return_cost=True)
         paths.append(path)
         full = splice(path, n, context)
         first = int(a - max(0, a - context))  # position of the path's first frame in ``full``
@@ -424,7 +434,7 @@ def resequence(motion: Motion, include_global: bool, method: str, metric: str, k
         for i, t in enumerate(tr):
             trows.append({"pair": p, "transition": i, **t})
     a, b = main_pair(n, pc)
-    main_path, _ = shortest_path_frames(G, a, b)
+    main_path = est.path(a, b)
     padded = pad_path(main_path, pc["pad_to"], pc["pad_mode"])
     main = play_path(motion, padded, root=mode, name=f"{motion.name}_{method}_{metric}_{gdof_name(include_global)}",
                      same_pass=same_pass)

@@ -1,16 +1,14 @@
 """One call from a capture to a re-sequenced motion (CLI, notebooks): explicit keyword arguments instead of the
-workflow's config block, the same methods as the workflow steps (:mod:`.jobs`)."""
+workflow's config block, the same estimator as the workflow steps (:mod:`.jobs`) and the comparison
+(:class:`~.generator.Resequencer`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ..motion import Motion
-from .distances import l2_distances, lee_distances
-from .embedding import checked_graph, min_connected_k, spatio_temporal_distances
-from .features import motion_features
-from .paths import pad_path, play_path, resolve_frame, shortest_path_frames
-from .settings import METHODS, METRICS
+from .generator import Resequencer
+from .paths import pad_path, play_path, resolve_frame
 
 __all__ = ["resequence_motion"]
 
@@ -30,7 +28,8 @@ def resequence_motion(motion: Motion, start: int, end: int, method: str = "stiso
     method : {"stisomap", "st-isomap", "isomap"}
     metric : {"l2", "lee"}
     k : int, optional
-        Neighbours; default the smallest k giving one connected component of the method's graph.
+        Neighbours; default the smallest k giving one connected component of the method's graph
+        (:class:`~.generator.Resequencer` with ``neighbours="dense"`` builds the graph and the path).
     global_dof : bool
         Include the root translation and orientation in the distances.
     length : int, optional
@@ -53,24 +52,9 @@ def resequence_motion(motion: Motion, start: int, end: int, method: str = "stiso
         The motion it plays.
     """
     method = {"st-isomap": "stisomap"}.get(method, method)
-    feats = motion_features(motion)
-    n = feats.n_frames
+    n = motion.n_frames
     a, b = resolve_frame(start, n, "start"), resolve_frame(end, n, "end")
-    if metric == "l2":
-        D = l2_distances(feats.linearised(global_dof, sign_mode))
-    elif metric == "lee":
-        D = lee_distances(feats, include_global=global_dof, **(lee or {}))
-    else:
-        raise ValueError(f"unknown metric {metric!r} (expected one of {METRICS})")
-    if method == "isomap":
-        Dm, always = D, None
-    elif method == "stisomap":
-        Dm, always, _ = spatio_temporal_distances(D, **(st or {}))
-    else:
-        raise ValueError(f"unknown method {method!r} (expected one of {METHODS})")
-    if k is None:
-        k = min_connected_k(Dm, always=always)
-    G = checked_graph(Dm, int(k), always, f"{method}/{metric}")
-    path, _ = shortest_path_frames(G, a, b)
-    path = pad_path(path, length, "hold")
+    est = Resequencer(method, k=None if k is None else int(k), neighbours="dense", metric=metric,
+                      global_dof=global_dof, sign_mode=sign_mode, lee=lee, st=st).fit([motion])
+    path = pad_path(est.path(a, b), length, "hold")
     return path, play_path(motion, path, root=root_playback, name="resequenced")

@@ -6,6 +6,9 @@ geometry    robust Delaunay triangulation (duplicates, rank deficiency, Qhull fa
 graph       the motion graph G', edge orientation, connectivity (SCC, H)
 field       training vectors (half / forward / central) and the interpolated vector field
 path        field following (one path, or many together) and target-directed shortest paths in G'
+generator   the method as one estimator (FieldFollower: PCA, training vectors, field, following, decoding),
+            called by the folds, the one-call route and the comparison
+generate    the one-call route for users and the CLI (generate_from_trials)
 metrics     Error A / Error F and point-to-polyline distances
 folds       leave-one-sequence-out folds, ensembles of starts, variant grids (the fold and member rows)
 tables      Table II in the paper's layout, in every unit, over the ensemble of starts, per fold
@@ -22,6 +25,7 @@ from .._lazy import lazy_exports
 # name -> module; imported on first use (the family's heavy libraries load only when needed)
 _EXPORTS = {
     "FOLD_COLUMNS": ".folds",
+    "FieldFollower": ".generator",
     "FieldStack": ".field",
     "MEMBER_COLUMNS": ".folds",
     "MotionGraph": ".graph",

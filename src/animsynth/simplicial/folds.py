@@ -19,6 +19,12 @@ reported
   held-out trial projected and reprojected): the part of ``error_a_pose``
   that is PCA reconstruction loss, not generation error.
 
+The method itself (PCA, training vectors, vector field, Euler steps, inverse PCA) is
+:class:`~animsynth.simplicial.generator.FieldFollower`, the estimator the CLI and the side-by-side comparison
+call too: a fold fits its latent space once per latent dimension (:func:`prepare_fold`) and one field per
+variant on it (:func:`variant_follower`). The motion graph G' of target-directed generation and the scores
+are the paper pipeline's own.
+
 ``length_ratio`` is the arc length of the generated latent path over that of
 the held-out latent path (about 0.5 means the walk covered half the motion).
 
@@ -47,11 +53,12 @@ import numpy as np
 import pandas as pd
 from sklearn.decomposition import PCA
 
-from .field import DERIVATIVES, VectorField, training_vectors
-from .geometry import SafeDelaunay, bbox_diagonal
+from .field import DERIVATIVES, VectorField
+from .generator import FieldFollower, fit_pca
+from .geometry import SafeDelaunay
 from .graph import MotionGraph
 from .metrics import error_a, error_f
-from .path import GeneratedPath, TargetPlanner, follow_batch, follow_field
+from .path import GeneratedPath, TargetPlanner, follow_batch
 
 GENERATIONS = ("field", "target")
 
@@ -140,21 +147,12 @@ def arc_length(points) -> float:
     return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) if len(p) > 1 else 0.0
 
 
-def fit_pca(train: list, latent_dim: int) -> PCA:
-    """PCA on the concatenated training frames (never the held-out one)."""
-    X = np.vstack([np.asarray(t, float) for t in train])
-    if not np.all(np.isfinite(X)):
-        raise ValueError("training joint angles contain NaN/inf")
-    max_dim = min(X.shape[0], X.shape[1])
-    if latent_dim > max_dim:
-        raise ValueError(f"config key 'simplicial.latent_dim': {latent_dim} exceeds what {X.shape[0]} frames x "
-                         f"{X.shape[1]} angles allow ({max_dim})")
-    return PCA(n_components=latent_dim, svd_solver="full").fit(X)
-
-
 @dataclass
 class FoldContext:
-    """What every variant of one fold at one latent dimension shares."""
+    """What every variant of one fold at one latent dimension shares: the latent space (``space``, a
+    :class:`~.generator.FieldFollower` fitted by :meth:`~.generator.FieldFollower.fit_latent` on the training
+    trials; ``pca``, ``clips``, ``X`` and ``diag`` are its ``pca_``, ``latent_clips_``, ``latent_`` and
+    ``scale_``), the held-out trial in it and the triangulation."""
 
     pca: PCA
     clips: list
@@ -165,7 +163,7 @@ class FoldContext:
     tri: SafeDelaunay
     diag: float
     floor: float
-    vectors: dict = field(default_factory=dict)
+    space: FieldFollower
 
 
 def prepare_fold(train: list, test, latent_dim: int, dup_tol: float = 1e-9, rank_tol: float = 1e-9,
@@ -174,22 +172,29 @@ def prepare_fold(train: list, test, latent_dim: int, dup_tol: float = 1e-9, rank
     test = np.asarray(test, float)
     if test.ndim != 2 or test.shape[0] < 2:
         raise ValueError(f"held-out trial {held_out!r} needs at least 2 frames")
-    pca = fit_pca(train, latent_dim)
-    clips = [pca.transform(np.asarray(t, float)) for t in train]
-    X = np.vstack(clips)
-    T = pca.transform(test)
+    space = FieldFollower(latent_dim=latent_dim, dup_tol=dup_tol, rank_tol=rank_tol).fit_latent(train)
+    X = space.latent_
+    T = space.encode(test)
     tri = SafeDelaunay(dup_tol, rank_tol).fit(X)
-    floor = error_a(test, pca.inverse_transform(T))[0]  # Error A of the perfect latent path (PCA loss alone)
-    return FoldContext(pca, clips, X, [len(c) for c in clips], T, test, tri, bbox_diagonal(X), floor)
+    floor = error_a(test, space.decode(T))[0]  # Error A of the perfect latent path (PCA loss alone)
+    return FoldContext(space.pca_, space.latent_clips_, X, [len(c) for c in space.latent_clips_], T, test, tri,
+                       space.scale_, floor, space)
+
+
+def variant_follower(ctx: FoldContext, variant: Variant, dup_tol: float = 1e-9,
+                     rank_tol: float = 1e-9) -> FieldFollower:
+    """The variant's :class:`~.generator.FieldFollower` on the fold's shared latent space and triangulation."""
+    return FieldFollower(variant.method, variant.latent_dim, variant.k, variant.derivative, weights=variant.weights,
+                         dup_tol=dup_tol, rank_tol=rank_tol).fit_field(space=ctx.space, triangulation=ctx.tri)
 
 
 def _variant_objects(ctx: FoldContext, variant: Variant, dup_tol: float, rank_tol: float):
-    if variant.derivative not in ctx.vectors:
-        ctx.vectors[variant.derivative] = training_vectors(ctx.clips, variant.derivative)
-    V = ctx.vectors[variant.derivative]
-    graph = MotionGraph(variant.method, variant.k, dup_tol, rank_tol).fit(ctx.X, V, ctx.lengths, triangulation=ctx.tri)
-    fld = VectorField(variant.method, variant.k, variant.weights, dup_tol, rank_tol).fit(ctx.X, V, triangulation=ctx.tri)
-    return V, graph, fld
+    """The variant's field follower and the motion graph G' on its training vectors (target-directed
+    generation; the paper's graph, not part of field following)."""
+    est = variant_follower(ctx, variant, dup_tol, rank_tol)
+    graph = MotionGraph(variant.method, variant.k, dup_tol, rank_tol).fit(ctx.X, est.vectors_, ctx.lengths,
+                                                                          triangulation=ctx.tri)
+    return est, graph
 
 
 def _fold_row(ctx: FoldContext, variant: Variant, path: GeneratedPath, graph: MotionGraph, reached, *,
@@ -259,10 +264,10 @@ def run_fold(train: list, test, variant: Variant, *, dataset: str = "", held_out
     """
     variant.check()
     ctx = prepare_fold(train, test, variant.latent_dim, dup_tol, rank_tol, held_out)
-    V, graph, fld = _variant_objects(ctx, variant, dup_tol, rank_tol)
+    est, graph = _variant_objects(ctx, variant, dup_tol, rank_tol)
     extra = {}
     if variant.generation == "field":
-        path = follow_field(fld, ctx.T[0], steps_for(steps, len(ctx.T)))
+        path = est.follow(ctx.T[0], steps_for(steps, len(ctx.T)))
         reached = ""
     else:
         planner = TargetPlanner(max_all_pairs).fit(graph)
@@ -274,7 +279,7 @@ def run_fold(train: list, test, variant: Variant, *, dataset: str = "", held_out
                          "error_a_norm": row["error_a_norm"], "error_f_norm": row["error_f_norm"],
                          "sep_initial_rel": 0.0, "sep_final_rel": 0.0}])
     row = _ensemble_columns(row, one)
-    return FoldResult(row, ctx.pca, ctx.clips, ctx.T, path, graph, fld, V, extra)
+    return FoldResult(row, ctx.pca, ctx.clips, ctx.T, path, graph, est.field_, est.vectors_, extra)
 
 
 def jittered_starts(start, n_starts: int, jitter: float, scale: float, seed: int) -> np.ndarray:
@@ -335,7 +340,9 @@ def run_fold_ensemble(train: list, test, variants, *, n_starts: int = 16, jitter
         if fld_idx:
             n = steps_for(steps, len(ctx.T))
             which = np.repeat(np.arange(len(fld_idx)), M)
-            bp = follow_batch([objs[i][2] for i in fld_idx], np.tile(starts, (len(fld_idx), 1)), n, which)
+            # every member of every variant at once: the batched form of FieldFollower.follow (follow_field is
+            # follow_batch of one path), one step loop over the variants' fields
+            bp = follow_batch([objs[i][0].field_ for i in fld_idx], np.tile(starts, (len(fld_idx), 1)), n, which)
             for j, i in enumerate(fld_idx):
                 paths[i] = [(bp.path(j * M + m), "") for m in range(M)]
         for i, v in enumerate(group):
@@ -488,5 +495,5 @@ def to_jsonable(row: dict) -> dict:
 __all__ = [
     "FOLD_COLUMNS", "GENERATIONS", "MEMBER_COLUMNS", "FoldContext", "FoldResult", "Variant", "arc_length",
     "beyond_variants", "derivative_variants", "fit_pca", "jittered_starts", "order_folds", "prepare_fold",
-    "run_fold", "run_fold_ensemble", "run_subset", "steps_for", "to_jsonable",
+    "run_fold", "run_fold_ensemble", "run_subset", "steps_for", "to_jsonable", "variant_follower",
 ]

@@ -1,12 +1,11 @@
-"""One-call motion generation for users (CLI, notebooks): train on clips, follow the field."""
+"""One-call motion generation for users (CLI, notebooks): train on clips, follow the field
+(:class:`~.generator.FieldFollower`, the estimator the paper folds and the comparison call too)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .folds import fit_pca
-from .field import VectorField, training_vectors
-from .path import follow_field
+from .generator import FieldFollower
 
 
 def generate_from_trials(clips, method: str = "delaunay", k: int = 16, latent_dim: int = 2, steps: int = 300,
@@ -18,7 +17,7 @@ def generate_from_trials(clips, method: str = "delaunay", k: int = 16, latent_di
     clips : list of arrays (frames_i, D)
         Training joint angles (root DOF already removed, e.g. ``Motion.without_root()``).
     method : {"delaunay", "knn", "kdelaunay"}
-    k, latent_dim, weights : see :class:`VectorField`
+    k, latent_dim, weights : see :class:`~.generator.FieldFollower` and :class:`~.field.VectorField`
     steps : int
         Number of field steps (frames generated = steps + 1).
     start : array (D,), optional
@@ -41,11 +40,8 @@ def generate_from_trials(clips, method: str = "delaunay", k: int = 16, latent_di
     clips = [np.asarray(c, float) for c in clips]
     if not clips:
         raise ValueError("generate_from_trials: no training clips")
-    pca = fit_pca(clips, latent_dim)
-    latent = [pca.transform(c) for c in clips]
-    vec = training_vectors(latent, derivative)
-    field = VectorField(method=method, k=k, weights=weights).fit(np.vstack(latent), vec)
-    x0 = pca.transform(np.asarray(clips[0][0] if start is None else start, float).reshape(1, -1))[0]
-    path = follow_field(field, x0, steps)
-    angles = pca.inverse_transform(path.points)
+    est = FieldFollower(method, latent_dim, k, derivative, weights=weights).fit_angles(clips)
+    x0 = est.encode(np.asarray(clips[0][0] if start is None else start, float).reshape(1, -1))[0]
+    path = est.follow(x0, steps)
+    angles = est.decode(path.points)
     return angles, f"{method}, {path.fallback_steps} fallback steps of {path.steps}"

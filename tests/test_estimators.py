@@ -1,0 +1,177 @@
+"""One estimator per method: the paper pipeline, the one-call route (CLI) and the comparison's rows call the same
+code, so their numbers agree exactly; every estimator keeps the scikit-learn conventions."""
+
+from __future__ import annotations
+
+import ast
+import inspect
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from animsynth.compare import generators as G
+from animsynth.compare import jobs as cjobs
+from animsynth.compare import settings
+from animsynth.motion import Motion
+from animsynth.resequencing import jobs as rjobs
+from animsynth.resequencing.generator import Resequencer
+from animsynth.resequencing.quick import resequence_motion
+from animsynth.resequencing.settings import st_parameters
+from animsynth.simplicial import folds as fl
+from animsynth.simplicial.generate import generate_from_trials
+from animsynth.simplicial.generator import FieldFollower
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+from conftest import config_block, default_config
+
+
+@pytest.fixture(scope="module")
+def cfg():
+    config = default_config()
+    return dict(settings.job_cfg(config), **settings.clips_cfg(config), seeds=2)
+
+
+@pytest.fixture(scope="module")
+def walks():
+    sk = cmu_like_skeleton("est", 2)
+    return [cjobs.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
+
+
+@pytest.fixture(scope="module")
+def capture():
+    return generate_motion("walk_straight", 200, 5, cmu_like_skeleton("est", 1), name="capture")
+
+
+def _start(m: Motion, n: int = 8) -> Motion:
+    return Motion(m.values[:n].copy(), m.skeleton, m.fps, "start")
+
+
+# ----------------------------------------------------------------------------- simplicial
+
+
+@pytest.mark.parametrize("method", ["delaunay", "knn"])
+def test_compare_row_and_the_cli_route_give_the_same_poses(walks, cfg, method):
+    """The comparison's delaunay / knn row (no jitter) and generate_from_trials (the CLI) from the same start:
+    the same PCA, field and steps, so the same joint angles, bit for bit."""
+    field = dict(cfg["field"], jitter=0.0)
+    gen = G.make_generator(method, dict(cfg, field=field)).fit(walks[1:])
+    assert isinstance(gen, FieldFollower)
+    start, length = _start(walks[0]), 20
+    out = gen.generate(start, length, seed=3)
+    n_root = 6
+    angles, _ = generate_from_trials([w.without_root() for w in walks[1:]], method=method, k=field["k"],
+                                     latent_dim=field["latent_dim"], derivative=field["derivative"],
+                                     steps=length * gen.steps_per_frame_, start=start.values[-1, n_root:])
+    spf = gen.steps_per_frame_
+    np.testing.assert_array_equal(out.values[:, n_root:], angles[spf::spf])
+
+
+@pytest.mark.parametrize("variant", [fl.Variant("delaunay"), fl.Variant("knn", method="knn", k=4),
+                                     fl.Variant("fw", derivative="forward", weights="barycentric", latent_dim=3)])
+def test_a_paper_fold_follows_the_estimator(walks, variant):
+    """run_fold's latent path, field and training vectors are those of the estimator fitted on the training trials."""
+    trials = [w.without_root() for w in walks]
+    res = fl.run_fold(trials[1:], trials[0], variant)
+    est = FieldFollower(variant.method, variant.latent_dim, variant.k, variant.derivative,
+                        weights=variant.weights).fit_angles(trials[1:])
+    np.testing.assert_array_equal(res.vectors, est.vectors_)
+    np.testing.assert_array_equal(res.test_latent, est.encode(trials[0]))
+    path = est.follow(est.encode(trials[0])[0], len(trials[0]))  # the held-out trial's first latent frame
+    np.testing.assert_array_equal(res.path.points, path.points)
+    np.testing.assert_array_equal(res.path.fallback, path.fallback)
+
+
+def test_the_compare_pca_is_the_family_pca(walks):
+    """fit(database) fits PCA on the stacked joint angles as fit_pca does (one code path)."""
+    est = FieldFollower().fit(walks)
+    pca = fl.fit_pca([w.without_root() for w in walks], 2)
+    np.testing.assert_array_equal(est.pca_.components_, pca.components_)
+    np.testing.assert_array_equal(est.pca_.mean_, pca.mean_)
+
+
+def test_a_shared_latent_space_must_have_the_same_dimension(walks):
+    space = FieldFollower(latent_dim=2).fit_latent([w.without_root() for w in walks])
+    with pytest.raises(ValueError, match="latent_dim 3"):
+        FieldFollower(latent_dim=3).fit_field(space=space)
+
+
+# ----------------------------------------------------------------------------- resequencing
+
+
+@pytest.mark.parametrize("method", ["isomap", "stisomap"])
+@pytest.mark.parametrize("metric", ["l2", "lee"])
+def test_the_estimator_path_is_resequence_motion_path(capture, method, metric):
+    path, played = resequence_motion(capture, 150, 20, method=method, metric=metric)
+    est = Resequencer(method, neighbours="dense", metric=metric).fit([capture])
+    np.testing.assert_array_equal(est.path(150, 20), path)
+    assert est.min_k_ == est.k_
+
+
+@pytest.mark.parametrize("method", ["isomap", "stisomap"])
+def test_the_study_paths_are_the_cli_route_paths(capture, method):
+    """The paper study's measured paths (jobs.resequence) and resequence_motion with the same settings (L2, the
+    config's ST-Isomap block in frames, the same k) run on the same graph."""
+    cfg = config_block("resequencing")
+    k = 12
+    paths, (main, _), _, _ = rjobs.resequence(capture, False, method, "l2", k, cfg, seed=3)
+    st = st_parameters(cfg["stisomap"], capture.fps)
+    for (a, b), p in zip(rjobs.path_pairs(capture.n_frames, cfg["path"], 3), paths):
+        q, _ = resequence_motion(capture, a, b, method=method, metric="l2", k=k, st=st,
+                                 sign_mode=cfg["linearisation"]["sign_mode"])
+        np.testing.assert_array_equal(p, q)
+
+
+def test_the_sparse_and_dense_graphs_agree_on_the_smallest_k_of_one_capture(capture):
+    """Both neighbourhoods of one capture under L2 (Isomap) connect at the same smallest k."""
+    dense = Resequencer("isomap", neighbours="dense").fit([capture])
+    sparse = Resequencer("isomap", neighbours="sparse").fit([capture])
+    assert sparse.min_k_ == dense.min_k_
+
+
+def test_dense_needs_one_clip_and_sparse_needs_l2(walks):
+    with pytest.raises(ValueError, match="one capture"):
+        Resequencer(neighbours="dense").fit(walks[:2])
+    with pytest.raises(ValueError, match="l2 metric"):
+        Resequencer(metric="lee").fit(walks[:2])
+
+
+# ----------------------------------------------------------------------------- the conventions
+
+
+def _unfitted(name, cfg, walks):
+    return G.make_generator(name, cfg, held_out=walks[0])
+
+
+@pytest.mark.parametrize("name", [n for n in G.GENERATORS if n not in G.FAIRMOTION_ROWS] + ["fairmotion"])
+def test_estimator_conventions(name, cfg, walks):
+    """Parameters stored as given in __init__, fit returns self, everything fit adds ends in ``_`` (a private
+    fitted attribute starts with ``_`` too)."""
+    if settings.unavailable(name):
+        pytest.skip(f"{name}: {settings.unavailable(name)}")
+    gen = _unfitted(name, cfg, walks)
+    params = [p for p in inspect.signature(type(gen).__init__).parameters if p != "self"]
+    for p in params:
+        assert hasattr(gen, p), f"{name}: parameter {p!r} is not stored on the estimator"
+    before = set(vars(gen))
+    assert gen.fit(walks[1:]) is gen
+    added = sorted(set(vars(gen)) - before)
+    assert added and all(a.endswith("_") or a.startswith("_") for a in added), (name, added)
+
+
+def test_the_family_estimators_add_only_trailing_underscore_attributes(walks, capture):
+    for est, data in ((FieldFollower(), walks), (Resequencer("stisomap", stisomap=config_block("resequencing")
+                                                              ["stisomap"]), walks),
+                      (Resequencer(neighbours="dense", metric="lee"), [capture])):
+        before = set(vars(est))
+        est.fit(data)
+        added = set(vars(est)) - before
+        assert added and all(a.endswith("_") and not a.startswith("_") for a in added), added
+
+
+def test_the_registry_holds_no_method_code():
+    """compare/generators.py names estimators and reads their settings; it defines no class."""
+    src = Path(G.__file__).read_text()
+    classes = [n.name for n in ast.walk(ast.parse(src)) if isinstance(n, ast.ClassDef)]
+    assert classes == []
+    assert G.FieldFollower is FieldFollower and G.Resequencer is Resequencer
