@@ -328,7 +328,7 @@ class MotionMatching(Generator):
                              f"{self.exclude_frames_ + 1} frames at {fps:g} fps)")
         q, vec = self._state(self.track_, fps, m)
         self.rot_, self.vec_ = q, vec
-        self._memo = None
+        self._memo_ = None
         self.angular_velocity_ = self._angular_velocity(q, fps, starts)
         self.root_velocity_ = self._vec_velocity(vec, fps, starts)
         if self.foot_lock:
@@ -401,14 +401,14 @@ class MotionMatching(Generator):
         key = None
         if trajectory is None:
             key = (int(length), np.asarray(start.values, float).tobytes())
-            memo = getattr(self, "_memo", None)
+            memo = getattr(self, "_memo_", None)
             if memo is not None and memo[0] == key:
                 m = memo[1]
                 return Motion(m.values.copy(), m.skeleton, m.fps, m.name,
                               {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in m.meta.items()})
         out = self._rollout(start, length, trajectory)
         if key is not None:
-            self._memo = (key, out)
+            self._memo_ = (key, out)
             return Motion(out.values.copy(), out.skeleton, out.fps, out.name,
                           {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in out.meta.items()})
         return out
