@@ -18,7 +18,13 @@ def scale_steps(recorder, n: int, metric: str = "l2", method: str = "isomap", n_
                        landmarks: str = "maxmin", n_components: int = 2, seed: int = 0, trial_frames: int = 1000,
                        cmu_mirror: str | None = None, algorithm: str = "kd_tree", st: dict | None = None,
                        lee: dict | None = None):
-    """Re-sequencing of an ``n``-frame database: neighbours, exact min k, embedding, one path."""
+    """Re-sequencing of an ``n``-frame database: neighbours, exact min k, embedding, one path.
+
+    The graph is the estimator's (:func:`.sparse.sparse_graph`, as :class:`.generator.Resequencer` builds it)
+    with the harness's deliberate differences, as parameters: one listing of ``n_candidates`` (no doubling:
+    the harness measures one), the Lee metric through :func:`.sparse.lee_neighbours` besides L2, and ST-Isomap's
+    parameters ``st`` in frames with their defaults where absent (the estimator reads the study's block).
+    """
     from ..io.cmu_mirror import read_mirror_motions
     from ..synth.mocap import synthetic_motions
     from . import landmark as lm
@@ -31,30 +37,23 @@ def scale_steps(recorder, n: int, metric: str = "l2", method: str = "isomap", n_
     n = int(seq.size)
     S = recorder("resequencing", n, metric=metric, method=method)
     lee = lee or {}
-    with S.step("neighbours", candidates=n_candidates):
-        if metric == "l2":
+    if metric == "l2":
+        def neighbours(m):
             X = np.vstack([f.linearised(False) for f in feats])
-            dist, idx = sp.l2_neighbours(X, n_candidates, algorithm=algorithm)
-            pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)  # noqa: E731
-        elif metric == "lee":
-            kw = {"weights": lee.get("weights"), "nu": float(lee.get("nu", 0.01)), "sqrt": bool(lee.get("sqrt", False))}
-            dist, idx = sp.lee_neighbours(feats, n_candidates, algorithm=algorithm, **kw)
+            return (*sp.l2_neighbours(X, m, algorithm=algorithm),
+                    lambda i, j: np.linalg.norm(X[i] - X[j], axis=1))
+    elif metric == "lee":
+        kw = {"weights": lee.get("weights"), "nu": float(lee.get("nu", 0.01)), "sqrt": bool(lee.get("sqrt", False))}
+
+        def neighbours(m):
+            dist, idx = sp.lee_neighbours(feats, m, algorithm=algorithm, **kw)
             parts = sp._lee_parts(feats, kw["weights"], kw["nu"], False)
-            pair = lambda i, j: sp.lee_pair_metric(parts, i, j, kw["sqrt"])  # noqa: E731
-        else:
-            raise ValueError(f"unknown metric {metric!r} (l2, lee)")
-        always = None
-        if method == "stisomap":
-            st = dict(st or {})
-            dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
-            always = sp.st_always_edges(seq, st.get("temporal_window", 1), st.get("c_atn", 10.0), pair)
-        elif method != "isomap":
-            raise ValueError(f"unknown method {method!r} (isomap, stisomap)")
-    with S.step("min_k") as info:
-        kmin = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
-        info["min_k"] = kmin
-    kk = max(kmin, int(k or kmin))
-    G = sp.sparse_knn_graph(dist, idx, kk, always=always)
+            return dist, idx, lambda i, j: sp.lee_pair_metric(parts, i, j, kw["sqrt"])
+    else:
+        raise ValueError(f"unknown metric {metric!r} (l2, lee)")
+    # one listing of n_candidates, timed as the steps "neighbours" (listing + ST adjustment) and "min_k"
+    g = sp.sparse_graph(neighbours, seq, method, n_candidates, k, st=st, grow=False, step=S.step)
+    kk, G = g.k, g.graph
     with S.step("embedding") as info:
         res = lm.embed(G, n_components, embedding, exact_max_frames, n_landmarks, landmarks, seed)
         info.update(embedding_method=res.method, rv_d2=float(res.residual_variance[min(1, n_components - 1)]))
@@ -75,7 +74,8 @@ def landmark_vs_exact(n: int, metric: str = "l2", method: str = "isomap", n_cand
       a database graph is often a chain, whose geodesics are 1-D, and a 2-D
       Procrustes comparison would compare rounding noise.
     * The dense pipeline (:mod:`.embedding`: full distance matrix,
-      exact min k) and the sparse one (:mod:`.sparse`) must give the
+      exact min k) and the sparse one (:func:`.sparse.sparse_graph`, one listing
+      of ``n_candidates``, no doubling) must give the
       same minimum k and the same path costs (``pairs`` seeded start/end pairs).
     * On the sparse graph, exact Isomap vs Landmark Isomap for each number of
       landmarks x landmark seed: Procrustes disparity of the 2-D embeddings
@@ -105,23 +105,19 @@ def landmark_vs_exact(n: int, metric: str = "l2", method: str = "isomap", n_cand
         raise ValueError("landmark_vs_exact compares on the L2 metric (the dense Lee metric of a multi-trial "
                          "database would mix velocities across trial boundaries)")
     X = np.vstack([f.linearised(False) for f in feats])
-    dist, idx = sp.l2_neighbours(X, n_candidates, algorithm="kd_tree")
     D = l2_distances(X)
+    always_dense = None
     if method == "stisomap":
         if len(feats) != 1:
             raise ValueError("the dense ST-Isomap adjustment handles one sequence; use one trial for stisomap")
         st = dict(st or {})
-        pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)  # noqa: E731
-        dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
-        always = sp.st_always_edges(seq, st.get("temporal_window", 1), st.get("c_atn", 10.0), pair)
         D = spatio_temporal_distances(D, **st)[0]
         always_dense = temporal_adjacency(n, st.get("temporal_window", 1))
-    else:
-        always, always_dense = None, None
-    kmin_sparse = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
+    pair = lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)  # noqa: E731
+    g = sp.sparse_graph(lambda m: (*sp.l2_neighbours(X, m, algorithm="kd_tree"), pair), seq, method,
+                        n_candidates, k, st=st, grow=False)
+    kmin_sparse, kk, G = g.min_k, g.k, g.graph
     kmin_dense = min_connected_k(D, always=always_dense)
-    kk = max(kmin_sparse, int(k or kmin_sparse))
-    G = sp.sparse_knn_graph(dist, idx, kk, always=always)
     Gd = knn_graph(D, kk, always=always_dense)
     rng = np.random.default_rng(seed)
     ab = [tuple(int(x) for x in rng.choice(n, 2, replace=False)) for _ in range(int(pairs))]

@@ -175,36 +175,15 @@ class Resequencer(Generator):
                              "(the lee metric: neighbours='dense')")
         if self.method == "stisomap" and not self.stisomap:
             raise ValueError("stisomap needs its parameters (the re-sequencing study's stisomap block)")
-        db = self.db_
         feats, seq = sp.concat_features(feats)
         X = np.vstack([self._linearised(f) for f in feats])
-        n = X.shape[0]
 
         def pair(i, j):
             return np.linalg.norm(X[i] - X[j], axis=1)
 
-        m = min(int(self.n_candidates), n - 1)
-        while True:
-            dist, idx = sp.l2_neighbours(X, m)
-            always = None
-            if self.method == "stisomap":
-                st = self._st(db.fps)
-                dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
-                always = sp.st_always_edges(seq, st["temporal_window"], st["c_atn"], pair)
-            try:
-                kmin = sp.sparse_min_connected_k(idx, always=None if always is None else always[0])
-                break
-            except sp.CandidateCountError:
-                if m >= n - 1:
-                    raise
-                m = min(2 * m, n - 1)
-        self.min_k_ = int(kmin)
-        self.k_ = max(self.min_k_, int(self.k or 0))
-        if self.k_ > idx.shape[1]:
-            dist, idx = sp.l2_neighbours(X, min(self.k_, n - 1))
-            if self.method == "stisomap":
-                dist, idx, _ = sp.st_neighbours(dist, idx, seq, pair_distance=pair, **st)
-        self.graph_ = sp.sparse_knn_graph(dist, idx, self.k_, always=always)
+        g = sp.sparse_graph(lambda m: (*sp.l2_neighbours(X, m), pair), seq, self.method, self.n_candidates,
+                            self.k, st=self._st(self.db_.fps) if self.method == "stisomap" else None)
+        self.min_k_, self.k_, self.graph_ = g.min_k, g.k, g.graph
         self.features_ = X
 
     # ------------------------------------------------------------------ paths and generation

@@ -69,6 +69,8 @@ from __future__ import annotations
 
 import logging
 import math
+from contextlib import nullcontext
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
@@ -83,7 +85,7 @@ log = logging.getLogger("animsynth.resequencing")
 
 __all__ = ["CandidateCountError", "concat_features", "l2_neighbours", "lee_index_vectors", "lee_pair_metric",
            "lee_neighbours", "sparse_knn_graph", "sparse_min_connected_k", "st_always_edges", "st_neighbours",
-           "shortest_path", "temporal_pairs",
+           "shortest_path", "temporal_pairs", "SparseGraph", "sparse_graph",
            "LEE_INDEX_RATIO"]
 
 #: Upper bound of lee / index-distance (squared metric): (pi/2)^2 (module docstring).
@@ -602,6 +604,95 @@ def shortest_path(graph, start: int, end: int):
     when ``end`` is unreachable.
     """
     return shortest_path_frames(graph, start, end)
+
+
+# ----------------------------------------------------------------------------- the method's graph, once
+
+
+@dataclass
+class SparseGraph:
+    """What :func:`sparse_graph` built: the (ST-adjusted) neighbour lists ``dist``, ``idx`` ``(frames, m)``,
+    ST-Isomap's always-kept edges (``None`` for Isomap), the smallest connecting k, the k used and the graph
+    (symmetric CSR ``(frames, frames)``)."""
+
+    dist: np.ndarray
+    idx: np.ndarray
+    always: tuple | None
+    min_k: int
+    k: int
+    graph: csr_matrix
+
+
+def _untimed(name: str, **info):
+    return nullcontext(info)
+
+
+def sparse_graph(neighbours, sequence, method: str = "isomap", n_candidates: int = 20, k=None,
+                 st: dict | None = None, grow: bool = True, step=_untimed) -> SparseGraph:
+    """The Isomap / ST-Isomap neighbourhood graph of a database from neighbour lists, the steps in order:
+    list the candidates (``neighbours``), ST-Isomap's adjustment (:func:`st_neighbours`) and always-kept edges
+    (:func:`st_always_edges`), the smallest connecting k (:func:`sparse_min_connected_k`), the k-NN graph
+    (:func:`sparse_knn_graph`) at ``max(min k, k)``.
+
+    Used by :class:`.generator.Resequencer` (``grow=True``) and the cost harness (:mod:`.cost`, ``grow=False``,
+    ``step`` its recorder's timer).
+
+    Parameters
+    ----------
+    neighbours : callable ``m -> (dist, idx, pair)``: the neighbour lists ``(frames, m)`` of ``m`` candidates
+        per frame and the metric's pair distance ``pair(i, j) -> (E,)`` between frame index arrays ``i``, ``j``
+        (``(E,)`` each; what the ST adjustment re-measures). The metric is the caller's: L2
+        (:func:`l2_neighbours`) for the estimator, L2 or the Lee route (:func:`lee_neighbours`) for the harness
+    sequence : (frames,) int array, the trial of every frame (:func:`concat_features`)
+    method : {"isomap", "stisomap"}
+    n_candidates : int, candidates listed per frame
+    k : int or None, neighbours of the graph; fewer than the smallest connecting k (or None) gives that k
+    st : dict, optional, ST-Isomap's parameters in frames (keyword arguments of :func:`st_neighbours`); the
+        always-kept edges read ``temporal_window`` and ``c_atn`` with their defaults (1, 10.0) where absent
+    grow : bool
+        ``True`` (the estimator): at most ``frames - 1`` candidates, doubled until the smallest connecting k
+        fits in the lists, and listed again when the k used exceeds them. ``False`` (the cost harness, which
+        measures one listing): ``n_candidates`` as given, a :class:`CandidateCountError` propagates
+    step : callable ``(name, **info) -> context manager`` yielding a dict, optional
+        Times the steps: ``"neighbours"`` (listing and ST adjustment, ``info`` ``candidates``) and ``"min_k"``
+        (``info["min_k"]`` set); e.g. :meth:`animsynth.scale.Steps.step`. Called for every listing (once with
+        ``grow=False``). Default: untimed.
+
+    Returns
+    -------
+    SparseGraph
+    """
+    if method not in ("isomap", "stisomap"):
+        raise ValueError(f"unknown method {method!r} (isomap, stisomap)")
+    seq = np.asarray(sequence)
+    n = int(seq.size)
+    st = dict(st or {})
+
+    def listed(m):
+        with step("neighbours", candidates=m):
+            dist, idx, pair = neighbours(m)
+            always = None
+            if method == "stisomap":
+                dist, idx, _ = st_neighbours(dist, idx, seq, pair_distance=pair, **st)
+                always = st_always_edges(seq, st.get("temporal_window", 1), st.get("c_atn", 10.0), pair)
+        return dist, idx, always
+
+    m = min(int(n_candidates), n - 1) if grow else n_candidates
+    while True:
+        dist, idx, always = listed(m)
+        try:
+            with step("min_k") as info:
+                kmin = sparse_min_connected_k(idx, always=None if always is None else always[0])
+                info["min_k"] = kmin
+            break
+        except CandidateCountError:
+            if not grow or m >= n - 1:
+                raise
+            m = min(2 * m, n - 1)
+    kk = max(int(kmin), int(k or 0))
+    if grow and kk > idx.shape[1]:
+        dist, idx, _ = listed(min(kk, n - 1))
+    return SparseGraph(dist, idx, always, int(kmin), kk, sparse_knn_graph(dist, idx, kk, always=always))
 
 
 __all__ += ["DisconnectedGraphError"]
