@@ -24,8 +24,6 @@ from .motion import Motion
 __all__ = ["Database", "Generator", "align_root", "check_generated", "play_path"]
 
 
-
-
 # ----------------------------------------------------------------------------- root helpers
 
 

@@ -40,6 +40,19 @@ def frame_distances(features, metric: str, include_global: bool = False, sign_mo
     ``l2``: between the linearised features (:meth:`.features.MotionFeatures.linearised`, ``sign_mode`` and
     ``translation_scale`` applied); ``lee``: :func:`.distances.lee_distances` with ``translation_scale`` and the
     keyword arguments ``lee`` (``weights``, ``nu``, ``sqrt``; a ``translation_scale`` there wins).
+
+    Parameters
+    ----------
+    features : MotionFeatures, the capture's ``N`` frames (:func:`.features.motion_features`)
+    metric : {"l2", "lee"}
+    include_global : bool, the root's orientation and position in the distances
+    sign_mode : str, quaternion linearisation of the L2 features (:func:`.features.linearize_quaternions`)
+    translation_scale : float, root translation with ``include_global``: radians per metre
+    lee : dict, optional, keyword arguments of :func:`.distances.lee_distances`
+
+    Returns
+    -------
+    ndarray (N, N) float64, symmetric, zero diagonal
     """
     from .distances import l2_distances, lee_distances
 
@@ -56,7 +69,20 @@ def method_matrix(D: np.ndarray, method: str, st: dict | None = None):
     common-temporal-neighbour matrix.
 
     Isomap: ``(D, None, None)``. ST-Isomap: :func:`.embedding.spatio_temporal_distances` with the keyword
-    arguments ``st`` (frames; its defaults where absent)."""
+    arguments ``st`` (frames; its defaults where absent).
+
+    Parameters
+    ----------
+    D : ndarray (N, N), the frame distances (:func:`frame_distances`)
+    method : {"isomap", "stisomap"}
+    st : dict, optional, ST-Isomap's parameters in frames
+
+    Returns
+    -------
+    Dm : ndarray (N, N), the (adjusted) distances the k-NN graph is built on
+    always : ndarray (N, N) of bool or None, the adjacent temporal neighbours kept whatever k (ST-Isomap)
+    ctn : ndarray (N, N) of bool or None, the common temporal neighbours (ST-Isomap)
+    """
     from .embedding import spatio_temporal_distances
 
     if method == "isomap":
@@ -189,7 +215,22 @@ class Resequencer(Generator):
     # ------------------------------------------------------------------ paths and generation
     def path(self, start: int, end: int, return_cost: bool = False):
         """The Dijkstra shortest-cost path of database frames from ``start`` to ``end`` on the graph
-        (:func:`.paths.shortest_path_frames`); with ``return_cost`` also its cost."""
+        (:func:`.paths.shortest_path_frames`).
+
+        Parameters
+        ----------
+        start, end : int, database frame indices (``0 <= i < N``)
+        return_cost : bool, also return the path's cost
+
+        Returns
+        -------
+        path : ndarray (m,) int64, the frames from ``start`` to ``end`` inclusive
+        cost : float, the sum of the path's edge weights (only with ``return_cost``)
+
+        Raises
+        ------
+        :class:`~.embedding.DisconnectedGraphError` if ``end`` is unreachable from ``start``.
+        """
         from .paths import shortest_path_frames
 
         path, cost = shortest_path_frames(self.graph_, start, end)

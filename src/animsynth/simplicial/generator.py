@@ -26,8 +26,23 @@ __all__ = ["FieldFollower", "fit_pca"]
 
 
 def fit_pca(train: list, latent_dim: int, what: str = "config key 'simplicial.latent_dim'"):
-    """PCA on the concatenated training frames (never the held-out one); ``what`` names the setting in the
-    error of a ``latent_dim`` the frames do not allow."""
+    """PCA on the concatenated training frames (never the held-out one).
+
+    Parameters
+    ----------
+    train : list of array-like (n_i, D), the training trials' joint angles
+    latent_dim : int, principal components kept (at most ``min(sum n_i, D)``)
+    what : str, names the setting in the error of a ``latent_dim`` the frames do not allow
+
+    Returns
+    -------
+    sklearn.decomposition.PCA, fitted (``svd_solver="full"``) on the stacked ``(sum n_i, D)`` frames:
+    ``components_`` ``(latent_dim, D)``, ``mean_`` ``(D,)``
+
+    Raises
+    ------
+    ValueError if the frames hold NaN/inf or ``latent_dim`` exceeds ``min(sum n_i, D)``.
+    """
     from sklearn.decomposition import PCA
 
     X = np.vstack([np.asarray(t, float) for t in train])
@@ -158,6 +173,22 @@ class FieldFollower(Generator):
         return self
 
     def generate(self, start: Motion, length: int, seed: int) -> Motion:
+        """Follow the field from the start's last pose and decode the path to poses.
+
+        Parameters
+        ----------
+        start : Motion, ``(>= 2, n_dof)`` values of the database's skeleton; its last frame's joint angles are
+            encoded, the latent point moved by the seeded ``jitter``
+        length : int, output frames; the path takes ``length * steps_per_frame_`` Euler steps
+        seed : int, the jitter's random direction
+
+        Returns
+        -------
+        Motion, ``(length, n_dof)`` values: joint angles decoded from every ``steps_per_frame_``-th path point,
+        the root played from the database frames nearest in latent space (integrated from the start's last
+        frame); ``meta``: ``seams`` (empty, int64), ``source_frames`` ``(length, 2)`` int64 of -1 (decoded poses
+        have no source frame), ``fallback_share`` (float, the share of steps that fell back to k-NN)
+        """
         self._check_start(start, length)
         db, spf, length = self.db_, self.steps_per_frame_, int(length)
         x0 = self.encode(np.asarray(start.values, float)[-1:, db.n_root:])[0]
