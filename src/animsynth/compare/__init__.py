@@ -3,7 +3,8 @@
 The same held-out clips (CMU's Gauch & Peters subsets by leave one out, the re-sequencing clips by a
 temporal split), the same starts and seeds, one set of metrics (foot skating, seam jumps, smoothness,
 LAFAN1's L2P / L2Q / NPSS, coverage, diversity, novelty) and the cost of each generator. This package
-sits above the four families: it imports their public functions to score them; no family imports it.
+sits above the four families: it fits and runs their estimators (the registry, :mod:`.generators`)
+to score them; no family imports it.
 
 Modules
 -------

@@ -24,7 +24,7 @@ Generators (``GENERATORS``):
     angles, the training vectors, the interpolated vector field and Euler steps from the start's
     latent point (moved by a seeded jitter, so seeds differ), decoded to joint angles. Root motion
     (an extension: the paper has no root) is the capture's own root step of the database frame
-    nearest in latent space, integrated from the start (:func:`animsynth.resequencing.play_path`).
+    nearest in latent space, integrated from the start (:func:`animsynth.generator.play_path`).
 ``isomap``, ``stisomap``
     re-sequencing on the neighbourhood graph (:class:`animsynth.resequencing.generator.Resequencer`): L2 between
     linearised joint rotations, the smallest k that connects the graph (ST-Isomap: with the
