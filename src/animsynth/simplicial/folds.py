@@ -151,19 +151,31 @@ def arc_length(points) -> float:
 class FoldContext:
     """What every variant of one fold at one latent dimension shares: the latent space (``space``, a
     :class:`~.generator.FieldFollower` fitted by :meth:`~.generator.FieldFollower.fit_latent` on the training
-    trials; ``pca``, ``clips``, ``X`` and ``diag`` are its ``pca_``, ``latent_clips_``, ``latent_`` and
+    trials; ``pca``, ``clips``, ``X`` and ``diag`` read its ``pca_``, ``latent_clips_``, ``latent_`` and
     ``scale_``), the held-out trial in it and the triangulation."""
 
-    pca: PCA
-    clips: list
-    X: np.ndarray
+    space: FieldFollower
     lengths: list
     T: np.ndarray
     test: np.ndarray
     tri: SafeDelaunay
-    diag: float
     floor: float
-    space: FieldFollower
+
+    @property
+    def pca(self) -> PCA:
+        return self.space.pca_
+
+    @property
+    def clips(self) -> list:
+        return self.space.latent_clips_
+
+    @property
+    def X(self) -> np.ndarray:
+        return self.space.latent_
+
+    @property
+    def diag(self) -> float:
+        return self.space.scale_
 
 
 def prepare_fold(train: list, test, latent_dim: int, dup_tol: float = 1e-9, rank_tol: float = 1e-9,
@@ -177,8 +189,7 @@ def prepare_fold(train: list, test, latent_dim: int, dup_tol: float = 1e-9, rank
     T = space.encode(test)
     tri = SafeDelaunay(dup_tol, rank_tol).fit(X)
     floor = error_a(test, space.decode(T))[0]  # Error A of the perfect latent path (PCA loss alone)
-    return FoldContext(space.pca_, space.latent_clips_, X, [len(c) for c in space.latent_clips_], T, test, tri,
-                       space.scale_, floor, space)
+    return FoldContext(space, [len(c) for c in space.latent_clips_], T, test, tri, floor)
 
 
 def variant_follower(ctx: FoldContext, variant: Variant, dup_tol: float = 1e-9,
