@@ -130,3 +130,35 @@ def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp
               "accel_jump_max"):
         assert np.isclose(s[c], row[c], rtol=1e-4, atol=1e-6), (c, s[c], row[c])
     assert all(np.isnan(s[c]) for c in DATABASE_METRICS)  # no --database
+
+
+@pytest.mark.workflow
+def test_fairmotion_rows_and_sweep_are_one_job_and_our_graph_keeps_its_own(tmp_path):
+    """With a budget sweep, fairmotion's two rows and the fixed row's further budgets are planned as one job
+    (compare_run_fairmotion, which builds each graph once); our motion graph's budgets stay compare_sweep_run jobs
+    and every other generator keeps its compare_run job."""
+    import re
+
+    from conftest import copy_workflow, run_snakemake
+
+    from animsynth.compare.settings import unavailable
+
+    if unavailable("fairmotion"):
+        pytest.skip(f"needs fairmotion: {unavailable('fairmotion')}")
+    wd = copy_workflow(tmp_path / "wf")
+    (wd / "config" / "sweep.yaml").write_text("compare:\n  budget_sweep: [2, 8]\n")
+    res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml", "config/sweep.yaml", "--",
+                        "results/compare/budget_sweep.csv", "results/compare/verdicts.csv")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-3000:]
+    jobs = re.findall(r"^(?:local)?rule (compare_\w+):\n((?:    .*\n)+)", res.stdout, flags=re.M)
+    names = [rule for rule, _ in jobs]
+    assert names.count("compare_run_fairmotion") == 1
+    block = dict(jobs)["compare_run_fairmotion"]
+    for f in ("runs/fairmotion.csv", "runs/fairmotion_fixed.csv", "sweep/fairmotion_fixed_2.csv",
+              "sweep/fairmotion_fixed_8.csv"):
+        assert f"results/compare/{f}" in block, f
+    sweeps = [b for r, b in jobs if r == "compare_sweep_run"]
+    assert len(sweeps) == 2 and all("sweep/motion_graph_" in b for b in sweeps)
+    runs = [b for r, b in jobs if r == "compare_run"]
+    assert not any("runs/fairmotion" in b for b in runs) and any("runs/motion_graph.csv" in b for b in runs)
