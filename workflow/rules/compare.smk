@@ -200,6 +200,8 @@ if CMP_FM:
             roles={},  # as compare_run's
             sweep_roles=config["joint_roles"],  # as compare_sweep_run's
             showcase=CMP_SHOWCASE,
+        # the comparison's longest job (438 s of CPU on the paper run): started early, so it does not run alone at the end
+        priority: 10
         threads: 1
         resources:
             mem_mb=2500,
