@@ -162,3 +162,10 @@ def test_fairmotion_rows_and_sweep_are_one_job_and_our_graph_keeps_its_own(tmp_p
     assert len(sweeps) == 2 and all("sweep/motion_graph_" in b for b in sweeps)
     runs = [b for r, b in jobs if r == "compare_run"]
     assert not any("runs/fairmotion" in b for b in runs) and any("runs/motion_graph.csv" in b for b in runs)
+    # without our motion graph the sweep is fairmotion's alone: no compare_sweep_run job, and the run still plans
+    (wd / "config" / "fm_only.yaml").write_text(
+        "compare:\n  budget_sweep: [2, 8]\n  generators: [delaunay, fairmotion, fairmotion_fixed, replay, concat]\n")
+    res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml", "config/fm_only.yaml")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-3000:]
+    assert "rule compare_run_fairmotion:" in res.stdout and "rule compare_sweep_run:" not in res.stdout

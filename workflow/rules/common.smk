@@ -415,9 +415,9 @@ def compare_benchmarks():
         + (job_benchmarks("compare_run_fairmotion") if CMP_FM else [])
         + job_benchmarks("compare_tables")
         + job_benchmarks("compare_figures")
-        + (job_benchmarks("compare_sweep_run", cmpgraph=[g for b in CMP_SWEEP for g in CMP_GRAPHS if g not in CMP_FM],
-                          budget=[b for b in CMP_SWEEP for g in CMP_GRAPHS if g not in CMP_FM])
-           + job_benchmarks("compare_sweep") if CMP_SWEEP and CMP_GRAPHS else [])
+        + (job_benchmarks("compare_sweep_run", cmpgraph=[g for g, _b in CMP_OWN_SWEEP],
+                           budget=[b for _g, b in CMP_OWN_SWEEP]) if CMP_OWN_SWEEP else [])
+        + (job_benchmarks("compare_sweep") if CMP_SWEEP and CMP_GRAPHS else [])
     )
 
 

@@ -38,6 +38,8 @@ CMP_OUT = {
 CMP_FM = [g for g in FAIRMOTION_ROWS if g in CMP_RUN]
 CMP_FM_SWEEP = [(g, b) for b in CMP_SWEEP for g in CMP_GRAPHS if g in CMP_FM]
 CMP_OWN_JOB = [g for g in CMP_RUN if g not in CMP_FM]
+# the sweep's jobs of the other graph generators (compare_sweep_run): (generator, budget)
+CMP_OWN_SWEEP = [(g, b) for b in CMP_SWEEP for g in CMP_GRAPHS if g not in CMP_FM]
 
 
 wildcard_constraints:
@@ -218,7 +220,7 @@ if CMP_FM:
 
 rule compare_sweep_run:
     wildcard_constraints:
-        cmpgraph="|".join(g for g in CMP_GRAPHS if g not in CMP_FM) or "none",
+        cmpgraph="|".join(dict.fromkeys(g for g, _b in CMP_OWN_SWEEP)) or "none",
     input:
         CMP_CLIPS,
     output:
