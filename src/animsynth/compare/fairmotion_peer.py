@@ -228,7 +228,7 @@ _CONSTRUCTED: dict = {}
 _CONSTRUCTED_MAX = 64
 
 
-def _load_native(clip: Motion, up: int, bvh, velocity, on=None):
+def _load_native(clip: Motion, up: int, bvh, velocity, on=None, key: str | None = None):
     """fairmotion's ``MotionWithVelocity`` of ``clip`` at ``up`` times its rate: the clip upsampled
     (:func:`upsample`), written to BVH, read by fairmotion's loader, put on the skeleton ``on`` and given
     fairmotion's velocities (``MotionWithVelocity.from_motion``), as :meth:`FairmotionGraph.fit` needs it.
@@ -242,7 +242,7 @@ def _load_native(clip: Motion, up: int, bvh, velocity, on=None):
     fairmotion's loading and velocities (most of a graph's build) run once per trial and job, not once per
     database. The copy is what fairmotion would have computed again: the same file, read and differentiated by
     the same code (a test checks the graph and the walks equal those of a fresh load)."""
-    key = _native_key(clip, up, on)
+    key = _native_key(clip, up, on) if key is None else key  # the caller's, when it has hashed the clip already
     if key not in _LOADED:
         with tempfile.TemporaryDirectory(prefix="animsynth_fairmotion_") as tmp:
             f = os.path.join(tmp, "clip.bvh")
@@ -369,8 +369,11 @@ class FairmotionGraph:
             raise ValueError(f"fairmotion native_fps {native:g} must be a whole multiple of the database's "
                              f"{fps:g} fps")
         up = int(round(up))
-        loaded = [_load_native(first, up, bvh, velocity)]
-        loaded += [_load_native(c, up, bvh, velocity, on=(first, loaded[0].skel)) for c in clips[1:]]
+        # each clip's memo key, hashed once: the loading memo's and, together, the construction memo's below
+        keys = [_native_key(c, up, None if i == 0 else (first, None)) for i, c in enumerate(clips)]
+        loaded = [_load_native(first, up, bvh, velocity, key=keys[0])]
+        loaded += [_load_native(c, up, bvh, velocity, on=(first, loaded[0].skel), key=k)
+                   for c, k in zip(clips[1:], keys[1:])]
         for c, m in zip(clips, loaded):
             if not np.isclose(m.fps, native):
                 raise ValueError(f"fairmotion read clip {c.name!r} at {m.fps} fps, not {native:g} (its BVH loader "
@@ -391,8 +394,7 @@ class FairmotionGraph:
         # the graph at an infinite threshold depends on the loaded clips, the lengths, the weights and the comparison
         # count, not on the threshold, the budget or the walk's fixes: both rows and every budget of the sweep build
         # it once per process (the edges kept are then chosen per threshold below)
-        key = repr(([_native_key(c, up, None if i == 0 else (first, None)) for i, c in enumerate(clips)], native,
-                    graph.base_length, graph.stride_length, graph.blend_length, graph.compare_length,
+        key = repr((keys, native, graph.base_length, graph.stride_length, graph.blend_length, graph.compare_length,
                     sorted(weights.items()), int(self.num_comparison)))
         if key in _CONSTRUCTED:
             node_list, edge_list = _CONSTRUCTED[key]
