@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -486,3 +488,73 @@ def test_fairmotion_reuses_its_construction_across_rows_and_budgets(sk):
     # another comparison count is another graph
     fp.FairmotionGraph(base=8, blend=4, compare=4, transitions_per_s=2.0, native_fps=60.0, num_comparison=2).fit([a, b])
     assert len(fp._CONSTRUCTED) == 2
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_construct_in_process_equals_its_pool(sk):
+    """``construct``'s node comparisons mapped in this process (default) give the graph fairmotion's own
+    one-worker pool gives (``pool=True``, as released): the same nodes and every edge's weight to the bit,
+    in the same order; and the walks on both are equal."""
+    from animsynth.compare import fairmotion_peer as fp
+
+    a, b, c = (generate_motion(kind, 48, s, sk, fps=FPS) for kind, s in
+               (("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5)))
+    start = Motion(a.values[:10], sk, FPS, "start")
+    graphs = {}
+    for pool in (True, False):
+        fp._CONSTRUCTED.clear()
+        fp._LOADED.clear()
+        g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
+                               fixes=fp.FIXES, pool=pool).fit([a, b, c])
+        assert not g.construct_reused_
+        key = next(iter(fp._CONSTRUCTED))
+        graphs[pool] = (fp._CONSTRUCTED[key], g.transitions_.to_numpy(),
+                        [g.generate(start, 30, seed=s).values for s in (1, 2)])
+    (nodes_p, edges_p), tr_p, walks_p = graphs[True]
+    (nodes_s, edges_s), tr_s, walks_s = graphs[False]
+    assert len(edges_p) > len(nodes_p) > 3
+    assert nodes_s == nodes_p
+    assert [(u, v) for u, v, _ in edges_s] == [(u, v) for u, v, _ in edges_p]
+    assert np.array_equal(np.array([w for *_, w in edges_s]), np.array([w for *_, w in edges_p]))
+    assert np.array_equal(tr_s, tr_p)
+    assert all(np.array_equal(x, y) for x, y in zip(walks_s, walks_p))
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
+    """Each walk copies a clip the first time it reads it (``_CopyOnRead``, one memo: the clips' shared skeleton
+    copied once) and walks exactly as on a deep copy of every clip; the loaded clips stay untouched."""
+    from animsynth.compare import fairmotion_peer as fp
+
+    clips = [generate_motion(kind, 48, s, sk, fps=FPS) for kind, s in
+             (("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5), ("walk_turn", 3))]
+    start = Motion(clips[0].values[:10], sk, FPS, "start")
+    g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
+                           fixes=fp.FIXES).fit(clips)
+    before = [np.array([np.asarray(p.data) for p in m.poses]) for m in g._loaded_]
+    lazy = [g.generate(start, 40, seed=s).values for s in (1, 2, 3)]
+    assert all(np.array_equal(x, np.array([np.asarray(p.data) for p in m.poses]))
+               for x, m in zip(before, g._loaded_))
+    seen = []
+
+    class Whole(fp._CopyOnRead):  # the copy before: every clip deep-copied at once
+        def __init__(self, motions):
+            super().__init__(motions)
+            whole = copy.deepcopy(self._src)
+            self._copies = dict(enumerate(whole))
+            seen.append(self)
+
+    monkeypatch.setattr(fp, "_CopyOnRead", Whole)
+    whole = [g.generate(start, 40, seed=s).values for s in (1, 2, 3)]
+    assert len(seen) == 3
+    assert all(np.array_equal(x, y) for x, y in zip(lazy, whole))
+    monkeypatch.undo()
+    # a walk reads some clips: those are copied, with one skeleton between them
+    view = fp._CopyOnRead(g._loaded_)
+    m0, m2 = view[0], view[np.int64(2)]
+    assert view[0] is m0 and m0 is not g._loaded_[0]
+    assert m0.skel is m2.skel and m0.skel is not g._loaded_[0].skel
+    assert sorted(view._copies) == [0, 2]
+    assert view[-1] is view[3]
+    with pytest.raises(IndexError):
+        view[4]

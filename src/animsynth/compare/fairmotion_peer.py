@@ -259,6 +259,49 @@ def _load_native(clip: Motion, up: int, bvh, velocity, on=None, key: str | None 
     return copy.deepcopy(_LOADED[key])
 
 
+class _CopyOnRead:
+    """The loaded clips as one walk sees them (``MotionGraph.motions`` during :meth:`FairmotionGraph.generate`):
+    clip ``i`` is deep-copied from ``motions`` the first time the walk reads it, every copy with one shared memo,
+    so the clips a walk reads are exactly what ``copy.deepcopy(motions)`` makes of them (objects the clips share,
+    their skeleton, copied once and shared). 0.0.4's walk moves the poses it appends in place, hence a copy per
+    walk; a walk reads a few of the database's clips, hence copies on first read (a whole deep copy was a tenth
+    of a walk's CPU)."""
+
+    def __init__(self, motions):
+        self._src = list(motions)
+        self._copies: dict = {}
+        self._memo: dict = {}
+
+    def __len__(self) -> int:
+        return len(self._src)
+
+    def _index(self, i) -> int:
+        i = int(i)
+        if not -len(self._src) <= i < len(self._src):
+            raise IndexError(f"clip index {i} out of range for {len(self._src)} clips")
+        return i % len(self._src)
+
+    def __getitem__(self, i):
+        i = self._index(i)
+        if i not in self._copies:
+            self._copies[i] = copy.deepcopy(self._src[i], self._memo)
+        return self._copies[i]
+
+    def __setitem__(self, i, motion) -> None:
+        self._copies[self._index(i)] = motion
+
+    def __iter__(self):
+        return (self[i] for i in range(len(self._src)))
+
+
+def _run_serially(func, iterable, num_cpus=1, **kwargs):
+    """fairmotion's ``utils.run_parallel`` for one worker, in this process: ``[func(x, **kwargs) for x in
+    iterable]``. Its own runs ``Pool(1).map``, which pickles the clips to a worker process once per chunk; the
+    functions it maps (``create_nodes``, ``compare_and_connect_edge``) only read the clips, so the results are
+    the same (a test compares the graphs)."""
+    return [func(x, **kwargs) for x in iterable]
+
+
 class FairmotionGraph:
     """fairmotion 0.0.4's motion graph behind the compare generator interface (see the module docstring).
 
@@ -289,6 +332,11 @@ class FairmotionGraph:
         fairmotion's similarity weights.
     num_comparison : int
         fairmotion's comparisons per node pair.
+    pool : bool
+        Run ``construct`` as released: its node comparisons in a ``multiprocessing`` pool of one worker process,
+        to which the clips are pickled once per chunk (what a user of fairmotion runs; the build benchmark).
+        ``False`` (default): the same functions mapped in this process (:func:`_run_serially`); the graph is
+        the same (tested), without the pickling and the worker.
 
     Attributes
     ----------
@@ -317,8 +365,10 @@ class FairmotionGraph:
                  threshold: float | None = None, threshold_quantile: float = 0.5, w_joint_pos: float = 8.0,
                  w_joint_vel: float = 2.0, w_root_pos: float = 0.5, w_root_vel: float = 1.5, w_ee_pos: float = 3.0,
                  w_ee_vel: float = 1.0, w_trajectory: float = 1.0, num_comparison: int = 3,
-                 transitions_per_s: float | None = None, native_fps: float | None = NATIVE_FPS, fixes=()):
+                 transitions_per_s: float | None = None, native_fps: float | None = NATIVE_FPS, fixes=(),
+                 pool: bool = False):
         self.transitions_per_s = transitions_per_s
+        self.pool = pool
         self.native_fps = native_fps
         self.fixes = fixes
         self.base = base
@@ -405,9 +455,15 @@ class FairmotionGraph:
                 setattr(graph, name, value)
             self.construct_reused_ = True
         else:
-            with contextlib.redirect_stderr(io.StringIO()):  # its tqdm progress bars
-                graph.construct(w_joints=None, **weights, diff_threshold=np.inf, num_comparison=self.num_comparison,
-                                num_workers=1)
+            parallel = motion_graph.utils.run_parallel
+            if not self.pool:
+                motion_graph.utils.run_parallel = _run_serially  # one worker: no Pool, no pickled clips (same graph)
+            try:
+                with contextlib.redirect_stderr(io.StringIO()):  # its tqdm progress bars
+                    graph.construct(w_joints=None, **weights, diff_threshold=np.inf,
+                                    num_comparison=self.num_comparison, num_workers=1)
+            finally:
+                motion_graph.utils.run_parallel = parallel
             if len(_CONSTRUCTED) >= _CONSTRUCTED_MAX:
                 _CONSTRUCTED.pop(next(iter(_CONSTRUCTED)))
             _CONSTRUCTED[key] = ([(n, dict(a)) for n, a in graph.graph.nodes(data=True)],
@@ -576,7 +632,7 @@ class FairmotionGraph:
             # the data's), lasts the requested seconds: ask for the frames at that rate, then, if the output is
             # built at the walk's rate (the output_rate fix, or a later release), at that rate
             for rate in dict.fromkeys((velocity_default_fps(), self.native_fps_)):
-                graph.motions = copy.deepcopy(self._loaded_)  # 0.0.4's walk moves the poses it appends in place
+                graph.motions = _CopyOnRead(self._loaded_)  # 0.0.4's walk moves the poses it appends in place
                 pieces.clear()
                 blend_sources.clear()
                 random.seed(seed)
