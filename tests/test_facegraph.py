@@ -3,9 +3,13 @@ synthesis, determinism, pre-processing and the face-graph baseline."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pandas as pd
 import pytest
+from scipy.optimize import OptimizeWarning
+from scipy.special import expit
 
 from animsynth.config import ConfigError
 from animsynth.facegraph import (FaceGraphBaseline, FaceGraphModel, FacePreprocessor, FaceSynthesizer,
@@ -436,6 +440,122 @@ def test_sigmoid_fit_recovers_known_sigmoid():
     step[20:, 0, 1] = 2.0
     fit, status = fit_sigmoid_landmarks(step, min_range=0.5)
     assert status == ["grid"] and np.abs(np.diff(fit[:, 0, 1])).max() < 1.5
+
+
+def _old_sigmoid_xy(tt, ax, ay, bx, by, k, c):
+    # the model curve_fit was given: x displacements then y displacements, shared timing (k, c)
+    n = tt.size // 2
+    s = expit(k * (tt[:n] - c))
+    return np.concatenate([ax + bx * s, ay + by * s])
+
+
+def _old_sigmoid_xy_jac(tt, ax, ay, bx, by, k, c):
+    n = tt.size // 2
+    t = tt[:n]
+    s = expit(k * (t - c))
+    ds = s * (1.0 - s)
+    one, zero = np.ones(n), np.zeros(n)
+    jx = np.stack([one, zero, s, zero, bx * ds * (t - c), -bx * ds * k], 1)
+    jy = np.stack([zero, one, zero, s, by * ds * (t - c), -by * ds * k], 1)
+    return np.concatenate([jx, jy], 0)
+
+
+def _old_curve_fit(t, y, p0):
+    """The refinement as fit_sigmoid_landmarks called it before it called leastsq itself."""
+    from scipy.optimize import curve_fit
+
+    popt, _ = curve_fit(_old_sigmoid_xy, np.concatenate([t, t]), y, p0=p0, jac=_old_sigmoid_xy_jac, maxfev=400)
+    return popt
+
+
+def _curve_fit_reference(d, min_range=1.0):
+    """fit_sigmoid_landmarks as it was with ``scipy.optimize.curve_fit``: fitted displacements, statuses and, per
+    refined landmark, (data, start, curve_fit's parameters or the type of the exception it raised)."""
+    from animsynth.facegraph.preprocess import _GRID_K, sigmoid_grid_fit
+
+    d = np.asarray(d, float)
+    n, L, _ = d.shape
+    t = np.arange(n, dtype=float)
+    tt = np.concatenate([t, t])
+    a, b, k, c = sigmoid_grid_fit(d)
+    k_max = _GRID_K[-1] / max(n - 1, 1)
+    out = np.empty_like(d)
+    status, fits = [], {}
+    for i in range(L):
+        di = d[:, i]
+        if np.ptp(np.sqrt((di ** 2).sum(-1))) < min_range and np.ptp(di, axis=0).max() < min_range:
+            out[:, i] = di.mean(0)
+            status.append("static")
+            continue
+        grid_y = a[i] + b[i] * expit(k[i] * (t - c[i]))[:, None]
+        p0 = (a[i, 0], a[i, 1], b[i, 0], b[i, 1], k[i], c[i])
+        y = np.concatenate([di[:, 0], di[:, 1]])
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", OptimizeWarning)
+                warnings.simplefilter("ignore", RuntimeWarning)
+                popt = _old_curve_fit(t, y, p0)
+            fits[i] = (y, p0, popt)
+            fitted = _old_sigmoid_xy(tt, *popt).reshape(2, n).T
+            steep_ok = abs(popt[4]) <= k_max
+            if (steep_ok and np.all(np.isfinite(fitted))
+                    and ((fitted - di) ** 2).sum() <= ((grid_y - di) ** 2).sum() + 1e-9):
+                out[:, i] = fitted
+                status.append("fit")
+                continue
+        except (RuntimeError, ValueError) as e:
+            fits[i] = (y, p0, type(e))
+        out[:, i] = grid_y
+        status.append("grid")
+    return out, status, fits
+
+
+def test_sigmoid_fit_is_curve_fits_bit_for_bit():
+    # fit_sigmoid_landmarks calls scipy's leastsq itself (no covariance, no curve_fit wrappers): the fitted
+    # displacements, statuses and parameters are curve_fit's exactly (np.array_equal, not a tolerance)
+    from animsynth.facegraph.preprocess import _sigmoid_xy_fit, _sigmoid_xy_jac_buffer
+
+    samples = []
+    for kw in (dict(seed=3), dict(seed=4, jitter_px=2.5, head_rotation_deg=4.0)):  # real-shaped; noisy
+        seqs = generate_sequences(n_subjects=2, n_sequences=4, total_frames=100, n_unlabelled=0, **kw)
+        samples += [s.landmarks - s.landmarks[0] for s in seqs]
+    t = np.arange(25.0)
+    toy = np.zeros((25, 4, 2))
+    toy[:, 0, 0] = sigmoid(t, 0.2, 8.0, 0.6, 12.0)
+    toy[:, 0, 1] = sigmoid(t, -0.1, -3.0, 0.6, 12.0)
+    toy[:, 1, :] = 0.01 * np.sin(t)[:, None]                        # static
+    toy[20:, 2, 1] = 2.0                                             # a one-frame step: the grid sigmoid is kept
+    toy[:, 3] = np.random.default_rng(0).normal(0.0, 1.5, (25, 2))  # noise only
+    samples.append(toy)
+    seen, n_params, n_raised = set(), 0, 0
+    for d in samples:
+        fit, status = fit_sigmoid_landmarks(d)
+        ref, ref_status, fits = _curve_fit_reference(d)
+        assert status == ref_status
+        assert np.array_equal(fit, ref)
+        seen.update(status)
+        td = np.arange(len(d), dtype=float)
+        jac = _sigmoid_xy_jac_buffer(len(d))
+        for i, (y, p0, ref_p) in fits.items():
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                if isinstance(ref_p, type):  # curve_fit raised (maxfev reached): so does the leastsq path
+                    with pytest.raises(ref_p):
+                        _sigmoid_xy_fit(td, y, p0, jac)
+                    n_raised += 1
+                elif status[i] == "fit":
+                    # parameters of the kept fits; those of rejected ones are discarded and, in rank-deficient
+                    # steps, depend on memory scipy 1.17's MINPACK reads past its Jacobian copy (curve_fit's too)
+                    assert np.array_equal(_sigmoid_xy_fit(td, y, p0, jac), ref_p)
+                    n_params += 1
+    assert seen == {"fit", "grid", "static"} and n_params > 350 and n_raised > 10
+    # non-finite data: both raise ValueError (the landmark keeps its grid sigmoid)
+    y, p0, _ = fits[0]
+    y = np.where(np.arange(50) == 7, np.nan, y)
+    with pytest.raises(ValueError):
+        _old_curve_fit(t, y, p0)
+    with pytest.raises(ValueError):
+        _sigmoid_xy_fit(t, y, p0, _sigmoid_xy_jac_buffer(25))
 
 
 def test_preprocessing_alignment_and_reversal(db):

@@ -8,10 +8,11 @@ Steps, per labelled neutral-to-peak sequence (sample):
 2. **Sigmoid fit (eq. 1-2).** The displacement of every landmark from the
    first (neutral) frame, ``d(t) = p(t) - p(0)`` (eq. 2), is fitted with
    ``d(t) ~ a + b / (1 + exp(-k (t - c)))`` (eq. 1; per landmark the x and y
-   displacements share the timing k, c) by ``scipy.optimize.curve_fit``
-   started from the best point of a (c, k) grid; the landmark becomes
-   ``p(0) + fit(t)``. This removes tracking jitter and keeps the
-   neutral-to-peak onset shape. Fallbacks (counted, logged and stored in
+   displacements share the timing k, c) by ``scipy.optimize.curve_fit``'s
+   Levenberg-Marquardt fit (its result, computed by calling ``leastsq``
+   directly: :func:`_sigmoid_xy_fit`) started from the best point of a (c, k)
+   grid; the landmark becomes ``p(0) + fit(t)``. This removes tracking jitter
+   and keeps the neutral-to-peak onset shape. Fallbacks (counted, logged and stored in
    :attr:`FacePreprocessor.report_`): a landmark whose displacement varies by
    less than ``sigmoid_min_range_px`` is *static* and replaced by
    ``p(0) + mean(d)``; when curve_fit fails, does not improve on its grid
@@ -43,7 +44,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import OptimizeWarning, curve_fit
+from scipy.optimize import leastsq
 from scipy.special import expit
 
 from ..atomic import atomic_path
@@ -59,22 +60,76 @@ def sigmoid(t, a, b, k, c):
     return a + b * expit(k * (np.asarray(t, float) - c))
 
 
-def _sigmoid_xy(tt, ax, ay, bx, by, k, c):
-    # tt = [t, t]: x displacement then y displacement, shared timing (k, c)
-    n = tt.size // 2
-    s = expit(k * (tt[:n] - c))
-    return np.concatenate([ax + bx * s, ay + by * s])
+_LM_SUCCESS = (1, 2, 3, 4)  # MINPACK's converged codes; curve_fit raises RuntimeError on any other
 
 
-def _sigmoid_xy_jac(tt, ax, ay, bx, by, k, c):
-    n = tt.size // 2
-    t = tt[:n]
-    s = expit(k * (t - c))
-    ds = s * (1.0 - s)
-    one, zero = np.ones(n), np.zeros(n)
-    jx = np.stack([one, zero, s, zero, bx * ds * (t - c), -bx * ds * k], 1)
-    jy = np.stack([zero, one, zero, s, by * ds * (t - c), -by * ds * k], 1)
-    return np.concatenate([jx, jy], 0)
+def _sigmoid_xy_fit(t: np.ndarray, y: np.ndarray, p0, jac: np.ndarray) -> np.ndarray:
+    """Levenberg-Marquardt refinement of one landmark's eq.-1 fit; the result is ``curve_fit``'s.
+
+    ``y`` is the landmark's x displacements then its y displacements at frames ``t`` (2n values), ``p0`` the start
+    (ax, ay, bx, by, k, c): x and y have their own offset a and amplitude b and share the timing (k, c).
+    Returns the parameters that ``scipy.optimize.curve_fit(model, [t, t], y, p0=p0, jac=jacobian, maxfev=400)``
+    (method 'lm') returns for eq. 1, bit for bit, and raises as it does where it matters here: ValueError when
+    ``y`` is not finite, RuntimeError when MINPACK does not converge (``ier`` not in 1-4: maxfev reached or a
+    tolerance too small). ``jac`` is a preallocated (2n, 6) buffer holding the Jacobian's constant columns
+    (d/dax, d/day: ones in the x rows, resp. the y rows, zeros elsewhere); its other entries are rewritten
+    on every call.
+
+    ``scipy.optimize.leastsq`` is called directly: curve_fit's wrappers (memoiser, input checks) and the
+    covariance it computes on every call (``full_output``) cost about as much as the fit itself here, and the
+    covariance is discarded. The residual is curve_fit's (model minus data) with the same arithmetic per element,
+    the Jacobian has the same entries computed in the same operation order, and leastsq gets the same start,
+    ``maxfev`` and default tolerances, so MINPACK takes the same steps (tests/test_facegraph.py compares the
+    two on real-shaped landmarks). Residual and Jacobian at one parameter vector share ``t - c`` and the
+    sigmoid (MINPACK mostly asks for the Jacobian where it last evaluated the residual): the same floats,
+    computed once.
+    """
+    y = np.asarray_chkfinite(y, float)  # curve_fit's input check (ValueError on NaN/inf)
+    n = t.size
+    y2 = y.reshape(2, n)
+    jv = jac.reshape(2, n, 6)  # view: [0] the x rows, [1] the y rows
+    jx_bx, jy_by, j_k, j_c = jv[0, :, 2], jv[1, :, 3], jv[:, :, 4], jv[:, :, 5]
+    last = [None, None, None]  # parameter bytes, t - c, sigmoid
+
+    def timing(p):
+        key = p.tobytes()
+        if key != last[0]:
+            tc = t - p[5]
+            last[:] = key, tc, expit(p[4] * tc)
+        return last[1], last[2]
+
+    def residual(p):
+        # (a + b * s) - y per element, x rows then y rows: curve_fit's model minus data; a new array on every
+        # call (leastsq keeps the first one as its residual workspace)
+        _, s = timing(p)
+        return (p[:2, None] + p[2:4, None] * s - y2).reshape(-1)
+
+    def jacobian(p):
+        # d/dbx = s, d/dk = b * ds * (t - c), d/dc = -b * ds * k (products left to right), ds = s * (1 - s);
+        # (b * ds) * (-k) is (-b * ds) * k exactly: IEEE rounding is symmetric in the sign
+        tc, s = timing(p)
+        ds = s * (1.0 - s)
+        bds = p[2:4, None] * ds
+        np.copyto(jx_bx, s)
+        np.copyto(jy_by, s)
+        np.multiply(bds, tc, out=j_k)
+        np.multiply(bds, -p[4], out=j_c)
+        return jac  # leastsq copies it
+
+    # m = 2n >= 8 residuals > 6 parameters and positive tolerances: leastsq's "improper input" (ier 0,
+    # a TypeError with full_output=False) cannot occur
+    popt, ier = leastsq(residual, np.array(p0, float), Dfun=jacobian, maxfev=400)
+    if ier not in _LM_SUCCESS:
+        raise RuntimeError(f"Optimal parameters not found (MINPACK ier={ier})")
+    return popt
+
+
+def _sigmoid_xy_jac_buffer(n: int) -> np.ndarray:
+    """(2n, 6) Jacobian buffer for :func:`_sigmoid_xy_fit` with its constant columns filled."""
+    jac = np.zeros((2 * n, 6))
+    jac[:n, 0] = 1.0
+    jac[n:, 1] = 1.0
+    return jac
 
 
 _GRID_C = np.linspace(-0.2, 1.2, 29)
@@ -135,7 +190,7 @@ def fit_sigmoid_landmarks(d: np.ndarray, min_range: float = 1.0) -> tuple[np.nda
     if n < 4:
         raise ValueError(f"a sigmoid fit needs at least 4 frames, got {n}")
     t = np.arange(n, dtype=float)
-    tt = np.concatenate([t, t])
+    jac = _sigmoid_xy_jac_buffer(n)
     a, b, k, c = sigmoid_grid_fit(d)
     k_max = _GRID_K[-1] / max(n - 1, 1)
     out = np.empty_like(d)
@@ -150,11 +205,9 @@ def fit_sigmoid_landmarks(d: np.ndarray, min_range: float = 1.0) -> tuple[np.nda
         p0 = (a[i, 0], a[i, 1], b[i, 0], b[i, 1], k[i], c[i])
         try:
             with warnings.catch_warnings():
-                warnings.simplefilter("ignore", OptimizeWarning)
                 warnings.simplefilter("ignore", RuntimeWarning)
-                popt, _ = curve_fit(_sigmoid_xy, tt, np.concatenate([di[:, 0], di[:, 1]]), p0=p0,
-                                    jac=_sigmoid_xy_jac, maxfev=400)
-            y = _sigmoid_xy(tt, *popt).reshape(2, n).T
+                popt = _sigmoid_xy_fit(t, np.concatenate([di[:, 0], di[:, 1]]), p0, jac)
+            y = (popt[:2, None] + popt[2:4, None] * expit(popt[4] * (t - popt[5]))).T
             steep_ok = abs(popt[4]) <= k_max
             if steep_ok and np.all(np.isfinite(y)) and ((y - di) ** 2).sum() <= ((grid_y - di) ** 2).sum() + 1e-9:
                 out[:, i] = y
