@@ -409,7 +409,7 @@ def cpu_seconds() -> float:
 
 def peak_rss_mb() -> float:
     """The largest resident memory (MB) so far of this process and of its largest finished child process
-    (``getrusage``): a generator job's peak, fairmotion's pool included."""
+    (``getrusage``): a generator job's peak, a pool it starts included."""
     import resource
 
     return max(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss,
