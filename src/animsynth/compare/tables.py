@@ -82,7 +82,8 @@ def winners_table(metrics: pd.DataFrame, summary: pd.DataFrame, order) -> pd.Dat
 def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
     """Per generator: builds (clips it was built on), median and total build CPU and wall seconds, generation
     frames per CPU and wall second, the generator job's peak resident memory (MB: the whole job, Python and
-    scoring included; a child process, such as a pool a user generator starts, by its largest). Machine-dependent (a timing table)."""
+    scoring included; a child process, such as a pool a user generator starts, by its largest). Machine-dependent
+    (a timing table)."""
     rows = []
     for g in order_generators(timing["generator"].unique(), order):
         t = timing[timing["generator"] == g]
