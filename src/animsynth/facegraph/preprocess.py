@@ -207,7 +207,7 @@ def fit_sigmoid_landmarks(d: np.ndarray, min_range: float = 1.0) -> tuple[np.nda
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
                 popt = _sigmoid_xy_fit(t, np.concatenate([di[:, 0], di[:, 1]]), p0, jac)
-            y = (popt[:2, None] + popt[2:4, None] * expit(popt[4] * (t - popt[5]))).T
+            y = sigmoid(t, popt[:2, None], popt[2:4, None], popt[4], popt[5]).T  # eq. 1, x and y rows
             steep_ok = abs(popt[4]) <= k_max
             if steep_ok and np.all(np.isfinite(y)) and ((y - di) ** 2).sum() <= ((grid_y - di) ** 2).sum() + 1e-9:
                 out[:, i] = y
