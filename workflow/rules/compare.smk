@@ -11,7 +11,9 @@ from animsynth.compare.settings import (clip_ids, clips_cfg, generator_order, gr
                                         showcase, user_generators)
 
 CMP = config["compare"]
-CMP_SUBSETS, CMP_RESEQ = groups(config)
+# the leave-one-out groups and temporal splits (the Table I subsets, the re-sequencing clips, then the comparison's
+# own per-subject sets of compare.subjects); a group holding a trial whose mirror cannot be read now is left out
+CMP_SUBSETS, CMP_RESEQ = groups(config, CMP_MISSING)
 CMP_RUN, CMP_LEFT_OUT = run_generators(config)
 # the user's own generators (compare.user_generators), run after the family's; their job's rerun trigger is the
 # content of their file (compare_job_cfg), and they are in every table and figure, not in the verdicts
