@@ -115,7 +115,7 @@ def _rename_path(exc: Exception, files: dict, shown: dict):
 
 def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
                bvh_length_to_m: float = 1.0, up_axis: str | None = "auto", forward_axis: str | None = "auto",
-               source_files: dict | None = None) -> Motion:
+               source_files: dict | None = None, first_frame: int = 0) -> Motion:
     """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion` in the canonical frame (+y up, +z forward).
 
     Parameters
@@ -143,6 +143,10 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     source_files : dict, optional
         ``{"amc"|"asf"|"bvh": the user's own path}``: named in errors instead
         of the copy that is read (the workflow reads copies under resources/).
+    first_frame : int
+        Frames before this one are dropped after reading (the trial record's
+        ``first_frame``: e.g. the T-pose frame 0 that cgspeed's BVH
+        conversions put before the capture's first frame).
 
     The standing height (median over frames of the extent along the up axis,
     :func:`animsynth.kinematics.standing_height`) in metres outside
@@ -167,6 +171,14 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
             m = read_amc(amc, read_asf(asf), fps=fps)
     except MotionFormatError as exc:
         raise _rename_path(exc, files, shown) from None
+    first_frame = int(first_frame)
+    if first_frame:
+        if not 0 < first_frame < m.n_frames:
+            raise ConfigError(f"config key 'first_frame': {first_frame} leaves no frame of the {m.n_frames} "
+                              f"in {where}")
+        m = Motion(m.values[first_frame:], m.skeleton, m.fps, m.name, m.meta)
+        log.info("%s: frames 0-%d dropped (first_frame %d), %d left", where, first_frame - 1, first_frame,
+                 m.n_frames)
     try:
         check_role_overrides(m.skeleton.names, joint_roles)
     except ValueError as exc:

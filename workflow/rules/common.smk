@@ -515,6 +515,8 @@ def trial_settings(wildcards):
         "up_axis": trial_setting(config, rec, "up_axis"),
         "forward_axis": trial_setting(config, rec, "forward_axis"),
         "source_files": {k: (f"{root.rstrip('/')}/{v}" if root else v) for k, v in own.items()},
+        # only when the record sets it, so the settings (a rerun trigger) of every other trial stay as they were
+        **({"first_frame": rec["first_frame"]} if rec.get("first_frame") else {}),
     }
 
 
