@@ -177,7 +177,7 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
             raise ConfigError(f"config key 'first_frame': {first_frame} leaves no frame of the {m.n_frames} "
                               f"in {where}")
         m = Motion(m.values[first_frame:], m.skeleton, m.fps, m.name, m.meta)
-        log.info("%s: frames 0-%d dropped (first_frame %d), %d left", where, first_frame - 1, first_frame,
+        log.info("%s: the first %d frame(s) dropped (first_frame), %d left", where, first_frame,
                  m.n_frames)
     try:
         check_role_overrides(m.skeleton.names, joint_roles)
