@@ -3,7 +3,8 @@
 
 Real CMU files are fetched per file from ``<mirror>/subjects/<SS>/<file>``
 where the mirror is ``http://mocap.cs.cmu.edu`` (the official site) or any URL
-or local folder with the same layout (``cmu_mirror`` in the config).
+or local folder with the same layout (``cmu_mirror`` in the config; a trial
+whose record sets ``mirror: many`` is read from ``cmu_many_mirror``).
 Checksums are SHA-256 of the file with line endings normalised to LF, since
 mirrors of the same CMU file differ only in CRLF vs LF. Files are written
 atomically: a failed download or a checksum mismatch leaves no file behind.

@@ -1,6 +1,7 @@
 # Beyond the papers: every generator of the project and the classic motion graph side by side
 # (animsynth.compare, docs/compare.md). compare_clips builds every held-out clip's database and start
-# (leave one out within each Gauch & Peters subset, a temporal split of each re-sequencing clip) at the
+# (leave one out within each Gauch & Peters subset and each compare.subjects set of 2+ trials, a temporal split of each
+# re-sequencing clip and one-trial subject set) at the
 # working rate; one job per generator fits it on every clip's database and runs every seed from the clip's
 # start, scoring each motion (its benchmark file is the generator's whole cost); compare_tables and
 # compare_figures gather them. A generator that cannot run here (fairmotion without its package) is left
