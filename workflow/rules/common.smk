@@ -53,6 +53,8 @@ def trial_source(trial):
 def trial_source_param(wildcards):
     """Params function: the mirror of the trial of one download job."""
     return trial_source(wildcards.trial)
+
+
 BVH_TRIALS = {t for t, rec in TRIALS.items() if "bvh" in rec and "amc" not in rec}
 
 
@@ -216,10 +218,11 @@ def _probe_other_mirrors(mocap_ok):
 
 
 FAMILY_STATUS, FAMILY_RAN = _family_status()
-# the comparison's own per-subject trials are fetched and parsed with the others when it runs (and their mirror
-# can be read); the papers' families never read them
+# the comparison's own per-subject trials are fetched and parsed with the others when it runs (the sets none of
+# whose trials is missing: the sets it compares); the papers' families never read them
 if FAMILY_RAN["compare"]:
-    USED_TRIALS = list(dict.fromkeys(USED_TRIALS + [t for t in CMP_SUBJECT_TRIALS if t not in CMP_MISSING]))
+    USED_TRIALS = list(dict.fromkeys(USED_TRIALS + [t for ids in subject_sets(config).values()
+                                                    if not CMP_MISSING & set(ids) for t in ids]))
 # Real or synthetic data per family, from the data sources themselves (never from words in a table), by the kind
 # of data the registry gives each family (the report's order).
 _REAL = {
