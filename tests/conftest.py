@@ -31,6 +31,8 @@ _BLAS_LIMIT = threadpool_limits(1, user_api="blas")
 REPO = Path(__file__).resolve().parents[1]
 SHARED = Path(os.environ.get("ANIMSYNTH_SHARED_DATA", REPO.parent / "shared" / "data"))
 CMU = SHARED / "cmu_mocap"
+#: the comparison's extra subjects (config/cmu.yaml trials with mirror: many; config/paper.yaml's cmu_many_mirror)
+CMU_MANY = SHARED / "cmu_mocap_many"
 VLASIC = SHARED / "vlasic_mesh_animation"
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
 PAPERS = REPO / "tests" / "papers"
@@ -60,6 +62,11 @@ def need(path: Path):
 @pytest.fixture(scope="session")
 def cmu_dir():
     return need(CMU / "subjects")
+
+
+@pytest.fixture(scope="session")
+def cmu_many_dir():
+    return need(CMU_MANY / "subjects")
 
 
 @pytest.fixture(scope="session")

@@ -628,3 +628,92 @@ def test_the_claims_against_the_peer_quote_the_budget_sweep():
     without = CV.build_verdicts(metrics, dict(VC, min_groups=2), "test data", {}).set_index("claim")
     assert "budget sweep" not in without.loc[fixed, "evidence"]
     assert (v["verdict"] == without["verdict"]).all()  # evidence, not a vote: decided at the default budget
+
+
+# --- one group per CMU subject: the paper run's 12 subjects -----------------
+
+def _paper_config() -> dict:
+    """config.yaml, cmu.yaml, samba.yaml and paper.yaml merged as the paper run merges them, validated."""
+    import yaml
+    from snakemake.utils import update_config
+
+    from animsynth.config import validate_config
+    from conftest import REPO
+
+    cfg = {}
+    for name in ("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml"):
+        update_config(cfg, yaml.safe_load((REPO / "config" / name).read_text()))
+    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
+    return cfg
+
+
+def _clips_table_of(config: dict, missing=()) -> pd.DataFrame:
+    """The clips table's identifying columns as compare_clips writes them (clip, group, protocol, held_out,
+    database), built from the config alone (no trial read: a temporal split's frame range is a placeholder)."""
+    subsets, reseq = settings.groups(config, missing)
+    rows = [{"clip": f"{g}/{t}", "group": g, "protocol": "leave one out", "held_out": t,
+             "database": " ".join(o for o in ids if o != t)} for g, ids in subsets.items() for t in ids]
+    rows += [{"clip": f"{g}/{t}", "group": g, "protocol": "temporal split", "held_out": f"{t}[70:100]",
+              "database": f"{t} frames 0-69"} for g, t in reseq.items()]
+    return pd.DataFrame(rows)
+
+
+def test_the_paper_configs_clips_make_one_group_per_subject_twelve_in_all():
+    cfg = _paper_config()
+    settings.check(cfg)
+    table = _clips_table_of(cfg)
+    assert list(table["clip"]) == settings.clip_ids(cfg)
+    groups = CV.independent_groups(table)
+    subjects = {c.split("/")[1].split("_")[0] for c in table["clip"]}
+    assert subjects == {"35", "16", "127", "05", "02", "09", "07", "12", "49", "17", "06", "10"}
+    assert len(set(groups.values())) == 12
+    for clip, label in groups.items():  # each group is one subject, named by it
+        assert label.startswith(f"subject {clip.split('/')[1].split('_')[0]} ("), (clip, label)
+    # the Table I subsets and re-sequencing clips are as before; the new subjects come after them
+    assert [c for c in table["clip"] if c.split("/")[0] in ("w1", "w2", "r1", "r2", "walk", "run", "dance")] == \
+        settings.clip_ids(dict(cfg, compare=dict(cfg["compare"], subjects={})))
+    proto = dict(zip(table["group"], table["protocol"]))
+    assert proto["s09"] == proto["s07"] == proto["s02"] == "leave one out"
+    assert proto["s17"] == proto["s06"] == proto["s10"] == "temporal split"
+    assert len(table) == 19 + (3 + 4 + 3 + 3 + 3) + 3
+    # a mirror that cannot be read: its subjects' groups are left out, the others stay
+    many = [t["id"] for t in cfg["trials"] if t.get("mirror") == "many"]
+    left = CV.independent_groups(_clips_table_of(cfg, many))
+    assert len(set(left.values())) == 6  # 35, 16, 127, 05, 02, 09
+
+
+def test_the_demo_has_no_subject_sets_and_its_clips_are_unchanged():
+    cfg = _config()
+    assert cfg["compare"]["subjects"] == {}
+    subsets, reseq = settings.groups(cfg)
+    assert subsets == {s: cfg["subsets"][s] for s in cfg["compare"]["subsets"]}
+    assert reseq == dict(cfg["resequencing_trials"])
+
+
+def test_a_subject_set_is_left_one_out_or_split_in_time_by_its_size(walks):
+    cfg = copy.deepcopy(_config())
+    ids = [t["id"] for t in cfg["trials"]]
+    cfg["compare"]["subjects"] = {"pair": ids[:2], "one": [ids[2]]}
+    settings.check(cfg)
+    subsets, reseq = settings.groups(cfg)
+    assert subsets["pair"] == ids[:2] and reseq["one"] == ids[2]
+    assert settings.clip_ids(cfg)[-1] == f"one/{ids[2]}"
+    trials = {t: Motion(w.values, w.skeleton, 30.0, t) for t, w in zip(ids, walks)}
+    cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
+    clips = jobs.prepare_clips(trials, {"pair": ids[:2]}, {"one": ids[2]}, cc)
+    assert [(c.clip, c.protocol) for c in clips] == [(f"pair/{ids[0]}", "leave one out"),
+                                                     (f"pair/{ids[1]}", "leave one out"),
+                                                     (f"one/{ids[2]}", "temporal split")]
+    assert clips[0].database_names == [ids[1]]
+
+
+@pytest.mark.parametrize("sets,fragment", [
+    ({"w1": ["x"]}, "compare.subjects.w1': 'w1' is the name of a subset"),
+    ({"walk": ["x"]}, "compare.subjects.walk': 'walk' is the name of a subset or re-sequencing clip"),
+    ({"s99": ["99_01"]}, r"compare.subjects.s99': unknown trial id\(s\) \['99_01'\]"),
+])
+def test_a_subject_set_with_a_taken_name_or_an_unknown_trial_is_refused(sets, fragment):
+    cfg = copy.deepcopy(_config())
+    cfg["compare"]["subjects"] = sets
+    with pytest.raises(ConfigError, match=fragment):
+        settings.check(cfg)

@@ -93,3 +93,77 @@ def test_snakemake_stops_on_unknown_key(tmp_path):
     out = (res.stdout + res.stderr).strip()
     assert res.returncode != 0 and "config key 'fps': 'fast' is not of type" in out
     assert len(out.splitlines()) <= 10, out
+
+
+# --- every real trial on its own subject's skeleton -------------------------
+
+def _paper_config(**top) -> dict:
+    """config.yaml, cmu.yaml, samba.yaml and paper.yaml merged as the paper run merges them, validated."""
+    from snakemake.utils import update_config
+
+    from animsynth.config import validate_config
+
+    cfg = {}
+    for name in ("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml"):
+        update_config(cfg, yaml.safe_load((REPO / "config" / name).read_text()))
+    cfg.update(top)
+    validate_config(cfg, SCHEMA)
+    return cfg
+
+
+def test_the_shipped_cmu_trials_are_each_on_their_own_subjects_skeleton():
+    cfg = _paper_config()
+    check_config(cfg)
+    for t in cfg["trials"]:
+        if "asf" in t:
+            subject = t["id"].split("_")[0]
+            assert t["asf"] == f"subjects/{subject}/{subject}.asf", t["id"]
+
+
+@pytest.mark.parametrize("asf", ["subjects/16/16.asf", "subjects/127/16.asf", "subjects/16/127.asf"])
+def test_a_trial_on_another_subjects_asf_is_refused_naming_trial_and_file(asf):
+    cfg = _paper_config()
+    k = next(i for i, t in enumerate(cfg["trials"]) if t["id"] == "127_09")
+    cfg["trials"][k]["asf"] = asf
+    with pytest.raises(ConfigError) as ei:
+        check_config(cfg)
+    msg = str(ei.value)
+    assert f"trials[{k}]" in msg and "'127_09'" in msg and repr(asf) in msg and "subjects/127/127.asf" in msg
+
+
+def test_an_asf_whose_subject_cannot_be_told_is_refused_for_cmu():
+    cfg = _paper_config()
+    cfg["trials"][0]["asf"] = "skeletons/any.asf"
+    with pytest.raises(ConfigError, match=r"'35_16'.*'skeletons/any\.asf' is not subjects/<SS>/<SS>\.asf"):
+        check_config(cfg)
+
+
+@pytest.mark.parametrize("source", ["cmu", "user"])
+def test_an_amc_trial_without_a_skeleton_is_refused_naming_the_file(source, tmp_path):
+    cfg = _paper_config()
+    if source == "user":
+        cfg.update(mocap_source="user", data_dir=str(tmp_path))
+        for t in cfg["trials"]:
+            t.pop("mirror", None)
+    k = next(i for i, t in enumerate(cfg["trials"]) if t["id"] == "07_01")
+    del cfg["trials"][k]["asf"]
+    with pytest.raises(ConfigError) as ei:
+        check_config(cfg)
+    msg = str(ei.value)
+    assert f"trials[{k}]" in msg and "AMC file 'subjects/07/07_01.amc' has no skeleton" in msg
+
+
+def test_a_trials_mirror_field_picks_cmu_many_mirror_or_cmu_mirror():
+    from animsynth.config import trial_mirror
+
+    cfg = _paper_config(cmu_mirror="../shared/data/cmu_mocap")
+    many = next(t for t in cfg["trials"] if t["id"] == "07_01")
+    main = next(t for t in cfg["trials"] if t["id"] == "02_01")
+    assert many["mirror"] == "many" and "mirror" not in main
+    assert trial_mirror(cfg, many) == "../shared/data/cmu_mocap_many"
+    assert trial_mirror(cfg, main) == "../shared/data/cmu_mocap"
+    cfg["cmu_many_mirror"] = None  # null: the official site (or cmu_mirror) holds them too
+    assert trial_mirror(cfg, many) == "../shared/data/cmu_mocap"
+    user = dict(cfg, mocap_source="user", data_dir="mine")
+    with pytest.raises(ConfigError, match=r"trials\[\d+\]\.mirror.*needs mocap_source 'cmu'"):
+        check_config(user)

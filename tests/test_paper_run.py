@@ -29,12 +29,12 @@ def test_without_mirror_or_meshes_the_real_families_are_skipped(tmp_path):
     assert "results/paper/summary.md" in out
 
 
-def test_paper_run_plans_every_family_into_results_paper(tmp_path, cmu_dir, vlasic_dir):
+def test_paper_run_plans_every_family_into_results_paper(tmp_path, cmu_dir, cmu_many_dir, vlasic_dir):
     wd = copy_workflow(tmp_path / "wd")
     crane = tmp_path / "crane.yaml"  # the copied workflow is elsewhere: point crane at the data folder
     crane.write_text(f"meshdetail:\n  sequences:\n    crane:\n      mesh_dir: {vlasic_dir / 'crane'}\n")
     res = run_snakemake(wd, "-n", *PAPER, str(crane), "--config", f"cmu_mirror={cmu_dir.parent}",
-                        f"mesh_dir={vlasic_dir / 'samba'}")
+                        f"cmu_many_mirror={cmu_many_dir.parent}", f"mesh_dir={vlasic_dir / 'samba'}")
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-4000:]
     assert "animsynth: skipping" not in out
@@ -46,6 +46,21 @@ def test_paper_run_plans_every_family_into_results_paper(tmp_path, cmu_dir, vlas
         assert f"results/paper/meshdetail/{seq}/dembones.csv" in out and f"data/mesh_checksums/{seq}.csv" in out
     assert "results/paper/meshdetail/sequences.csv" in out
     assert "results/simplicial/" not in out  # nothing of the default run is touched
+
+
+def test_an_unreadable_second_mirror_leaves_only_its_trials_out_of_the_comparison(tmp_path, cmu_dir):
+    """cmu_many_mirror absent: one line names it, the comparison keeps the subjects of cmu_mirror, the other
+    families plan as before (none of them reads those trials)."""
+    wd = copy_workflow(tmp_path / "wd")
+    res = run_snakemake(wd, "-n", *PAPER, "--config", f"cmu_mirror={cmu_dir.parent}",
+                        f"cmu_many_mirror={tmp_path / 'no_many'}", f"mesh_dir={tmp_path / 'no_meshes'}")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-4000:]
+    lines = [ln for ln in out.splitlines() if ln.startswith("animsynth: compare: leaving out")]
+    assert len(lines) == 1 and "no_many" in lines[0] and "07_01" in lines[0] and "06_01" in lines[0], lines
+    assert "compare_clips" in out and "simplicial_fold" in out and "resequencing_path" in out
+    assert "download_bvh_trial" not in out  # the BVH trials are all in the unreadable mirror
+    assert "trials/07_01.npz" not in out and "trials/09_01.npz" in out
 
 
 def _sequence_archive(tmp_path, corrupt=None):

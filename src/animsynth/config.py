@@ -205,6 +205,90 @@ def normalise_resequencing_trials(config: dict, defaults: dict | None = None) ->
     return notes
 
 
+#: Values of a trial record's ``mirror`` field: ``main`` reads it from ``cmu_mirror``, ``many`` from
+#: ``cmu_many_mirror`` (``cmu_mirror`` when that is null).
+TRIAL_MIRRORS = ("main", "many")
+
+
+def trial_mirror(config: dict, trial: dict) -> str | None:
+    """Where one real trial's files are read from.
+
+    Parameters
+    ----------
+    config : dict
+        The whole config (``mocap_source``, ``cmu_mirror``, ``cmu_many_mirror``, ``data_dir``).
+    trial : dict
+        One record of ``trials``.
+
+    Returns
+    -------
+    str or None
+        ``data_dir`` for ``mocap_source: user``; for ``cmu``, ``cmu_many_mirror`` when the record sets
+        ``mirror: many`` and that key is not null, else ``cmu_mirror``; None for synthetic trials.
+    """
+    src = config.get("mocap_source")
+    if src == "synthetic":
+        return None
+    if src != "cmu":
+        return config.get("data_dir")
+    if trial.get("mirror") == "many" and config.get("cmu_many_mirror"):
+        return config["cmu_many_mirror"]
+    return config.get("cmu_mirror")
+
+
+_CMU_TRIAL = re.compile(r"^(\d+)_\d+$")
+_CMU_ASF = re.compile(r"(?:^|/)subjects/([^/]+)/([^/]+)\.asf$", re.IGNORECASE)
+
+
+def asf_subject(path: str) -> str | None:
+    """The subject whose skeleton a CMU ASF path names: ``SS`` of ``subjects/<SS>/<SS>.asf``.
+
+    Returns None when the path is not of that form; a path whose folder and file name name different
+    subjects (``subjects/16/127.asf``) gives ``"<folder>/<file>"``, which matches no trial.
+    """
+    m = _CMU_ASF.search(posixpath.normpath(str(path).replace("\\", "/")))
+    if m is None:
+        return None
+    folder, stem = m.group(1), m.group(2)
+    return folder if folder == stem else f"{folder}/{stem}"
+
+
+def check_trial_skeleton(trial: dict, where: str, cmu: bool) -> None:
+    """Refuse a real trial record that plays its motion on no skeleton or on another subject's.
+
+    Parameters
+    ----------
+    trial : dict
+        One record of ``trials`` (not synthetic).
+    where : str
+        How the error names the record, e.g. ``config key 'trials[3]' (id '127_09')``.
+    cmu : bool
+        ``mocap_source: cmu``: the ASF must be ``subjects/<SS>/<SS>.asf`` of the trial id's subject
+        ``SS`` (``<SS>_<TT>``; the record's ``subject`` for an id of another form).
+
+    Raises
+    ------
+    ConfigError
+        An AMC file without ``asf`` (naming the AMC file), or, for CMU, an ASF file of another subject or
+        not of the form ``subjects/<SS>/<SS>.asf`` (naming the trial id and the ASF file).
+    """
+    if "amc" in trial and "asf" not in trial:
+        raise ConfigError(f"{where}: AMC file {trial['amc']!r} has no skeleton: give 'asf', the ASF file of its "
+                          "subject (an AMC file holds joint angles only)")
+    if not cmu or "asf" not in trial:
+        return
+    m = _CMU_TRIAL.match(str(trial["id"]))
+    subject = m.group(1) if m else str(trial["subject"])
+    got = asf_subject(trial["asf"])
+    if got is None:
+        raise ConfigError(f"{where}: ASF file {trial['asf']!r} is not subjects/<SS>/<SS>.asf, so whose skeleton it "
+                          f"is cannot be told; give subjects/{subject}/{subject}.asf")
+    if got != subject:
+        raise ConfigError(f"{where}: trial {trial['id']!r} (subject {subject}) would be played on ASF file "
+                          f"{trial['asf']!r}, the skeleton of subject {got}; a trial is read only with its own "
+                          f"subject's skeleton: give subjects/{subject}/{subject}.asf")
+
+
 def trial_setting(config: dict, trial: dict, key: str):
     """A per-trial setting: the trial record's ``key`` if it sets one, else the top-level config value.
 
@@ -254,9 +338,13 @@ def check_config(config: dict) -> None:
             if t["kind"] not in ("walk_straight", "walk_turn", "run_straight", "run_turn", "dance"):
                 raise ConfigError(f"{where}: the synthetic generator cannot make kind {t['kind']!r}")
         else:
+            check_trial_skeleton(t, where, cmu=src == "cmu")
             has_amc = "amc" in t and "asf" in t
             if not has_amc and "bvh" not in t:
                 raise ConfigError(f"{where}: mocap_source {src!r} needs 'amc' and 'asf', or 'bvh'")
+            if t.get("mirror", "main") != "main" and src != "cmu":
+                raise ConfigError(f"config key 'trials[{k}].mirror': {t['mirror']!r} needs mocap_source 'cmu' "
+                                  f"(mocap_source {src!r} reads every trial from data_dir)")
             if src == "cmu" and "sha256" not in t:
                 raise ConfigError(f"{where}: CMU trials need 'sha256' (LF-normalised) so downloads are verified")
             for ax in ("up_axis", "forward_axis"):
@@ -270,7 +358,7 @@ def check_config(config: dict) -> None:
             up, fwd = trial_setting(config, t, "up_axis"), trial_setting(config, t, "forward_axis")
             if up not in (None, "auto") and fwd not in (None, "auto") and up[-1] == fwd[-1]:
                 raise ConfigError(f"{where}: up_axis {up!r} and forward_axis {fwd!r} must be perpendicular")
-            root = config.get("cmu_mirror") if src == "cmu" else config.get("data_dir")
+            root = trial_mirror(config, t)
             for field in TRIAL_FILE_KEYS:
                 if field in t:
                     resolve_inside(root or ".", t[field], f"trials[{k}].{field}")

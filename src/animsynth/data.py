@@ -3,7 +3,8 @@
 
 Real CMU files are fetched per file from ``<mirror>/subjects/<SS>/<file>``
 where the mirror is ``http://mocap.cs.cmu.edu`` (the official site) or any URL
-or local folder with the same layout (``cmu_mirror`` in the config).
+or local folder with the same layout (``cmu_mirror`` in the config; a trial
+whose record sets ``mirror: many`` is read from ``cmu_many_mirror``).
 Checksums are SHA-256 of the file with line endings normalised to LF, since
 mirrors of the same CMU file differ only in CRLF vs LF. Files are written
 atomically: a failed download or a checksum mismatch leaves no file behind.
@@ -115,7 +116,7 @@ def _rename_path(exc: Exception, files: dict, shown: dict):
 
 def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
                bvh_length_to_m: float = 1.0, up_axis: str | None = "auto", forward_axis: str | None = "auto",
-               source_files: dict | None = None) -> Motion:
+               source_files: dict | None = None, first_frame: int = 0) -> Motion:
     """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion` in the canonical frame (+y up, +z forward).
 
     Parameters
@@ -143,6 +144,10 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     source_files : dict, optional
         ``{"amc"|"asf"|"bvh": the user's own path}``: named in errors instead
         of the copy that is read (the workflow reads copies under resources/).
+    first_frame : int
+        Frames before this one are dropped after reading (the trial record's
+        ``first_frame``: e.g. the T-pose frame 0 that cgspeed's BVH
+        conversions put before the capture's first frame).
 
     The standing height (median over frames of the extent along the up axis,
     :func:`animsynth.kinematics.standing_height`) in metres outside
@@ -167,6 +172,14 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
             m = read_amc(amc, read_asf(asf), fps=fps)
     except MotionFormatError as exc:
         raise _rename_path(exc, files, shown) from None
+    first_frame = int(first_frame)
+    if first_frame:
+        if not 0 < first_frame < m.n_frames:
+            raise ConfigError(f"config key 'first_frame': {first_frame} leaves no frame of the {m.n_frames} "
+                              f"in {where}")
+        m = Motion(m.values[first_frame:], m.skeleton, m.fps, m.name, m.meta)
+        log.info("%s: the first %d frame(s) dropped (first_frame), %d left", where, first_frame,
+                 m.n_frames)
     try:
         check_role_overrides(m.skeleton.names, joint_roles)
     except ValueError as exc:

@@ -6,7 +6,8 @@ from pathlib import Path
 
 from snakemake.io import is_flagged, strip_wildcard_constraints
 
-from animsynth.config import check_config, derive_seed, normalise_resequencing_trials, trial_setting
+from animsynth.compare.settings import subject_sets
+from animsynth.config import check_config, derive_seed, normalise_resequencing_trials, trial_mirror, trial_setting
 from animsynth.families import FAMILIES, report_order
 from animsynth.meshdetail.settings import mesh_sequences
 from animsynth.sources import is_archive, is_url, mesh_source_name, probe_source
@@ -27,8 +28,10 @@ for _family in FAMILIES:
 TRIALS = {t["id"]: t for t in config["trials"]}
 SUBSETS = {k: v for k, v in config["subsets"].items() if v}  # null drops a subset
 RESEQ_TRIALS = dict(config["resequencing_trials"])
-# Every trial any experiment uses (subsets first, in config order).
+# Every trial the papers' experiments use (subsets first, in config order); the comparison's own per-subject
+# trials (compare.subjects) join them below once their mirror is known to be readable (CMP_SUBJECT_TRIALS).
 USED_TRIALS = list(dict.fromkeys([t for ids in SUBSETS.values() for t in ids] + list(RESEQ_TRIALS.values())))
+CMP_SUBJECT_TRIALS = list(dict.fromkeys(t for ids in subject_sets(config).values() for t in ids))
 
 
 wildcard_constraints:
@@ -37,8 +40,21 @@ wildcard_constraints:
 
 
 SOURCE = config["mocap_source"]
-# Where real trials come from: the CMU site or a mirror, or the user's folder.
+# Where real trials come from: the CMU site or a mirror, or the user's folder; a CMU trial whose record sets
+# mirror: many comes from cmu_many_mirror (cmu_mirror when that is null).
 MOCAP_MIRROR = config["cmu_mirror"] if SOURCE == "cmu" else config["data_dir"]
+
+
+def trial_source(trial):
+    """The mirror or folder one real trial's files are read from (animsynth.config.trial_mirror)."""
+    return trial_mirror(config, TRIALS[trial])
+
+
+def trial_source_param(wildcards):
+    """Params function: the mirror of the trial of one download job."""
+    return trial_source(wildcards.trial)
+
+
 BVH_TRIALS = {t for t, rec in TRIALS.items() if "bvh" in rec and "amc" not in rec}
 
 
@@ -164,6 +180,7 @@ def _family_status():
     # each family's data source, by the kind of data the registry gives it (the report's order)
     sources = {"mocap": mocap, "mesh": mesh, "faces": faces}
     status = {"data": mocap, **{f.name: sources[f.data] for f in report_order()}}
+    _probe_other_mirrors(mocap[1])
     if not config["resequencing"]["datasets"]:  # resequencing_trials all null (or none of them in the run)
         status["resequencing"] = (mocap[0], False, "no trial in resequencing_trials")
     skipped = {}
@@ -175,7 +192,37 @@ def _family_status():
     return status, {fam: ok for fam, (_label, ok, _why) in status.items()}
 
 
+# Trials of the comparison whose mirror cannot be read now (on_missing_data: skip): the comparison leaves out
+# every group holding one (animsynth.compare.settings.groups), the other families are unaffected.
+CMP_MISSING = set()
+
+
+def _probe_other_mirrors(mocap_ok):
+    """Probe the mirror of the comparison's own trials whose record sets ``mirror: many`` (cmu_many_mirror, or
+    cmu_mirror when that is null: then for their own files), only when the main mocap source is readable
+    (otherwise every mocap family is skipped already); the trials of one that cannot be read go to CMP_MISSING,
+    with one line naming the mirror."""
+    if SOURCE == "synthetic" or not mocap_ok:
+        return
+    by_mirror = {}
+    for t in CMP_SUBJECT_TRIALS:
+        if TRIALS[t].get("mirror", "main") != "main":
+            by_mirror.setdefault(trial_source(t), []).append(t)
+    for src, ids in by_mirror.items():
+        rec = TRIALS[ids[0]]
+        _label, ok, why = _status(src, src, rec.get("amc") or rec.get("bvh"))
+        if not ok:
+            print(f"animsynth: compare: leaving out trials {' '.join(ids)} of mirror {src}: data unavailable ({why})",
+                  file=sys.stderr)
+            CMP_MISSING.update(ids)
+
+
 FAMILY_STATUS, FAMILY_RAN = _family_status()
+# the comparison's own per-subject trials are fetched and parsed with the others when it runs (the sets none of
+# whose trials is missing: the sets it compares); the papers' families never read them
+if FAMILY_RAN["compare"]:
+    USED_TRIALS = list(dict.fromkeys(USED_TRIALS + [t for ids in subject_sets(config).values()
+                                                    if not CMP_MISSING & set(ids) for t in ids]))
 # Real or synthetic data per family, from the data sources themselves (never from words in a table), by the kind
 # of data the registry gives each family (the report's order).
 _REAL = {
@@ -464,13 +511,15 @@ def trial_settings(wildcards):
     and the user's own file (named in error messages instead of the copy under resources/)."""
     rec = TRIALS[wildcards.trial]
     own = {k: rec[k] for k in ("amc", "asf", "bvh") if k in rec}
-    root = MOCAP_MIRROR if SOURCE != "synthetic" else None
+    root = trial_source(wildcards.trial) if SOURCE != "synthetic" else None
     return {
         "joint_roles": trial_setting(config, rec, "joint_roles"),
         "bvh_length_to_m": trial_setting(config, rec, "bvh_length_to_m"),
         "up_axis": trial_setting(config, rec, "up_axis"),
         "forward_axis": trial_setting(config, rec, "forward_axis"),
         "source_files": {k: (f"{root.rstrip('/')}/{v}" if root else v) for k, v in own.items()},
+        # only when the record sets it, so the settings (a rerun trigger) of every other trial stay as they were
+        **({"first_frame": rec["first_frame"]} if rec.get("first_frame") else {}),
     }
 
 

@@ -1,6 +1,7 @@
 # Beyond the papers: every generator of the project and the classic motion graph side by side
 # (animsynth.compare, docs/compare.md). compare_clips builds every held-out clip's database and start
-# (leave one out within each Gauch & Peters subset, a temporal split of each re-sequencing clip) at the
+# (leave one out within each Gauch & Peters subset and each compare.subjects set of 2+ trials, a temporal split of each
+# re-sequencing clip and one-trial subject set) at the
 # working rate; one job per generator fits it on every clip's database and runs every seed from the clip's
 # start, scoring each motion (its benchmark file is the generator's whole cost); compare_tables and
 # compare_figures gather them. A generator that cannot run here (fairmotion without its package) is left
@@ -11,7 +12,9 @@ from animsynth.compare.settings import (clip_ids, clips_cfg, generator_order, gr
                                         showcase, user_generators)
 
 CMP = config["compare"]
-CMP_SUBSETS, CMP_RESEQ = groups(config)
+# the leave-one-out groups and temporal splits (the Table I subsets, the re-sequencing clips, then the comparison's
+# own per-subject sets of compare.subjects); a group holding a trial whose mirror cannot be read now is left out
+CMP_SUBSETS, CMP_RESEQ = groups(config, CMP_MISSING)
 CMP_RUN, CMP_LEFT_OUT = run_generators(config)
 # the user's own generators (compare.user_generators), run after the family's; their job's rerun trigger is the
 # content of their file (compare_job_cfg), and they are in every table and figure, not in the verdicts

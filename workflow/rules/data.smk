@@ -44,7 +44,7 @@ else:
             amc=R("resources/mocap/{trial}.amc"),
             asf=R("resources/mocap/{trial}.asf"),
         params:
-            source=MOCAP_MIRROR,
+            source=trial_source_param,
             amc=trial_field("amc"),
             asf=trial_field("asf"),
             sha256=trial_field("sha256", required=False),
@@ -66,7 +66,7 @@ else:
         output:
             bvh=R("resources/mocap/{trial}.bvh"),
         params:
-            source=MOCAP_MIRROR,
+            source=trial_source_param,
             bvh=trial_field("bvh"),
             sha256=trial_field("sha256", required=False),
         threads: 1

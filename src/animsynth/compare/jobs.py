@@ -106,8 +106,10 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
     Parameters
     ----------
     trials : {trial id: Motion} (parsed trials at their own rate)
-    subsets : {subset: [trial ids]}, the subsets of ``compare.subsets`` (leave one out)
-    resequencing : {dataset: trial id}, the clips of ``compare.resequencing`` (temporal split)
+    subsets : {group: [trial ids]}, leave one out within each group: the subsets of ``compare.subsets`` and the
+        sets of ``compare.subjects`` with two or more trials (:func:`animsynth.compare.settings.groups`)
+    resequencing : {group: trial id}, a temporal split of each: the clips of ``compare.resequencing`` and the
+        sets of ``compare.subjects`` with one trial
     cfg : the ``compare`` config block (``fps``, ``context``, ``length``, ``min_length``,
         ``holdout_fraction``)
     """

@@ -12,25 +12,55 @@ from ..config import ConfigError
 
 log = logging.getLogger("animsynth.compare")
 
-__all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "clips_cfg", "job_cfg", "unavailable",
+__all__ = ["check", "groups", "clip_ids", "subject_sets", "showcase", "run_generators", "clips_cfg", "job_cfg", "unavailable",
            "user_generators", "generator_order", "user_job_cfg", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
-def groups(config: dict) -> tuple[dict, dict]:
-    """The databases of the comparison: ``({subset: [trial ids]}, {dataset: trial id})`` in config order
-    (the subsets of ``compare.subsets`` that the run has, the clips of ``compare.resequencing``; null: every
-    subset / re-sequencing clip of the run)."""
+def subject_sets(config: dict) -> dict:
+    """``{name: [trial ids]}`` of ``compare.subjects`` (the comparison's own per-subject sets), in config order."""
+    return {k: list(v) for k, v in (config["compare"].get("subjects") or {}).items()}
+
+
+def groups(config: dict, missing=()) -> tuple[dict, dict]:
+    """The databases of the comparison: ``({group: [trial ids]}, {group: trial id})`` in config order.
+
+    Parameters
+    ----------
+    config : dict
+        The whole (validated) config.
+    missing : collection of str
+        Trial ids whose files cannot be read in this run (a mirror that is not there, with
+        ``on_missing_data: skip``): every group holding one is left out.
+
+    Returns
+    -------
+    (dict, dict)
+        The leave-one-out groups: the subsets of ``compare.subsets`` that the run has (null: every subset),
+        then the sets of ``compare.subjects`` with two or more trials; the temporal splits: the clips of
+        ``compare.resequencing`` (null: every re-sequencing clip of the run), then the sets of
+        ``compare.subjects`` with one trial.
+    """
     cmp = config["compare"]
     subsets = {k: list(v) for k, v in config["subsets"].items() if v}
     reseq = dict(config["resequencing_trials"])
     use_s = list(subsets) if cmp["subsets"] is None else cmp["subsets"]
     use_r = list(reseq) if cmp["resequencing"] is None else cmp["resequencing"]
-    return ({s: subsets[s] for s in use_s if s in subsets}, {d: reseq[d] for d in use_r if d in reseq})
+    loo = {s: subsets[s] for s in use_s if s in subsets}
+    split = {d: reseq[d] for d in use_r if d in reseq}
+    for name, ids in subject_sets(config).items():
+        if len(ids) >= 2:
+            loo[name] = ids
+        elif ids:
+            split[name] = ids[0]
+    gone = set(missing)
+    return ({g: ids for g, ids in loo.items() if not gone & set(ids)},
+            {g: t for g, t in split.items() if t not in gone})
 
 
-def clip_ids(config: dict) -> list[str]:
-    """Every held-out clip of the protocol: ``<subset>/<trial>`` then ``<dataset>/<trial>``."""
-    subsets, reseq = groups(config)
+def clip_ids(config: dict, missing=()) -> list[str]:
+    """Every held-out clip of the protocol: ``<group>/<trial>`` of the leave-one-out groups, then of the
+    temporal splits (:func:`groups`; ``missing``: trial ids left out of this run)."""
+    subsets, reseq = groups(config, missing)
     return [f"{s}/{t}" for s, ids in subsets.items() for t in ids] + [f"{d}/{t}" for d, t in reseq.items()]
 
 
@@ -168,6 +198,16 @@ def check(config: dict) -> None:
             parse_spec(spec)
         except ValueError as exc:
             raise ConfigError(f"config key 'compare.user_generators.{name}': {exc}") from None
+    known = {t["id"] for t in config["trials"]}
+    taken = set(config["subsets"]) | set(config["resequencing_trials"])
+    for name, ids in subject_sets(config).items():
+        if name in taken:
+            raise ConfigError(f"config key 'compare.subjects.{name}': {name!r} is the name of a subset or "
+                              "re-sequencing clip; give the set another name")
+        bad = [t for t in ids if t not in known]
+        if bad:
+            raise ConfigError(f"config key 'compare.subjects.{name}': unknown trial id(s) {bad} (every trial of "
+                              "the comparison is a record of 'trials', so it is fetched and parsed)")
     subsets, reseq = groups(config)
     if not subsets and not reseq:
         raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': no clip to compare")
