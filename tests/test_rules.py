@@ -122,6 +122,13 @@ def test_every_rule_has_threads_and_resources():
     assert not missing, "rules not ready for a cluster:\n" + "\n".join(missing)
 
 
+def test_scripts_read_config_only_through_params():
+    """A script that read ``snakemake.config`` would not rerun when that key changes (Snakemake's rerun trigger
+    is the job's params): every config value reaches a script through ``params:``."""
+    readers = [p.name for p in SCRIPTS if re.search(r"snakemake\.config\b", p.read_text())]
+    assert not readers, f"workflow scripts reading snakemake.config instead of params: {readers}"
+
+
 def test_local_rules_run_nothing():
     for name, info in all_rules().items():
         if _is_local(info):

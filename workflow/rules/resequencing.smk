@@ -60,6 +60,7 @@ rule resequencing_analyse:
     params:
         trial=reseq_trial,
         cfg=RESEQ_ANALYSE_CFG,
+        budget_gib=config["memory_budget_gib"],
     log:
         L("resequencing/analyse/{rsdata}_{rsgdof}.log"),
     benchmark:
@@ -83,6 +84,7 @@ rule resequencing_explain:
     params:
         trial=reseq_trial,
         cfg=RESEQ_EXPLAIN_CFG,
+        budget_gib=config["memory_budget_gib"],
     log:
         L("resequencing/explain/{rsdata}.log"),
     benchmark:
@@ -117,6 +119,7 @@ rule resequencing_path:
         configs=RESEQ_PATH_CONFIGS,
         gdof=RESEQ_GDOF,
         seed=reseq_pairs_seed,
+        budget_gib=config["memory_budget_gib"],
     log:
         L("resequencing/path/{rsdata}.log"),
     benchmark:

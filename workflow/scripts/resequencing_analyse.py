@@ -13,7 +13,7 @@ wc = snakemake.wildcards
 motion = prepare_motion(Motion.load_npz(snakemake.input[0]), cfg["max_frames"], cfg["frame_step"])
 log.info("%s (%s): %d frames at %.4g fps", wc.rsdata, snakemake.params.trial, motion.n_frames, motion.fps)
 min_k, rv, emb, timing = analyse(motion, wc.rsdata, snakemake.params.trial, gdof_flag(wc.rsgdof), cfg,
-                                  budget_gib=snakemake.config.get("memory_budget_gib"))
+                                  budget_gib=snakemake.params.budget_gib)
 out = snakemake.output
 with atomic_path(out.min_k) as tmp:
     min_k.to_csv(tmp, index=False, lineterminator="\n")

@@ -8,7 +8,7 @@ log = setup_logging(snakemake)
 wc = snakemake.wildcards
 motion = Motion.load_npz(snakemake.input[0])
 grid, flips = explain(motion, wc.rsdata, snakemake.params.trial, snakemake.params.cfg,
-                      budget_gib=snakemake.config.get("memory_budget_gib"))
+                      budget_gib=snakemake.params.budget_gib)
 with atomic_path(snakemake.output.grid) as tmp:
     grid.to_csv(tmp, index=False, lineterminator="\n")
 with atomic_path(snakemake.output.flips) as tmp:

@@ -22,7 +22,7 @@ for i, (method, metric, gdof) in enumerate(snakemake.params.configs):
     k = min_k[(method, metric, gdof)]
     paths, (main_path, main), per_path, per_tr = resequence(motion, gdof_flag(gdof), method, metric, k, cfg,
                                                             seed=snakemake.params.seed,
-                                                            budget_gib=snakemake.config.get("memory_budget_gib"))
+                                                            budget_gib=snakemake.params.budget_gib)
     rows = [{"pair": "main", "start": int(main_path[0]), "end": int(main_path[-1]), "step": j, "frame": int(f)}
             for j, f in enumerate(main_path)]
     rows += [{"pair": p, "start": int(path[0]), "end": int(path[-1]), "step": j, "frame": int(f)}
