@@ -80,7 +80,7 @@ def _gif(path):
     return durations
 
 
-def test_a_preview_is_titled_by_its_input_and_a_long_clip_is_not_a_slideshow(tmp_path, monkeypatch):
+def test_a_preview_is_titled_by_its_input_and_a_long_clip_is_not_a_slideshow(tmp_path, monkeypatch, capsys):
     import animsynth.viz as viz
 
     seen = []
@@ -90,6 +90,7 @@ def test_a_preview_is_titled_by_its_input_and_a_long_clip_is_not_a_slideshow(tmp
     short = tmp_path / "short.gif"
     assert main(["preview", str(DATA / "bandai.bvh"), str(short), "--length-to-m", "0.01"]) == 0
     assert seen[-1][0][3] == ["bandai.bvh"]
+    assert "bandai.bvh stands 1.6 m tall" in capsys.readouterr().out  # the height, to check the unit by
     d = _gif(short)
     assert len(d) == 6 and sum(d) / 1000 == pytest.approx(24 / 120, abs=0.03)  # real time
     # 40 s at 120 fps: too long for real time within the preview's frames: evenly subsampled, played at about

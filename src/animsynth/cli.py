@@ -291,7 +291,11 @@ def cmd_preview(a) -> None:
     _check_frames(a, m.n_frames, len(m.skeleton.joints), "frames of " + src)
     # titled by the input file; plays in real time, or a long clip evenly subsampled with its speed-up stated
     motion_previews(m, gif_path=a.out, titles=[os.path.basename(src)], max_frames=PREVIEW_MAX_FRAMES)
-    print(f"wrote {a.out}")
+    from .kinematics import standing_height
+
+    height = standing_height(m.skeleton, m.values) * float(m.skeleton.length_to_m)
+    print(f"wrote {a.out}: {src} stands {height:.3g} m tall (median over frames along its up axis; check "
+          "--length-to-m if that is not the body's height)")
 
 
 def cmd_generate(a) -> None:
