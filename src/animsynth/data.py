@@ -207,10 +207,11 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
            if auto_up and bvh is not None else "given" if not auto_up else "ASF/AMC")
     if auto_up and bvh is not None:
         if not info["biped"]:
-            log.warning("%s: the body is not a biped (%s); %s; set %s if that is wrong", where, info["why"],
+            log.warning("%s: the body is not a biped (%s); %s; set %s if that is wrong%s", where, info["why"],
                         f"up axis {up} from its legs" if info["sign_from"] == "legs" else
                         "its up axis is ambiguous: the file's own axes are kept (+y up, BVH's convention)",
-                        override)
+                        override, f" (a biped whose joint names the role map does not know: name its head and "
+                                  f"feet with {names['joint_roles']})" if info["why"].startswith("no head") else "")
         elif info["ambiguous"]:
             log.warning("%s: the up axis %s is ambiguous (%s; median extents x y z %s); set %s", where, up,
                         info["why"], _fmt(info["extent"]), override)
