@@ -206,3 +206,72 @@ def write_class(motion: Motion, cls: str, path) -> float:
         return float(m.skeleton.length_to_m)
     write_bvh(path, m, scale=m.skeleton.length_to_m / unit)
     return unit
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# bodies that are not bipeds (made here: offsets in metres, +y up, +z forward, sinusoidal joint angles)
+# ---------------------------------------------------------------------------------------------------------------
+#: (name, parent, offset, tail) of a four-legged animal about 2 m tall and 3.4 m long (an elephant's
+#: proportions): the hind legs carry the biped leg names and the front legs the arm names, so the role map finds
+#: a head and two feet (as on animal rigs made from a biped template) but the legs number four.
+QUADRUPED = [
+    ("Hips", None, (0.0, 1.25, 0.0), (0.0, 0.0, 0.5)),
+    ("Spine", "Hips", (0.0, 0.05, 0.5), (0.0, 0.0, 0.6)),
+    ("Chest", "Spine", (0.0, 0.0, 0.6), (0.0, 0.1, 0.4)),
+    ("Neck", "Chest", (0.0, 0.1, 0.4), (0.0, 0.2, 0.2)),
+    ("Head", "Neck", (0.0, 0.2, 0.2), (0.0, 0.35, 0.3)),
+    ("Trunk", "Head", (0.0, 0.0, 0.35), (0.0, -0.4, 0.2)),
+    ("TrunkTip", "Trunk", (0.0, -0.4, 0.2), (0.0, -0.3, 0.05)),
+    ("Tail", "Hips", (0.0, -0.05, -0.3), (0.0, -0.3, -0.3)),
+    ("TailTip", "Tail", (0.0, -0.3, -0.3), (0.0, -0.3, -0.1)),
+]
+for _side, _x in (("Left", 0.35), ("Right", -0.35)):
+    QUADRUPED += [
+        (f"{_side}UpLeg", "Hips", (_x, -0.1, 0.0), (0.0, -0.55, 0.0)),
+        (f"{_side}Leg", f"{_side}UpLeg", (0.0, -0.55, 0.0), (0.0, -0.5, 0.0)),
+        (f"{_side}Foot", f"{_side}Leg", (0.0, -0.5, 0.0), (0.0, -0.1, 0.08)),
+        (f"{_side}Arm", "Chest", (_x, -0.15, 0.1), (0.0, -0.55, 0.0)),
+        (f"{_side}ForeArm", f"{_side}Arm", (0.0, -0.55, 0.0), (0.0, -0.5, 0.0)),
+        (f"{_side}Hand", f"{_side}ForeArm", (0.0, -0.5, 0.0), (0.0, -0.15, 0.08)),
+    ]
+#: a crab: a wide flat body (0.7 m across, 0.6 m front to back with the claws, 0.2 m tall), eight legs
+#: fanned out sideways and down, two claws forward, two eye stalks; no joint name the role map knows
+CRAB = [("Carapace", None, (0.0, 0.12, 0.0), (0.0, 0.02, 0.1)),
+        ("EyeL", "Carapace", (0.03, 0.03, 0.1), (0.0, 0.06, 0.0)), ("EyeR", "Carapace", (-0.03, 0.03, 0.1),
+                                                                    (0.0, 0.06, 0.0))]
+for _side, _s in (("L", 1.0), ("R", -1.0)):
+    for _k, _deg in enumerate((-35.0, -12.0, 12.0, 35.0)):
+        _c, _z = np.cos(np.radians(_deg)), np.sin(np.radians(_deg))
+        CRAB += [(f"Leg{_side}{_k}a", "Carapace", (_s * 0.08, 0.0, 0.03 * (_k - 1.5)), (_s * 0.12 * _c, 0.04, 0.12 * _z)),
+                 (f"Leg{_side}{_k}b", f"Leg{_side}{_k}a", (_s * 0.12 * _c, 0.04, 0.12 * _z),
+                  (_s * 0.1 * _c, -0.06, 0.1 * _z)),
+                 (f"Leg{_side}{_k}c", f"Leg{_side}{_k}b", (_s * 0.1 * _c, -0.06, 0.1 * _z),
+                  (_s * 0.04 * _c, -0.1, 0.04 * _z))]
+    CRAB += [(f"Claw{_side}a", "Carapace", (_s * 0.06, 0.02, 0.1), (_s * 0.03, 0.01, 0.1)),
+             (f"Claw{_side}b", f"Claw{_side}a", (_s * 0.03, 0.01, 0.1), (0.0, 0.0, 0.12))]
+
+
+def creature(parts, frames: int = 48, fps: float = 30.0, swing: float = 12.0, name: str = "creature") -> Motion:
+    """A body of ``parts`` ((name, parent, offset, tail), metres, +y up) walking forward along +z for
+    ``frames`` frames: every joint below the root swings by up to ``swing`` degrees about the axis across its
+    segment, with its own phase; the root sways by 2 degrees."""
+    index = {p[0]: i for i, p in enumerate(parts)}
+    joints = [Joint(n, -1 if par is None else index[par], np.asarray(off if par is not None else (0.0, 0.0, 0.0),
+                                                                    float),
+                    np.asarray(tail, float), (["tx", "ty", "tz"] if par is None else []) + ["rz", "rx", "ry"])
+              for n, par, off, tail in parts]
+    sk = Skeleton(joints, length_to_m=1.0, name=name)
+    t = np.arange(frames) / fps
+    rots, trans = [], []
+    for k, j in enumerate(joints):
+        seg = j.tail / max(np.linalg.norm(j.tail), 1e-9)
+        across = np.cross(seg, [0.0, 0.0, 1.0]) if abs(seg[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+        across /= np.linalg.norm(across)
+        amp = 2.0 if k == 0 else swing
+        ang = np.radians(amp * np.sin(2 * np.pi * 1.0 * t + 1.7 * k))
+        rots.append(Rotation.from_rotvec(ang[:, None] * across[None, :]))
+        trans.append(np.tile(j.offset, (frames, 1)))
+    root = np.tile(np.asarray(parts[0][2], float), (frames, 1))
+    root[:, 2] += 0.8 * t
+    trans[0] = root
+    return _rebuild(sk, rots, np.stack(trans, axis=1), fps, name)

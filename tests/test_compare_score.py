@@ -170,3 +170,40 @@ def test_joint_roles_are_resolved_as_everywhere_else(run, tmp_path, capsys):
                   "--out", tmp_path / "b.csv") == 0
     a, b = pd.read_csv(tmp_path / "a.csv"), pd.read_csv(tmp_path / "b.csv")
     pd.testing.assert_frame_equal(a[jobs.METRIC_NAMES], b[jobs.METRIC_NAMES])
+
+
+def test_without_a_database_no_foot_roles_are_needed(run, tmp_path, capsys):
+    """No database and no floor height: no foot metric is computed, so a skeleton without a toe joint that the
+    name rules know is scored (the skating columns empty) instead of asking for --role left_toe."""
+    d, _clip = run
+    files = [_renamed(d / f, tmp_path / f) for f in ("knn.bvh", "held_out.bvh")]
+    assert _score(files[0], "--reference", files[1], "--out", tmp_path / "a.csv") == 0, capsys.readouterr().err
+    assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--out", tmp_path / "b.csv") == 0
+    a, b = pd.read_csv(tmp_path / "a.csv"), pd.read_csv(tmp_path / "b.csv")
+    assert a[list(SKATING_METRICS)].isna().all().all()
+    pd.testing.assert_frame_equal(a[jobs.METRIC_NAMES], b[jobs.METRIC_NAMES])
+    # a floor height asks for the feet again: one line naming the role
+    assert _score(files[0], "--reference", files[1], "--floor-m", "0", "--out", tmp_path / "c.csv") == 2
+    assert "left_toe" in capsys.readouterr().err
+
+
+def test_a_file_with_an_extra_end_joint_is_read_joint_by_joint(run, tmp_path, capsys):
+    """docs/compare.md: files are read onto the reference's skeleton joint by joint; a joint the reference
+    does not have (here a hat on the head) is left out and the scores are the file's without it."""
+    import copy
+
+    from animsynth.skeleton import Joint
+
+    d, _clip = run
+    m = read_bvh(d / "knn.bvh")
+    sk = copy.deepcopy(m.skeleton)
+    sk.joints.append(Joint("hat", sk.index("head"), np.array([0.0, 1.0, 0.0]), np.array([0.0, 1.0, 0.0]),
+                           ["rz", "rx", "ry"]))
+    sk.__post_init__()
+    n = m.n_frames
+    write_bvh(tmp_path / "hat.bvh", Motion(np.hstack([m.values, np.full((n, 3), 10.0)]), sk, m.fps, "hat"))
+    assert _score(tmp_path / "hat.bvh", "--reference", d / "held_out.bvh", "--out", tmp_path / "a.csv") == 0, \
+        capsys.readouterr().err
+    assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--out", tmp_path / "b.csv") == 0
+    a, b = pd.read_csv(tmp_path / "a.csv"), pd.read_csv(tmp_path / "b.csv")
+    pd.testing.assert_frame_equal(a[jobs.METRIC_NAMES], b[jobs.METRIC_NAMES], rtol=1e-6)

@@ -808,3 +808,35 @@ def test_explanation_claim_is_named_the_same_without_the_published_table():
     rows = explanation_verdicts(pd.DataFrame(), None, 1)
     assert len(rows) == 1 and rows[0]["claim"].startswith("which candidate explanation matches")
     assert rows[0]["verdict"] == "not reproduced" and "not available" in rows[0]["evidence"]
+
+
+def test_the_papers_min_k_stands_only_beside_the_trials_it_measured(tmp_path):
+    """Table 2 shows the paper's min k beside the CMU trials the paper used (and the synthetic stand-ins of the
+    default run), not beside a user's own capture, and the verdicts do not compare a user's trial with it."""
+    from pathlib import Path
+
+    import yaml
+
+    from animsynth.resequencing.tables import comparable_published, paper_comparable
+
+    root = Path(__file__).resolve().parents[1] / "config"
+    user = yaml.safe_load((root / "user_example.yaml").read_text())
+    user["mocap_source"] = "user"
+    # u35_01 and u35_17 are the CMU files 35_01.amc and 35_17.amc; u05_03 is another dance than the paper's 05_02
+    assert paper_comparable(user, user["resequencing_trials"]) == {"walk": True, "run": True, "dance": False}
+    cmu = yaml.safe_load((root / "cmu.yaml").read_text())
+    assert set(paper_comparable(cmu, cmu["resequencing_trials"]).values()) == {True}
+    mine = {"mocap_source": "user", "trials": [{"id": "w", "bvh": "me/walk.bvh"}]}
+    assert paper_comparable(mine, {"walk": "w"}) == {"walk": False}
+    assert paper_comparable({"mocap_source": "synthetic", "trials": []}, {"walk": "syn35_01"}) == {"walk": True}
+    f = tmp_path / "t2.csv"
+    _published().to_csv(f, index=False)
+    pub = published_table2(f)
+    grid = pd.DataFrame([{"dataset": "walk", "trial": "w", "frame_step": 1, "fps": 120, "frames": 10,
+                          "global_dof": False, "sign_mode": "continuous", "method": "isomap", "metric": "l2",
+                          "min_k": 3, "components_at_min_k_minus_1": 2, "components_at_min_k": 1}])
+    assert comparable_published(pub, {"walk": False}) is None
+    t = min_k_table(grid, comparable_published(pub, {"walk": False}), 1)
+    assert t["min_k_paper"].isna().all() and t["min_k_minus_paper"].isna().all()
+    t = min_k_table(grid, comparable_published(pub, {"walk": True}), 1)
+    assert t["min_k_paper"].tolist() == [70]

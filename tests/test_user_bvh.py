@@ -121,3 +121,7 @@ def test_simplicial_and_resequencing_run_on_a_hips_bvh_through_the_own_data_rout
     assert res.returncode == 0, (res.stdout + res.stderr)[-6000:]
     t2 = pd.read_csv(wd / "results/simplicial/table2.csv")
     assert np.isfinite(t2["all"].to_numpy(float)).all()
+    # the user's own walk, run and dance are not the paper's CMU clips: its min k is not shown beside them
+    k = pd.read_csv(wd / "results/resequencing/table2_min_k.csv")
+    assert len(k) and k["min_k_paper"].isna().all() and k["min_k"].notna().all()
+    assert "not the paper's CMU trial" in (wd / "results/resequencing/table2_min_k.md").read_text()

@@ -40,6 +40,9 @@ import numpy as np
 from .limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
 
 MOTION_OUTPUTS = (".bvh", ".amc", ".gif")
+#: GIF frames of ``animsynth preview``: 20 s in real time at 30 GIF frames per second; a longer clip plays
+#: faster, evenly subsampled, the speed-up in its title (see :func:`animsynth.viz.skeleton_gif`).
+PREVIEW_MAX_FRAMES = 600
 
 
 class UsageError(ValueError):
@@ -205,7 +208,42 @@ def _load_bvh(a, path: str):
             raise UsageError(opt, f"expected auto or one of {', '.join(AXES)}, got {v!r}")
         axes[key] = v
     return load_trial(bvh=path, joint_roles=_roles_for(a.role, path), bvh_length_to_m=unit,
-                      name=os.path.splitext(os.path.basename(path))[0], **axes)
+                      name=os.path.splitext(os.path.basename(path))[0], setting_names=CLI_SETTING_NAMES, **axes)
+
+
+#: How :func:`animsynth.data.load_trial` names its settings in errors and warnings from the command line.
+CLI_SETTING_NAMES = {"joint_roles": "argument --role", "up_axis": "--up-axis (e.g. --up-axis FILE=+y)",
+                     "bvh_length_to_m": "--length-to-m"}
+#: The per-file options (``FILE=VALUE``; ``--role FILE.bvh:ROLE=JOINT``) of the commands that read BVH files.
+PER_FILE_OPTIONS = (("--length-to-m", "length_to_m"), ("--up-axis", "up_axis"), ("--forward-axis", "forward_axis"),
+                    ("--role", "role"))
+
+
+def _check_per_file_options(a) -> None:
+    """Refuse a per-file option that names no input file, or gives a file no value (``walk.bvh=``).
+
+    A ``FILE=VALUE`` entry (``FILE.bvh:ROLE=JOINT`` for ``--role``) whose ``FILE`` is none of the command's
+    input files, by path or by file name, would be ignored: a typo would silently leave that file at the
+    default. Entries without a file part apply to every file and are checked where they are used.
+    """
+    inputs = [f for f in _inputs(a) if f.lower().endswith(".bvh")]
+    for option, key in PER_FILE_OPTIONS:
+        for v in getattr(a, key, None) or []:
+            if key == "role":
+                cut = v.lower().find(".bvh:")
+                if cut < 0:
+                    continue
+                head, value = v[:cut + 4], v[cut + 5:]
+            else:
+                head, found, value = v.partition("=")
+                if not found or not head.lower().endswith(".bvh"):
+                    continue
+            if not any(os.path.normpath(head) == os.path.normpath(f) or os.path.basename(f) == head
+                       for f in inputs):
+                raise UsageError(option, f"{v!r} names {head!r}, which is not one of the input files "
+                                         f"({', '.join(inputs) or 'none is a .bvh file'})")
+            if not value.strip():
+                raise UsageError(option, f"{v!r} gives {head!r} no value")
 
 
 def _split_motion_args(files: list[str], out: str | None, outputs: tuple[str, ...]):
@@ -251,8 +289,13 @@ def cmd_preview(a) -> None:
     files, a.out = _split_motion_args(a.files, None, (".gif",))
     m, src = _load_any(a, files)
     _check_frames(a, m.n_frames, len(m.skeleton.joints), "frames of " + src)
-    motion_previews(m, gif_path=a.out)  # plays in real time at the motion's --fps
-    print(f"wrote {a.out}")
+    # titled by the input file; plays in real time, or a long clip evenly subsampled with its speed-up stated
+    motion_previews(m, gif_path=a.out, titles=[os.path.basename(src)], max_frames=PREVIEW_MAX_FRAMES)
+    from .kinematics import standing_height
+
+    height = standing_height(m.skeleton, m.values) * float(m.skeleton.length_to_m)
+    print(f"wrote {a.out}: {src} stands {height:.3g} m tall (median over frames along its up axis; check "
+          "--length-to-m if that is not the body's height)")
 
 
 def cmd_generate(a) -> None:
@@ -570,6 +613,7 @@ def main(argv=None) -> int:
     logging.basicConfig(level=logging.WARNING, format="animsynth: %(levelname)s: %(message)s")
     try:
         _check_out_is_not_an_input(args)
+        _check_per_file_options(args)
         args.func(args)
     except MemoryError:  # numpy's _ArrayMemoryError too: a budget above what the machine has
         print(f"animsynth {args.command}: error: {_out_of_memory(args)}", file=sys.stderr)

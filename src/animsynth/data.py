@@ -99,6 +99,10 @@ def fetch_file(source: str, rel: str, dest, sha256: str | None, attempts: int = 
     return got
 
 
+#: How errors and warnings of :func:`load_trial` name its settings (the workflow's config keys).
+CONFIG_SETTING_NAMES = {"joint_roles": "config key joint_roles", "up_axis": "up_axis on the trial (config key)",
+                        "bvh_length_to_m": "bvh_length_to_m"}
+
 #: A skeleton's standing height (metres) outside this range is logged as a probably wrong unit.
 HEIGHT_RANGE_M = (0.3, 3.0)
 
@@ -116,7 +120,8 @@ def _rename_path(exc: Exception, files: dict, shown: dict):
 
 def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
                bvh_length_to_m: float = 1.0, up_axis: str | None = "auto", forward_axis: str | None = "auto",
-               source_files: dict | None = None, first_frame: int = 0) -> Motion:
+               source_files: dict | None = None, first_frame: int = 0,
+               setting_names: dict | None = None) -> Motion:
     """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion` in the canonical frame (+y up, +z forward).
 
     Parameters
@@ -148,6 +153,18 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         Frames before this one are dropped after reading (the trial record's
         ``first_frame``: e.g. the T-pose frame 0 that cgspeed's BVH
         conversions put before the capture's first frame).
+    setting_names : dict, optional
+        How errors and warnings name the settings ``joint_roles``, ``up_axis``
+        and ``bvh_length_to_m`` (default :data:`CONFIG_SETTING_NAMES`, the
+        config keys; the command line passes its options).
+
+    Up axis: detected by :func:`animsynth.kinematics.detect_up_axis` (a biped
+    by its joint roles, another body by its legs). A warning names the file
+    and the ``up_axis`` setting when the body is not a biped, when the answer
+    is ambiguous (for a body that is not a biped the file's own axes are then
+    kept, +y up), and when a given ``up_axis`` leaves the body lying down or on
+    its head (:func:`animsynth.kinematics.lying_down`). A joint that plays two
+    roles is warned about.
 
     The standing height (median over frames of the extent along the up axis,
     :func:`animsynth.kinematics.standing_height`) in metres outside
@@ -157,7 +174,7 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     from .errors import MotionFormatError
     from .joints import check_role_overrides
     from .kinematics import (CANONICAL_FORWARD, CANONICAL_UP, default_forward, detect_forward_axis, detect_up_axis,
-                             parse_axis, standing_height, to_canonical_frame, translated_joints)
+                             lying_down, parse_axis, standing_height, to_canonical_frame, translated_joints)
 
     files = {"amc": amc, "asf": asf, "bvh": bvh}
     shown = dict(source_files or {})
@@ -180,28 +197,43 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         m = Motion(m.values[first_frame:], m.skeleton, m.fps, m.name, m.meta)
         log.info("%s: the first %d frame(s) dropped (first_frame), %d left", where, first_frame,
                  m.n_frames)
+    names = dict(CONFIG_SETTING_NAMES, **(setting_names or {}))
     try:
-        check_role_overrides(m.skeleton.names, joint_roles)
+        check_role_overrides(m.skeleton.names, joint_roles, where=names["joint_roles"])
     except ValueError as exc:
-        raise ConfigError(f"config key {exc} (in {where})") from None
+        raise ConfigError(f"{exc} (in {where})") from None
     m.skeleton.roles = dict(joint_roles or {})
     roles = m.skeleton.roles
+    _warn_shared_roles(m.skeleton, roles, where, names["joint_roles"])
     sk, v = m.skeleton, m.values
     auto_up = up_axis in (None, "auto")
     detected, info = detect_up_axis(sk, v, roles)
+    override = names["up_axis"]
     if bvh is None and auto_up:
         up = CANONICAL_UP
-        if detected != up:
-            log.warning("%s: the motion looks %s up (median extents x y z: %s), ASF/AMC is read +y up; set up_axis "
-                        "on the trial if the file is not", where, detected, _fmt(info["extent"]))
+        if detected != up and not info["ambiguous"]:
+            log.warning("%s: the motion looks %s up (%s; median extents x y z: %s), ASF/AMC is read +y up; set %s "
+                        "if the file is not", where, detected, info["why"], _fmt(info["extent"]), override)
     else:
         up = detected if auto_up else parse_axis(up_axis)
     fwd = default_forward(up) if forward_axis in (None, "auto") else parse_axis(forward_axis)
-    how = (f"detected (tallest along it in most frames, sign from {info['sign_from']}; median extents x y z "
-           f"{_fmt(info['extent'])})" if auto_up and bvh is not None else "given" if not auto_up else "ASF/AMC")
-    if auto_up and bvh is not None and info["ratio"] > 0.8:
-        log.warning("%s: the up axis %s is ambiguous (median extents x y z %s); set up_axis on the trial",
-                    where, up, _fmt(info["extent"]))
+    how = (f"detected ({info['why']}; median extents x y z {_fmt(info['extent'])})"
+           if auto_up and bvh is not None else "given" if not auto_up else "ASF/AMC")
+    if auto_up and bvh is not None:
+        if not info["biped"]:
+            log.warning("%s: the body is not a biped (%s); %s; set %s if that is wrong%s", where, info["why"],
+                        f"up axis {up} from its legs" if info["sign_from"] == "legs" else
+                        "its up axis is ambiguous: the file's own axes are kept (+y up, BVH's convention)",
+                        override, f" (a biped whose joint names the role map does not know: name its head and "
+                                  f"feet with {names['joint_roles']})" if info["why"].startswith("no head") else "")
+        elif info["ambiguous"]:
+            log.warning("%s: the up axis %s is ambiguous (%s; median extents x y z %s); set %s", where, up,
+                        info["why"], _fmt(info["extent"]), override)
+    if not auto_up:
+        lying = lying_down(sk, v, up, roles)
+        if lying:
+            log.warning("%s: with the given up axis %s the body lies down or stands on its head (%s); check %s",
+                        where, up, lying, override)
     if (up, fwd) != (CANONICAL_UP, CANONICAL_FORWARD):
         sk, v = to_canonical_frame(sk, v, up, fwd)
         m = Motion(v, sk, m.fps, m.name, m.meta)
@@ -212,17 +244,35 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     moved = translated_joints(sk)
     if moved:
         log.info("%s: joints other than the root with translation over the frames: %s (their translation is part "
-                 "of the pose: see docs/data.md for how each family uses it)", where, ", ".join(moved))
+                 "of the pose: see config/README.md, BVH files, for how each family uses it)", where, ", ".join(moved))
     height = standing_height(sk, v, CANONICAL_UP) * sk.length_to_m if bvh is not None else None
     if height is not None:
         log.info("%s: stands %.3g m tall (median over frames along the up axis) with bvh_length_to_m=%g", where,
                  height, bvh_length_to_m)
     if height is not None and not HEIGHT_RANGE_M[0] <= height <= HEIGHT_RANGE_M[1]:
         log.warning("%s: the skeleton stands %.3g m tall (median over frames along the up axis %s) with "
-                    "bvh_length_to_m=%g; set bvh_length_to_m to the file's unit (0.01 for centimetres, 0.0254 for "
-                    "inches, 0.05644 for cgspeed's CMU conversions)", where, height, up, bvh_length_to_m)
+                    "bvh_length_to_m=%g; set %s to the file's unit (0.01 for centimetres, 0.0254 for "
+                    "inches, 0.05644 for cgspeed's CMU conversions)", where, height, up, bvh_length_to_m,
+                    names["bvh_length_to_m"])
     m.name = name or m.name
     return m
+
+
+def _warn_shared_roles(skeleton, overrides: dict, where: str, setting: str) -> None:
+    """Log a warning for every joint that plays two roles or more (given or found by name)."""
+    from .joints import ROLES, JointRoleError, resolve_role
+
+    played: dict[str, list[str]] = {}
+    for role in ROLES:
+        try:
+            played.setdefault(resolve_role(skeleton, role, overrides), []).append(role)
+        except JointRoleError:
+            continue
+    for joint, rs in played.items():
+        if len(rs) > 1:
+            given = [r for r in rs if r in (overrides or {})]
+            log.warning("%s: joint %r plays %d roles (%s%s); each role should be its own joint: check %s", where,
+                        joint, len(rs), ", ".join(rs), f"; given: {', '.join(given)}" if given else "", setting)
 
 
 def _fmt(a) -> str:

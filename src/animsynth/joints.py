@@ -96,13 +96,19 @@ def _names_and_overrides(skeleton_or_names, overrides):
 
 
 def check_role_overrides(names, overrides: dict | None, where: str = "joint_roles") -> None:
-    """Raise :class:`JointRoleError` for an override of an unknown role or naming a joint not in ``names``."""
+    """Raise :class:`JointRoleError` for an override of an unknown role or naming a joint not in ``names``.
+
+    ``where`` names the setting: a config key (``"config key joint_roles"``: the message starts
+    ``config key joint_roles.ROLE:``) or a command-line option (``"argument --role"``: it starts
+    ``argument --role: ROLE=JOINT:``).
+    """
     names = list(names)
     for role, joint in (overrides or {}).items():
+        label = f"{where}: {role}={joint}" if where.startswith("argument ") else f"{where}.{role}"
         if role not in ROLES:
-            raise JointRoleError(f"{where}.{role}: unknown joint role {role!r}; roles are {', '.join(ROLES)}")
+            raise JointRoleError(f"{label}: unknown joint role {role!r}; roles are {', '.join(ROLES)}")
         if joint not in names:
-            raise JointRoleError(f"{where}.{role}: the skeleton has no joint {joint!r}; its joints are "
+            raise JointRoleError(f"{label}: the skeleton has no joint {joint!r}; its joints are "
                                  f"{', '.join(names)}")
 
 
@@ -139,7 +145,8 @@ def resolve_role(skeleton_or_names, role: str, overrides: dict | None = None) ->
     if role == "pelvis" and names:
         return names[0]
     raise JointRoleError(f"no joint for role {role!r} (looked for {', '.join(ROLES[role][:6])}, ...); joints "
-                         f"available: {', '.join(names)}; name it with the config key joint_roles.{role}")
+                         f"available: {', '.join(names)}; name it with the config key joint_roles.{role} "
+                         f"(command line: --role {role}=JOINT)")
 
 
 def resolve_roles(skeleton_or_names, roles, overrides: dict | None = None) -> list[str]:

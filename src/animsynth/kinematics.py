@@ -12,9 +12,11 @@ floor, foot contacts, facing, heading, root alignment and the figures all read
 the up axis from here. A file in another frame (Z up, as Blender and 3ds Max
 write it) is turned into the canonical one when it is loaded
 (:func:`to_canonical_frame`, called by :func:`animsynth.data.load_trial`),
-with the up axis detected from the motion (:func:`detect_up_axis`: the axis
-along which the body is tallest in most frames, signed by head above feet) or
-given (config ``up_axis`` / ``forward_axis``). A rest pose lying along X
+with the up axis detected from the motion (:func:`detect_up_axis`: for a
+biped by its joint roles, the head above the feet; for another body, a
+quadruped or a crab, by its legs standing on the floor; when that is
+ambiguous for a body that is not a biped, the file's own +y is kept) or given
+(config ``up_axis`` / ``forward_axis``; :func:`lying_down` checks a given one). A rest pose lying along X
 (LAFAN1) is not a different frame: the up axis comes from the frames, not the
 rest pose, and facing from the hips (:func:`facing`), so such a file needs no
 change.
@@ -461,38 +463,203 @@ def standing_height(skeleton: Skeleton, values, up="+y", positions: np.ndarray |
     return float(np.median(h.max(axis=1) - h.min(axis=1)))
 
 
-def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) -> tuple[str, dict]:
-    """The up axis of a motion: the world axis along which the body is tallest in most frames.
+#: A body is read as a biped when it has a head and two feet by joint role and at most this many leg-like chains
+#: (three would be a person with a hand on the floor, or a contorted pose: still a biped; four, an animal).
+MAX_BIPED_LEGS = 3
+#: A leaf chain is leg-like when its end is this share of the body's largest extent from the floor or closer
+#: in a quarter of the frames at least (a foot stands in part of a gait) ...
+LEG_FLOOR_SHARE = 0.05
+#: ... and it points down: the cosine between its start-to-end vector and the down direction is at least this.
+LEG_DOWN_COS = 0.3
+#: Second best over best above this (by leg count for a non-biped, by the head-to-feet vector's components for
+#: a biped, by extent between the tallest axes) makes the up axis ambiguous.
+AMBIGUOUS_RATIO = 0.7
 
-    The axis with the largest median per-frame extent of the joint positions
-    (a standing, walking or dancing body is taller than it is wide or deep;
-    the rest pose plays no part). Its sign: the head above the ankles (median
-    over frames), by joint role; without those roles the side holding more of
-    the joints (a body has more joints above its hips than below), which is
-    logged.
+
+def _leaf_chains(skeleton: Skeleton) -> list[tuple[int, int]]:
+    """``(first joint, leaf joint)`` of every chain that runs without branching from just below a branching
+    joint (or the root) to a leaf of at least two segments: the limbs, tails, necks of a skeleton."""
+    kids: dict[int, list[int]] = {i: [] for i in range(len(skeleton.joints))}
+    for i, j in enumerate(skeleton.joints):
+        if j.parent >= 0:
+            kids[j.parent].append(i)
+    out = []
+    for leaf in (i for i, k in kids.items() if not k and i > 0):
+        first, n = leaf, 1
+        while True:
+            p = skeleton.joints[first].parent
+            if p <= 0 or len(kids[p]) > 1:
+                break
+            first, n = p, n + 1
+        if n >= 2:
+            out.append((first, leaf))
+    return out
+
+
+def count_legs(skeleton: Skeleton, starts: np.ndarray, ends: np.ndarray, up) -> int:
+    """How many leg-like chains :func:`leg_chains` finds."""
+    return len(leg_chains(skeleton, starts, ends, up))
+
+
+def leg_chains(skeleton: Skeleton, starts: np.ndarray, ends: np.ndarray, up) -> list[set[int]]:
+    """Leg-like chains of a body for the signed axis ``up``: leaf chains (:func:`_leaf_chains`) that point
+    down (:data:`LEG_DOWN_COS`, median over frames) and end on the floor (within :data:`LEG_FLOOR_SHARE` of
+    the body's largest extent above its lowest point, in a quarter of the frames at least).
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    starts, ends : ndarray (frames, joints, 3)
+        Joint starts and segment ends (:func:`forward_kinematics`).
+    up : str
+        A signed axis (:data:`AXES`).
+
+    Returns
+    -------
+    list of set of int
+        The joint indices of each leg-like chain.
+    """
+    u = axis_vector(up)
+    pos = np.concatenate([starts, ends], axis=1)
+    size = float(np.max(np.median(pos.max(axis=1) - pos.min(axis=1), axis=0)))
+    h = pos @ u
+    floor = h.min(axis=1)
+    legs = []
+    for first, leaf in _leaf_chains(skeleton):
+        v = np.median(ends[:, leaf] - starts[:, first], axis=0)
+        nv = float(np.linalg.norm(v))
+        if nv <= 0 or float(-(v @ u)) / nv < LEG_DOWN_COS:
+            continue
+        if float(np.quantile(ends[:, leaf] @ u - floor, 0.25)) <= LEG_FLOOR_SHARE * size:
+            chain, i = {leaf}, leaf
+            while i != first:
+                i = skeleton.joints[i].parent
+                chain.add(i)
+            legs.append(chain)
+    return legs
+
+
+def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) -> tuple[str, dict]:
+    """The up axis of a motion, from the joint roles for a biped, from the legs otherwise.
+
+    *A biped* (a ``head`` and two feet, ``left_ankle``/``right_ankle`` or
+    ``left_toe``/``right_toe``, by joint role; at most :data:`MAX_BIPED_LEGS`
+    leg-like chains, :func:`leg_chains`, along any axis along which a foot's
+    chain is one of them): the signed axis nearest to the head minus the
+    mid-point of the feet (median over frames). It is ambiguous when
+    that vector's second largest component is more than
+    :data:`AMBIGUOUS_RATIO` of its largest (the body lies diagonally), when the
+    hips are not between head and feet along it, or when the body is clearly
+    tallest along another axis (a lying body).
+
+    *Not a biped* (no head or feet by role, or four or more leg-like chains:
+    a quadruped, a crab): a four-legged body is longer than it is tall, so the
+    extents do not tell up. The up axis is the signed axis with the most
+    leg-like chains (pointing down and ending on the floor). It is ambiguous
+    with fewer than three such chains or when another axis has more than
+    :data:`AMBIGUOUS_RATIO` of them; then the file's own axes are kept
+    (``+y``, BVH's convention), never a turn.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    values : array (frames, n_dof)
+    overrides : dict, optional
+        ``{role: joint name}`` over the skeleton's own.
 
     Returns
     -------
     axis : str
         One of :data:`AXES`.
     info : dict
-        ``extent`` (3,) median extents, ``ratio`` (second largest / largest:
-        near 1 means ambiguous), ``sign_from`` (``"head"`` or ``"joints"``).
+        ``extent`` (3,) median extents; ``ratio`` (second largest / largest
+        extent); ``biped`` (bool); ``legs`` (leg-like chains along ``axis``);
+        ``sign_from`` (``"roles"``: head above feet; ``"legs"``; ``"file"``:
+        kept, as nothing told); ``ambiguous`` (bool); ``why`` (str: what was
+        found, for the log).
     """
     starts = forward_kinematics(skeleton, values, ends=False)
-    pos = np.concatenate([starts, forward_kinematics(skeleton, values, ends=True)], axis=1)
+    ends = forward_kinematics(skeleton, values, ends=True)
+    pos = np.concatenate([starts, ends], axis=1)
     ext = np.median(pos.max(axis=1) - pos.min(axis=1), axis=0)
-    a = int(np.argmax(ext))
-    ratio = float(np.sort(ext)[-2] / max(ext[a], 1e-300))
-    idx = _role_index(skeleton, ("head", "left_ankle", "right_ankle"), overrides)
-    if idx is not None:
-        d = starts[:, idx[0], a] - 0.5 * (starts[:, idx[1], a] + starts[:, idx[2], a])
-        sign, src = (1.0 if np.median(d) >= 0 else -1.0), "head"
+    tall = int(np.argmax(ext))
+    ratio = float(np.sort(ext)[-2] / max(ext[tall], 1e-300))
+    info = {"extent": ext, "ratio": ratio, "biped": False, "legs": 0, "ambiguous": False, "why": ""}
+    head = _role_index(skeleton, ("head",), overrides)
+    feet = (_role_index(skeleton, ("left_ankle", "right_ankle"), overrides)
+            or _role_index(skeleton, ("left_toe", "right_toe"), overrides))
+    chains = {ax: leg_chains(skeleton, starts, ends, ax) for ax in AXES}
+    counts = {ax: len(c) for ax, c in chains.items()}
+    # four or more legs where the feet (by role) stand: a four-legged animal on a biped template's names
+    most = max((n for ax, n in counts.items()
+                if feet is None or any(f in c for c in chains[ax] for f in feet)), default=0)
+    if head is not None and feet is not None and most <= MAX_BIPED_LEGS:
+        d = np.median(starts[:, head[0]] - 0.5 * (starts[:, feet[0]] + starts[:, feet[1]]), axis=0)
+        a = int(np.argmax(np.abs(d)))
+        axis = ("+" if d[a] >= 0 else "-") + "xyz"[a]
+        info.update(biped=True, legs=counts[axis], sign_from="roles")
+        why = []
+        second = float(np.sort(np.abs(d))[-2] / max(abs(d[a]), 1e-300))
+        if second > AMBIGUOUS_RATIO:
+            why.append(f"the head-to-feet vector {_fmt_vec(d)} lies between two axes")
+        hips = _role_index(skeleton, ("left_hip", "right_hip"), overrides)
+        if hips is not None:
+            u = axis_vector(axis)
+            hh = float(np.median(0.5 * (starts[:, hips[0]] + starts[:, hips[1]]) @ u))
+            hd = float(np.median(starts[:, head[0]] @ u))
+            hf = float(np.median(0.5 * (starts[:, feet[0]] + starts[:, feet[1]]) @ u))
+            if not hf <= hh <= hd:
+                why.append("the hips are not between the head and the feet")
+        if tall != a and ratio < AMBIGUOUS_RATIO:
+            why.append(f"the body is tallest along {'xyz'[tall]} (lying down?)")
+        info.update(ambiguous=bool(why), why="; ".join(why) or "head above feet")
+        return axis, info
+    if head is not None and feet is not None:
+        info["why"] = f"head and feet found by role, but {most} leg-like chains"
     else:
-        mid = 0.5 * (pos[:, :, a].max(axis=1) + pos[:, :, a].min(axis=1))
-        sign, src = (1.0 if np.median(np.mean(starts[:, :, a] > mid[:, None], axis=1)) >= 0.5 else -1.0), "joints"
-    axis = ("+" if sign > 0 else "-") + "xyz"[a]
-    return axis, {"extent": ext, "ratio": ratio, "sign_from": src}
+        info["why"] = "no head or feet by joint role"
+    best = max(AXES, key=lambda ax: (counts[ax], ax == CANONICAL_UP))
+    second = max(c for ax, c in counts.items() if ax != best)
+    info["legs"] = counts[best]
+    if counts[best] >= 3 and second <= AMBIGUOUS_RATIO * counts[best]:
+        info.update(sign_from="legs", why=info["why"] + f"; {counts[best]} legs stand on the floor along {best}")
+        return best, info
+    info.update(sign_from="file", ambiguous=True, legs=counts[CANONICAL_UP],
+                why=info["why"] + "; leg-like chains per up axis: "
+                + " ".join(f"{ax} {counts[ax]}" for ax in AXES))
+    return CANONICAL_UP, info
+
+
+def lying_down(skeleton: Skeleton, values, up, overrides: dict | None = None) -> str:
+    """Why the body would lie down or stand on its head with ``up`` as the up axis, or ``""``.
+
+    For a biped by joint role (head, ankles or toes): its head not above its
+    feet (median over frames), or its extent along ``up`` less than half its
+    largest extent across. For any body: :func:`detect_up_axis` finding
+    another axis without ambiguity.
+    """
+    u = axis_vector(up)
+    detected, info = detect_up_axis(skeleton, values, overrides)
+    why = []
+    head = _role_index(skeleton, ("head",), overrides)
+    feet = (_role_index(skeleton, ("left_ankle", "right_ankle"), overrides)
+            or _role_index(skeleton, ("left_toe", "right_toe"), overrides))
+    if info["biped"] and head is not None and feet is not None:
+        s = joint_starts(skeleton, values, [head[0], feet[0], feet[1]])
+        if float(np.median((s[:, 0] - 0.5 * (s[:, 1] + s[:, 2])) @ u)) <= 0:
+            why.append("its head is not above its feet")
+        ext = info["extent"]
+        k = int(np.argmax(np.abs(u)))
+        across = max(ext[i] for i in range(3) if i != k)
+        if ext[k] < 0.5 * across:
+            why.append(f"it is {ext[k]:.3g} units tall along {up} but {across:.3g} across")
+    if detected != parse_axis(up) and not info["ambiguous"] and not why:
+        why.append(f"its {'head is above its feet' if info['biped'] else 'legs stand'} along {detected}")
+    return "; ".join(why)
+
+
+def _fmt_vec(v) -> str:
+    return "(" + " ".join(f"{float(x):.3g}" for x in v) + ")"
 
 
 def detect_forward_axis(skeleton: Skeleton, values, up, overrides: dict | None = None) -> tuple[str, str]:

@@ -30,6 +30,27 @@ def _camera(elev_deg: float = 10.0, azim_deg: float = -60.0) -> np.ndarray:
     return np.vstack([right, up])
 
 
+def gif_timing(n: int, fps: float, step: int, max_frames: int, source_fps: float | None) -> tuple[int, float, float]:
+    """The frame step, playback rate and speed-up of a GIF of ``n`` motion frames (see :func:`skeleton_gif`).
+
+    Returns
+    -------
+    step : int
+        Every ``step``-th motion frame is drawn (at most ``max_frames`` of them).
+    fps : float
+        GIF frames per second.
+    speedup : float
+        Playback speed over real time: 1 when the clip fits in real time (or ``source_fps`` is None); a clip
+        too long for real time within ``max_frames`` is evenly subsampled and still played at about ``fps``
+        frames per second, so ``speedup`` times faster (not as a slideshow).
+    """
+    if source_fps is None:
+        return max(step, int(np.ceil(n / max_frames))), fps, 1.0
+    real = max(1, int(round(source_fps / fps)))
+    step = max(real, int(np.ceil(n / max_frames)))
+    return step, source_fps / real, step / real
+
+
 def skeleton_gif(path, positions_list, parents, titles=None, fps: float = 30.0, step: int = 4,
                  follow_root: bool = True, max_frames: int = 150, source_fps: float | None = None,
                  panel_px: int = 230) -> None:
@@ -52,8 +73,11 @@ def skeleton_gif(path, positions_list, parents, titles=None, fps: float = 30.0, 
     max_frames : cap on GIF frames (the step is increased to respect it)
     source_fps : frame rate of the motions; when given, the GIF plays in real
         time: ``step`` is chosen so that the GIF runs at about ``fps`` frames
-        per second (or slower, within ``max_frames``) and its playback rate is
-        ``source_fps / step``
+        per second and its playback rate is ``source_fps / step``. A clip too
+        long for that within ``max_frames`` is evenly subsampled (a larger
+        ``step``) and still plays at about ``fps`` frames per second, so
+        faster than real time, not as a slideshow: the titles then state the
+        speed-up (``x4 speed``)
     panel_px : width and height of one figure's panel in pixels
     """
     from PIL import Image, ImageDraw
@@ -62,14 +86,12 @@ def skeleton_gif(path, positions_list, parents, titles=None, fps: float = 30.0, 
         raise ValueError(f"GIF frame rate must be a positive number, got {fps!r}")
     positions_list = [np.asarray(p, float) for p in positions_list]
     n = max(p.shape[0] for p in positions_list)
-    if source_fps is not None:
-        step = max(1, int(round(source_fps / fps)))
-    step = max(step, int(np.ceil(n / max_frames)))
-    if source_fps is not None:
-        fps = source_fps / step
-    frames = list(range(0, n, step))
+    step, fps, speedup = gif_timing(n, fps, step, max_frames, source_fps)
     k = len(positions_list)
-    titles = titles or [""] * k
+    titles = list(titles or [""] * k)
+    if speedup > 1:
+        titles = [f"{t} (x{speedup:.3g} speed)".strip() for t in titles]
+    frames = list(range(0, n, step))
     segs = _segments(parents)
     shown = []
     for p in positions_list:
@@ -144,10 +166,12 @@ def filmstrip(path, positions, parents, n_panels: int = 8, title: str = "") -> N
 
 
 def motion_previews(motion, gif_path=None, bvh_path=None, png_path=None, original=None, titles=None,
-                    fps: float = 30.0) -> None:
+                    fps: float = 30.0, max_frames: int = 150) -> None:
     """Write the standard previews of a generated motion: BVH, GIF (beside ``original`` if given), filmstrip.
 
-    The GIF plays in real time at ``motion.fps``, showing about ``fps`` frames per second.
+    The GIF plays in real time at ``motion.fps``, showing about ``fps`` frames per second; a clip longer than
+    ``max_frames`` GIF frames is evenly subsampled and plays faster, its speed-up in the titles
+    (:func:`skeleton_gif`). ``titles``: one per figure (default ``original``/``generated``).
     """
     from .io.bvh import write_bvh
     from .kinematics import forward_kinematics
@@ -162,6 +186,6 @@ def motion_previews(motion, gif_path=None, bvh_path=None, png_path=None, origina
             plist = [forward_kinematics(original.skeleton, original.values) * original.skeleton.length_to_m, pos]
         default_titles = ["original", "generated"] if original is not None else ["generated"]
         skeleton_gif(gif_path, plist, sk.parents(), titles or default_titles, fps=fps,
-                     source_fps=motion.fps)
+                     source_fps=motion.fps, max_frames=max_frames)
     if png_path:
         filmstrip(png_path, pos, sk.parents(), title=motion.name)

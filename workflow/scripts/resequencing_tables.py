@@ -3,7 +3,8 @@ import pandas as pd
 
 from animsynth.atomic import atomic_path
 from animsynth.resequencing.jobs import summarise_paths
-from animsynth.resequencing.tables import lee_weights_table, min_k_table, published_table2
+from animsynth.resequencing.tables import (PAPER_CMU_TRIALS, comparable_published, lee_weights_table,
+                                          min_k_table, paper_comparable, published_table2)
 from animsynth.resequencing.verdicts import build_verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
@@ -29,7 +30,13 @@ def csv(df, path):
         df.to_csv(tmp, index=False, lineterminator="\n", float_format="%.6g")
 
 
-table2_paper = published_table2(published(inp.published_table2))
+# the paper's values stand only beside the trials it measured (its CMU clips, or the synthetic stand-ins)
+comparable = paper_comparable(snakemake.config, trials)
+not_comparable = [d for d, ok in comparable.items() if not ok]
+for d in not_comparable:
+    log.info("resequencing Table 2: %s trial %s is not the paper's CMU %s: the paper's min k is not shown beside it",
+             d, trials[d], PAPER_CMU_TRIALS.get(d, "trial"))
+table2_paper = comparable_published(published_table2(published(inp.published_table2)), comparable)
 grid = cat(inp.explain)
 step = int(cfg["frame_step"])
 table2 = min_k_table(grid, table2_paper, step)
@@ -46,7 +53,10 @@ write_table(table2, out.table2, title="Table 2: smallest k giving one connected 
                  "ST-Isomap L2 rows repeat its Isomap L2 values (79, 107), which a graph holding the temporal chain "
                  "cannot give, while its ST-Isomap Lee rows (1) match ours. min_k_paper: the "
                  "paper's value on the rows of its setting (global DOF excluded for walk and run, included for dance)"
-                 + ("." if table2_paper is not None else "; empty: the published file was not found."))
+                 + (f"; empty for {', '.join(not_comparable)}: not the paper's CMU trial (your own data), so the "
+                    "paper's values are not comparable with it" if not_comparable else "")
+                 + ("." if table2_paper is not None or not_comparable else "; empty: the published file was not "
+                    "found."))
 write_table(grid, out.explanations, title="Minimum k under the candidate explanations of the paper's Table 2",
             note=CLIPS + "Every combination of sign mode, frame step (120 fps / frame_step) and global DOF.")
 flips = cat(inp.flips)

@@ -44,17 +44,38 @@ UNSCORED = ("transition_skate_share", "n_seams", "seams_per_s", "transitions_kep
 
 def on_skeleton(motion: Motion, skeleton, what: str) -> Motion:
     """``motion`` on ``skeleton`` (the reference's): its values as they are when the DOF columns are the same,
-    else mapped joint by joint (the same joint names in the same order are required)."""
+    else read joint by joint, by name.
+
+    Every joint of ``skeleton`` must be in ``motion`` with the same parent joint (by name); joints of
+    ``motion`` that the reference does not have (an extra end joint, a prop, a finger) are left out, logged.
+    Otherwise (a joint missing, or one whose parent differs: an extra joint inside a chain would move its
+    children) a ``ValueError`` names the joints.
+    """
     if motion.skeleton.columns() == skeleton.columns():
         return Motion(np.asarray(motion.values, float), skeleton, motion.fps, motion.name)
-    if motion.skeleton.names != skeleton.names:
-        raise ValueError(f"{what}: its joints differ from the reference's ({len(motion.skeleton.names)} joints "
-                         f"{motion.skeleton.names[:4]}... vs {len(skeleton.names)} {skeleton.names[:4]}...); "
-                         "score motions on the reference's skeleton")
+    msk = motion.skeleton
+    missing = [n for n in skeleton.names if n not in msk.names]
+    if missing:
+        raise ValueError(f"{what}: its joints differ from the reference's: {len(missing)} of the reference's "
+                         f"{len(skeleton.names)} joints are not in it ({', '.join(missing[:5])}"
+                         f"{', ...' if len(missing) > 5 else ''}); score motions on the reference's skeleton")
+
+    def parent(sk, name):
+        p = sk[name].parent
+        return sk.joints[p].name if p >= 0 else None
+
+    moved = [n for n in skeleton.names if parent(msk, n) != parent(skeleton, n)]
+    if moved:
+        raise ValueError(f"{what}: joint(s) {', '.join(moved[:5])} hang from another parent than in the "
+                         "reference (an extra joint inside a chain would move them); score motions on the "
+                         "reference's skeleton")
     from ..io.bvh import motion_from_bvh_on
 
+    extra = [n for n in msk.names if n not in skeleton.names]
+    if extra:
+        log.info("%s: joints the reference does not have are left out: %s", what, ", ".join(extra))
     log.info("%s: its channels differ from the reference's; its joint rotations are read onto the reference's "
-             "skeleton", what)
+             "skeleton joint by joint", what)
     return motion_from_bvh_on(motion, skeleton)
 
 
@@ -101,6 +122,16 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
             note = "no database: foot skating (no floor height), L2P, coverage and novelty empty"
         else:
             note = "no database: L2P, coverage and novelty empty"
+    roles = None
+    if SKATING_METRICS[0] in blank:  # no foot metric: the feet need no joint (the columns are left empty)
+        from ..joints import FOOT_ROLES, JointRoleError, resolve_roles
+
+        try:
+            resolve_roles(sk, FOOT_ROLES)
+        except JointRoleError:
+            roles = {r: sk.names[0] for r in FOOT_ROLES}
+            log.info("%s: no joints for the foot roles; foot skating is not scored (no database, no floor height)",
+                     reference_name)
     rows = []
     for name, g in generated.items():
         if not np.isclose(float(g.fps), fps):
@@ -116,8 +147,8 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
         _check_start(m, ref, context, name, reference_name)
         clip = Clip(reference_name, "", "scored file", reference_name, ref, db or [ref], context, length)
         std = run_stats([clip], mcfg) if db else np.ones((len(sk.joints), 3))
-        row, _f = score(clip, reference(clip, mcfg, None, std),
-                        Motion(np.asarray(m.values[context:], float), sk, fps, name), name, mcfg)
+        row, _f = score(clip, reference(clip, mcfg, roles, std),
+                        Motion(np.asarray(m.values[context:], float), sk, fps, name), name, mcfg, roles)
         row["transitions_kept"] = np.nan
         row.update({k: np.nan for k in blank})
         rows.append({"clip": reference_name, "group": "", "protocol": "scored file", "generator": name, "seed": "",

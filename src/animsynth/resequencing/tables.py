@@ -7,6 +7,8 @@ whose layout the paper does not have raises :class:`animsynth.published.Publishe
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pandas as pd
 
@@ -15,13 +17,54 @@ from ..tables import add_paper_differences
 from .features import SIGN_MODES
 from .settings import METRICS
 
-__all__ = ["PAPER_GLOBAL_DOF", "PAPER_METHODS", "TABLE2_COLUMNS", "published_table2", "lee_weights_table",
-           "min_k_table"]
+__all__ = ["PAPER_GLOBAL_DOF", "PAPER_METHODS", "TABLE2_COLUMNS", "PAPER_CMU_TRIALS", "published_table2",
+           "lee_weights_table", "min_k_table", "paper_comparable", "comparable_published"]
 
 #: The paper's Table 2 names -> ours.
 PAPER_GLOBAL_DOF = {"included": True, "excluded": False}
 PAPER_METHODS = {"isomap": "isomap", "st-isomap": "stisomap", "stisomap": "stisomap"}
 TABLE2_COLUMNS = ("motion", "frames", "global_dof", "method", "metric", "min_k")
+#: The CMU trials that stand for the paper's walk, run and dance (config/cmu.yaml's resequencing_trials).
+PAPER_CMU_TRIALS = {"walk": "35_01", "run": "35_17", "dance": "05_02"}
+
+
+def paper_comparable(config: dict, trials: dict) -> dict[str, bool]:
+    """Which re-sequencing datasets run on the paper's trial, so that its Table 2 values may stand beside ours.
+
+    Parameters
+    ----------
+    config : dict
+        The run's config (``mocap_source``, ``trials``).
+    trials : dict
+        ``{dataset: trial id}`` (``resequencing_trials``).
+
+    Returns
+    -------
+    dict
+        ``{dataset: bool}``. ``True`` for the synthetic stand-ins of the paper's clips (the default run) and
+        for a CMU or user trial whose file (``amc``, or ``bvh``) is the CMU trial of :data:`PAPER_CMU_TRIALS`
+        for that dataset (``35_01.amc``); ``False`` for anything else: a user's own capture is not the motion
+        the paper measured, so its min k is not comparable with the paper's.
+    """
+    records = {str(t.get("id")): t for t in config.get("trials") or []}
+    out = {}
+    for dataset, tid in trials.items():
+        if config.get("mocap_source") == "synthetic":
+            out[dataset] = True
+            continue
+        rec = records.get(str(tid), {})
+        stems = {os.path.splitext(os.path.basename(str(rec[k])))[0] for k in ("amc", "bvh") if rec.get(k)}
+        out[dataset] = PAPER_CMU_TRIALS.get(dataset) in stems
+    return out
+
+
+def comparable_published(published: pd.DataFrame | None, comparable: dict) -> pd.DataFrame | None:
+    """``published`` (:func:`published_table2`) without the rows of datasets that are not comparable
+    (:func:`paper_comparable`); ``None`` when none is left."""
+    if published is None:
+        return None
+    keep = published[published["dataset"].map(lambda d: bool(comparable.get(d, False)))]
+    return keep.reset_index(drop=True) if len(keep) else None
 
 
 def published_table2(path) -> pd.DataFrame | None:

@@ -26,6 +26,11 @@ not come from any other project:
   ``rest_along_x.bvh`` (the rest pose lying along +X, cm), ``z_up.bvh`` (Z
   up, -Y forward, metres), ``mixed_orders.bvh`` (a different rotation order
   on every joint, cm).
+* ``creatures/`` (a folder of its own: the files above are all bipeds),
+  bodies that are not bipeds (tests/bvh_classes.py, metres, +y up):
+  ``quadruped.bvh`` (four legs, a long horizontal body, a head in front and a
+  trunk, 2 m tall and 3.4 m long; biped joint names on its legs) and
+  ``crab.bvh`` (a wide flat body on eight splayed legs, two claws).
 * ``multiroot/blender_two_roots.bvh`` (a folder of its own: it is refused, the
   files above are read): what the exporter writes for an armature with two
   root bones, a dummy ``ROOT __0`` with ``OFFSET 0.0 0.0 0.0`` and
@@ -159,6 +164,7 @@ def main():
           unconnected=("lupleg", "rupleg", "lshoulder", "rshoulder", "larm", "rarm"))
     write_two_roots()
     write_classes()
+    write_creatures()
 
 
 #: file name -> class of tests/bvh_classes.py
@@ -177,6 +183,19 @@ def write_classes() -> None:
     walk = generate_motion("walk_turn", FRAMES, 3, cmu_like_skeleton("wild", 0), name="walk")
     for name, cls in CLASS_FILES.items():
         write_class(walk, cls, HERE / name)
+
+
+def write_creatures() -> None:
+    """Bodies that are not bipeds, in metres, +y up (tests/bvh_classes.py): a four-legged animal and a crab."""
+    import sys
+
+    sys.path[:0] = [str(HERE.parents[1]), str(HERE.parents[2] / "src")]
+    from bvh_classes import CRAB, QUADRUPED, creature
+    from animsynth.io.bvh import write_bvh
+
+    (HERE / "creatures").mkdir(exist_ok=True)
+    write_bvh(HERE / "creatures" / "quadruped.bvh", creature(QUADRUPED, name="quadruped"))
+    write_bvh(HERE / "creatures" / "crab.bvh", creature(CRAB, swing=8.0, name="crab"))
 
 
 def write_two_roots() -> None:
