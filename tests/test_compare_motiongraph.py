@@ -375,6 +375,43 @@ def test_fairmotion_rigid_turn_fix_turns_the_path_with_the_piece(sk):
     assert worst[base_fixes] > 1e-4
 
 
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_cut_copy_fix_keeps_the_walks_clips_in_place(sk, monkeypatch):
+    """Released, ``cut`` hands out the clips' own poses and placing a piece moves them, so the next piece of the
+    same clip starts displaced and jumps back after its blend; with ``cut_copy`` no pose of the walk's clips moves
+    and no root step of the output is far beyond the database's largest."""
+    from animsynth.compare import fairmotion_peer as fp
+
+    seen = []
+
+    class Seen(fp._CopyOnRead):  # the clips one walk reads (its copies of the loaded clips)
+        def __init__(self, motions):
+            super().__init__(motions)
+            seen.append(self)
+
+    monkeypatch.setattr(fp, "_CopyOnRead", Seen)
+
+    def poses(m):
+        return np.array([np.asarray(p.data) for p in m.poses])
+
+    worst, moved = {}, {}
+    for fixes in ((), fp.FIXES[:3], fp.FIXES):
+        g, clips, start = _fm(sk, fixes=fixes, native_fps=60.0, turn=True)
+        db_step = max(np.linalg.norm(np.diff(_positions(c)[:, 0], axis=0), axis=-1).max() for c in clips)
+        ratios, n_moved = [], 0
+        for seed in range(8):
+            seen.clear()
+            out = g.generate(start, 40, seed=seed)
+            ratios.append(np.linalg.norm(np.diff(_positions(out)[:, 0], axis=0), axis=-1).max() / db_step)
+            view = seen[-1]
+            assert view._copies
+            n_moved += sum(not np.array_equal(poses(m), poses(g._loaded_[i])) for i, m in view._copies.items())
+        worst[fixes], moved[fixes] = max(ratios), n_moved
+    assert moved[fp.FIXES] == 0 and worst[fp.FIXES] < 1.5
+    assert moved[fp.FIXES[:3]] > 0 and worst[fp.FIXES[:3]] > 5.0  # the other three fixes alone
+    assert moved[()] > 0 and worst[()] > 5.0  # the released row: as released
+
+
 def test_fairmotion_runs_at_its_native_rate_and_answers_at_ours(sk):
     g, clips, start = _fm(sk, native_fps=60.0)
     g.fixes = ()

@@ -39,7 +39,7 @@ Generators (``GENERATORS``):
     (:func:`animsynth.compare.settings.unavailable` gives the reason when not).
 ``fairmotion_fixed``
     the same with upstream's later fixes of its walk (output rate, blend source, rigid turn of the
-    appended piece), each a named patch (:data:`animsynth.compare.fairmotion_peer.FIXES`).
+    appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.fairmotion_peer.FIXES`).
 
 The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare.transitions_per_s``
 (:func:`animsynth.compare.motiongraph.budget_count`).
