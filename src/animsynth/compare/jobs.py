@@ -84,6 +84,13 @@ class Clip:
         return Motion(np.asarray(h.values[:self.context], float), h.skeleton, h.fps, f"{self.clip}:start")
 
     @property
+    def future(self) -> Motion:
+        """Every held-out frame after the start (the truth and what follows it): the query trajectory of a
+        generator whose ``query`` is ``"future_trajectory"``."""
+        h = self.held_out
+        return Motion(np.asarray(h.values[self.context:], float), h.skeleton, h.fps, f"{self.clip}:future")
+
+    @property
     def truth(self) -> Motion:
         h = self.held_out
         return Motion(np.asarray(h.values[self.context:self.context + self.length], float), h.skeleton, h.fps,
@@ -489,6 +496,21 @@ def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> tuple[li
     return rows, timing
 
 
+def generation_query(gen, clip: Clip) -> dict:
+    """What ``gen.generate`` is given besides the start, length and seed, by its ``query``
+    (:class:`animsynth.generator.Generator`): nothing for ``"start"``; ``trajectory`` = the clip's held-out frames
+    after the start (:attr:`Clip.future`) for ``"future_trajectory"``."""
+    from ..generator import QUERY_FUTURE_TRAJECTORY, QUERY_START
+
+    query = getattr(gen, "query", QUERY_START)
+    if query == QUERY_START:
+        return {}
+    if query == QUERY_FUTURE_TRAJECTORY:
+        return {"trajectory": clip.future}
+    raise ValueError(f"generator {getattr(gen, 'name', gen)!r}: unknown query {query!r} (one of "
+                     f"{[QUERY_START, QUERY_FUTURE_TRAJECTORY]})")
+
+
 def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
@@ -516,9 +538,10 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         ref = reference(clip, mcfg, roles, std[_joint_count(clip)], kin)
         gen_cpu = gen_wall = 0.0
         feats = []
+        query = generation_query(gen, clip)
         for i, s in enumerate(seeds):
             c0, w0 = cpu_seconds(), time.perf_counter()
-            m = gen.generate(start, clip.length, s)
+            m = gen.generate(start, clip.length, s, **query)
             gen_cpu += cpu_seconds() - c0
             gen_wall += time.perf_counter() - w0
             row, f = score(clip, ref, m, generator, mcfg, roles)

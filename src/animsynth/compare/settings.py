@@ -98,7 +98,8 @@ RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
 GENERATOR_BLOCKS = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph",
                     "stisomap": "resequencing_graph", "motion_graph": "motion_graph", "fairmotion": "fairmotion",
                     "fairmotion_fixed": "fairmotion", "motion_matching": "motion_matching",
-                    "motion_matching_pose": "motion_matching", "genmm": "genmm", "concat": "concat"}
+                    "motion_matching_pose": "motion_matching", "motion_matching_traj": "motion_matching",
+                    "genmm": "genmm", "concat": "concat"}
 
 
 def clips_cfg(config: dict) -> dict:
