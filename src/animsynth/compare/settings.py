@@ -12,7 +12,7 @@ from ..config import ConfigError
 
 log = logging.getLogger("animsynth.compare")
 
-__all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "clips_cfg", "job_cfg", "unavailable",
+__all__ = ["check", "groups", "clip_ids", "showcase", "run_generators", "clips_cfg", "native_rates", "job_cfg", "unavailable",
            "user_generators", "generator_order", "user_job_cfg", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
@@ -102,9 +102,22 @@ GENERATOR_BLOCKS = {"delaunay": "field", "knn": "field", "isomap": "resequencing
                     "genmm": "genmm", "concat": "concat"}
 
 
+def native_rates(config: dict) -> list[float]:
+    """The native rates the clips are also prepared at: ``compare.fairmotion.native_fps`` when a fairmotion row is
+    among ``compare.generators`` and the rate is set and differs from ``compare.fps`` (else none)."""
+    from .generators import FAIRMOTION_ROWS
+
+    cmp = config["compare"]
+    rate = (cmp.get("fairmotion") or {}).get("native_fps")
+    if rate is None or not set(FAIRMOTION_ROWS) & set(cmp["generators"]) or float(rate) == float(cmp["fps"]):
+        return []
+    return [float(rate)]
+
+
 def clips_cfg(config: dict) -> dict:
-    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block)."""
-    return {k: config["compare"][k] for k in CLIP_KEYS}
+    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block) and, as ``native_fps``, the
+    native rates its clips also carry (:func:`native_rates`)."""
+    return {**{k: config["compare"][k] for k in CLIP_KEYS}, "native_fps": native_rates(config)}
 
 
 def job_cfg(config: dict, generator: str | None = None, budget: float | None = None) -> dict:
