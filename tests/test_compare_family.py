@@ -717,3 +717,36 @@ def test_a_subject_set_with_a_taken_name_or_an_unknown_trial_is_refused(sets, fr
     cfg["compare"]["subjects"] = sets
     with pytest.raises(ConfigError, match=fragment):
         settings.check(cfg)
+
+
+def test_the_runner_gives_the_held_out_future_to_a_generator_whose_query_is_it(walks, cfg, monkeypatch):
+    """``motion_matching_traj`` (``query = "future_trajectory"``) is passed the clip's held-out frames after the
+    start, by its query attribute, not its name; a generator of the default query gets nothing more."""
+    from animsynth.compare.motionmatching import MotionMatchingTrajectory
+    from animsynth.generator import Generator
+
+    trials = {f"t{i}": w for i, w in enumerate(walks)}
+    cc = {k: cfg[k] for k in settings.CLIP_KEYS}
+    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
+    seen = []
+    real = MotionMatchingTrajectory.generate
+
+    def spy(self, start, length, seed, trajectory=None):
+        seen.append(trajectory)
+        return real(self, start, length, seed, trajectory=trajectory)
+
+    monkeypatch.setattr(MotionMatchingTrajectory, "generate", spy)
+    metrics, _, _ = jobs.run_generator(clips, "motion_matching_traj", cfg, 7)
+    assert len(seen) == 3 * cfg["seeds"] and (metrics["note"] == "").all()
+    assert (metrics["seed_diversity_m"] == 0).all()
+    for i, c in enumerate(clips):
+        got = seen[i * cfg["seeds"]]
+        assert np.array_equal(got.values, c.held_out.values[c.context:])
+        assert np.array_equal(got.values[:c.length], c.truth.values)
+    assert Generator.query == "start" and jobs.generation_query(G.make_generator("motion_matching", cfg), clips[0]) == {}
+
+    class Odd(Generator):
+        query = "the answer"
+
+    with pytest.raises(ValueError, match="unknown query"):
+        jobs.generation_query(Odd(), clips[0])

@@ -334,7 +334,7 @@ def test_completeness_sends_the_second_patch_to_the_unused_target():
 
 def test_genmm_without_noise_from_a_database_segment_returns_that_segment(walks):
     clip, a, c, length = walks[1], 10, 8, 35
-    g = GenMM(noise_sigma=0.0, alpha=INF, coarse_patches=100).fit(walks[1:])  # one level: the full rate
+    g = GenMM(noise_sigma=0.0, alpha=INF, coarse_patches=100, min_levels=1).fit(walks[1:])  # one level: the full rate
     assert g.scales_ == [1.0]
     segment = _cut(clip, a, a + c + length, "segment")
     m = g.generate(_cut(clip, a, a + c, "start"), length, 0, initial=segment)
@@ -343,7 +343,7 @@ def test_genmm_without_noise_from_a_database_segment_returns_that_segment(walks)
     assert m.meta["match_distance"] < 1e-6
     assert _angle_diff(m.values, clip.values[a + c:a + c + length]) < 1e-8
     # with noise the same start gives something else
-    n = GenMM(alpha=INF, coarse_patches=100).fit(walks[1:]).generate(_cut(clip, a, a + c), length, 0,
+    n = GenMM(alpha=INF, coarse_patches=100, min_levels=1).fit(walks[1:]).generate(_cut(clip, a, a + c), length, 0,
                                                                      initial=segment)
     assert _angle_diff(n.values, clip.values[a + c:a + c + length]) > 1.0
 
@@ -352,7 +352,9 @@ def test_genmm_without_noise_from_a_database_segment_returns_that_segment(walks)
 def test_genmm_keeps_the_interface_and_is_seeded(walks, root):
     g = make_genmm({}, root=root).fit(walks[1:])
     assert g.scales_[-1] == 1.0 and np.all(np.diff(g.scales_) > 0) and len(g.scales_) > 1
-    assert g.scales_[0] == pytest.approx(5 * 11 / max(w.n_frames for w in walks[1:]))
+    # 60-frame clips: the 5-patch rule gives 2 levels, so the coarsest is the floor, 3 patches of the longest clip
+    assert g.scales_[0] == pytest.approx(3 * 11 / max(w.n_frames for w in walks[1:])) and len(g.scales_) == 4
+    assert make_genmm({}, min_levels=1).fit(walks[1:]).scales_[0] == pytest.approx(5 * 11 / 60)
     start, length = _cut(walks[0], 0, 8), 40
     a = g.generate(start, length, 5)
     assert a.values.shape == (length, walks[0].skeleton.n_dof) and np.all(np.isfinite(a.values))
@@ -387,3 +389,62 @@ def test_genmm_patches_never_cross_clips(walks):
     joined = extract_patches(np.vstack(rows[:2]), 11)
     crossing = joined[50:60]  # windows that would start in the first clip and end in the second
     assert not any(np.any(np.all(np.isclose(keys, c), axis=1)) for c in crossing)
+
+
+def test_genmm_keeps_a_pyramid_on_a_short_database(walks):
+    """A 40-frame database is shorter than the 5-patch rule's coarsest level (55 frames): it still gets a pyramid
+    of several levels, every level at least a patch long, each finer level by the pyramid factor; the rule alone
+    (``min_levels=1``) gives one level, and a long database keeps the rule's levels."""
+    from animsynth.compare.genmm import level_scales
+
+    db = [_cut(w, 0, 40, f"short{i}") for i, w in enumerate(walks[1:])]
+    g = make_genmm({}).fit(db)
+    assert len(g.scales_) > 1 and g.scales_[-1] == 1.0
+    frames = [int(round(40 * s)) for s in g.scales_]
+    assert frames == [33, 40] and min(frames) >= 3 * g.patch_size
+    longer = level_scales(100, 11, 5.0, 0.75, 7, 3.0)  # levels scaled by the pyramid factor
+    assert [int(round(100 * s)) for s in longer] == [33, 44, 59, 78, 100]
+    assert np.allclose(np.array(longer[1:-1]) / longer[:-2], 1 / 0.75)
+    assert all(k.shape[0] > 0 for k in g.keys_)  # a patch at every level
+    m = g.generate(_cut(walks[0], 0, 8), 30, 1)
+    assert m.meta["levels"].size == len(g.scales_) and np.all(m.meta["levels"] >= g.patch_size)
+    assert np.all(np.isfinite(m.values))
+    assert make_genmm({}, min_levels=1).fit(db).scales_ == [1.0]
+    assert len(level_scales(200, 11, 5.0, 0.75, 7, 3.0)) == 7 and len(level_scales(200, 11, 5.0, 0.75, 1)) == 6
+    # a floor of one patch: the levels go down to the patch itself
+    assert [int(round(40 * s)) for s in level_scales(40, 11, 5.0, 0.75, 7, 1.0)] == [11, 15, 20, 26, 35, 40]
+    assert level_scales(400, 11, 5.0, 0.75, 7) == level_scales(400, 11, 5.0, 0.75, 1)  # 8 levels by the rule
+    with pytest.raises(ValueError, match="min_levels"):
+        make_genmm({}, min_levels=0).fit(db)
+    with pytest.raises(ValueError, match="min_coarse_patches"):
+        make_genmm({}, min_coarse_patches=0.5).fit(db)
+    # the seed still matters on the short database
+    outs = {g.generate(_cut(walks[0], 0, 8), 30, s).values.tobytes() for s in range(6)}
+    assert len(outs) == 6
+
+
+def test_motion_matching_traj_follows_the_held_out_path_closer_than_the_gamepad():
+    """A turning held-out walk: the row whose query trajectory is the held-out future (``motion_matching_traj``)
+    follows the capture's root path closer than the steady gamepad from the start (``motion_matching``), which
+    walks on in the start's direction; without the future it refuses to run."""
+    sk = cmu_like_skeleton("cmp", 3)
+    db = [jobs.resample(generate_motion(k, 480, s, sk, name=f"{k}{s}"), 30.0)
+          for k, s in (("walk_straight", 1), ("walk_turn", 2), ("walk_turn", 3), ("walk_straight", 4))]
+    held = jobs.resample(generate_motion("walk_turn", 480, 9, sk, name="held"), 30.0)
+    c, length = 10, 90
+    start, future = _cut(held, 0, c, "start"), _cut(held, c, held.n_frames, "future")
+    truth = root_translation(sk, held.values[c:c + length])[:, [0, 2]]
+    # the capture turns: its heading at the end differs from the start's straight line
+    chord, step = truth[-1] - truth[0], truth[5] - truth[0]
+    assert np.degrees(np.arccos(chord @ step / np.linalg.norm(chord) / np.linalg.norm(step))) > 10
+    err = {}
+    for name in ("motion_matching", "motion_matching_traj"):
+        g = G.make_generator(name, {"motion_matching": {}})
+        assert g.name == name and g.query == ("future_trajectory" if name.endswith("traj") else "start")
+        g.fit(db)
+        kw = {"trajectory": future} if g.query == "future_trajectory" else {}
+        m = g.generate(start, length, 0, **kw)
+        err[name] = np.linalg.norm(root_translation(sk, m.values)[:, [0, 2]] - truth, axis=1).mean() * sk.length_to_m
+    assert err["motion_matching_traj"] < 0.6 * err["motion_matching"], err
+    with pytest.raises(ValueError, match="future trajectory"):
+        g.generate(start, length, 0)

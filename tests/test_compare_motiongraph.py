@@ -375,6 +375,43 @@ def test_fairmotion_rigid_turn_fix_turns_the_path_with_the_piece(sk):
     assert worst[base_fixes] > 1e-4
 
 
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_cut_copy_fix_keeps_the_walks_clips_in_place(sk, monkeypatch):
+    """Released, ``cut`` hands out the clips' own poses and placing a piece moves them, so the next piece of the
+    same clip starts displaced and jumps back after its blend; with ``cut_copy`` no pose of the walk's clips moves
+    and no root step of the output is far beyond the database's largest."""
+    from animsynth.compare import fairmotion_peer as fp
+
+    seen = []
+
+    class Seen(fp._CopyOnRead):  # the clips one walk reads (its copies of the loaded clips)
+        def __init__(self, motions):
+            super().__init__(motions)
+            seen.append(self)
+
+    monkeypatch.setattr(fp, "_CopyOnRead", Seen)
+
+    def poses(m):
+        return np.array([np.asarray(p.data) for p in m.poses])
+
+    worst, moved = {}, {}
+    for fixes in ((), fp.FIXES[:3], fp.FIXES):
+        g, clips, start = _fm(sk, fixes=fixes, native_fps=60.0, turn=True)
+        db_step = max(np.linalg.norm(np.diff(_positions(c)[:, 0], axis=0), axis=-1).max() for c in clips)
+        ratios, n_moved = [], 0
+        for seed in range(8):
+            seen.clear()
+            out = g.generate(start, 40, seed=seed)
+            ratios.append(np.linalg.norm(np.diff(_positions(out)[:, 0], axis=0), axis=-1).max() / db_step)
+            view = seen[-1]
+            assert view._copies
+            n_moved += sum(not np.array_equal(poses(m), poses(g._loaded_[i])) for i, m in view._copies.items())
+        worst[fixes], moved[fixes] = max(ratios), n_moved
+    assert moved[fp.FIXES] == 0 and worst[fp.FIXES] < 1.5
+    assert moved[fp.FIXES[:3]] > 0 and worst[fp.FIXES[:3]] > 5.0  # the other three fixes alone
+    assert moved[()] > 0 and worst[()] > 5.0  # the released row: as released
+
+
 def test_fairmotion_runs_at_its_native_rate_and_answers_at_ours(sk):
     g, clips, start = _fm(sk, native_fps=60.0)
     g.fixes = ()
@@ -558,3 +595,124 @@ def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
     assert view[-1] is view[3]
     with pytest.raises(IndexError):
         view[4]
+
+
+# ---------------------------------------------------------------- the native-rate clips (fed from the source)
+def _trials_120(sk):
+    from animsynth.synth.mocap import generate_motion as gm
+
+    return {f"t{i}": gm(kind, 240, s, sk, name=f"t{i}")  # 120 fps, 2 s each
+            for i, (kind, s) in enumerate((("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5)))}
+
+
+_CC = {"fps": 30, "context": 8, "length": 20, "min_length": 6, "holdout_fraction": 0.4}
+
+
+def test_clips_carry_the_native_rate_database_and_start_from_the_source(sk, tmp_path):
+    from animsynth.compare import jobs
+
+    trials = _trials_120(sk)
+    clips = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {"split": "t1"}, dict(_CC, native_fps=[60.0]))
+    for c in clips:
+        assert len(c.native) == 1
+        nat = c.at_rate(60.0)
+        assert nat.fps == 60.0 and nat.note == "" and c.at_rate(90.0) is None
+        src = trials[c.trial].values[::2]  # 120 -> 60 fps: every second source frame
+        assert nat.start.n_frames == (c.context - 1) * 2 + 1
+        assert np.array_equal(nat.start.values[::2], c.start.values)  # the same instants as the working start
+        if c.protocol == "leave one out":
+            assert np.array_equal(nat.start.values, src[:nat.start.n_frames])
+            for d, n, name in zip(c.database, nat.database, c.database_names):
+                assert np.array_equal(n.values, trials[name].values[::2])
+                assert np.array_equal(n.values[::2], d.values) and n.fps == 60.0
+        else:
+            n_db = c.database[0].n_frames
+            assert np.array_equal(nat.database[0].values, src[:2 * n_db])  # nothing of the held-out part
+            assert np.array_equal(nat.start.values, src[2 * n_db:2 * n_db + nat.start.n_frames])
+    # stored and read back; a file written before the native clips loads with none
+    jobs.save_clips(tmp_path / "c.npz", clips)
+    back = jobs.load_clips(tmp_path / "c.npz")
+    for a, b in zip(clips, back):
+        x, y = a.at_rate(60.0), b.at_rate(60.0)
+        assert np.array_equal(x.start.values, y.start.values) and y.start.fps == 60.0
+        assert all(np.array_equal(p.values, q.values) and p.name == q.name for p, q in zip(x.database, y.database))
+    table = jobs.clips_table(back)
+    assert list(table["native_fps"]) == ["60"] * 4 and list(table["note"]) == [""] * 4
+    old = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, _CC)
+    assert all(c.native == [] for c in old)
+    jobs.save_clips(tmp_path / "old.npz", old)
+    with np.load(tmp_path / "old.npz") as z:
+        arrays = {k: z[k] for k in z.files}
+    import json
+
+    manifest = json.loads(str(arrays["manifest"]))
+    for m in manifest:
+        del m["native"]
+    arrays["manifest"] = np.array(json.dumps(manifest))
+    np.savez_compressed(tmp_path / "older.npz", **arrays)
+    assert all(c.native == [] for c in jobs.load_clips(tmp_path / "older.npz"))
+
+
+def test_a_source_rate_that_is_no_multiple_of_the_native_rate_falls_back_with_a_note(sk, caplog):
+    from animsynth.compare import jobs
+
+    trials = {k: Motion(v.values, v.skeleton, 90.0, k) for k, v in _trials_120(sk).items()}  # 90 fps: 60 does not divide it
+    with caplog.at_level("INFO", logger="animsynth.compare.jobs"):
+        clips = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))
+    nat = clips[0].at_rate(60.0)
+    assert nat.database == [] and nat.start is None and "not a whole multiple of 60" in nat.note
+    assert "upsample" in nat.note and "no 60 fps database" in caplog.text
+    assert all("not a whole multiple" in n for n in jobs.clips_table(clips)["note"])
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_fairmotion_builds_on_the_sources_60_fps_frames_not_the_30_fps_clips_upsampled(sk, monkeypatch):
+    """Given the clips' 60 fps database (the runner passes it), fairmotion's loaded frames are the source trial's
+    every second frame, not an interpolation of the 30 fps clip; without it, the upsampled clip as before."""
+    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare import jobs
+
+    trials = _trials_120(sk)
+    clips = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))
+    clip = clips[0]
+
+    def root_m(loaded):  # fairmotion's root positions (metres, the BVH is written in metres)
+        return np.array([np.asarray(p.data)[0, :3, 3] for p in loaded.poses])
+
+    gen = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0, fixes=fp.FIXES)
+    fit_kw, gen_kw = jobs.native_inputs(gen, clip)
+    assert set(fit_kw) == {"native_clips"} and set(gen_kw) == {"native_start"}
+    gen.fit(clip.database, **fit_kw)
+    assert gen.native_input_ == "source" and gen.upsample_ == 2
+    old = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0).fit(clip.database)
+    assert old.native_input_ == "upsampled"
+    for i, name in enumerate(clip.database_names):
+        source = positions_m_root(trials[name].values[::2], sk)
+        got, up = root_m(gen._loaded_[i]), root_m(old._loaded_[i])
+        assert got.shape == source.shape and np.allclose(got, source, atol=1e-6)
+        n = min(len(up), len(source))
+        assert np.abs(up[1:n:2] - source[1:n:2]).max() > 1e-4  # the upsampled clip interpolates between
+        assert np.allclose(up[0:n:2], source[0:n:2], atol=1e-6)  # and agrees on the working frames
+    out = gen.generate(clip.start, clip.length, 3, **gen_kw)
+    assert out.fps == 30.0 and out.values.shape == (clip.length, sk.n_dof)
+    # the runner passes them
+    seen = []
+    real = fp.FairmotionGraph.fit
+
+    def spy(self, database, native_clips=None):
+        seen.append(native_clips)
+        return real(self, database, native_clips=native_clips)
+
+    monkeypatch.setattr(fp.FairmotionGraph, "fit", spy)
+    from conftest import default_config
+    from animsynth.compare import settings
+
+    config = default_config()
+    cfg = dict(settings.job_cfg(config, "fairmotion_fixed"), seeds=1)
+    cfg["fairmotion"] = dict(cfg["fairmotion"], base=8, blend=4, compare=4)
+    jobs.run_generator(clips[:1], "fairmotion_fixed", cfg, 7)
+    assert seen and seen[0] is clip.at_rate(60.0).database
+
+
+def positions_m_root(values, sk):
+    return root_translation(sk, values) * sk.length_to_m

@@ -21,7 +21,8 @@ from .kinematics import (heading, local_rotations, root_rotation, root_translati
                          wrap_radians)
 from .motion import Motion
 
-__all__ = ["Database", "Generator", "align_root", "check_generated", "play_path"]
+__all__ = ["Database", "Generator", "align_root", "check_generated", "play_path", "QUERY_START",
+           "QUERY_FUTURE_TRAJECTORY"]
 
 
 # ----------------------------------------------------------------------------- root helpers
@@ -141,6 +142,12 @@ class Database:
         return np.stack([self.clip[path], self.frame[path]], axis=1)
 
 
+#: ``Generator.query``: the generator is given the start alone (every generator's protocol by default)
+QUERY_START = "start"
+#: ``Generator.query``: the generator is also given the held-out future (``generate(..., trajectory=future)``)
+QUERY_FUTURE_TRAJECTORY = "future_trajectory"
+
+
 class Generator:
     """Base class: ``fit(database)`` then ``generate(start, length, seed)``.
 
@@ -149,9 +156,15 @@ class Generator:
     fitted attributes (names ending in ``_``) and returns ``self``; ``generate(start, length, seed)`` returns
     ``length`` frames continuing ``start`` (>= 2 frames), checked by :func:`check_generated`, with
     ``meta["seams"]`` and ``meta["source_frames"]``.
+
+    ``query`` says what a generator is given besides the database: :data:`QUERY_START` (``"start"``, every
+    generator by default: the start alone) or :data:`QUERY_FUTURE_TRAJECTORY` (``"future_trajectory"``: its
+    ``generate`` takes ``trajectory=``, the held-out frames after the start, and the compare family's runner
+    passes them; information the other generators do not see).
     """
 
     name = "generator"
+    query = "start"
 
     def fit(self, database) -> "Generator":  # pragma: no cover - every generator overrides it
         raise NotImplementedError

@@ -1,4 +1,5 @@
-"""Every held-out clip of the comparison (database, start, length) at the working rate -> clips.npz, clips.csv."""
+"""Every held-out clip of the comparison (database, start, length) at the working rate, and its database and start
+at the native rate of the generators that run at one (fairmotion's 60 fps) -> clips.npz, clips.csv."""
 from animsynth.compare.jobs import clips_table, prepare_clips, save_clips
 from animsynth.motion import Motion
 from animsynth.tables import write_table

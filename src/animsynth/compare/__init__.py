@@ -13,7 +13,7 @@ base            the one interface (``fit(database)``, ``generate(start, length, 
 generators      the registry: names -> estimators and their settings (``make_generator``), no method code:
                 delaunay, knn (the simplicial family's FieldFollower), isomap, stisomap (the resequencing
                 family's Resequencer), motion_graph, fairmotion, fairmotion_fixed, motion_matching,
-                motion_matching_pose, genmm, replay, concat
+                motion_matching_pose, motion_matching_traj (its query: the held-out future), genmm, replay, concat
 references      the two reference rows: replay (the held-out capture) and concat (random segments)
 motiongraph     the classic motion graph (Kovar, Gleicher & Pighin 2002)
 motionmatching  motion matching with inertialization and foot locking (Clavet 2016; Holden et al. 2020)

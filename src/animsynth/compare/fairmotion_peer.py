@@ -44,15 +44,21 @@ a ground truth sees).
 Its native rate
 ---------------
 fairmotion's walk assumes 60 fps (its output motion is built at its default 60 fps whatever the data's rate).
-The peer is therefore fed its native rate: ``native_fps`` = 60 (default) upsamples every database clip from the
-working rate by an integer factor before it is written to BVH (:func:`upsample`: joint rotations slerped,
-the root translation interpolated linearly between neighbouring frames), lengths stay in seconds, and the walk's
-output is taken back to the working rate by keeping every factor-th frame. ``native_fps=None`` feeds the
-working rate unchanged.
+The peer is therefore fed its native rate, ``native_fps`` = 60 (default; a whole multiple ``k`` of the working
+rate). In the comparison the clips carry the database and the start at that rate taken by frame step from the
+source trials (CMU's 120 fps: every second frame; :class:`animsynth.compare.jobs.NativeRate`), and the runner
+passes them (``fit(database, native_clips=...)``, ``generate(..., native_start=...)``; the class attribute
+``input_rate = "native"`` says the peer takes them): fairmotion builds its graph and walks on the captured 60 fps
+frames, and the start node is chosen by the 60 fps start. Without them (a source rate that is not a whole multiple
+of 60, or a caller that has only the working-rate clips) every database clip is upsampled from the working rate by
+``k`` before it is written to BVH (:func:`upsample`: joint rotations slerped, the root translation interpolated
+linearly between neighbouring frames). Either way lengths stay in seconds and the walk's output is taken back to
+the working rate by keeping every ``k``-th frame (native frame ``i * k`` is working frame ``i``).
+``native_fps=None`` feeds the working rate unchanged.
 
 Defects of the release, and the fixes (``fixes``)
 -------------------------------------------------
-Three defects of 0.0.4's walk were changed upstream after the release (never released). The peer runs as
+Four defects of 0.0.4's walk were changed upstream after the release (never released). The peer runs as
 released (``fixes=()``, the row ``fairmotion``) and with each fix applied as a small patch of the walk
 (``fixes=FIXES``, the row ``fairmotion_fixed``); each patch swaps one thing for the duration of one walk and is
 undone afterwards:
@@ -72,11 +78,20 @@ undone afterwards:
     rotates every pose's orientation about the vertical but leaves its root path where it was, so a piece
     walks sideways or backwards after a turn. Patch: ``ops.motion.rotate`` turns the piece rigidly about its
     first pose's root (orientation and path), as upstream's ``transform(..., pivot=0)`` does.
+``cut_copy``
+    ``ops.motion.cut`` deep-copies the clip but hands back the Pose objects of the loaded clip itself
+    (``motion.poses[start:end]``), and ``append_and_blend`` moves the appended piece's poses in place
+    (``translate``, ``rotate``). The walk cuts each node with ``frames_blend`` extra frames, so consecutive
+    pieces of one clip share those frames: placing one piece displaces the first frames of the next piece read
+    from the same clip (and of any later visit), which then jumps back where its own frames were not moved
+    (a reviewer measured, on the fixed row of the paper run: the 95th percentile of the per-frame velocity
+    jump 1.69 m/s without this fix, 1.08 m/s with it; the largest 11.3 and 3.6 m/s). Patch: ``cut`` returns the
+    poses of its own deep copy (``cut_motion.poses[start:end]``, and its velocities cut alike), as upstream's
+    fix in the same commit as the three above does; the loaded clips are then never moved by a walk.
 
-Left as released in both rows: ``ops.motion.cut`` shares the Pose objects with the loaded clips and
-``append_and_blend`` moves them in place, so a walk displaces poses that later pieces of the same walk reuse.
-Only between walks do we step in: every :meth:`FairmotionGraph.generate` walks a fresh copy of the loaded clips,
-so walks are reproducible and do not depend on each other.
+Released (the row ``fairmotion``), ``cut`` shares the poses and a walk displaces poses that later pieces of the
+same walk reuse. Between walks we step in for both rows: every :meth:`FairmotionGraph.generate` walks a fresh
+copy of the loaded clips, so walks are reproducible and do not depend on each other.
 
 Random choices: fairmotion's walk draws from Python's global ``random`` module; :meth:`FairmotionGraph.generate`
 seeds it with ``seed`` and restores its previous state afterwards.
@@ -113,7 +128,7 @@ FAIRMOTION_VERSION = "0.0.4"
 INSTALL_COMMAND = "pip install --no-deps fairmotion==0.0.4 networkx==3.6.1 tqdm==4.70.1"
 
 #: The fixes of the walk that upstream made after 0.0.4 (module docstring), in the order they are named.
-FIXES = ("output_rate", "blend_source", "rigid_turn")
+FIXES = ("output_rate", "blend_source", "rigid_turn", "cut_copy")
 #: The frame rate fairmotion's walk assumes (its Motion's default).
 NATIVE_FPS = 60.0
 
@@ -305,6 +320,9 @@ def _run_serially(func, iterable, num_cpus=1, **kwargs):
 class FairmotionGraph:
     """fairmotion 0.0.4's motion graph behind the compare generator interface (see the module docstring).
 
+    ``input_rate = "native"``: :meth:`fit` and :meth:`generate` also take the database and the start at
+    ``native_fps`` (``native_clips``, ``native_start``), which the compare runner passes when the clips carry them.
+
     Lengths are in frames at the database's rate (converted to fairmotion's seconds). Defaults: nodes of
     ``base`` = 15 frames (0.5 s at 30 fps; fairmotion's own 1.5 s leaves a few nodes on clips of seconds),
     a new node every ``stride`` = ``base`` frames (fairmotion's default), ``blend`` = 10 and ``compare`` =
@@ -355,11 +373,16 @@ class FairmotionGraph:
     construct_reused_ : bool
         Whether ``construct`` ran in this fit or its graph came from the process's memo (an earlier fit on the
         same clips with the same lengths, weights and comparison count: the other row, another budget).
+    native_input_ : str
+        ``"source"`` (fitted on the native-rate clips given) or ``"upsampled"`` (the working-rate clips upsampled;
+        also when native_fps_ equals the database's rate).
     last_walk_ : dict
         Of the last :meth:`generate`: ``out_fps`` (the rate of fairmotion's output motion), ``pieces``
         (first output frame, frames of each appended piece, at that rate), ``blend_sources`` (root position of
         every source pose a blend drew, in order).
     """
+
+    input_rate = "native"
 
     def __init__(self, base: int = 15, stride: int | None = None, blend: int = 10, compare: int = 10,
                  threshold: float | None = None, threshold_quantile: float = 0.5, w_joint_pos: float = 8.0,
@@ -393,8 +416,16 @@ class FairmotionGraph:
             s = np.nextafter(s, np.inf)
         return float(s)
 
-    def fit(self, database) -> "FairmotionGraph":
-        """Write the clips to BVH, load them with fairmotion and build and reduce its graph."""
+    def fit(self, database, native_clips=None) -> "FairmotionGraph":
+        """Write the clips to BVH, load them with fairmotion and build and reduce its graph.
+
+        Parameters
+        ----------
+        database : list of Motion, the clips at the working rate (one skeleton and rate)
+        native_clips : list of Motion, optional
+            The same clips at ``native_fps`` from the source (frame ``i * k`` of each the working clip's frame
+            ``i``, ``k = native_fps / rate``), fed to fairmotion instead of the working clips upsampled.
+        """
         found, bvh, velocity, _, motion_graph = _fairmotion()
         stride = self.base if self.stride is None else self.stride
         if not (self.base >= stride >= 1 and self.base > self.blend >= 1 and self.compare >= self.blend):
@@ -419,11 +450,21 @@ class FairmotionGraph:
             raise ValueError(f"fairmotion native_fps {native:g} must be a whole multiple of the database's "
                              f"{fps:g} fps")
         up = int(round(up))
+        src, load_up = clips, up  # what is written for fairmotion: the working clips, upsampled by up
+        if native_clips is not None and up > 1:
+            src, load_up = list(native_clips), 1  # the native-rate clips from the source, as they are
+            if len(src) != len(clips):
+                raise ValueError(f"fairmotion graph: {len(src)} native-rate clips for {len(clips)} database clips")
+            for c, n in zip(clips, src):
+                if (not np.isclose(n.fps, native) or n.skeleton.columns() != first.skeleton.columns()
+                        or n.n_frames < (c.n_frames - 1) * up + 1):
+                    raise ValueError(f"fairmotion graph: native clip {n.name!r} is not clip {c.name!r} at {native:g} fps "
+                                     f"(its rate {n.fps:g}, {n.n_frames} frames, need >= {(c.n_frames - 1) * up + 1})")
         # each clip's memo key, hashed once: the loading memo's and, together, the construction memo's below
-        keys = [_native_key(c, up, None if i == 0 else (first, None)) for i, c in enumerate(clips)]
-        loaded = [_load_native(first, up, bvh, velocity, key=keys[0])]
-        loaded += [_load_native(c, up, bvh, velocity, on=(first, loaded[0].skel), key=k)
-                   for c, k in zip(clips[1:], keys[1:])]
+        keys = [_native_key(c, load_up, None if i == 0 else (src[0], None)) for i, c in enumerate(src)]
+        loaded = [_load_native(src[0], load_up, bvh, velocity, key=keys[0])]
+        loaded += [_load_native(c, load_up, bvh, velocity, on=(src[0], loaded[0].skel), key=k)
+                   for c, k in zip(src[1:], keys[1:])]
         for c, m in zip(clips, loaded):
             if not np.isclose(m.fps, native):
                 raise ValueError(f"fairmotion read clip {c.name!r} at {m.fps} fps, not {native:g} (its BVH loader "
@@ -507,6 +548,8 @@ class FairmotionGraph:
         self._loaded_ = copy.deepcopy(graph.motions)
         self._names_ = [j.name for j in skel.joints]
         self._pos_ = [positions_m(c) for c in clips]
+        self._native_pos_ = [positions_m(c) for c in src] if src is not clips else None
+        self.native_input_ = "source" if src is not clips else "upsampled"
         self.fairmotion_version_ = found
         self.skeleton_ = first.skeleton
         self.fps_ = fps
@@ -515,24 +558,32 @@ class FairmotionGraph:
         self.fixes_ = fixes
         return self
 
-    def _start(self, start: Motion):
-        """The reduced graph's node whose preceding frames are nearest the end of ``start``, and its placement."""
+    def _start(self, start: Motion, native_start: Motion | None = None):
+        """The reduced graph's node whose preceding frames are nearest the end of ``start``, and its placement;
+        with ``native_start`` (and native-rate clips fitted), compared at the native rate: its last ``blend * k``
+        frames against the native frames before each node."""
         if not hasattr(self, "_graph_"):
             raise RuntimeError("FairmotionGraph is not fitted: call fit(database) first")
         if not isinstance(start, Motion) or start.n_frames < 1:
             raise ValueError("start must be a Motion with at least one frame")
         if not np.isclose(start.fps, self.fps_):
             raise ValueError(f"start {start.name!r} is at {start.fps:g} fps, the database at {self.fps_:g} fps")
-        q = positions_m(start)
-        m = min(self.blend, start.n_frames)
-        nodes = self._graph_.graph.nodes
         up = self.upsample_
-        ids = [n for n in nodes if nodes[n]["frame_start"] // up >= m] or list(nodes)
+        pos, div = self._pos_, up
+        if native_start is not None and self._native_pos_ is not None:
+            if not np.isclose(native_start.fps, self.native_fps_) or native_start.columns != start.columns:
+                raise ValueError(f"native start {native_start.name!r} is at {native_start.fps:g} fps, not "
+                                 f"{self.native_fps_:g}, or on other DOF columns")
+            start, pos, div = native_start, self._native_pos_, 1
+        q = positions_m(start)
+        m = min(self.blend * (up // div), start.n_frames)
+        nodes = self._graph_.graph.nodes
+        ids = [n for n in nodes if nodes[n]["frame_start"] // div >= m] or list(nodes)
         clouds = []
         for n in ids:
-            c, f = int(nodes[n]["motion_idx"]), int(nodes[n]["frame_start"]) // up
+            c, f = int(nodes[n]["motion_idx"]), int(nodes[n]["frame_start"]) // div
             lo = max(f - m, 0)
-            clouds.append(self._pos_[c][lo:lo + m])
+            clouds.append(pos[c][lo:lo + m])
         w = np.full(m * q.shape[1], 1.0 / (m * q.shape[1]))
         d2, a, b, cp, cq = pair_terms(window_clouds(q[-m:], m), np.stack(clouds).reshape(len(ids), -1, 3), w)
         best = int(np.argmin(d2[0]))
@@ -590,13 +641,28 @@ class FairmotionGraph:
                 pose.set_root_transform(conversions.Rp2T(np.dot(R, R0), pivot + np.dot(R, p0 - pivot)), local=False)
             return motion
 
+        def copying_cut(motion, frame_start, frame_end):
+            # fix: the cut piece's poses are its own copy's (released: the loaded clip's Pose objects themselves,
+            # which append_and_blend then moves in place)
+            cut_motion = copy.deepcopy(motion)
+            cut_motion.name = f"{motion.name}_{frame_start}_{frame_end}"
+            cut_motion.poses = cut_motion.poses[frame_start:frame_end]
+            if hasattr(cut_motion, "vels"):
+                cut_motion.vels = cut_motion.vels[frame_start:frame_end]
+            return cut_motion
+
         swap = {"append_and_blend": recorder, "blend": blend_recorder}
         if "rigid_turn" in fixes:
             swap["rotate"] = rigid_rotate
+        if "cut_copy" in fixes:
+            swap["cut"] = copying_cut
         return pieces, swap
 
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, native_start: Motion | None = None) -> Motion:
         """fairmotion's ``create_random_motion`` from the node nearest the end of ``start``, ``length`` frames.
+
+        ``native_start``: the start at ``native_fps_`` (its last frame the start's last), which chooses the start
+        node at the native rate when the graph was fitted on native-rate clips (ignored otherwise).
 
         The walk runs at ``native_fps_`` (``(length - 1) x upsample_ + 1`` frames) with the fixes of
         ``fixes_`` patched in for its duration; its output is taken back to the database's rate by keeping
@@ -611,7 +677,7 @@ class FairmotionGraph:
         if isinstance(length, bool) or not isinstance(length, (int, np.integer)) or length < 1:
             raise ValueError(f"length must be an integer >= 1 (frames), got {length!r}")
         length = int(length)
-        node, place = self._start(start)
+        node, place = self._start(start, native_start)
         _, _, velocity, motion_ops, _ = _fairmotion()
         up = self.upsample_
         n_native = (length - 1) * up + 1

@@ -39,7 +39,7 @@ Generators (``GENERATORS``):
     (:func:`animsynth.compare.settings.unavailable` gives the reason when not).
 ``fairmotion_fixed``
     the same with upstream's later fixes of its walk (output rate, blend source, rigid turn of the
-    appended piece), each a named patch (:data:`animsynth.compare.fairmotion_peer.FIXES`).
+    appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.fairmotion_peer.FIXES`).
 
 The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare.transitions_per_s``
 (:func:`animsynth.compare.motiongraph.budget_count`).
@@ -49,6 +49,14 @@ The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare
     steady "gamepad" from the start; deterministic (every seed gives the same motion).
 ``motion_matching_pose``
     the same with the trajectory weights at 0: matching on the pose only.
+``motion_matching_traj``
+    the same with the held-out future as its query trajectory (``query = "future_trajectory"``,
+    :class:`animsynth.compare.motionmatching.MotionMatchingTrajectory`; the runner passes the held-out frames
+    after the start): it sees where the capture went next, information no other generator is given, so it
+    is a different protocol (following a known path), not a better generator.
+
+Every generator's ``query`` (:class:`animsynth.generator.Generator`) says what it is given: ``"start"`` (the
+start alone; all but ``motion_matching_traj``) or ``"future_trajectory"``.
 ``genmm``
     generative motion matching (Li et al. 2023; :mod:`animsynth.compare.genmm`) in keyframe mode from the
     start; seeds differ by the initial noise.
@@ -77,7 +85,7 @@ __all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINIST
 
 #: every generator name, in the order of the tables
 GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "fairmotion_fixed",
-              "motion_matching", "motion_matching_pose", "genmm", "replay", "concat")
+              "motion_matching", "motion_matching_pose", "motion_matching_traj", "genmm", "replay", "concat")
 #: the motion-graph generators: one transition budget for all of them
 GRAPHS = ("motion_graph", "fairmotion", "fairmotion_fixed")
 #: the generators that run fairmotion's package
@@ -85,7 +93,7 @@ FAIRMOTION_ROWS = ("fairmotion", "fairmotion_fixed")
 #: the two reference rows (bounds, not methods)
 REFERENCES = ("replay", "concat")
 #: the generators whose motion the seed does not change (seed diversity 0)
-DETERMINISTIC = ("motion_matching", "motion_matching_pose", "replay")
+DETERMINISTIC = ("motion_matching", "motion_matching_pose", "motion_matching_traj", "replay")
 
 
 # ----------------------------------------------------------------------------- the factory
@@ -114,11 +122,12 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
 
         return FairmotionGraph(**cfg["fairmotion"], transitions_per_s=cfg.get("transitions_per_s"),
                                fixes=FIXES if name == "fairmotion_fixed" else ())
-    if name in ("motion_matching", "motion_matching_pose"):
+    if name in ("motion_matching", "motion_matching_pose", "motion_matching_traj"):
         from .motionmatching import make_motion_matching
 
         mm = dict(cfg["motion_matching"])
-        return make_motion_matching(mm, trajectory_weight=0.0 if name == "motion_matching_pose" else None, name=name)
+        return make_motion_matching(mm, trajectory_weight=0.0 if name == "motion_matching_pose" else None, name=name,
+                                    future_trajectory=name == "motion_matching_traj")
     if name == "genmm":
         from .genmm import make_genmm
 

@@ -9,6 +9,11 @@ Protocol (docs/compare.md, "Protocol"):
 * **Temporal split** (each re-sequencing clip of ``compare.resequencing``): the last part of the
   clip is held out (``compare.holdout_fraction`` of it, at least ``context + min_length``
   frames); the database is the frames before it.
+* For the generators that run at a native rate (fairmotion's 60 fps, ``compare.fairmotion.native_fps``),
+  every clip also carries its database and start at that rate, taken by frame step from the trials too
+  (:class:`NativeRate`): the same instants as the working-rate frames and the real frames between them. A
+  trial whose rate is not a whole multiple of the native rate has none (a log line and the clips table's
+  ``note`` say so), and the generator upsamples the working-rate clips instead.
 * The start is the held-out clip's first ``compare.context`` frames; every generator makes
   ``length = min(compare.length, held-out frames - context)`` frames from it; the ground truth
   is the held-out frames that follow the start (the ``replay`` row).
@@ -54,6 +59,27 @@ TIMING_COLUMNS = ["generator", "clip", "database_frames", "build_cpu_s", "build_
 
 
 @dataclass
+class NativeRate:
+    """One clip's database and start at a generator's native rate (by frame step from the trials).
+
+    Attributes
+    ----------
+    fps : float, the native rate (a whole multiple ``k`` of the working rate)
+    database : list of Motion at ``fps``, the clip's database clips in the same order (native frame ``i * k`` is
+        working frame ``i``; the ``k - 1`` real frames after each are kept); empty when the trials' rate is not a
+        whole multiple of ``fps`` (``note`` says so)
+    start : Motion or None, the start at ``fps``: ``(context - 1) * k + 1`` frames, its last frame the working
+        start's last
+    note : str, why there is no native database ("" when there is one)
+    """
+
+    fps: float
+    database: list
+    start: Motion | None
+    note: str = ""
+
+
+@dataclass
 class Clip:
     """One held-out clip with its database (all at the working rate).
 
@@ -66,6 +92,8 @@ class Clip:
     held_out : Motion, the held-out frames (the start, then the ground truth)
     database : list of Motion
     context, length : int, start frames and generated frames
+    database_names : list of str
+    native : list of NativeRate, the database and start at each native rate of ``compare``'s generators
     """
 
     clip: str
@@ -77,11 +105,26 @@ class Clip:
     context: int
     length: int
     database_names: list = field(default_factory=list)
+    native: list = field(default_factory=list)
+
+    def at_rate(self, fps: float) -> NativeRate | None:
+        """The clip at the native rate ``fps`` (``None``: not prepared for that rate)."""
+        for n in self.native:
+            if np.isclose(n.fps, float(fps)):
+                return n
+        return None
 
     @property
     def start(self) -> Motion:
         h = self.held_out
         return Motion(np.asarray(h.values[:self.context], float), h.skeleton, h.fps, f"{self.clip}:start")
+
+    @property
+    def future(self) -> Motion:
+        """Every held-out frame after the start (the truth and what follows it): the query trajectory of a
+        generator whose ``query`` is ``"future_trajectory"``."""
+        h = self.held_out
+        return Motion(np.asarray(h.values[self.context:], float), h.skeleton, h.fps, f"{self.clip}:future")
 
     @property
     def truth(self) -> Motion:
@@ -111,14 +154,51 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
     resequencing : {group: trial id}, a temporal split of each: the clips of ``compare.resequencing`` and the
         sets of ``compare.subjects`` with one trial
     cfg : the ``compare`` config block (``fps``, ``context``, ``length``, ``min_length``,
-        ``holdout_fraction``)
+        ``holdout_fraction``) and ``native_fps`` (optional: the native rates to prepare,
+        :func:`animsynth.compare.settings.native_rates`)
     """
     fps, context = float(cfg["fps"]), int(cfg["context"])
     length, min_length = int(cfg["length"]), int(cfg["min_length"])
     work = {t: resample(m, fps) for t, m in trials.items()}
+    rates = sorted({float(r) for r in cfg.get("native_fps") or []} - {fps})
+    native = {}  # {(rate, trial): (Motion at the rate, k) or the reason there is none}
+    for r in rates:
+        k = r / fps
+        for t, m in trials.items():
+            step = float(m.fps) / r
+            if abs(k - round(k)) > 1e-6 or round(k) < 1:
+                why = f"{r:g} fps is not a whole multiple of the working rate {fps:g} fps"
+            elif abs(step - round(step)) > 1e-6 or round(step) < 1:
+                why = f"trial {t!r} at {float(m.fps):g} fps is not a whole multiple of {r:g} fps"
+            else:
+                native[r, t] = (resample(m, r, key="compare.fairmotion.native_fps"), int(round(k)))
+                continue
+            native[r, t] = (f"{why}: its generators upsample the {fps:g} fps clips to {r:g} fps")
+            log.info("clips: no %g fps database from trial %s (%s)", r, t, native[r, t])
     clips = []
 
-    def add(clip_id, group, protocol, trial, held, db, db_names):
+    def at_rates(trial: str, db_trials: list, db_names: list, first: int, n_db: int | None) -> list:
+        """The clip at every native rate: the held-out trial's start from working frame ``first``, the database
+        trials (the whole trials; ``n_db``: the held-out trial's first ``n_db`` working frames)."""
+        out = []
+        for r in rates:
+            got = [native[r, t] for t in [trial] + db_trials]
+            why = next((g for g in got if isinstance(g, str)), "")
+            if why:
+                out.append(NativeRate(r, [], None, why))
+                continue
+            (held, k), dbs = got[0], got[1:]
+            vals = np.asarray(held.values, float)
+            start = Motion(vals[first * k:first * k + (context - 1) * k + 1], held.skeleton, r,
+                           f"{trial}:start@{r:g}")
+            if n_db is None:
+                db = [Motion(np.asarray(m.values, float), m.skeleton, r, name) for (m, _k), name in zip(dbs, db_names)]
+            else:
+                db = [Motion(vals[:n_db * k], held.skeleton, r, db_names[0])]
+            out.append(NativeRate(r, db, start))
+        return out
+
+    def add(clip_id, group, protocol, trial, held, db, db_names, nat):
         n_after = held.n_frames - context
         L = min(length, n_after)
         if L < min_length:
@@ -129,14 +209,15 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
             if d.n_frames < max(4, context):
                 raise ValueError(f"clip {clip_id}: database clip {d.name!r} has {d.n_frames} frames at {fps:g} fps "
                                  f"(need >= {max(4, context)}; config keys 'compare.fps', 'compare.holdout_fraction')")
-        clips.append(Clip(clip_id, group, protocol, trial, held, db, context, L, db_names))
+        clips.append(Clip(clip_id, group, protocol, trial, held, db, context, L, db_names, nat))
 
     for group, ids in subsets.items():
         if len(ids) < 2:
             raise ValueError(f"config key 'compare.subsets': subset {group!r} needs >= 2 trials for leave one out")
         for t in ids:
             others = [o for o in ids if o != t]
-            add(f"{group}/{t}", group, "leave one out", t, work[t], [work[o] for o in others], others)
+            add(f"{group}/{t}", group, "leave one out", t, work[t], [work[o] for o in others], others,
+                at_rates(t, others, [work[o].name for o in others], 0, None))
     for group, t in resequencing.items():
         m = work[t]
         n = m.n_frames
@@ -146,7 +227,8 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
                              "after the held-out part (config keys 'compare.holdout_fraction', 'compare.length')")
         db = Motion(m.values[:n - hold], m.skeleton, m.fps, f"{t}[0:{n - hold}]")
         held = Motion(m.values[n - hold:], m.skeleton, m.fps, f"{t}[{n - hold}:{n}]")
-        add(f"{group}/{t}", group, "temporal split", t, held, [db], [f"{t} frames 0-{n - hold - 1}"])
+        add(f"{group}/{t}", group, "temporal split", t, held, [db], [f"{t} frames 0-{n - hold - 1}"],
+            at_rates(t, [], [db.name], n - hold, n - hold))
     return clips
 
 
@@ -159,10 +241,18 @@ def save_clips(path, clips: list[Clip]) -> None:
         arrays[f"c{i}_held"] = np.asarray(c.held_out.values, float)
         for j, d in enumerate(c.database):
             arrays[f"c{i}_db{j}"] = np.asarray(d.values, float)
+        nat = []
+        for r, n in enumerate(c.native):
+            for j, d in enumerate(n.database):
+                arrays[f"c{i}_n{r}_db{j}"] = np.asarray(d.values, float)
+            if n.start is not None:
+                arrays[f"c{i}_n{r}_start"] = np.asarray(n.start.values, float)
+            nat.append({"fps": float(n.fps), "database": [d.name for d in n.database], "note": n.note,
+                        "start": None if n.start is None else n.start.name})
         manifest.append({"clip": c.clip, "group": c.group, "protocol": c.protocol, "trial": c.trial,
                          "context": c.context, "length": c.length, "fps": c.held_out.fps, "skeleton": key,
                          "held_name": c.held_out.name, "database": [d.name for d in c.database],
-                         "database_names": list(c.database_names)})
+                         "database_names": list(c.database_names), "native": nat})
     for sk, key in skeletons.items():
         arrays[key] = np.array(sk)
     arrays["manifest"] = np.array(json.dumps(manifest))
@@ -171,7 +261,8 @@ def save_clips(path, clips: list[Clip]) -> None:
 
 
 def load_clips(path) -> list[Clip]:
-    """The clips stored by :func:`save_clips`."""
+    """The clips stored by :func:`save_clips` (a file without native-rate clips, written before they existed, loads
+    with ``native`` empty)."""
     with np.load(path, allow_pickle=False) as z:
         manifest = json.loads(str(z["manifest"]))
         sks = {k: Skeleton.from_json(str(z[k])) for k in z.files if k.startswith("skeleton")}
@@ -180,8 +271,14 @@ def load_clips(path) -> list[Clip]:
             sk, fps = sks[m["skeleton"]], float(m["fps"])
             held = Motion(np.array(z[f"c{i}_held"]), sk, fps, m["held_name"])
             db = [Motion(np.array(z[f"c{i}_db{j}"]), sk, fps, name) for j, name in enumerate(m["database"])]
+            nat = []
+            for r, n in enumerate(m.get("native", [])):
+                nfps = float(n["fps"])
+                ndb = [Motion(np.array(z[f"c{i}_n{r}_db{j}"]), sk, nfps, name) for j, name in enumerate(n["database"])]
+                start = None if n["start"] is None else Motion(np.array(z[f"c{i}_n{r}_start"]), sk, nfps, n["start"])
+                nat.append(NativeRate(nfps, ndb, start, n["note"]))
             clips.append(Clip(m["clip"], m["group"], m["protocol"], m["trial"], held, db, int(m["context"]),
-                              int(m["length"]), list(m["database_names"])))
+                              int(m["length"]), list(m["database_names"]), nat))
     return clips
 
 
@@ -191,6 +288,8 @@ def clips_table(clips: list[Clip]) -> pd.DataFrame:
         "clip": c.clip, "group": c.group, "protocol": c.protocol, "held_out": c.held_out.name,
         "database": " ".join(c.database_names), "database_frames": int(sum(d.n_frames for d in c.database)),
         "held_out_frames": c.held_out.n_frames, "fps": c.held_out.fps, "context": c.context, "length": c.length,
+        "native_fps": " ".join(f"{n.fps:g}" for n in c.native if n.database),
+        "note": "; ".join(n.note for n in c.native if n.note),
     } for c in clips])
 
 
@@ -491,6 +590,34 @@ def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> tuple[li
     return rows, timing
 
 
+def generation_query(gen, clip: Clip) -> dict:
+    """What ``gen.generate`` is given besides the start, length and seed, by its ``query``
+    (:class:`animsynth.generator.Generator`): nothing for ``"start"``; ``trajectory`` = the clip's held-out frames
+    after the start (:attr:`Clip.future`) for ``"future_trajectory"``."""
+    from ..generator import QUERY_FUTURE_TRAJECTORY, QUERY_START
+
+    query = getattr(gen, "query", QUERY_START)
+    if query == QUERY_START:
+        return {}
+    if query == QUERY_FUTURE_TRAJECTORY:
+        return {"trajectory": clip.future}
+    raise ValueError(f"generator {getattr(gen, 'name', gen)!r}: unknown query {query!r} (one of "
+                     f"{[QUERY_START, QUERY_FUTURE_TRAJECTORY]})")
+
+
+def native_inputs(gen, clip: Clip) -> tuple[dict, dict]:
+    """What ``gen.fit`` and ``gen.generate`` are given at the generator's native rate: for a generator with
+    ``input_rate = "native"`` (fairmotion's peer) whose ``native_fps`` the clip carries from the source
+    (:class:`NativeRate`), ``({"native_clips": database}, {"native_start": start})``; else ``({}, {})`` (the generator
+    upsamples the working-rate clips itself)."""
+    if getattr(gen, "input_rate", "working") != "native" or getattr(gen, "native_fps", None) is None:
+        return {}, {}
+    nat = clip.at_rate(float(gen.native_fps))
+    if nat is None or not nat.database:
+        return {}, {}
+    return {"native_clips": nat.database}, {"native_start": nat.start}
+
+
 def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
@@ -501,9 +628,10 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
         db_frames = int(sum(d.n_frames for d in clip.database))
         gen = make_generator(generator, cfg, held_out=clip.held_out)
+        fit_native, generate_native = native_inputs(gen, clip)
         c0, w0 = cpu_seconds(), time.perf_counter()
         try:
-            gen.fit(clip.database)
+            gen.fit(clip.database, **fit_native)
         except ValueError as exc:  # e.g. a motion graph without transitions on a short database
             if showcase is not None and clip.clip == showcase[0]:
                 raise ValueError(f"{generator} cannot be built on the showcase clip {clip.clip} ({exc}); choose "
@@ -518,9 +646,10 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         ref = reference(clip, mcfg, roles, std[_joint_count(clip)], kin)
         gen_cpu = gen_wall = 0.0
         feats = []
+        query = {**generation_query(gen, clip), **generate_native}
         for i, s in enumerate(seeds):
             c0, w0 = cpu_seconds(), time.perf_counter()
-            m = gen.generate(start, clip.length, s)
+            m = gen.generate(start, clip.length, s, **query)
             gen_cpu += cpu_seconds() - c0
             gen_wall += time.perf_counter() - w0
             row, f = score(clip, ref, m, generator, mcfg, roles)

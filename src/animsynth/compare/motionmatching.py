@@ -46,6 +46,13 @@ position, velocity (backward difference; acceleration taken as zero) and facing 
 ``generate(..., trajectory=motion)`` replaces the gamepad with a given future (the known-answer tests:
 a clip's own continuation), its root positions and facings read relative to the generated root.
 
+Query protocols (the rows of the compare family): ``motion_matching`` (the gamepad from the start),
+``motion_matching_pose`` (trajectory weights 0: the pose only) and ``motion_matching_traj``
+(:class:`MotionMatchingTrajectory`, ``query = "future_trajectory"``): the query trajectory is the held-out
+future itself, which the runner passes as ``trajectory``. That row sees information no other generator sees
+(where the capture went next): it measures how well the database and the matching follow a known path, not
+how a generator continues a start on its own.
+
 Foot locking and leg IK (``foot_lock=True``, the reference's default ``ik_enabled``;
 :mod:`animsynth.compare.footlock`): the database's frames are labelled in contact where the foot's contact
 point (the end of the ankle role's segment: the ball of the foot, the reference's toe bone) moves slower
@@ -543,18 +550,37 @@ class MotionMatching(Generator):
                      "contact_states": self.contacts_[played].copy()}
 
 
+class MotionMatchingTrajectory(MotionMatching):
+    """:class:`MotionMatching` whose query trajectory is the held-out future (the row ``motion_matching_traj``).
+
+    ``query = "future_trajectory"``: the compare family's runner passes the held-out frames after the start as
+    ``trajectory`` to :meth:`generate`, which then requires it (without it this would be the gamepad row).
+    """
+
+    name = "motion_matching_traj"
+    query = "future_trajectory"
+
+    def generate(self, start: Motion, length: int, seed: int, trajectory: Motion | None = None) -> Motion:
+        if trajectory is None:
+            raise ValueError(f"{self.name}: its query is the future trajectory: pass trajectory= (the held-out "
+                             "frames after the start)")
+        return super().generate(start, length, seed, trajectory=trajectory)
+
+
 def make_motion_matching(cfg: dict | None = None, trajectory_weight: float | None = None,
-                         name: str | None = None, foot_lock: bool | None = None) -> MotionMatching:
+                         name: str | None = None, foot_lock: bool | None = None,
+                         future_trajectory: bool = False) -> MotionMatching:
     """An unfitted :class:`MotionMatching` from a config block (its keys are the parameters; ``None``: the
     reference's constants); ``trajectory_weight`` overrides the block's (0: the pose-only ablation row),
-    ``foot_lock`` its foot locking (``False``: the ablation without the reference's foot locking and IK) and
+    ``foot_lock`` its foot locking (``False``: the ablation without the reference's foot locking and IK),
+    ``future_trajectory`` makes it a :class:`MotionMatchingTrajectory` (the query is the held-out future) and
     ``name`` the generator's name (the row, e.g. ``motion_matching_pose``)."""
     kw = dict(cfg or {})
     if trajectory_weight is not None:
         kw["trajectory_weight"] = trajectory_weight
     if foot_lock is not None:
         kw["foot_lock"] = bool(foot_lock)
-    gen = MotionMatching(**kw)
+    gen = (MotionMatchingTrajectory if future_trajectory else MotionMatching)(**kw)
     if name is not None:
         gen.name = name
     return gen

@@ -12,7 +12,8 @@ from ..config import ConfigError
 
 log = logging.getLogger("animsynth.compare")
 
-__all__ = ["check", "groups", "clip_ids", "subject_sets", "showcase", "run_generators", "clips_cfg", "job_cfg", "unavailable",
+__all__ = ["check", "groups", "clip_ids", "subject_sets", "showcase", "run_generators", "clips_cfg", "native_rates",
+           "job_cfg", "unavailable",
            "user_generators", "generator_order", "user_job_cfg", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
@@ -128,12 +129,26 @@ RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
 GENERATOR_BLOCKS = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph",
                     "stisomap": "resequencing_graph", "motion_graph": "motion_graph", "fairmotion": "fairmotion",
                     "fairmotion_fixed": "fairmotion", "motion_matching": "motion_matching",
-                    "motion_matching_pose": "motion_matching", "genmm": "genmm", "concat": "concat"}
+                    "motion_matching_pose": "motion_matching", "motion_matching_traj": "motion_matching",
+                    "genmm": "genmm", "concat": "concat"}
+
+
+def native_rates(config: dict) -> list[float]:
+    """The native rates the clips are also prepared at: ``compare.fairmotion.native_fps`` when a fairmotion row is
+    among ``compare.generators`` and the rate is set and differs from ``compare.fps`` (else none)."""
+    from .generators import FAIRMOTION_ROWS
+
+    cmp = config["compare"]
+    rate = (cmp.get("fairmotion") or {}).get("native_fps")
+    if rate is None or not set(FAIRMOTION_ROWS) & set(cmp["generators"]) or float(rate) == float(cmp["fps"]):
+        return []
+    return [float(rate)]
 
 
 def clips_cfg(config: dict) -> dict:
-    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block)."""
-    return {k: config["compare"][k] for k in CLIP_KEYS}
+    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block) and, as ``native_fps``, the
+    native rates its clips also carry (:func:`native_rates`)."""
+    return {**{k: config["compare"][k] for k in CLIP_KEYS}, "native_fps": native_rates(config)}
 
 
 def job_cfg(config: dict, generator: str | None = None, budget: float | None = None) -> dict:

@@ -169,6 +169,11 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
            + ", ".join(generators) + ".", ""]
     if left_out:
         out += ["Left out: " + "; ".join(f"**{g}**: {why}" for g, why in left_out.items()) + ".", ""]
+    if "motion_matching_traj" in generators:
+        out += ["Query protocol: **motion_matching_traj** is given the held-out future as its query trajectory "
+                "(where the capture went next), information no other generator sees; its scores against the ground "
+                "truth are not comparable with those of the rows that see the start alone (docs/compare.md, "
+                "Motion matching).", ""]
     if not_built is not None and len(not_built):
         failed = not_built[not_built["note"].str.startswith("failed: ")].drop_duplicates("generator")
         not_built = not_built[~not_built["note"].str.startswith("failed: ")]

@@ -420,7 +420,7 @@ def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | 
                    if sweep is not None and len(sweep) else ""))
     pair("our motion graph's transitions skate less than fairmotion's with upstream's walk fixes",
          "motion_graph", "fairmotion_fixed", "transition_skate_share",
-         caveat="fairmotion with the fixes output_rate, blend_source, rigid_turn; both graphs keep the same "
+         caveat="fairmotion with the fixes output_rate, blend_source, rigid_turn, cut_copy; both graphs keep the same "
                 "transition budget" + (f"; {ev}" if (ev := _sweep_evidence(sweep, "motion_graph", "fairmotion_fixed",
                                                                           "transition_skate_share")) else ""))
     pair("ST-Isomap re-sequencing jumps less than Isomap re-sequencing (95th percentile of the per-frame velocity "
