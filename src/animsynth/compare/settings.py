@@ -83,12 +83,15 @@ def run_generators(config: dict) -> tuple[list[str], dict]:
 
 
 def user_job_cfg(config: dict, name: str) -> dict:
-    """What a user generator's job adds to the shared keys: its spec and, as the job's rerun trigger, the
-    SHA-256 of its file (:func:`animsynth.compare.user.file_sha256`: a changed file reruns that job alone)."""
+    """What a user generator's job adds to the shared keys: its spec, as the job's rerun trigger the SHA-256 of its
+    file (:func:`animsynth.compare.user.file_sha256`: a changed file reruns that job alone), and how the class runs
+    (``compare.user_timeout_s``, ``compare.user_process``)."""
     from .user import file_sha256
 
     spec = user_generators(config)[name]
-    return {"user_generators": {name: spec}, "user_file_sha256": file_sha256(spec)}
+    cmp = config["compare"]
+    return {"user_generators": {name: spec}, "user_file_sha256": file_sha256(spec),
+            "user_timeout_s": cmp.get("user_timeout_s"), "user_process": cmp.get("user_process", True)}
 
 
 #: the ``compare`` keys the clips job reads (the protocol: rate, start, lengths, temporal split)
