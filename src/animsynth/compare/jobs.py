@@ -31,6 +31,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import sys
 import time
 from dataclasses import dataclass, field
 
@@ -463,8 +464,6 @@ def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase:
     """The files of a generator that could not run at all: ``why`` logged as one error line (and printed to
     stderr, the run's console), every clip x seed row with no values and ``note`` = "failed: <why>", every timing
     row empty, and as the showcase the showcase clip's start alone (no generated frame; ``meta["note"]``)."""
-    import sys
-
     line = " ".join(why.split())
     log.error("%s", line)
     print(f"animsynth: ERROR: {line}", file=sys.stderr)
@@ -474,11 +473,16 @@ def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase:
         rows += r
         trows.append(t)
         if showcase is not None and clip.clip == showcase[0]:
-            start = clip.start
-            shown = Motion(np.asarray(start.values, float), start.skeleton, start.fps, f"{generator} {clip.clip}",
-                           {"context": clip.context, "seams": np.zeros(0, np.int64), "note": f"failed: {line}"})
+            shown = _start_only(clip, generator, f"failed: {line}")
     return (pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"]), pd.DataFrame(trows, columns=TIMING_COLUMNS),
             shown)
+
+
+def _start_only(clip: Clip, generator: str, note: str) -> Motion:
+    """The showcase of a generator with no motion for the clip: the start alone, ``meta["note"]`` saying why."""
+    start = clip.start
+    return Motion(np.asarray(start.values, float), start.skeleton, start.fps, f"{generator} {clip.clip}",
+                  {"context": clip.context, "seams": np.zeros(0, np.int64), "note": note})
 
 
 def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> tuple[list, dict]:
@@ -493,6 +497,8 @@ def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> tuple[li
 
 
 def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
+    from .cost import guard as cost_guard
+
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
     kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
@@ -501,6 +507,19 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
         db_frames = int(sum(d.n_frames for d in clip.database))
+        # the cost guard (compare.cost_guard; animsynth.compare.cost): an estimate before the build
+        level, line = cost_guard(generator, clip.clip, db_frames, cfg, clip.length, len(seeds))
+        if level == "refuse":
+            log.error("%s", line)
+            print(f"animsynth: compare: {line}", file=sys.stderr)
+            r, t = _empty_rows(clip, generator, len(seeds), f"not run: {line}")
+            rows += r
+            trows.append(t)
+            if showcase is not None and clip.clip == showcase[0]:
+                shown = _start_only(clip, generator, f"not run: {line}")
+            continue
+        if level == "warn":
+            log.warning("%s", line)
         gen = make_generator(generator, cfg, held_out=clip.held_out)
         if hasattr(gen, "child_cpu_s_"):  # a user generator: its log lines name the clip
             gen.clip = clip.clip

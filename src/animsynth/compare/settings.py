@@ -97,7 +97,7 @@ def user_job_cfg(config: dict, name: str) -> dict:
 #: the ``compare`` keys the clips job reads (the protocol: rate, start, lengths, temporal split)
 CLIP_KEYS = ("fps", "context", "length", "min_length", "holdout_fraction")
 #: the ``compare`` keys every generator job reads
-RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
+RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s", "cost_guard")
 #: each generator's own ``compare`` block (a changed block reruns only the jobs of the generators that read it)
 GENERATOR_BLOCKS = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph",
                     "stisomap": "resequencing_graph", "motion_graph": "motion_graph", "fairmotion": "fairmotion",
