@@ -283,3 +283,114 @@ def test_without_user_generators_the_job_config_is_unchanged():
     assert settings.run_generators(cfg) == settings.run_generators(c2)
     assert settings.generator_order(cfg) == list(cfg["compare"]["generators"])
     assert np.all([g in cfg["compare"]["generators"] for g in settings.run_generators(cfg)[0]])
+
+
+# ----------------------------------------------------------------------------- the child process (compare.user_process)
+
+def _guarded_run(tmp_path, name, cfg, clips_file):
+    """The job's files below ``tmp_path/results/compare`` (so the guarded results folder is that one)."""
+    folder = tmp_path / "results" / "compare" / "runs"
+    folder.mkdir(parents=True, exist_ok=True)
+    return _run(folder, name, cfg, clips_file)
+
+
+def test_in_a_child_process_a_well_behaved_class_scores_as_in_process(tmp_path, clips_file):
+    (tmp_path / "mine.py").write_text(CONCAT_WRAPPER)
+    spec = f"{tmp_path / 'mine.py'}:Wrapped"
+    child = pd.read_csv(_run(tmp_path, "wrapped", dict(_cfg(wrapped=spec), user_timeout_s=60), clips_file)["metrics"])
+    inproc = pd.read_csv(_run(tmp_path, "inproc", dict(_cfg(inproc=spec), user_process=False), clips_file)["metrics"])
+    assert child["note"].isna().all()
+    pd.testing.assert_frame_equal(child.drop(columns="generator"), inproc.drop(columns="generator"))
+    t = pd.read_csv(tmp_path / "wrapped_timing_timing.csv")  # the child's CPU is counted
+    assert (t["build_cpu_s"] >= 0).all() and (t["generate_cpu_s"] > 0).all()
+
+
+def test_a_class_that_hangs_is_stopped_at_the_time_limit(tmp_path, clips_file, capsys, caplog):
+    (tmp_path / "mine.py").write_text(CONCAT_WRAPPER + """
+
+class Hangs(Wrapped):
+    def fit(self, database):
+        import time
+        time.sleep(30)
+""")
+    import time
+
+    t0 = time.perf_counter()
+    with caplog.at_level("INFO", logger="animsynth"):
+        out = _run(tmp_path, "mine", dict(_cfg(mine=f"{tmp_path / 'mine.py'}:Hangs"), user_timeout_s=2), clips_file)
+    assert time.perf_counter() - t0 < 25  # stopped at 2 s, not after the sleep
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert len(err) == 1 and "user generator 'mine'" in err[0] and "fit(database) on clip w1/t0" in err[0]
+    assert "time limit of 2 s (config key 'compare.user_timeout_s')" in err[0]
+    m = pd.read_csv(out["metrics"])
+    assert m["skate_share"].isna().all() and m["note"].str.contains("time limit").all()
+    # the job's log: a line before the call (it is not an empty log while the class runs)
+    assert "user generator mine: fit on clip w1/t0 (" in caplog.text and "frames) ..." in caplog.text
+
+
+def test_relative_writes_land_in_the_temporary_working_directory(tmp_path, clips_file, monkeypatch):
+    (tmp_path / "mine.py").write_text(CONCAT_WRAPPER + f"""
+
+class Writes(Wrapped):
+    def fit(self, database):
+        import os
+        with open("scratch.txt", "w") as fh:
+            fh.write("hello")
+        with open({str(tmp_path / 'cwd.txt')!r}, "w") as fh:
+            fh.write(os.getcwd())
+        return super().fit(database)
+""")
+    project = tmp_path / "project"
+    project.mkdir()
+    monkeypatch.chdir(project)
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    out = _guarded_run(tmp_path, "mine", _cfg(mine=f"{tmp_path / 'mine.py'}:Writes"), clips_file)
+    assert pd.read_csv(out["metrics"])["note"].isna().all()
+    workdir = (tmp_path / "cwd.txt").read_text()
+    assert workdir.startswith(str(tmp_path / "tmp" / "animsynth-user-mine-"))
+    assert (tmp_path / "tmp" / workdir.rsplit("/", 1)[1] / "scratch.txt").read_text() == "hello"  # kept: not empty
+    assert not (project / "scratch.txt").exists() and not list((tmp_path / "results").rglob("scratch.txt"))
+
+
+def test_a_write_into_the_results_folder_is_refused_and_named(tmp_path, clips_file, capsys):
+    target = tmp_path / "results" / "compare" / "runs" / "knn.csv"
+    (tmp_path / "mine.py").write_text(CONCAT_WRAPPER + f"""
+
+class Spoils(Wrapped):
+    def fit(self, database):
+        with open({str(target)!r}, "w") as fh:
+            fh.write("spoilt")
+        return super().fit(database)
+""")
+    out = _guarded_run(tmp_path, "mine", _cfg(mine=f"{tmp_path / 'mine.py'}:Spoils"), clips_file)
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert len(err) == 1 and "fit(database) raised PermissionError at mine.py:" in err[0] and str(target) in err[0]
+    assert not target.exists()
+    assert pd.read_csv(out["metrics"])["note"].str.contains("PermissionError").all()
+
+
+@pytest.mark.parametrize("body, says", [
+    ("import os\n        os._exit(3)", "ended its process with exit code 3"),
+    ("import os, signal\n        os.kill(os.getpid(), signal.SIGSEGV)", "was killed by signal SIGSEGV"),
+])
+def test_an_exit_inside_the_class_is_blamed_on_it_and_the_job_completes(tmp_path, clips_file, capsys, body, says):
+    (tmp_path / "mine.py").write_text(HOLD.format(body=f"        {body}"))
+    out = _run(tmp_path, "mine", _cfg(mine=f"{tmp_path / 'mine.py'}:Hold"), clips_file)
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert len(err) == 1, err
+    assert f"user generator 'mine' ({tmp_path / 'mine.py'}:Hold): generate(start, 12, " in err[0]
+    assert "on clip w1/t0" in err[0] and says in err[0]
+    m = pd.read_csv(out["metrics"], keep_default_na=False, na_values=[""])
+    assert len(m) == 6 and m["skate_share"].isna().all() and m["note"].str.contains(says).all()
+    assert jobs.load_shown(out["shown"]).meta["note"].startswith("failed: ")
+
+
+def test_a_user_job_reads_the_time_limit_and_the_route():
+    cfg = _config()
+    cfg["compare"]["user_generators"] = {"mine": "x.py:A"}
+    c = settings.job_cfg(cfg, "mine")
+    assert c["user_timeout_s"] == 600 and c["user_process"] is True
+    assert "user_timeout_s" not in settings.job_cfg(cfg, "knn")  # the family's jobs: unchanged, no rerun

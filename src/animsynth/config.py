@@ -374,6 +374,15 @@ def check_config(config: dict) -> None:
             raise ConfigError(f"config key 'resequencing_trials.{name}': unknown trial id {tid!r}")
 
 
+def unused_trials(config: dict) -> list[str]:
+    """The trials of ``trials`` that no family uses (in no subset of ``subsets`` and no clip of
+    ``resequencing_trials``), one line each naming those keys (the workflow prints them at parse time on a
+    user's data: such a trial is never read)."""
+    used = {t for ids in config["subsets"].values() if ids for t in ids} | set(config["resequencing_trials"].values())
+    return [f"trial {t['id']!r} is in no subset (subsets) and no re-sequencing clip (resequencing_trials): no "
+            "family uses it" for t in config["trials"] if t["id"] not in used]
+
+
 def _where(path) -> str:
     out = ""
     for p in path:

@@ -24,6 +24,17 @@ with open(Path(workflow.basedir) / "config" / "config.yaml") as _f:
 check_config(config)
 for _family in FAMILIES:
     importlib.import_module(f"animsynth.{_family.name}.settings").check(config)
+# On a user's data, every trial, subset or clip that a family's selection key leaves out is one line on stderr naming
+# the key (a family's settings.left_out(config); the demo's own selections, e.g. compare.subsets: [r1], would
+# otherwise leave a user's groups out silently).
+if config["mocap_source"] == "user":
+    from animsynth.config import unused_trials
+
+    _left = unused_trials(config)
+    for _family in FAMILIES:
+        _left += getattr(importlib.import_module(f"animsynth.{_family.name}.settings"), "left_out", lambda c: [])(config)
+    for _line in _left:
+        print(f"animsynth: {_line}", file=sys.stderr)
 
 TRIALS = {t["id"]: t for t in config["trials"]}
 SUBSETS = {k: v for k, v in config["subsets"].items() if v}  # null drops a subset

@@ -105,7 +105,9 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
     Parameters
     ----------
     name : one of :data:`GENERATORS`, or a key of ``cfg["user_generators"]`` (a user's class:
-        :class:`animsynth.compare.user.UserGenerator`)
+        :class:`animsynth.compare.user.UserGenerator`, run in a child process unless ``cfg["user_process"]`` is
+        false, with the time limit ``cfg["user_timeout_s"]`` per call and the folders ``cfg["user_guard"]``
+        guarded)
     cfg : dict, the ``compare`` block with ``stisomap`` (the re-sequencing study's block) added
     held_out : Motion, the held-out clip (``replay`` only)
     """
@@ -143,5 +145,6 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
     if name in user:  # a researcher's own class (compare.user_generators; animsynth.compare.user)
         from .user import UserGenerator
 
-        return UserGenerator(name, user[name])
+        return UserGenerator(name, user[name], timeout_s=cfg.get("user_timeout_s"),
+                             process=bool(cfg.get("user_process", True)), guard=cfg.get("user_guard") or ())
     raise ValueError(f"config key 'compare.generators': unknown generator {name!r} (one of {list(GENERATORS)})")

@@ -35,6 +35,8 @@ from __future__ import annotations
 
 import json
 import logging
+import os
+import sys
 import time
 from dataclasses import dataclass, field
 
@@ -549,20 +551,20 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     A user generator (``compare.user_generators``) that fails in any way (:class:`UserGeneratorError`) stops at
     its first failure: one error line, and every row of it empty (:func:`failed_run`).
     """
-    from .user import UserGeneratorError
+    from .user import UserGeneratorError, close_processes
 
     try:
         return _run_generator(clips, generator, cfg, master_seed, roles, showcase)
     except UserGeneratorError as exc:
         return failed_run(clips, generator, cfg, str(exc), showcase)
+    finally:
+        close_processes()  # a user generator's child process ends with its job
 
 
 def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase: tuple[str, int] | None = None):
     """The files of a generator that could not run at all: ``why`` logged as one error line (and printed to
     stderr, the run's console), every clip x seed row with no values and ``note`` = "failed: <why>", every timing
     row empty, and as the showcase the showcase clip's start alone (no generated frame; ``meta["note"]``)."""
-    import sys
-
     line = " ".join(why.split())
     log.error("%s", line)
     print(f"animsynth: ERROR: {line}", file=sys.stderr)
@@ -572,11 +574,16 @@ def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase:
         rows += r
         trows.append(t)
         if showcase is not None and clip.clip == showcase[0]:
-            start = clip.start
-            shown = Motion(np.asarray(start.values, float), start.skeleton, start.fps, f"{generator} {clip.clip}",
-                           {"context": clip.context, "seams": np.zeros(0, np.int64), "note": f"failed: {line}"})
+            shown = _start_only(clip, generator, f"failed: {line}")
     return (pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"]), pd.DataFrame(trows, columns=TIMING_COLUMNS),
             shown)
+
+
+def _start_only(clip: Clip, generator: str, note: str) -> Motion:
+    """The showcase of a generator with no motion for the clip: the start alone, ``meta["note"]`` saying why."""
+    start = clip.start
+    return Motion(np.asarray(start.values, float), start.skeleton, start.fps, f"{generator} {clip.clip}",
+                  {"context": clip.context, "seams": np.zeros(0, np.int64), "note": note})
 
 
 def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> tuple[list, dict]:
@@ -619,6 +626,8 @@ def native_inputs(gen, clip: Clip) -> tuple[dict, dict]:
 
 
 def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
+    from .cost import guard as cost_guard
+
     mcfg = cfg["metrics"]
     rows, trows, shown = [], [], None
     kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
@@ -627,8 +636,23 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
         db_frames = int(sum(d.n_frames for d in clip.database))
+        # the cost guard (compare.cost_guard; animsynth.compare.cost): an estimate before the build
+        level, line = cost_guard(generator, clip.clip, db_frames, cfg, clip.length, len(seeds))
+        if level == "refuse":
+            log.error("%s", line)
+            print(f"animsynth: compare: {line}", file=sys.stderr)
+            r, t = _empty_rows(clip, generator, len(seeds), f"not run: {line}")
+            rows += r
+            trows.append(t)
+            if showcase is not None and clip.clip == showcase[0]:
+                shown = _start_only(clip, generator, f"not run: {line}")
+            continue
+        if level == "warn":
+            log.warning("%s", line)
         gen = make_generator(generator, cfg, held_out=clip.held_out)
         fit_native, generate_native = native_inputs(gen, clip)
+        if hasattr(gen, "child_cpu_s_"):  # a user generator: its log lines name the clip
+            gen.clip = clip.clip
         c0, w0 = cpu_seconds(), time.perf_counter()
         try:
             gen.fit(clip.database, **fit_native)
@@ -642,6 +666,8 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
             trows.append(t)
             continue
         build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
+        # a user generator's child process: its CPU is not among the job's finished children until it ends
+        build_cpu += float(getattr(gen, "child_cpu_s_", 0.0))
         start = clip.start
         ref = reference(clip, mcfg, roles, std[_joint_count(clip)], kin)
         gen_cpu = gen_wall = 0.0
@@ -650,7 +676,7 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         for i, s in enumerate(seeds):
             c0, w0 = cpu_seconds(), time.perf_counter()
             m = gen.generate(start, clip.length, s, **query)
-            gen_cpu += cpu_seconds() - c0
+            gen_cpu += cpu_seconds() - c0 + float(getattr(gen, "child_cpu_s_", 0.0))
             gen_wall += time.perf_counter() - w0
             row, f = score(clip, ref, m, generator, mcfg, roles)
             row["transitions_kept"] = float(getattr(gen, "n_below_threshold_", np.nan))
@@ -670,7 +696,7 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
                       "build_cpu_s": build_cpu, "build_wall_s": build_wall, "generate_cpu_s": gen_cpu,
                       "generate_wall_s": gen_wall, "frames_generated": clip.length * len(seeds),
-                      "peak_rss_mb": peak_rss_mb()})
+                      "peak_rss_mb": max(peak_rss_mb(), float(getattr(gen, "child_rss_mb_", 0.0)))})
         log.info("%s on %s: build %.3f s CPU, %d seeds x %d frames in %.3f s CPU", generator, clip.clip, build_cpu,
                  len(seeds), clip.length, gen_cpu)
     metrics = pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"])
@@ -710,6 +736,10 @@ def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict
     from ..tables import write_table
 
     clips = load_clips(clips_path)
+    if generator in (cfg.get("user_generators") or {}):
+        # a user generator may not change files in the project (the working directory) or beside this job's outputs
+        outs = [os.path.dirname(os.path.abspath(p)) for p in out.values()]
+        cfg = dict(cfg, user_guard=list(dict.fromkeys([os.getcwd(), os.path.commonpath(outs)])))
     # one BLAS thread, as the job's threads: 1 (the simplex searches make many small LAPACK calls)
     with threadpool_limits(1, user_api="blas"):
         metrics, timing, shown = run_generator(clips, generator, cfg, master_seed, roles, showcase)

@@ -13,8 +13,8 @@ from ..config import ConfigError
 log = logging.getLogger("animsynth.compare")
 
 __all__ = ["check", "groups", "clip_ids", "subject_sets", "showcase", "run_generators", "clips_cfg", "native_rates",
-           "job_cfg", "unavailable",
-           "user_generators", "generator_order", "user_job_cfg", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
+           "job_cfg", "unavailable", "user_generators", "generator_order", "user_job_cfg", "left_out", "trial_rate",
+           "check_trial_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
 def subject_sets(config: dict) -> dict:
@@ -113,18 +113,21 @@ def run_generators(config: dict) -> tuple[list[str], dict]:
 
 
 def user_job_cfg(config: dict, name: str) -> dict:
-    """What a user generator's job adds to the shared keys: its spec and, as the job's rerun trigger, the
-    SHA-256 of its file (:func:`animsynth.compare.user.file_sha256`: a changed file reruns that job alone)."""
+    """What a user generator's job adds to the shared keys: its spec, as the job's rerun trigger the SHA-256 of its
+    file (:func:`animsynth.compare.user.file_sha256`: a changed file reruns that job alone), and how the class runs
+    (``compare.user_timeout_s``, ``compare.user_process``)."""
     from .user import file_sha256
 
     spec = user_generators(config)[name]
-    return {"user_generators": {name: spec}, "user_file_sha256": file_sha256(spec)}
+    cmp = config["compare"]
+    return {"user_generators": {name: spec}, "user_file_sha256": file_sha256(spec),
+            "user_timeout_s": cmp.get("user_timeout_s"), "user_process": cmp.get("user_process", True)}
 
 
 #: the ``compare`` keys the clips job reads (the protocol: rate, start, lengths, temporal split)
 CLIP_KEYS = ("fps", "context", "length", "min_length", "holdout_fraction")
 #: the ``compare`` keys every generator job reads
-RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s")
+RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s", "cost_guard")
 #: each generator's own ``compare`` block (a changed block reruns only the jobs of the generators that read it)
 GENERATOR_BLOCKS = {"delaunay": "field", "knn": "field", "isomap": "resequencing_graph",
                     "stisomap": "resequencing_graph", "motion_graph": "motion_graph", "fairmotion": "fairmotion",
@@ -230,6 +233,7 @@ def check(config: dict) -> None:
         if len(ids) < 2:
             raise ConfigError(f"config key 'compare.subsets': subset {s!r} has {len(ids)} trial; leave one out "
                               "needs at least 2")
+    check_trial_rates(config)  # a user's trials: each at its own rate (a BVH file's Frame Time)
     if config["mocap_source"] != "user":  # AMC trials run at the config's fps (BVH files carry their own)
         ratio = float(config["fps"]) / float(cmp["fps"])
         if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
@@ -279,3 +283,90 @@ def check(config: dict) -> None:
     if cmp["metrics"]["window"] > cmp["min_length"]:
         raise ConfigError(f"config key 'compare.metrics.window': {cmp['metrics']['window']} frames exceed "
                           f"compare.min_length ({cmp['min_length']}): a short clip would have no window")
+
+
+def _flow(values) -> str:
+    """``[a, b]`` as the YAML of a config file writes a list."""
+    return "[" + ", ".join(str(v) for v in values) + "]"
+
+
+def left_out(config: dict) -> list[str]:
+    """What the comparison leaves out of this run's data, one line each naming the config key that does it.
+
+    A subset of the run (``subsets``) not named by ``compare.subsets`` and a re-sequencing clip
+    (``resequencing_trials``) not named by ``compare.resequencing``; each line names the trials it holds. The
+    workflow prints them at parse time on a user's data (``mocap_source: user``), where the demo's
+    ``compare.subsets: [r1]`` would otherwise leave a user's other subsets out silently.
+    """
+    cmp = config["compare"]
+    subsets = {k: list(v) for k, v in config["subsets"].items() if v}
+    reseq = dict(config["resequencing_trials"])
+    lines = []
+    if cmp["subsets"] is not None:
+        for s, ids in subsets.items():
+            if s not in cmp["subsets"]:
+                lines.append(f"compare: subset {s!r} ({', '.join(ids)}) of this run left out by compare.subsets: "
+                             f"{_flow(cmp['subsets'])} (set compare.subsets: null for every subset)")
+    if cmp["resequencing"] is not None:
+        for d, t in reseq.items():
+            if d not in cmp["resequencing"]:
+                lines.append(f"compare: re-sequencing clip {d!r} ({t}) of this run left out by compare.resequencing: "
+                             f"{_flow(cmp['resequencing'])} (set compare.resequencing: null for every clip of "
+                             "resequencing_trials)")
+    return lines
+
+
+def trial_rate(config: dict, trial: dict) -> tuple[float | None, str]:
+    """``(frame rate, where it comes from)`` of one trial record as its parse job will read it.
+
+    An ASF/AMC trial (and a synthetic or CMU one) runs at the config's ``fps``; a BVH trial at the rate of its
+    file's ``Frame Time`` line (:func:`animsynth.io.bvh.bvh_frame_rate`: the header only, not the motion).
+    ``(None, why)`` when the file cannot be read here (a URL ``data_dir``, a file not there yet): the clips job
+    then checks the rate.
+    """
+    if "bvh" not in trial or "amc" in trial:
+        return float(config["fps"]), f"fps: {config['fps']}"
+    from ..config import resolve_inside
+    from ..io.bvh import bvh_frame_rate
+
+    root = config.get("cmu_mirror") if config["mocap_source"] == "cmu" else config.get("data_dir")
+    if not root or "://" in str(root):
+        return None, "its file is not local"
+    try:
+        path = resolve_inside(str(root), trial["bvh"], "bvh")
+        return float(bvh_frame_rate(path)), f"the Frame Time of {path}"
+    except (OSError, ValueError) as exc:
+        return None, " ".join(str(exc).split())
+
+
+def check_trial_rates(config: dict) -> None:
+    """Refuse a ``compare.fps`` that is not a trial's rate divided by a whole number, for every trial the
+    comparison uses (the clips job keeps every n-th frame, n = trial fps / compare.fps: a whole number).
+
+    Only a user's data (``mocap_source: user``) is read here: the other sources' trials all run at ``fps``
+    (checked by :func:`check`). A BVH file that cannot be read now is left to the clips job.
+
+    Raises
+    ------
+    ConfigError
+        naming ``compare.fps``, the trial and its rate
+    """
+    if config["mocap_source"] != "user":
+        return
+    want = float(config["compare"]["fps"])
+    subsets, reseq = groups(config)
+    used = list(dict.fromkeys([t for ids in subsets.values() for t in ids] + list(reseq.values())))
+    records = {t["id"]: t for t in config["trials"]}
+    for tid in used:
+        if tid not in records:
+            continue  # an unknown id: animsynth.config.check_config names it
+        fps, where = trial_rate(config, records[tid])
+        if fps is None:
+            continue
+        ratio = fps / want
+        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+            divisors = [f"{fps / n:g}" for n in range(1, 7) if abs(fps / n - round(fps / n)) < 1e-9][:4] or [f"{fps:g}"]
+            raise ConfigError(f"config key 'compare.fps': {config['compare']['fps']} fps is not the rate of trial "
+                              f"{tid!r} ({fps:g} fps, {where}) divided by a whole number (the comparison keeps every "
+                              f"n-th frame); set compare.fps to one of {', '.join(divisors)}, or leave the trial out "
+                              "of compare.subsets / compare.resequencing")

@@ -27,6 +27,7 @@ import importlib.util
 import inspect
 import os
 import sys
+import logging
 import traceback
 from pathlib import Path
 
@@ -35,7 +36,10 @@ import numpy as np
 from ..motion import Motion
 from ..generator import Database, Generator, check_generated
 
-__all__ = ["UserGeneratorError", "UserGenerator", "parse_spec", "resolve_path", "file_sha256", "load_class"]
+__all__ = ["UserGeneratorError", "UserGenerator", "UserProcess", "user_process", "close_processes", "parse_spec",
+           "resolve_path", "file_sha256", "load_class"]
+
+log = logging.getLogger("animsynth.compare.user")
 
 
 class UserGeneratorError(RuntimeError):
@@ -52,10 +56,10 @@ def parse_spec(spec: str) -> tuple[str, str]:
     return path, cls
 
 
-def resolve_path(path: str) -> Path:
-    """The file of a spec: absolute, or relative to the current working directory."""
+def resolve_path(path: str, base: str | None = None) -> Path:
+    """The file of a spec: absolute, or relative to ``base`` (default: the current working directory)."""
     p = Path(os.path.expanduser(path))
-    return p if p.is_absolute() else Path.cwd() / p
+    return p if p.is_absolute() else Path(base or os.getcwd()) / p
 
 
 def file_sha256(spec: str) -> str:
@@ -88,8 +92,10 @@ def _raised(exc: BaseException, where: str, path: Path) -> str:
 _CLASSES: dict = {}
 
 
-def load_class(name: str, spec: str):
+def load_class(name: str, spec: str, base: str | None = None):
     """The class of ``spec`` (imported once per process), checked for ``fit`` and ``generate``.
+
+    ``base``: the folder a relative path is read from (default: the current working directory).
 
     Raises
     ------
@@ -102,14 +108,14 @@ def load_class(name: str, spec: str):
     except ValueError as exc:
         raise UserGeneratorError(f"user generator {name!r}: config key 'compare.user_generators.{name}': "
                                  f"{exc}") from None
-    path = resolve_path(path_text)
+    path = resolve_path(path_text, base)
     head = f"user generator {name!r} ({path_text}:{cls_name})"
     key = (str(path), cls_name)
     if key in _CLASSES:
         return _CLASSES[key]
     if not path.is_file():
         raise UserGeneratorError(f"{head}: no such file {str(path)!r} (a path relative to the working directory "
-                                 f"{os.getcwd()!r} or absolute)")
+                                 f"{base or os.getcwd()!r} or absolute)")
     mod_name = "animsynth_user_" + hashlib.sha256(str(path).encode()).hexdigest()[:16]
     module = sys.modules.get(mod_name)
     if module is None:
@@ -148,6 +154,296 @@ def load_class(name: str, spec: str):
     return cls
 
 
+def _copy(m: Motion) -> Motion:
+    return Motion(np.array(m.values, float), m.skeleton, m.fps, m.name)
+
+
+def _head(name: str, spec: str) -> str:
+    try:
+        path, cls = parse_spec(spec)
+    except ValueError:
+        return f"user generator {name!r} ({spec})"
+    return f"user generator {name!r} ({path}:{cls})"
+
+
+def _spec_path(spec: str, base: str | None = None) -> Path:
+    try:
+        return resolve_path(parse_spec(spec)[0], base)
+    except ValueError:
+        return Path(spec)
+
+
+def _fit_model(name: str, spec: str, clips: list, base: str | None = None):
+    """A fresh instance of the user's class fitted on ``clips`` (every failure: :class:`UserGeneratorError`)."""
+    cls = load_class(name, spec, base)
+    head, path = _head(name, spec), _spec_path(spec, base)
+    try:
+        model = cls()
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - the user's code: any failure is reported as one line
+        raise UserGeneratorError(f"{head}: {_raised(exc, cls.__name__ + '()', path)}") from None
+    # the user's class sees its own copy of the clips (Database: .clips, .skeleton, .fps)
+    try:
+        model.fit(Database([_copy(c) for c in clips]))
+    except (Exception, SystemExit) as exc:  # noqa: BLE001
+        raise UserGeneratorError(f"{head}: {_raised(exc, 'fit(database)', path)}") from None
+    return model
+
+
+def _generate_raw(model, name: str, spec: str, start: Motion, length: int, seed: int, base: str | None = None):
+    """What the user's ``generate`` returns (unchecked; every exception: :class:`UserGeneratorError`)."""
+    try:
+        return model.generate(_copy(start), int(length), int(seed))
+    except (Exception, SystemExit) as exc:  # noqa: BLE001
+        raise UserGeneratorError(f"{_head(name, spec)}: "
+                                 f"{_raised(exc, 'generate(start, length, seed)', _spec_path(spec, base))}") from None
+
+
+# ----------------------------------------------------------------------------- the child process
+
+#: audit events that change a file, and the positions of their path arguments
+_WRITE_EVENTS = {"os.rename": (0, 1), "os.replace": (0, 1), "os.remove": (0,), "os.unlink": (0,), "os.rmdir": (0,),
+                 "os.mkdir": (0,), "shutil.rmtree": (0,), "os.truncate": (0,), "os.symlink": (1,), "os.link": (1,),
+                 "os.chmod": (0,), "os.utime": (0,), "shutil.copyfile": (1,), "shutil.move": (0, 1)}
+_WRITE_FLAGS = os.O_WRONLY | os.O_RDWR | os.O_CREAT | os.O_TRUNC | os.O_APPEND
+
+
+def _inside(path: str, root: str) -> bool:
+    try:
+        return os.path.commonpath([path, root]) == root
+    except ValueError:  # different drives
+        return False
+
+
+def _guarded_path(path, guard: list[str], allow: list[str]) -> str | None:
+    """The resolved ``path`` if it lies inside a guarded folder and no allowed one (else None); compiled-bytecode
+    caches (``__pycache__``) are never guarded (Python's import writes them)."""
+    if path is None or isinstance(path, int):
+        return None
+    try:
+        p = os.path.realpath(os.fsdecode(path))
+    except (TypeError, ValueError):
+        return None
+    if "__pycache__" in Path(p).parts:
+        return None
+    if any(_inside(p, a) for a in allow):
+        return None
+    return next((p for g in guard if _inside(p, g)), None)
+
+
+def _install_write_guard(guard: list[str], allow: list[str], refused: list) -> None:
+    """Refuse (PermissionError) and record every file change inside ``guard`` and outside ``allow`` made through
+    Python's audited calls (``open`` for writing, rename, remove, mkdir, ...) in this process."""
+    busy = []
+
+    def hook(event, args):
+        if busy:
+            return
+        if event == "open":
+            path, mode, flags = (tuple(args) + (None, None, None))[:3]
+            writes = (any(c in mode for c in "wax+") if isinstance(mode, str)
+                      else isinstance(flags, int) and bool(flags & _WRITE_FLAGS))
+            paths = [path] if writes else []
+        elif event in _WRITE_EVENTS:
+            paths = [args[i] for i in _WRITE_EVENTS[event] if i < len(args)]
+        else:
+            return
+        busy.append(1)
+        try:
+            hit = next((h for h in (_guarded_path(p, guard, allow) for p in paths) if h), None)
+        finally:
+            busy.pop()
+        if hit:
+            refused.append(hit)
+            raise PermissionError(f"a user generator may not change files inside the run's project or results folder "
+                                  f"({event} {hit}); write below its working directory or use an absolute path "
+                                  "elsewhere")
+
+    sys.addaudithook(hook)
+
+
+def _child_main(fd: int, name: str, spec: str, base: str, guard: list, allow: list) -> None:
+    """The child process of one job's user generator: answers ``("fit", clips)`` and ``("generate", start, length,
+    seed)`` requests on the connection ``fd`` until ``("stop",)`` or the end of the connection.
+
+    Each reply is ``(status, result, cpu_s, peak_rss_mb, refused writes)``: ``status`` ``"ok"`` (the fit's result
+    is None, the generation's the user's returned object) or ``"error"`` (``result``: the one-line message)."""
+    import resource
+    import time
+    from multiprocessing.connection import Connection
+
+    conn = Connection(fd)
+    refused: list = []
+    _install_write_guard(guard, allow, refused)
+    model = None
+    while True:
+        try:
+            msg = conn.recv()
+        except (EOFError, OSError):
+            return
+        if msg[0] == "stop":
+            return
+        c0 = time.process_time()
+        del refused[:]
+        try:
+            if msg[0] == "fit":
+                model = None
+                model = _fit_model(name, spec, msg[1], base)
+                reply = ("ok", None)
+            else:
+                reply = ("ok", _generate_raw(model, name, spec, msg[1], msg[2], msg[3], base))
+        except UserGeneratorError as exc:
+            reply = ("error", str(exc))
+        except BaseException as exc:  # noqa: BLE001 - anything else the class let out (KeyboardInterrupt, ...)
+            reply = ("error", f"{_head(name, spec)}: {msg[0]} raised {type(exc).__name__}: {_one_line(exc)}")
+        rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+        try:
+            conn.send(reply + (time.process_time() - c0, rss, list(refused)))
+        except Exception as exc:  # noqa: BLE001 - the returned object cannot be pickled
+            conn.send(("error", f"{_head(name, spec)}: {msg[0]} returned a {type(reply[1]).__name__} that cannot be "
+                                f"sent back to the job ({type(exc).__name__}: {_one_line(exc)})",
+                       time.process_time() - c0, rss, list(refused)))
+
+
+class UserProcess:
+    """The child process that runs one user generator for one job (fit once per clip, generate per seed).
+
+    Parameters
+    ----------
+    name, spec : the row name and ``"path/to/file.py:ClassName"``
+    guard : folders the class may not change files in (the project folder and the job's results folder)
+
+    Attributes
+    ----------
+    workdir : str, the child's working directory: a fresh temporary folder (relative writes land here); removed
+        when the job ends if empty, else kept and named in the log
+    """
+
+    def __init__(self, name: str, spec: str, guard=()):
+        import socket
+        import subprocess
+        import tempfile
+
+        self.name, self.spec = name, spec
+        self.base = os.getcwd()
+        self.workdir = tempfile.mkdtemp(prefix=f"animsynth-user-{name}-")
+        user_dir = str(_spec_path(spec, self.base).resolve().parent)
+        guard = [os.path.realpath(g) for g in guard]
+        # the file's own folder may be written (a cache beside the module) unless a guarded folder lies in it
+        allow = [os.path.realpath(self.workdir)] + ([user_dir] if not any(_inside(g, user_dir) for g in guard)
+                                                    else [])
+        mine, theirs = socket.socketpair()
+        code = ("import sys; sys.path[:0] = {path!r}; from animsynth.compare.user import _child_main; "
+                "_child_main({fd}, {name!r}, {spec!r}, {base!r}, {guard!r}, {allow!r})").format(
+            path=[p for p in sys.path if p], fd=theirs.fileno(), name=name, spec=spec, base=self.base, guard=guard,
+            allow=allow)
+        env = dict(os.environ)
+        for var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):  # one thread, as the job
+            env.setdefault(var, "1")
+        self.proc = subprocess.Popen([sys.executable, "-c", code], cwd=self.workdir, pass_fds=[theirs.fileno()],
+                                     env=env, start_new_session=True)
+        theirs.close()
+        from multiprocessing.connection import Connection
+
+        self.conn = Connection(mine.detach())
+        log.info("user generator %s: runs in process %d, working directory %s", name, self.proc.pid, self.workdir)
+
+    def _ended(self) -> str:
+        import signal
+
+        code = self.proc.wait()
+        if code < 0:
+            try:
+                return f"was killed by signal {signal.Signals(-code).name}"
+            except ValueError:
+                return f"was killed by signal {-code}"
+        return f"ended its process with exit code {code}"
+
+    def call(self, request: tuple, timeout_s: float | None, what: str):
+        """Send ``request``, wait at most ``timeout_s`` seconds for the reply; returns ``(result, cpu_s,
+        peak_rss_mb)``.
+
+        Raises
+        ------
+        UserGeneratorError
+            the class raised (its one line), the process ended (exit code or signal named) or the time limit passed
+            (the process and everything it started are stopped)
+        """
+        head = f"{_head(self.name, self.spec)}: {what}"
+        try:
+            self.conn.send(request)
+            ready = self.conn.poll(timeout_s)
+        except (BrokenPipeError, ConnectionError, EOFError, OSError):
+            raise UserGeneratorError(f"{head} {self._ended()} (os._exit, a crash or a signal inside the class)") \
+                from None
+        if not ready:
+            self.kill()
+            raise UserGeneratorError(f"{head} passed the time limit of {timeout_s:g} s (config key "
+                                     "'compare.user_timeout_s'): its process was stopped")
+        try:
+            status, result, cpu, rss, refused = self.conn.recv()
+        except (EOFError, OSError):
+            raise UserGeneratorError(f"{head} {self._ended()} (os._exit, a crash or a signal inside the class)") \
+                from None
+        if refused:
+            log.warning("%s: refused %d write(s) inside the project or results folder: %s", head, len(refused),
+                        ", ".join(dict.fromkeys(refused)))
+        if status != "ok":
+            raise UserGeneratorError(result)
+        return result, cpu, rss
+
+    def kill(self) -> None:
+        """Stop the child and every process it started (its own session)."""
+        import signal
+
+        if self.proc.poll() is None:
+            try:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                self.proc.kill()
+        self.proc.wait()
+
+    def close(self) -> None:
+        """Ask the child to stop (killed after 5 s), and remove its working directory if the class left nothing
+        there (else keep it and say where)."""
+        import shutil
+        import subprocess
+
+        try:
+            self.conn.send(("stop",))
+            self.proc.wait(timeout=5)
+        except (OSError, ValueError, subprocess.TimeoutExpired):
+            pass
+        self.kill()
+        self.conn.close()
+        try:
+            left = sorted(os.listdir(self.workdir))
+        except OSError:
+            return
+        if left:
+            log.info("user generator %s: left %d file(s) in its working directory %s (kept): %s", self.name,
+                     len(left), self.workdir, ", ".join(left[:10]))
+        else:
+            shutil.rmtree(self.workdir, ignore_errors=True)
+
+
+_PROCESSES: dict = {}
+
+
+def user_process(name: str, spec: str, guard=()) -> UserProcess:
+    """The job's child process of user generator ``name`` (started on the first call, then reused)."""
+    key = (name, spec)
+    proc = _PROCESSES.get(key)
+    if proc is None or proc.proc.poll() is not None:
+        proc = _PROCESSES[key] = UserProcess(name, spec, guard)
+    return proc
+
+
+def close_processes() -> None:
+    """Stop every child process of this job (the end of a generator job)."""
+    while _PROCESSES:
+        _PROCESSES.popitem()[1].close()
+
+
 class UserGenerator(Generator):
     """A user's class behind the family's interface.
 
@@ -155,55 +451,74 @@ class UserGenerator(Generator):
     ----------
     name : str, the row name (a key of ``compare.user_generators``)
     spec : str, ``"path/to/file.py:ClassName"``
+    timeout_s : float or None, the time limit of one ``fit`` or ``generate`` call (``compare.user_timeout_s``;
+        with ``process`` only)
+    process : bool, run the class in the job's child process (:class:`UserProcess`: a time limit, its own working
+        directory, writes into ``guard`` refused, an exit or crash blamed on it); False: in the job's own process
+        (``compare.user_process: false``, e.g. to debug the class)
+    guard : folders the class may not change files in (``process`` only)
 
     Attributes
     ----------
+    clip : str, the clip being fitted (set by the job; named in the log lines)
     db_ : Database, the clips the class was fitted on (copies: the class cannot change the family's data)
-    model_ : the user's fitted instance
+    model_ : the user's fitted instance (in-process route only)
+    child_cpu_s_, child_rss_mb_ : the CPU seconds of the last call in the child process and its peak resident
+        memory (0 in-process: the job's own counters hold them)
     """
 
-    def __init__(self, name: str, spec: str):
+    def __init__(self, name: str, spec: str, timeout_s: float | None = None, process: bool = False, guard=()):
         self.name = name
         self.spec = spec
+        self.timeout_s = timeout_s
+        self.process = process
+        self.guard = tuple(guard)
+        self.clip = ""
+        self.child_cpu_s_ = 0.0
+        self.child_rss_mb_ = 0.0
 
     def _head(self) -> str:
-        try:
-            path, cls = parse_spec(self.spec)
-        except ValueError:
-            return f"user generator {self.name!r} ({self.spec})"
-        return f"user generator {self.name!r} ({path}:{cls})"
-
-    def _path(self) -> Path:
-        try:
-            return resolve_path(parse_spec(self.spec)[0])
-        except ValueError:
-            return Path(self.spec)
+        return _head(self.name, self.spec)
 
     def fit(self, database) -> "UserGenerator":
-        cls = load_class(self.name, self.spec)
-        clips = [Motion(np.array(c.values, float), c.skeleton, c.fps, c.name) for c in database]
+        import time
+
+        clips = [_copy(c) for c in database]
         self.db_ = Database(clips)
-        try:
-            model = cls()
-        except (Exception, SystemExit) as exc:  # noqa: BLE001 - the user's code
-            raise UserGeneratorError(f"{self._head()}: {_raised(exc, cls.__name__ + '()', self._path())}") from None
-        # the user's class sees its own copy of the clips (Database: .clips, .skeleton, .fps)
-        try:
-            model.fit(Database([Motion(np.array(c.values, float), c.skeleton, c.fps, c.name) for c in clips]))
-        except (Exception, SystemExit) as exc:  # noqa: BLE001
-            raise UserGeneratorError(f"{self._head()}: {_raised(exc, 'fit(database)', self._path())}") from None
-        self.model_ = model
+        frames = int(sum(c.n_frames for c in clips))
+        log.info("user generator %s: fit on clip %s (%d frames) ...", self.name, self.clip or "?", frames)
+        t0 = time.perf_counter()
+        if self.process:
+            proc = user_process(self.name, self.spec, self.guard)
+            _, self.child_cpu_s_, self.child_rss_mb_ = proc.call(("fit", clips), self.timeout_s,
+                                                                 f"fit(database) on clip {self.clip or '?'}")
+            self.model_ = None
+        else:
+            self.model_ = _fit_model(self.name, self.spec, clips)
+        log.info("user generator %s: fit on clip %s done in %.2f s", self.name, self.clip or "?",
+                 time.perf_counter() - t0)
         return self
 
     def generate(self, start: Motion, length: int, seed: int) -> Motion:
+        import time
+
         self._check_start(start, length)
         length = int(length)
-        given = Motion(np.array(start.values, float), start.skeleton, start.fps, start.name)
-        try:
-            out = self.model_.generate(given, length, int(seed))
-        except (Exception, SystemExit) as exc:  # noqa: BLE001
-            raise UserGeneratorError(f"{self._head()}: {_raised(exc, 'generate(start, length, seed)', self._path())}") \
-                from None
+        log.info("user generator %s: generate on clip %s (%d frames, seed %d) ...", self.name, self.clip or "?",
+                 length, int(seed))
+        t0 = time.perf_counter()
+        if self.process:
+            out, self.child_cpu_s_, self.child_rss_mb_ = user_process(self.name, self.spec, self.guard).call(
+                ("generate", _copy(start), length, int(seed)), self.timeout_s,
+                f"generate(start, {length}, {int(seed)}) on clip {self.clip or '?'}")
+        else:
+            out = _generate_raw(self.model_, self.name, self.spec, start, length, seed)
+        log.info("user generator %s: generate on clip %s done in %.2f s", self.name, self.clip or "?",
+                 time.perf_counter() - t0)
+        return self._checked(out, start, length, seed)
+
+    def _checked(self, out, start: Motion, length: int, seed: int) -> Motion:
+        """The user's returned motion checked against the interface (one :class:`UserGeneratorError` if not)."""
         head = f"{self._head()}: generate(start, {length}, {int(seed)})"
         if not isinstance(out, Motion):
             raise UserGeneratorError(f"{head} returned a {type(out).__name__}, not an animsynth.motion.Motion")

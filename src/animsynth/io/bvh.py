@@ -216,6 +216,36 @@ def _frame_rate(ft_s: str, ftime: float) -> float:
     return fps
 
 
+def bvh_frame_rate(path) -> float:
+    """The frame rate of a BVH file from its ``Frame Time:`` line, without reading the motion.
+
+    The file is read line by line up to that line (the hierarchy and two header lines), so a long capture
+    costs no more than a short one. The rate is the one :func:`read_bvh` gives (a printed frame time such as
+    ``0.0333333`` is read as 30 fps).
+
+    Raises
+    ------
+    OSError
+        the file cannot be read
+    MotionFormatError
+        no ``Frame Time:`` line, or a frame time that is not a positive number in the accepted range
+    """
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        for ln, line in enumerate(fh, 1):
+            text = line.strip()
+            if text.startswith("Frame Time:"):
+                ft_s = text.split(":", 1)[1].strip()
+                ftime = parse_float(ft_s, path, ln, "frame time")
+                if ftime <= 0:
+                    raise MotionFormatError(path, ln, f"frame time must be positive (seconds per frame), got {ft_s!r}")
+                try:
+                    _check_frame_time(ftime, "frame time")
+                except ValueError as exc:
+                    raise MotionFormatError(path, ln, str(exc).replace("frame time: ", "")) from None
+                return _frame_rate(ft_s, ftime)
+    raise MotionFormatError(path, None, "no 'Frame Time:' line")
+
+
 def read_bvh(path, fps: float | None = None) -> Motion:
     """Read a BVH file into a generic skeleton and motion (see module docstring).
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ..config import ConfigError
 
-__all__ = ["METHODS", "METRICS", "GDOF", "METHOD_LABEL", "METRIC_LABEL", "check", "gdof_flag", "gdof_name",
+__all__ = ["METHODS", "METRICS", "GDOF", "METHOD_LABEL", "METRIC_LABEL", "check", "left_out", "gdof_flag", "gdof_name",
            "sign_mode_of", "st_parameters"]
 
 #: The methods and metrics of the study, the global-DOF wildcard values and the figures' labels.
@@ -40,6 +40,15 @@ def check(config: dict) -> None:
     if rs["linearisation"]["sign_mode"] not in rs["explanations"]["sign_modes"]:
         raise ConfigError(f"config key 'resequencing.explanations.sign_modes' {rs['explanations']['sign_modes']} "
                           f"must include resequencing.linearisation.sign_mode ({rs['linearisation']['sign_mode']!r})")
+
+
+def left_out(config: dict) -> list[str]:
+    """The re-sequencing clips of this run (``resequencing_trials``) that ``resequencing.datasets`` leaves out of
+    the study, one line each naming the key (the workflow prints them at parse time on a user's data)."""
+    rs = config["resequencing"]
+    return [f"resequencing: clip {d!r} ({t}) of resequencing_trials left out by resequencing.datasets: "
+            f"[{', '.join(rs['datasets'])}] (add {d} to resequencing.datasets)"
+            for d, t in config["resequencing_trials"].items() if d not in rs["datasets"]]
 
 
 def st_parameters(st: dict, fps: float) -> dict:

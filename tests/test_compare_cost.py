@@ -1,0 +1,95 @@
+"""The cost guard of the compare family (compare.cost_guard, animsynth.compare.cost): an estimate before each build,
+growing as each generator's method does; a warning line above the warning level, the clip not run (its rows empty,
+the key named) above the limit, and nothing at all below."""
+
+from __future__ import annotations
+
+import logging
+
+import pandas as pd
+import pytest
+
+from animsynth.compare import cost, jobs, settings
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+from conftest import default_config
+
+
+@pytest.fixture(scope="module")
+def clips_file(tmp_path_factory):
+    """Three short synthetic walks, leave one out (3 clips), 12 generated frames at 30 fps."""
+    sk = cmu_like_skeleton("cmp", 3)
+    walks = {f"t{s}": jobs.resample(generate_motion("walk_straight", 200, s, sk, name=f"t{s}"), 30.0) for s in range(3)}
+    cfg = default_config()["compare"]
+    cc = {k: cfg[k] for k in settings.CLIP_KEYS}
+    path = tmp_path_factory.mktemp("cost_clips") / "clips.npz"
+    jobs.save_clips(path, jobs.prepare_clips(walks, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=12)))
+    return path
+
+
+def _cfg(**guard) -> dict:
+    cfg = dict(settings.job_cfg(default_config()), seeds=2)
+    cfg["cost_guard"] = dict(cfg["cost_guard"], **guard)
+    return cfg
+
+
+def _run(tmp_path, generator, cfg, clips_file):
+    out = {k: str(tmp_path / f"{generator}_{k}{ext}") for k, ext in
+           (("metrics", ".csv"), ("timing", "_timing.csv"), ("shown", ".npz"), ("bvh", ".bvh"))}
+    jobs.run_job(clips_file, generator, cfg, 7, None, ("w1/t1", 1), out)
+    return out
+
+
+def test_the_estimate_grows_as_each_method_does():
+    cfg = settings.job_cfg(default_config())
+    e = lambda g, n, **kw: cost.estimate_cpu_s(g, n, cfg, **kw)  # noqa: E731
+    for g in ("fairmotion", "fairmotion_fixed", "motion_graph", "isomap", "stisomap"):
+        assert e(g, 2000) == pytest.approx(4 * e(g, 1000))  # O(frames^2)
+    for g in ("delaunay", "knn", "motion_matching", "motion_matching_pose", "replay", "concat"):
+        assert e(g, 2000) == pytest.approx(2 * e(g, 1000))  # O(frames)
+    # GenMM: the patch search over the database for every generated frame of every seed
+    assert e("genmm", 1000, length=120, seeds=5) - e("genmm", 1000) == pytest.approx(
+        2 * (e("genmm", 1000, length=60, seeds=5) - e("genmm", 1000)))
+    # fairmotion at its native 60 fps: twice the working frames
+    assert cost.model_frames("fairmotion", 1000, cfg) == 2000 and cost.model_frames("knn", 1000, cfg) == 1000
+    assert e("fairmotion", 1000) == pytest.approx(9.2e-6 * 2000 ** 2)
+    assert e("mine", 1000) is None  # a user generator: no model, no guard
+
+
+def test_the_paper_run_passes_and_a_large_lafan1_database_is_warned():
+    cfg = settings.job_cfg(default_config())
+    # the paper run's largest database: 339 frames at 30 fps (60 frames, 5 seeds)
+    for g in cost.COST_MODELS:
+        assert cost.guard(g, "w1/35_16", 339, cfg, 60, 5) == ("", ""), g
+    level, line = cost.guard("fairmotion", "lafan/walk1", 2146, cfg, 60, 5)
+    assert level == "warn" and "fairmotion on lafan/walk1: database of 2146 frames (4292 at its native rate)" in line
+    assert "compare.cost_guard.warn_cpu_s (60 s)" in line
+
+
+def test_a_database_over_the_limit_is_not_run_and_names_the_key(tmp_path, clips_file, capsys):
+    out = _run(tmp_path, "concat", _cfg(max_cpu_s=1e-9), clips_file)
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert len(err) == 3 and all("above compare.cost_guard.max_cpu_s (1e-09 s): not run" in x for x in err)
+    assert "concat on w1/t0: database of" in err[0]
+    m = pd.read_csv(out["metrics"])
+    assert len(m) == 6 and m["skate_share"].isna().all()
+    assert m["note"].str.startswith("not run: concat on w1/").all()
+    assert m["note"].str.contains("compare.cost_guard.max_cpu_s").all()
+    shown = jobs.load_shown(out["shown"])  # the job completes: the showcase is the start alone
+    assert shown.n_frames == shown.meta["context"] and shown.meta["note"].startswith("not run: ")
+
+
+def test_above_the_warning_level_one_line_per_clip_and_the_clip_runs(tmp_path, clips_file, caplog):
+    with caplog.at_level(logging.WARNING, logger="animsynth"):
+        out = _run(tmp_path, "concat", _cfg(warn_cpu_s=1e-9), clips_file)
+    lines = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    assert len(lines) == 3 and all("above compare.cost_guard.warn_cpu_s" in x for x in lines)
+    assert pd.read_csv(out["metrics"])["note"].isna().all()
+
+
+def test_below_the_warning_level_nothing_is_printed(tmp_path, clips_file, capsys, caplog):
+    with caplog.at_level(logging.WARNING, logger="animsynth"):
+        out = _run(tmp_path, "concat", _cfg(), clips_file)
+    assert capsys.readouterr().err.strip() == ""
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+    assert pd.read_csv(out["metrics"])["note"].isna().all()
