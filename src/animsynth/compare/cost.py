@@ -10,7 +10,7 @@ generator                                growth                  why
 ``motion_graph``                         ``c * n^2``             the frame-by-frame distance matrix
 ``isomap``, ``stisomap``                 ``c * n^2``             the neighbourhood graph's distances and shortest paths
 ``delaunay``, ``knn``                    ``c * n``               PCA and the training vectors of every frame
-``motion_matching(_pose)``               ``c * n``               the feature database (one row per frame)
+``motion_matching(_pose, _traj)``        ``c * n``               the feature database (one row per frame)
 ``genmm``                                ``c * n + g * n * L * S``  the features, then every generated frame's patch
                                                                  search over the database (``L`` frames, ``S`` seeds)
 ``replay``, ``concat``                   ``c * n``               a copy of the clips
@@ -56,6 +56,7 @@ COST_MODELS = {
     "knn": CostModel(1, 3e-5, growth="O(frames)"),
     "motion_matching": CostModel(1, 6e-4, growth="O(frames): the feature database"),
     "motion_matching_pose": CostModel(1, 6e-4, growth="O(frames): the feature database"),
+    "motion_matching_traj": CostModel(1, 6e-4, growth="O(frames): the feature database"),
     "genmm": CostModel(1, 2.4e-4, 4.4e-6, growth="O(frames x generated frames): patch search"),
     "replay": CostModel(1, 1.5e-6, growth="O(frames)"),
     "concat": CostModel(1, 1.5e-6, growth="O(frames)"),
