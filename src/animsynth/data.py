@@ -148,11 +148,16 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     :func:`animsynth.kinematics.standing_height`) in metres outside
     :data:`HEIGHT_RANGE_M` is logged as a warning (the unit is probably
     wrong). One log line gives the axes used and how they were found.
+
+    Every rotational DOF is made continuous along time
+    (:func:`animsynth.kinematics.unwrap_angles`: an angle that wraps past 180
+    degrees gets the multiple of 360 that removes the jump; logged when it
+    happens), so no method sees a wrap. Translations are untouched.
     """
     from .errors import MotionFormatError
     from .joints import check_role_overrides
     from .kinematics import (CANONICAL_FORWARD, CANONICAL_UP, default_forward, detect_forward_axis, detect_up_axis,
-                             parse_axis, standing_height, to_canonical_frame, translated_joints)
+                             parse_axis, standing_height, to_canonical_frame, translated_joints, unwrap_angles)
 
     files = {"amc": amc, "asf": asf, "bvh": bvh}
     shown = dict(source_files or {})
@@ -209,7 +214,7 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
                     "bvh_length_to_m=%g; set bvh_length_to_m to the file's unit (0.01 for centimetres, 0.0254 for "
                     "inches, 0.05644 for cgspeed's CMU conversions)", where, height, up, bvh_length_to_m)
     m.name = name or m.name
-    return m
+    return unwrap_angles(m, where)
 
 
 def _fmt(a) -> str:

@@ -110,10 +110,24 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
     resequencing : {dataset: trial id}, the clips of ``compare.resequencing`` (temporal split)
     cfg : the ``compare`` config block (``fps``, ``context``, ``length``, ``min_length``,
         ``holdout_fraction``)
+
+    Every trial's angles are made continuous at its own rate, before resampling
+    (:func:`animsynth.kinematics.unwrap_angles`: a fast joint may turn by more than 180 degrees between two
+    working frames without wrapping, so the working frames are not unwrapped again). A leave-one-out clip's database trials are put on the held-out
+    trial's skeleton (:func:`animsynth.skeleton.retarget`: the same skeleton is kept as it is; other rest
+    offsets are retargeted with a logged warning, or refused naming both trials) and every one of them, the
+    held-out trial too, on the angle branch of the database's first trial
+    (:func:`animsynth.kinematics.align_angle_branches`). A temporal split's database and held-out part are one
+    continuous trial and stay as they are.
     """
+    from ..kinematics import align_angle_branches, unwrap_angles
+    from ..skeleton import retarget
+
     fps, context = float(cfg["fps"]), int(cfg["context"])
     length, min_length = int(cfg["length"]), int(cfg["min_length"])
-    work = {t: resample(m, fps) for t, m in trials.items()}
+    # unwrapped at the capture's own rate: a fast joint may move more than 180 degrees between working frames
+    full = {t: unwrap_angles(m, f"trial {t}") for t, m in trials.items()}
+    work = {t: resample(m, fps) for t, m in full.items()}
     clips = []
 
     def add(clip_id, group, protocol, trial, held, db, db_names):
@@ -134,7 +148,9 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
             raise ValueError(f"config key 'compare.subsets': subset {group!r} needs >= 2 trials for leave one out")
         for t in ids:
             others = [o for o in ids if o != t]
-            add(f"{group}/{t}", group, "leave one out", t, work[t], [work[o] for o in others], others)
+            db = [resample(retarget(full[o], full[t].skeleton, f"trial {o}", f"trial {t}"), fps) for o in others]
+            db = [align_angle_branches(d, db[0]) for d in db]
+            add(f"{group}/{t}", group, "leave one out", t, align_angle_branches(work[t], db[0]), db, others)
     for group, t in resequencing.items():
         m = work[t]
         n = m.n_frames

@@ -42,20 +42,18 @@ UNSCORED = ("transition_skate_share", "n_seams", "seams_per_s", "transitions_kep
             "seed_diversity_m")
 
 
-def on_skeleton(motion: Motion, skeleton, what: str) -> Motion:
-    """``motion`` on ``skeleton`` (the reference's): its values as they are when the DOF columns are the same,
-    else mapped joint by joint (the same joint names in the same order are required)."""
-    if motion.skeleton.columns() == skeleton.columns():
-        return Motion(np.asarray(motion.values, float), skeleton, motion.fps, motion.name)
-    if motion.skeleton.names != skeleton.names:
-        raise ValueError(f"{what}: its joints differ from the reference's ({len(motion.skeleton.names)} joints "
-                         f"{motion.skeleton.names[:4]}... vs {len(skeleton.names)} {skeleton.names[:4]}...); "
-                         "score motions on the reference's skeleton")
-    from ..io.bvh import motion_from_bvh_on
+def on_skeleton(motion: Motion, skeleton, what: str, reference_name: str = "the reference") -> Motion:
+    """``motion`` on ``skeleton`` (the reference's): :func:`animsynth.skeleton.retarget`.
 
-    log.info("%s: its channels differ from the reference's; its joint rotations are read onto the reference's "
-             "skeleton", what)
-    return motion_from_bvh_on(motion, skeleton)
+    Its values as they are when it is the same skeleton (rest offsets within
+    :data:`animsynth.skeleton.SAME_SKELETON_TOL_M`) with the same DOF columns; its rotations read onto the
+    reference's DOF when only the channels or the rest frame differ (a Z-up re-export: every joint's position
+    unchanged); retargeted by joint name with a logged warning when the rest offsets differ; refused (naming
+    both and the largest offset difference) when the joints or the rest pose differ.
+    """
+    from ..skeleton import retarget
+
+    return retarget(motion, skeleton, what, reference_name)
 
 
 def score_motions(generated: dict, reference_motion: Motion, database: dict | None, context: int, mcfg: dict,
@@ -91,7 +89,7 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
     for name, d in (database or {}).items():
         if not np.isclose(float(d.fps), fps):
             raise ValueError(f"database {name}: {float(d.fps):g} fps, the reference runs at {fps:g} fps")
-        db.append(Motion(on_skeleton(d, sk, f"database {name}").values, sk, fps, name))
+        db.append(Motion(on_skeleton(d, sk, f"database {name}", reference_name).values, sk, fps, name))
     blank = set(UNSCORED)
     note = ""
     if not db:
@@ -106,7 +104,7 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
         if not np.isclose(float(g.fps), fps):
             raise ValueError(f"{name}: {float(g.fps):g} fps, the reference {reference_name} runs at {fps:g} fps "
                              "(score motions at the reference's rate)")
-        m = on_skeleton(g, sk, name)
+        m = on_skeleton(g, sk, name, reference_name)
         length = m.n_frames - context
         if length < 1:
             raise ValueError(f"{name}: {m.n_frames} frames, none after the {context} start frames")
