@@ -275,3 +275,34 @@ def creature(parts, frames: int = 48, fps: float = 30.0, swing: float = 12.0, na
     root[:, 2] += 0.8 * t
     trans[0] = root
     return _rebuild(sk, rots, np.stack(trans, axis=1), fps, name)
+
+
+def turned_joint_frames(m: Motion, names, Q: Rotation) -> Motion:
+    """The same world motion with the local frame of each joint in ``names`` turned by ``Q`` (a rig whose
+    bones rest turned, as Bandai-Namco's upper legs): ``L_j' = L_j Q``, its children's offsets, translations
+    and its tail ``Q^-1 x``, its children's rotations ``Q^-1 L_c`` (``Q^-1 L_c Q`` when turned too)."""
+    sk = copy.deepcopy(m.skeleton)
+    rots = local_rotations(m.skeleton, m.values)
+    trans = joint_translations(m.skeleton, m.values)
+    turned = {sk.index(n) for n in names}
+    for i, j in enumerate(sk.joints):
+        if i in turned:
+            rots[i] = rots[i] * Q
+            j.tail = Q.inv().apply(j.tail)
+        if j.parent in turned:
+            j.offset = Q.inv().apply(j.offset)
+            trans[:, i] = Q.inv().apply(trans[:, i])
+            rots[i] = Q.inv() * rots[i]
+    return _rebuild(sk, rots, trans, m.fps, m.name)
+
+
+#: the joints whose frames :func:`bandai_with_wraps` turns (names of :func:`hips_motion`)
+WRAP_JOINTS = ("LeftUpLeg", "RightUpLeg", "LeftArm", "RightArm")
+
+
+def bandai_with_wraps(motion: Motion) -> Motion:
+    """The ``bandai`` class with the upper legs' and upper arms' frames turned 180 degrees about +y: their
+    ``Yrotation`` channels swing about +-180 degrees, so the file's angles wrap from +180 to -180 as a walk's
+    legs swing (a Bandai-Namco walk's wraps). The world motion is the same."""
+    h = turned_joint_frames(hips_motion(motion), WRAP_JOINTS, Rotation.from_euler("y", 180, degrees=True))
+    return bandai(h)

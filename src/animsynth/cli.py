@@ -300,6 +300,7 @@ def cmd_preview(a) -> None:
 
 def cmd_generate(a) -> None:
     from .io import read_amc, read_asf
+    from .kinematics import continuous_clips
     from .motion import Motion
     from .simplicial import generate_from_trials
 
@@ -310,12 +311,13 @@ def cmd_generate(a) -> None:
     if any(bvh) and not all(bvh):
         raise UsageError("train", "give .bvh files or .amc files (with --asf), not both")
     if all(bvh):
+        from .skeleton import retarget
+
         train = [_load_bvh(a, p) for p in a.train]
         sk = train[0].skeleton
-        for p, m in zip(a.train[1:], train[1:]):
-            if m.skeleton.columns() != sk.columns():
-                raise UsageError("train", f"{p} has another skeleton than {a.train[0]} (the training files must share "
-                                          "joints and channels)")
+        # one skeleton: the first file's (other channels or rest frames read onto it, other rest offsets
+        # retargeted with a warning, other joints or rest poses refused naming both files)
+        train = [train[0]] + [retarget(m, sk, p, a.train[0]) for p, m in zip(a.train[1:], train[1:])]
     else:
         if a.asf is None:
             raise UsageError("--asf", "training .amc files need the skeleton: --asf SKEL.asf")
@@ -329,6 +331,8 @@ def cmd_generate(a) -> None:
                  8.0 * (a.steps + 1) * (2 * sk.n_dof + a.latent_dim + 3 * len(sk.joints)), a.memory_budget_gib)
     if not all(bvh):
         train = [read_amc(p, sk, fps=a.fps) for p in a.train]
+    # each file's angles continuous along time, on the branch of the first file's (the start pose too)
+    train = continuous_clips(train)
     n_start = train[a.start_trial].n_frames
     if a.start_frame >= n_start:
         raise UsageError("--start-frame", f"{a.start_frame} is outside {a.train[a.start_trial]} ({n_start} frames, 0-based)")
@@ -350,10 +354,12 @@ def cmd_generate(a) -> None:
 
 
 def cmd_resequence(a) -> None:
+    from .kinematics import unwrap_angles
     from .resequencing.quick import resequence_motion
 
     files, a.out = _split_motion_args(a.files, a.out, MOTION_OUTPUTS)
     m, a.amc = _load_any(a, files)
+    m = unwrap_angles(m, a.amc)  # a BVH file is already (load_trial); an AMC file here
     if a.length is not None:
         # played values, local rotations (quaternions) and joint positions of every frame, float64
         check_budget(f"argument --length: {a.length} frames",

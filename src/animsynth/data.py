@@ -170,11 +170,17 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     :func:`animsynth.kinematics.standing_height`) in metres outside
     :data:`HEIGHT_RANGE_M` is logged as a warning (the unit is probably
     wrong). One log line gives the axes used and how they were found.
+
+    Every rotational DOF is made continuous along time
+    (:func:`animsynth.kinematics.unwrap_angles`: an angle that wraps past 180
+    degrees gets the multiple of 360 that removes the jump; logged when it
+    happens), so no method sees a wrap. Translations are untouched.
     """
     from .errors import MotionFormatError
     from .joints import check_role_overrides
     from .kinematics import (CANONICAL_FORWARD, CANONICAL_UP, default_forward, detect_forward_axis, detect_up_axis,
-                             lying_down, parse_axis, standing_height, to_canonical_frame, translated_joints)
+                             lying_down, parse_axis, standing_height, to_canonical_frame, translated_joints,
+                             unwrap_angles)
 
     files = {"amc": amc, "asf": asf, "bvh": bvh}
     shown = dict(source_files or {})
@@ -255,7 +261,7 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
                     "inches, 0.05644 for cgspeed's CMU conversions)", where, height, up, bvh_length_to_m,
                     names["bvh_length_to_m"])
     m.name = name or m.name
-    return m
+    return unwrap_angles(m, where)
 
 
 def _warn_shared_roles(skeleton, overrides: dict, where: str, setting: str) -> None:

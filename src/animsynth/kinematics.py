@@ -756,3 +756,142 @@ def to_canonical_frame(skeleton: Skeleton, values, up, forward) -> tuple[Skeleto
     out = np.concatenate([block, values[:, sl.stop:]], axis=1).reshape(n, sk.n_dof)
     sk.__post_init__()
     return sk, out
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# continuous angles (the one place Euler angles are unwrapped along time and put on one branch across clips)
+# ---------------------------------------------------------------------------------------------------------------
+#: A rotation DOF that changes by more than this many degrees between consecutive frames has wrapped (a file
+#: writes every angle in (-180, 180], so a joint turning past 180 jumps by about 360): :func:`unwrap_angles`
+#: adds the multiple of 360 degrees that removes the jump (``numpy.unwrap`` with period 360).
+WRAP_JUMP_DEG = 180.0
+
+
+def rotation_columns(skeleton: Skeleton, root: bool = True) -> np.ndarray:
+    """Indices of the rotational DOF columns of a motion on ``skeleton``, shape ``(k,)`` int.
+
+    ``root=False`` leaves out the root joint's.
+    """
+    cols, k = [], 0
+    for i, j in enumerate(skeleton.joints):
+        for d in j.dofs:
+            if d in ROT_DOFS and (root or i > 0):
+                cols.append(k)
+            k += 1
+    return np.array(cols, dtype=int)
+
+
+def wrap_count(skeleton: Skeleton, values) -> int:
+    """How many frame-to-frame changes above :data:`WRAP_JUMP_DEG` the rotational DOF of ``values``
+    (frames, n_dof) hold (all columns together)."""
+    v = np.asarray(values, float)
+    cols = rotation_columns(skeleton)
+    if v.shape[0] < 2 or not cols.size:
+        return 0
+    return int(np.count_nonzero(np.abs(np.diff(v[:, cols], axis=0)) > WRAP_JUMP_DEG))
+
+
+def unwrap_angles(motion, what: str | None = None):
+    """``motion`` with every rotational DOF made continuous along time.
+
+    Each rotation column (the root's too) is unwrapped on its own with ``numpy.unwrap(period=360)``: a change
+    between consecutive frames above :data:`WRAP_JUMP_DEG` degrees gets the multiple of 360 degrees that makes
+    it at most 180. Every frame keeps the same rotation (an Euler angle plus 360 degrees is the same turn), so
+    forward kinematics is unchanged up to rounding; translations (the root's, and those of other joints) are
+    untouched. A column without such a change keeps its values bit for bit (no arithmetic touches it), and a
+    motion without any is returned as it is.
+
+    Parameters
+    ----------
+    motion : Motion, ``values`` (frames, n_dof)
+    what : str, optional
+        Names the motion in the log line (default its name).
+
+    Returns
+    -------
+    Motion
+        The same object when nothing wrapped, else a new one (same skeleton, frame rate, name; ``meta`` copied
+        with ``"unwrapped"``: the number of changes removed). One info line gives the count and the columns.
+    """
+    from .motion import Motion
+
+    v = np.asarray(motion.values, float)
+    if v.shape[0] < 2:
+        return motion
+    cols = rotation_columns(motion.skeleton)
+    if not cols.size:
+        return motion
+    jumps = np.abs(np.diff(v[:, cols], axis=0)) > WRAP_JUMP_DEG
+    hit = np.flatnonzero(jumps.any(axis=0))
+    if not hit.size:
+        return motion
+    out = v.copy()
+    for c in cols[hit]:
+        out[:, c] = np.unwrap(v[:, c], period=360.0)
+    names = motion.skeleton.columns()
+    n = int(jumps.sum())
+    log.info("%s: %d frame-to-frame change(s) above %g degrees in %d rotation column(s) (%s) read as wraps of "
+             "the Euler angle and unwrapped (the same rotations, continuous along time)", what or motion.name, n,
+             WRAP_JUMP_DEG, hit.size, ", ".join(names[c] for c in cols[hit][:8]) + (" ..." if hit.size > 8 else ""))
+    return Motion(out, motion.skeleton, motion.fps, motion.name, dict(motion.meta, unwrapped=n))
+
+
+def align_angle_branches(motion, reference):
+    """``motion`` with each non-root rotation column shifted by the multiple of 360 degrees that brings its
+    median nearest the ``reference``'s median of that column.
+
+    The branch rule of a database of clips: after :func:`unwrap_angles` each clip is continuous on its own,
+    but a joint that sits near 180 degrees may sit near +180 in one clip and near -180 in another. Shifting
+    the clip by ``360 * round((median_ref - median_clip) / 360)`` per column gives the same pose the same
+    value across clips (the same rotation). The root's rotation is left as it is: it is the clip's heading,
+    not part of the pose, and differs between clips anyway.
+
+    Parameters
+    ----------
+    motion : Motion, ``(frames, n_dof)``
+    reference : Motion or ndarray ``(frames_r, n_dof)`` on a skeleton with the same columns
+
+    Returns
+    -------
+    Motion, the same object when no column moves, else a new one (``meta["branch_shift"]``: the columns moved).
+    """
+    from .motion import Motion
+
+    ref = np.asarray(getattr(reference, "values", reference), float)
+    v = np.asarray(motion.values, float)
+    if ref.shape[1] != v.shape[1]:
+        raise ValueError(f"{motion.name!r}: {v.shape[1]} DOF columns, the reference has {ref.shape[1]}")
+    cols = rotation_columns(motion.skeleton, root=False)
+    if not cols.size or not len(ref) or not len(v):
+        return motion
+    k = np.round((np.median(ref[:, cols], axis=0) - np.median(v[:, cols], axis=0)) / 360.0)
+    moved = np.flatnonzero(k != 0)
+    if not moved.size:
+        return motion
+    out = v.copy()
+    out[:, cols[moved]] += 360.0 * k[moved]
+    names = motion.skeleton.columns()
+    log.info("%s: %d rotation column(s) (%s) shifted by a multiple of 360 degrees to the branch of the "
+             "database's first clip", motion.name, moved.size, ", ".join(names[c] for c in cols[moved][:8]))
+    return Motion(out, motion.skeleton, motion.fps, motion.name,
+                  dict(motion.meta, branch_shift=[names[c] for c in cols[moved]]))
+
+
+def continuous_clips(motions, reference=None) -> list:
+    """Clips made ready to share one database: each :func:`unwrap_angles` on its own, then
+    :func:`align_angle_branches` to ``reference`` (default: the first clip, itself unwrapped).
+
+    Parameters
+    ----------
+    motions : list of Motion on skeletons with the same DOF columns
+    reference : Motion, optional
+
+    Returns
+    -------
+    list of Motion (an input that needs no change is returned as it is)
+    """
+    out = [unwrap_angles(m) for m in motions]
+    if not out:
+        return out
+    ref = out[0] if reference is None else unwrap_angles(reference)
+    return [align_angle_branches(m, ref) for m in out]

@@ -30,10 +30,13 @@ Conventions (the Acclaim ones, which BVH maps onto losslessly):
 from __future__ import annotations
 
 import json
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+log = logging.getLogger("animsynth.skeleton")
 
 ROT_DOFS = ("rx", "ry", "rz")
 TRANS_DOFS = ("tx", "ty", "tz")
@@ -195,3 +198,198 @@ class Skeleton:
     @classmethod
     def from_json(cls, s: str) -> "Skeleton":
         return cls.from_dict(json.loads(s))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# is it the same skeleton? (rest offsets, not only joint names and channels)
+# ---------------------------------------------------------------------------------------------------------------
+#: Two skeletons are the same when every rest offset and End Site agrees within this many metres (after the
+#: rest-frame turn of :func:`compare_skeletons`). 1 mm: a file prints offsets to 1e-6 of its unit (1e-6 mm to
+#: 1e-3 mm for the units in use), so a re-export of the same skeleton agrees far closer; a difference of 1 mm per
+#: bone moves a joint at the end of a 6-bone chain by at most 6 mm, below what the position metrics resolve
+#: (they report centimetres), while any real difference of body proportions is larger.
+SAME_SKELETON_TOL_M = 1e-3
+#: Retargeting keeps each joint's local rotation, which carries the motion over only when the bones point the
+#: same way at rest: a bone (both at least :data:`DIRECTION_MIN_M` long) whose rest direction differs by more
+#: than this many degrees (after the rest-frame turn) is a different rest pose (A pose against T pose); such a
+#: pair is refused.
+RETARGET_MAX_ANGLE_DEG = 30.0
+#: Bones shorter than this (metres) in either skeleton give no rest direction to compare.
+DIRECTION_MIN_M = 0.01
+
+
+@dataclass
+class SkeletonDifference:
+    """What :func:`compare_skeletons` found.
+
+    Attributes
+    ----------
+    joints_match : bool, the same joint names with the same parents (by name)
+    why : str, what differs when they do not
+    largest_m : float, largest rest offset / End Site difference in metres, after ``turn``
+    joint : str, the joint where it is
+    turn : Rotation, the rest-frame turn ``Q`` with ``b's offsets ~= Q a's`` (identity unless the rest pose of
+        one is the other's turned, as a Blender Z-up export is)
+    largest_angle_deg : float, largest angle between the two rest directions of a bone (after ``turn``)
+    tol_m : float, the tolerance used
+    """
+
+    joints_match: bool
+    why: str = ""
+    largest_m: float = 0.0
+    joint: str = ""
+    turn: Rotation = field(default_factory=Rotation.identity)
+    largest_angle_deg: float = 0.0
+    tol_m: float = SAME_SKELETON_TOL_M
+
+    @property
+    def turn_deg(self) -> float:
+        return float(np.degrees(self.turn.magnitude()))
+
+    @property
+    def same(self) -> bool:
+        """The same skeleton (maybe with its rest frame turned): every offset within ``tol_m``."""
+        return self.joints_match and self.largest_m <= self.tol_m
+
+
+def _rest_vectors(sk: Skeleton, names: list[str]) -> np.ndarray:
+    """(2 * len(names), 3) metres: every joint's offset (the root's: zero, its translation DOF carry it) and tail."""
+    out = []
+    for n in names:
+        j = sk[n]
+        off = np.zeros(3) if j.parent < 0 else np.asarray(j.offset, float)
+        out += [off * sk.length_to_m, np.asarray(j.tail, float) * sk.length_to_m]
+    return np.asarray(out)
+
+
+def compare_skeletons(a: Skeleton, b: Skeleton, tol_m: float = SAME_SKELETON_TOL_M) -> SkeletonDifference:
+    """Compare two skeletons' joints and rest offsets (in metres, in the canonical frame the loader turned them
+    into).
+
+    The joints must have the same names and parents. The rest vectors compared are every non-root joint's
+    ``offset`` and every joint's ``tail`` (End Site), times each skeleton's ``length_to_m``; the root's offset
+    is left out (its translation DOF carry it). When a single rotation ``Q`` (the best fit, Kabsch) brings
+    ``a``'s rest vectors onto ``b``'s within ``tol_m``, or turns by more than :data:`RETARGET_MAX_ANGLE_DEG`
+    (the rest pose written in other axes, as Blender's Z-up export writes it: the loader turns the root only,
+    the children's offsets stay turned), the difference is measured after ``Q``; otherwise ``Q`` is the
+    identity (different bone lengths alone do not turn a rest frame).
+
+    Parameters
+    ----------
+    a, b : Skeleton
+    tol_m : float, metres (default :data:`SAME_SKELETON_TOL_M`)
+
+    Returns
+    -------
+    SkeletonDifference
+    """
+    if sorted(a.names) != sorted(b.names):
+        only_a = [n for n in a.names if n not in b._index][:3]
+        only_b = [n for n in b.names if n not in a._index][:3]
+        return SkeletonDifference(False, f"{len(a.names)} joints vs {len(b.names)}; only in the first: "
+                                         f"{only_a}, only in the second: {only_b}", tol_m=tol_m)
+    parent = lambda sk, n: sk.joints[sk[n].parent].name if sk[n].parent >= 0 else None  # noqa: E731
+    moved = [n for n in a.names if parent(a, n) != parent(b, n)]
+    if moved:
+        return SkeletonDifference(False, f"joint {moved[0]!r} hangs from {parent(a, moved[0])!r} in one and from "
+                                         f"{parent(b, moved[0])!r} in the other", tol_m=tol_m)
+    names = list(b.names)
+    va, vb = _rest_vectors(a, names), _rest_vectors(b, names)
+
+    def largest(Q):
+        d = np.linalg.norm(vb - Q.apply(va), axis=1)
+        k = int(np.argmax(d)) if d.size else 0
+        return (float(d[k]) if d.size else 0.0), (names[k // 2] if d.size else "")
+
+    Q = Rotation.identity()
+    big, where = largest(Q)
+    if big > tol_m and np.linalg.norm(va) > 0 and np.linalg.norm(vb) > 0:
+        fit, _ = Rotation.align_vectors(vb, va)
+        fit_big, fit_where = largest(fit)
+        if fit_big < big and (fit_big <= tol_m or np.degrees(fit.magnitude()) > RETARGET_MAX_ANGLE_DEG):
+            Q, big, where = fit, fit_big, fit_where
+    qa = Q.apply(va)
+    la, lb = np.linalg.norm(qa, axis=1), np.linalg.norm(vb, axis=1)
+    ok = (la >= DIRECTION_MIN_M) & (lb >= DIRECTION_MIN_M)
+    cos = np.sum(qa[ok] * vb[ok], axis=1) / (la[ok] * lb[ok])
+    angle = float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max()) if ok.any() else 0.0
+    return SkeletonDifference(True, "", big, where, Q, angle, tol_m)
+
+
+def retarget(motion, reference: Skeleton, what: str = "", reference_name: str = "", tol_m: float = SAME_SKELETON_TOL_M):
+    """``motion`` on the ``reference`` skeleton, by joint name.
+
+    * The same skeleton (:func:`compare_skeletons` within ``tol_m``, no rest-frame turn) with the same DOF
+      columns: the values as they are, on ``reference`` (bit for bit).
+    * The same skeleton otherwise (other channels or channel orders, or its rest pose turned, as in a Z-up
+      re-export): the local rotations read onto ``reference``'s DOF (``L' = Q L Q^-1``, the root's world
+      rotation ``W Q^-1``): every joint's world position is unchanged. One info line.
+    * Other rest offsets (bone lengths, or directions within :data:`RETARGET_MAX_ANGLE_DEG`): retargeted, the
+      local rotations kept (after the rest-frame turn) and the root's world translation kept, on
+      ``reference``'s offsets. One warning names both and the largest offset difference.
+    * Refused (ValueError naming both and the largest difference): other joint names or parents, or a bone
+      whose rest direction differs by more than :data:`RETARGET_MAX_ANGLE_DEG` (another rest pose: keeping the
+      local rotations would not carry the motion over).
+
+    Translation DOF of non-root joints the reference lacks are dropped; rotation DOF the reference lacks must be
+    zero (:func:`animsynth.kinematics.dof_values_from_local`). The result's angles are made continuous
+    (:func:`animsynth.kinematics.unwrap_angles`).
+
+    Parameters
+    ----------
+    motion : Motion, ``(frames, n_dof)``
+    reference : Skeleton
+    what, reference_name : str, name the motion and the reference in messages
+    tol_m : float, metres
+
+    Returns
+    -------
+    Motion, ``(frames, reference.n_dof)`` on ``reference``
+    """
+    from .kinematics import dof_values_from_local, joint_translations, local_rotations, root_translation, unwrap_angles
+    from .motion import Motion
+
+    what = what or motion.name or "motion"
+    ref_name = reference_name or reference.name
+    sk = motion.skeleton
+    diff = compare_skeletons(sk, reference, tol_m)
+    if not diff.joints_match:
+        raise ValueError(f"{what}: its joints differ from the reference's ({ref_name}): {diff.why}; "
+                         "give motions on the same skeleton")
+    values = np.asarray(motion.values, float)
+    same_cols = sk.columns() == reference.columns()
+    turned = diff.turn_deg > 0
+    if diff.same and same_cols and not turned:
+        return Motion(values, reference, motion.fps, motion.name, dict(motion.meta))
+    if diff.largest_angle_deg > RETARGET_MAX_ANGLE_DEG:
+        raise ValueError(f"{what} and {ref_name}: another rest pose (rest offsets differ by up to "
+                         f"{diff.largest_m * 1000:.1f} mm at joint {diff.joint!r}, a bone's rest direction by "
+                         f"{diff.largest_angle_deg:.0f} degrees > {RETARGET_MAX_ANGLE_DEG:g}); retargeting by joint "
+                         "name would not carry the motion over: give motions on one skeleton")
+    Q = diff.turn
+    L = local_rotations(sk, values)
+    T = joint_translations(sk, values)
+    n = values.shape[0]
+    rots, trans = [], np.empty((n, len(reference.joints), 3))
+    for i, j in enumerate(reference.joints):
+        k = sk.index(j.name)
+        rots.append(L[k] * Q.inv() if j.parent < 0 else Q * L[k] * Q.inv())
+        if j.parent >= 0:
+            moved = (T[:, k] - np.asarray(sk.joints[k].offset, float)) * (sk.length_to_m / reference.length_to_m)
+            trans[:, i] = np.asarray(j.offset, float) + Q.apply(moved)
+    root_t = root_translation(sk, values) * (sk.length_to_m / reference.length_to_m)
+    trans[:, 0] = root_t
+    out = Motion(dof_values_from_local(reference, rots, root_t, trans), reference, motion.fps, motion.name,
+                 dict(motion.meta))
+    if diff.same:
+        log.info("%s: the skeleton of %s%s (rest offsets within %g mm); its rotations are read onto %s's DOF "
+                 "(every joint's position unchanged)", what, ref_name,
+                 f" with its rest pose turned by {diff.turn_deg:.0f} degrees" if turned else "", tol_m * 1000,
+                 ref_name)
+    else:
+        log.warning("%s and %s: rest offsets differ by up to %.1f mm (joint %r; tolerance %g mm)%s; %s is "
+                    "retargeted onto %s's skeleton by joint name (local rotations kept, %s's offsets)", what,
+                    ref_name, diff.largest_m * 1000, diff.joint, tol_m * 1000,
+                    f" after turning the rest pose by {diff.turn_deg:.0f} degrees" if turned else "", what, ref_name,
+                    ref_name)
+    return unwrap_angles(out, what)

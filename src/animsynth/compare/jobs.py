@@ -158,15 +158,30 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
     cfg : the ``compare`` config block (``fps``, ``context``, ``length``, ``min_length``,
         ``holdout_fraction``) and ``native_fps`` (optional: the native rates to prepare,
         :func:`animsynth.compare.settings.native_rates`)
+
+    Every trial's angles are made continuous at its own rate, before resampling
+    (:func:`animsynth.kinematics.unwrap_angles`: a fast joint may turn by more than 180 degrees between two
+    working frames without wrapping, so the working frames are not unwrapped again). A leave-one-out clip's
+    database trials are put on the held-out trial's skeleton (:func:`animsynth.skeleton.retarget`: the same
+    skeleton is kept as it is; other rest offsets are retargeted with a logged warning, or refused naming
+    both trials) and every one of them, the held-out trial too, on the angle branch of the database's first
+    trial (:func:`animsynth.kinematics.align_angle_branches`). A temporal split's database and held-out part
+    are one continuous trial and stay as they are. The clips at a native rate are made the same way from
+    the unwrapped trials.
     """
+    from ..kinematics import align_angle_branches, unwrap_angles
+    from ..skeleton import retarget
+
     fps, context = float(cfg["fps"]), int(cfg["context"])
     length, min_length = int(cfg["length"]), int(cfg["min_length"])
-    work = {t: resample(m, fps) for t, m in trials.items()}
+    # unwrapped at the capture's own rate: a fast joint may move more than 180 degrees between working frames
+    full = {t: unwrap_angles(m, f"trial {t}") for t, m in trials.items()}
+    work = {t: resample(m, fps) for t, m in full.items()}
     rates = sorted({float(r) for r in cfg.get("native_fps") or []} - {fps})
     native = {}  # {(rate, trial): (Motion at the rate, k) or the reason there is none}
     for r in rates:
         k = r / fps
-        for t, m in trials.items():
+        for t, m in full.items():
             step = float(m.fps) / r
             if abs(k - round(k)) > 1e-6 or round(k) < 1:
                 why = f"{r:g} fps is not a whole multiple of the working rate {fps:g} fps"
@@ -193,8 +208,11 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
             vals = np.asarray(held.values, float)
             start = Motion(vals[first * k:first * k + (context - 1) * k + 1], held.skeleton, r,
                            f"{trial}:start@{r:g}")
-            if n_db is None:
-                db = [Motion(np.asarray(m.values, float), m.skeleton, r, name) for (m, _k), name in zip(dbs, db_names)]
+            if n_db is None:  # as the working-rate clip: on the held-out trial's skeleton and the database's branch
+                db = [Motion(np.asarray(retarget(m, held.skeleton, f"trial {o}", f"trial {trial}").values, float),
+                             held.skeleton, r, name) for (m, _k), o, name in zip(dbs, db_trials, db_names)]
+                db = [align_angle_branches(d, db[0]) for d in db]
+                start = align_angle_branches(start, db[0])
             else:
                 db = [Motion(vals[:n_db * k], held.skeleton, r, db_names[0])]
             out.append(NativeRate(r, db, start))
@@ -218,7 +236,9 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
             raise ValueError(f"config key 'compare.subsets': subset {group!r} needs >= 2 trials for leave one out")
         for t in ids:
             others = [o for o in ids if o != t]
-            add(f"{group}/{t}", group, "leave one out", t, work[t], [work[o] for o in others], others,
+            db = [resample(retarget(full[o], full[t].skeleton, f"trial {o}", f"trial {t}"), fps) for o in others]
+            db = [align_angle_branches(d, db[0]) for d in db]
+            add(f"{group}/{t}", group, "leave one out", t, align_angle_branches(work[t], db[0]), db, others,
                 at_rates(t, others, [work[o].name for o in others], 0, None))
     for group, t in resequencing.items():
         m = work[t]

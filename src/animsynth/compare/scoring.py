@@ -42,17 +42,21 @@ UNSCORED = ("transition_skate_share", "n_seams", "seams_per_s", "transitions_kep
             "seed_diversity_m")
 
 
-def on_skeleton(motion: Motion, skeleton, what: str) -> Motion:
-    """``motion`` on ``skeleton`` (the reference's): its values as they are when the DOF columns are the same,
-    else read joint by joint, by name.
+def on_skeleton(motion: Motion, skeleton, what: str, reference_name: str = "the reference") -> Motion:
+    """``motion`` on ``skeleton`` (the reference's), by joint name.
 
     Every joint of ``skeleton`` must be in ``motion`` with the same parent joint (by name); joints of
     ``motion`` that the reference does not have (an extra end joint, a prop, a finger) are left out, logged.
     Otherwise (a joint missing, or one whose parent differs: an extra joint inside a chain would move its
-    children) a ``ValueError`` names the joints.
+    children) a ``ValueError`` names the joints. The rest is :func:`animsynth.skeleton.retarget`: its values
+    as they are when it is the same skeleton (rest offsets within
+    :data:`animsynth.skeleton.SAME_SKELETON_TOL_M`) with the same DOF columns; its rotations read onto the
+    reference's DOF when only the channels or the rest frame differ (a Z-up re-export: every joint's position
+    unchanged); retargeted by joint name with a logged warning when the rest offsets differ; refused (naming
+    both and the largest offset difference) when the rest pose differs.
     """
-    if motion.skeleton.columns() == skeleton.columns():
-        return Motion(np.asarray(motion.values, float), skeleton, motion.fps, motion.name)
+    from ..skeleton import retarget
+
     msk = motion.skeleton
     missing = [n for n in skeleton.names if n not in msk.names]
     if missing:
@@ -69,14 +73,35 @@ def on_skeleton(motion: Motion, skeleton, what: str) -> Motion:
         raise ValueError(f"{what}: joint(s) {', '.join(moved[:5])} hang from another parent than in the "
                          "reference (an extra joint inside a chain would move them); score motions on the "
                          "reference's skeleton")
-    from ..io.bvh import motion_from_bvh_on
-
     extra = [n for n in msk.names if n not in skeleton.names]
     if extra:
         log.info("%s: joints the reference does not have are left out: %s", what, ", ".join(extra))
-    log.info("%s: its channels differ from the reference's; its joint rotations are read onto the reference's "
-             "skeleton joint by joint", what)
-    return motion_from_bvh_on(motion, skeleton)
+        motion = _without_joints(motion, set(extra))
+    return retarget(motion, skeleton, what, reference_name)
+
+
+def _without_joints(motion: Motion, drop: set) -> Motion:
+    """``motion`` with the joints ``drop`` (and their DOF columns) removed: the kept joints' parents re-indexed.
+    Only joints that no kept joint hangs from may be dropped (:func:`on_skeleton` checks the parents), so the
+    kept joints move as before."""
+    import copy
+
+    from ..skeleton import Skeleton
+
+    sk = motion.skeleton
+    keep = [i for i, j in enumerate(sk.joints) if j.name not in drop]
+    new_index = {old: new for new, old in enumerate(keep)}
+    joints = []
+    for i in keep:
+        j = copy.deepcopy(sk.joints[i])
+        j.parent = new_index[j.parent] if j.parent >= 0 else -1
+        joints.append(j)
+    out_sk = Skeleton(joints, length_to_m=sk.length_to_m, angle_unit=sk.angle_unit, name=sk.name,
+                      file_angle_unit=sk.file_angle_unit, roles=dict(sk.roles))
+    cols = sk.columns()
+    pos = {c: k for k, c in enumerate(cols)}
+    take = [pos[c] for c in out_sk.columns()]
+    return Motion(np.asarray(motion.values, float)[:, take], out_sk, motion.fps, motion.name, dict(motion.meta))
 
 
 def score_motions(generated: dict, reference_motion: Motion, database: dict | None, context: int, mcfg: dict,
@@ -112,7 +137,7 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
     for name, d in (database or {}).items():
         if not np.isclose(float(d.fps), fps):
             raise ValueError(f"database {name}: {float(d.fps):g} fps, the reference runs at {fps:g} fps")
-        db.append(Motion(on_skeleton(d, sk, f"database {name}").values, sk, fps, name))
+        db.append(Motion(on_skeleton(d, sk, f"database {name}", reference_name).values, sk, fps, name))
     blank = set(UNSCORED)
     note = ""
     if not db:
@@ -137,7 +162,7 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
         if not np.isclose(float(g.fps), fps):
             raise ValueError(f"{name}: {float(g.fps):g} fps, the reference {reference_name} runs at {fps:g} fps "
                              "(score motions at the reference's rate)")
-        m = on_skeleton(g, sk, name)
+        m = on_skeleton(g, sk, name, reference_name)
         length = m.n_frames - context
         if length < 1:
             raise ValueError(f"{name}: {m.n_frames} frames, none after the {context} start frames")

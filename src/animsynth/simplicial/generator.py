@@ -162,11 +162,19 @@ class FieldFollower(Generator):
 
     # ------------------------------------------------------------------ the generator interface
     def fit(self, database) -> "FieldFollower":
-        """Fit on a database of motions (list of Motion): the joint angles of every clip, root removed."""
+        """Fit on a database of motions (list of Motion): the joint angles of every clip, root removed, each clip
+        on the angle branch of the first clip's (:func:`animsynth.kinematics.align_angle_branches`; the
+        comparison's clips already are, and stay as they are). The clips are expected continuous along time
+        (:func:`animsynth.kinematics.unwrap_angles`, which :func:`animsynth.data.load_trial` and the
+        comparison's clips apply at the capture's own rate)."""
         from scipy.spatial import cKDTree
 
+        from ..kinematics import align_angle_branches
+
         self.db_ = db = Database(database)
-        self.fit_latent([np.asarray(c.values, float)[:, db.n_root:] for c in db.clips], what="latent_dim")
+        clips = [align_angle_branches(c, db.clips[0]) for c in db.clips]
+        self.branch_ref_ = clips[0]
+        self.fit_latent([np.asarray(c.values, float)[:, db.n_root:] for c in clips], what="latent_dim")
         self.fit_field()
         self.tree_ = cKDTree(self.latent_)
         self.steps_per_frame_ = 2 if self.derivative == "half" else 1
@@ -177,8 +185,9 @@ class FieldFollower(Generator):
 
         Parameters
         ----------
-        start : Motion, ``(>= 2, n_dof)`` values of the database's skeleton; its last frame's joint angles are
-            encoded, the latent point moved by the seeded ``jitter``
+        start : Motion, ``(>= 2, n_dof)`` values of the database's skeleton; its last frame's joint angles (put on
+            the database's angle branch) are encoded, the latent point moved by the seeded
+            ``jitter``
         length : int, output frames; the path takes ``length * steps_per_frame_`` Euler steps
         seed : int, the jitter's random direction
 
@@ -189,9 +198,12 @@ class FieldFollower(Generator):
         frame); ``meta``: ``seams`` (empty, int64), ``source_frames`` ``(length, 2)`` int64 of -1 (decoded poses
         have no source frame), ``fallback_share`` (float, the share of steps that fell back to k-NN)
         """
+        from ..kinematics import align_angle_branches
+
         self._check_start(start, length)
         db, spf, length = self.db_, self.steps_per_frame_, int(length)
-        x0 = self.encode(np.asarray(start.values, float)[-1:, db.n_root:])[0]
+        start_values = align_angle_branches(start, self.branch_ref_).values  # on the database's branch
+        x0 = self.encode(np.asarray(start_values, float)[-1:, db.n_root:])[0]
         u = np.random.default_rng(seed).normal(size=x0.size)
         x0 = x0 + float(self.jitter) * self.scale_ * u / max(float(np.linalg.norm(u)), 1e-300)
         path = self.follow(x0, length * spf)

@@ -29,15 +29,32 @@ log = logging.getLogger("animsynth.simplicial.jobs")
 
 
 def load_trials(paths, ids) -> tuple[dict, dict]:
-    """Parsed trials -> (id -> 56 joint-angle columns, id -> Motion), in the given order."""
+    """Parsed trials of one subset -> (id -> 56 joint-angle columns, id -> Motion), in the given order.
+
+    The subset's trials share one database in every fold, so they are put on one skeleton and one angle branch
+    first: every trial on the first trial's skeleton (:func:`animsynth.skeleton.retarget`: the same skeleton,
+    rest offsets within 1 mm, is kept as it is; other rest offsets are retargeted with a logged warning, or
+    refused naming both trials), each trial's angles continuous along time and on the branch of the first
+    trial's (:func:`animsynth.kinematics.continuous_clips`). A trial that needs neither keeps its values bit
+    for bit.
+    """
+    from ..kinematics import continuous_clips
+    from ..skeleton import retarget
+
     if len(paths) != len(ids):
         raise ValueError(f"{len(paths)} trial files for {len(ids)} trial ids")
-    angles, motions = {}, {}
+    loaded = []
     for p, tid in zip(paths, ids):
         stem = os.path.splitext(os.path.basename(os.fspath(p)))[0]
         if stem != tid:
             raise ValueError(f"trial file {p} does not match trial id {tid!r}")
-        m = Motion.load_npz(p)
+        loaded.append(Motion.load_npz(p))
+    if loaded:
+        first = loaded[0]
+        loaded = continuous_clips([first] + [retarget(m, first.skeleton, f"trial {tid}", f"trial {ids[0]}")
+                                             for m, tid in zip(loaded[1:], ids[1:])])
+    angles, motions = {}, {}
+    for p, tid, m in zip(paths, ids, loaded):
         a = np.asarray(m.without_root(), float)
         moved = translated_joints(m.skeleton)
         if moved:
