@@ -249,6 +249,9 @@ def results_markdown(compare_dir) -> str:
            to_markdown(pd.DataFrame(rows)), ""]
     v = pd.read_csv(d / "verdicts.csv", keep_default_na=False)
     out += ["**Findings** (`verdicts.csv`):", "", to_markdown(v[["claim", "verdict", "ours", "evidence"]]), ""]
+    if (d / "claims_stats.csv").exists():
+        out += ["**The declared claims' numbers** (`claims_stats.csv`):", "",
+                to_markdown(pd.read_csv(d / "claims_stats.csv")), ""]
     if (d / "sanity_checks.csv").exists():
         sc = pd.read_csv(d / "sanity_checks.csv", keep_default_na=False)
         out += ["**Sanity checks** (`sanity_checks.csv`):", "", to_markdown(sc[["claim", "verdict", "evidence"]]), ""]
