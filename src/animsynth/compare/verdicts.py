@@ -186,8 +186,8 @@ def per_clip(j: pd.DataFrame) -> pd.DataFrame:
     the claim holds on more of its seeds than its opposite, -1 for the reverse, 0 for a tie), ``effect`` (the
     median over seeds) and the seed counts ``seeds_for, seeds_against``."""
     g = j.groupby("clip", sort=False)
-    out = pd.DataFrame({"seeds_for": g["outcome"].apply(lambda o: int((o > 0).sum())),
-                        "seeds_against": g["outcome"].apply(lambda o: int((o < 0).sum()))})
+    out = pd.DataFrame({"seeds_for": (j["outcome"] > 0).groupby(j["clip"], sort=False).sum().astype(int),
+                        "seeds_against": (j["outcome"] < 0).groupby(j["clip"], sort=False).sum().astype(int)})
     out["effect"] = g["effect"].median() if "effect" in j else np.nan
     out["outcome"] = np.sign(out["seeds_for"] - out["seeds_against"]).astype(int)
     return out.reset_index()
@@ -200,8 +200,8 @@ def group_outcomes(j: pd.DataFrame, groups: dict, min_effect: float) -> pd.DataF
     c = per_clip(j)
     c["unit"] = c["clip"].map(groups).fillna(c["clip"])
     g = c.groupby("unit", sort=False)
-    out = pd.DataFrame({"clips": g.size(), "clips_for": g["outcome"].apply(lambda o: int((o > 0).sum())),
-                        "clips_against": g["outcome"].apply(lambda o: int((o < 0).sum())),
+    out = pd.DataFrame({"clips": g.size(), "clips_for": (c["outcome"] > 0).groupby(c["unit"], sort=False).sum().astype(int),
+                        "clips_against": (c["outcome"] < 0).groupby(c["unit"], sort=False).sum().astype(int),
                         "effect": g["effect"].median()})
     out["vote"] = V.unit_votes(out["clips_for"] - out["clips_against"], out["effect"], min_effect)
     return out
@@ -372,10 +372,11 @@ class Stats:
     j : DataFrame, :func:`pair_outcomes` (clip x seed effects)
     n, mean, lo, hi, p : the groups, their mean effect, its 95 % t interval, the sign-flip p
     subjects : DataFrame per group: ``for``, ``against`` (clip x seed effects each way), ``p`` (sign test),
-        ``p_holm`` (Holm over the groups), ``side`` (+1 significantly for, -1 against, 0 neither)
+        ``p_holm`` (Holm over the groups), ``side`` (+1 significantly for, -1 against, 0 neither); None when built
+        with ``subjects=False`` (the exploratory table, which decides nothing)
     """
 
-    def __init__(self, j: pd.DataFrame, groups: dict, min_effect: float, vc: dict, seed: int):
+    def __init__(self, j: pd.DataFrame, groups: dict, min_effect: float, vc: dict, seed: int, subjects: bool = True):
         self.j, self.min_effect = j, float(min_effect)
         self.per = group_outcomes(j, groups, min_effect)
         eff = self.per["effect"].to_numpy(float)
@@ -383,7 +384,7 @@ class Stats:
         self.mean = float(np.nanmean(eff)) if self.n else float("nan")
         self.lo, self.hi = t_interval(eff)
         self.p = sign_flip_p(eff, seed=seed, draws=int(vc.get("permutations", 100000)))
-        self.subjects = _subject_tests(j, groups, self.per, min_effect, float(vc["alpha"]))
+        self.subjects = _subject_tests(j, groups, self.per, min_effect, float(vc["alpha"])) if subjects else None
 
     @property
     def holding(self) -> int:
@@ -402,9 +403,8 @@ class Stats:
 def _subject_tests(j: pd.DataFrame, groups: dict, per: pd.DataFrame, min_effect: float, alpha: float) -> pd.DataFrame:
     """Per group: the two-sided exact sign test of its clip x seed effects, Holm over the groups, and its side."""
     unit = j["clip"].map(groups).fillna(j["clip"])
-    g = j.assign(unit=unit).groupby("unit", sort=False)["effect"]
-    out = pd.DataFrame({"for": g.apply(lambda e: int((e > 0).sum())),
-                        "against": g.apply(lambda e: int((e < 0).sum()))}).reindex(per.index)
+    out = pd.DataFrame({"for": (j["effect"] > 0).groupby(unit, sort=False).sum().astype(int),
+                        "against": (j["effect"] < 0).groupby(unit, sort=False).sum().astype(int)}).reindex(per.index)
     out["p"] = [V.sign_test(w, f) for w, f in zip(out["for"], out["against"])]
     out["p_holm"] = V.holm(out["p"])
     sig = out["p_holm"] < alpha
@@ -700,7 +700,7 @@ def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | Non
                 j = pair_outcomes(metrics, a, b, metric, better)
                 if not len(j):
                     continue
-                st = Stats(j, groups, me, vc, seed)
+                st = Stats(j, groups, me, vc, seed, subjects=False)
                 rows.append({"label": "exploratory", "a": a, "b": b, "metric": metric, "direction": better,
                              "n_groups": st.n, "groups_holding": st.holding, "groups_opposite": st.opposite,
                              "mean_effect": st.mean, "ci_low": st.lo, "ci_high": st.hi, "p": st.p, "min_effect": me})
