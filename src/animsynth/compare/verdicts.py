@@ -397,7 +397,7 @@ class Stats:
     def numbers(self, unit: str = "") -> str:
         """'mean effect 0.05 [95 % t interval 0.03, 0.07], p = 0.125' (the sign-flip p)."""
         return (f"mean effect {V.fmt(self.mean)}{' ' + unit if unit else ''} [95 % t interval {V.fmt(self.lo)}, "
-                f"{V.fmt(self.hi)}], p = {V.fmt(self.p, 2)}")
+                f"{V.fmt(self.hi)}], p = {V.fmt(self.p, 3)}")
 
 
 def _subject_tests(j: pd.DataFrame, groups: dict, per: pd.DataFrame, min_effect: float, alpha: float) -> pd.DataFrame:
@@ -451,7 +451,7 @@ def decide(st: Stats, p_holm: float, min_effect: float, vc: dict) -> tuple[str, 
                                 f"{st.opposite} of {st.n} the opposite (share holding {V.fmt(st.holding / st.n, 2)}), "
                                 "without a significant split")
     return "undecided", (f"too few {_units(vc)} or too wide an interval to decide (with {st.n} the smallest "
-                         f"possible p is {V.fmt(2.0 / 2 ** st.n if st.n else float('nan'), 2)})")
+                         f"possible p is {V.fmt(2.0 / 2 ** st.n if st.n else float('nan'), 3)})")
 
 
 def _median(metrics: pd.DataFrame, g: str, metric: str) -> float:
@@ -557,7 +557,7 @@ class _Claim:
         head = f"{word} ({st.n} {_units(vc, st.n)})" if word == "undecided" else f"{st.n} {_units(vc, st.n)}"
         text = (f"{head}: {'weakest part ' if self.parts else ''}mean {_units(vc, 1)}-level effect "
                 f"{V.fmt(st.mean)} {unit} (95 % t interval over {_units(vc)} {V.fmt(st.lo)} to {V.fmt(st.hi)}), "
-                f"sign-flip p = {V.fmt(self.p, 2)}, Holm p = {V.fmt(p_holm, 2)}")
+                f"sign-flip p = {V.fmt(self.p, 3)}, Holm p = {V.fmt(p_holm, 3)}")
         if self.b == EVERY:
             med = {g: _median(self.metrics, g, self.metric) for g, _s in self.parts}
             text += f"; {self.metric} median {self.a} {_spread(self.metrics, self.a, self.metric)}"
@@ -593,8 +593,8 @@ class _Claim:
             parts = "; ".join(f"{g}: {s.holding}/{s.opposite}/{s.n - s.holding - s.opposite}, {s.numbers()}"
                               for g, s in self.parts)
             text += (f"One intersection-union test over the {len(self.parts)} generators compared (the claim holds "
-                     f"only if it holds against each, so its p is the largest of theirs, p = {V.fmt(self.p, 2)}, and "
-                     f"it is one finding of the Holm correction: adjusted p = {V.fmt(p_holm, 2)}); {test}; per "
+                     f"only if it holds against each, so its p is the largest of theirs, p = {V.fmt(self.p, 3)}, and "
+                     f"it is one finding of the Holm correction: adjusted p = {V.fmt(p_holm, 3)}); {test}; per "
                      f"generator (groups holding / opposite / neither, mean effect, interval, p): {parts}")
             if self.left:
                 text += "; " + "; ".join(self.left)
@@ -606,7 +606,7 @@ class _Claim:
             subj = ", ".join(f"{g} {int(r['for'])}/{int(r['for'] + r['against'])} (Holm p {V.fmt(r.p_holm, 2)})"
                              for g, r in st.subjects.iterrows())
             text += (f"{st.n} independent {_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted p = "
-                     f"{V.fmt(p_holm, 2)}; {test}; holds in {st.holding}, opposite in {st.opposite}, neither in "
+                     f"{V.fmt(p_holm, 3)}; {test}; holds in {st.holding}, opposite in {st.opposite}, neither in "
                      f"{st.n - st.holding - st.opposite}; per group (clips holding / untied clips, median effect): "
                      f"{groups}; per-subject sign tests (clip x seed effects for / untied): {subj}; counted by clips "
                      f"instead: {ch} of {ch + cf} untied clips")
@@ -771,7 +771,7 @@ def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
         unit = _UNITS.get(metric, "")
         rows.append(V.row(claim, word, f"tested: {lead}; {word} because {why}. {st.n} independent "
                           f"{_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted over the {m} sanity checks p = "
-                          f"{V.fmt(pa, 2)}; holds in {st.holding}, opposite in {st.opposite} (minimum effect "
+                          f"{V.fmt(pa, 3)}; holds in {st.holding}, opposite in {st.opposite} (minimum effect "
                           f"{V.fmt(me)} {unit})", ours=ours, data=data, source="compare/metrics.csv"))
     return V.table(rows)
 
