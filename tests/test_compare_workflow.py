@@ -44,6 +44,15 @@ def test_compare_outputs(tiny_workflow):
     assert list(sanity.columns) == list(v.columns) and set(sanity["verdict"]) <= set(VOCABULARY)
     assert not set(sanity["claim"]) & set(v["claim"])  # true by construction: not among the findings
     assert (v["evidence"].str.contains("Holm") | (v["verdict"] == "not reproduced")).all()
+    # the declared claims' numbers, one row per verdict row; the exploratory pairs apart, without a verdict
+    from animsynth.compare.verdicts import EXPLORATORY_COLUMNS, STATS_COLUMNS
+
+    stats = pd.read_csv(r / "claims_stats.csv")
+    assert list(stats.columns) == list(STATS_COLUMNS) and len(stats) == len(v)
+    assert list(stats["verdict"]) == list(v["verdict"])
+    ex = pd.read_csv(r / "exploratory.csv")
+    assert list(ex.columns) == list(EXPLORATORY_COLUMNS) and len(ex) > 0 and set(ex["label"]) == {"exploratory"}
+    assert (r / "exploratory.md").stat().st_size > 0
     sens = pd.read_csv(r / "skating_sensitivity.csv")
     assert set(sens["speed_m_s"]) == {0.15, 0.3, 0.5}
     for png in ("metrics.png", "strips.png"):

@@ -34,6 +34,8 @@ VERDICT_COLOURS = {
     "within noise": "#fee08b",
     "not reproduced": "#fdae61",
     "contradicted": "#d7191c",
+    # not on the scale: too few independent units to decide (a neutral grey-blue, apart from "within noise")
+    "undecided": "#9fb4c7",
 }
 #: a verdict word outside the vocabulary (a family's newer word): drawn grey, named in the legend
 OTHER_COLOUR = "#bdbdbd"

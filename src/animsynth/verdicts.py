@@ -23,17 +23,20 @@ The vocabulary:
 * ``partly`` -- it holds for some of the cases the claim covers and not others, each of them stably;
 * ``not reproduced`` -- the effect is absent or the number out of range, stably;
 * ``contradicted`` -- the opposite holds on every nudge;
-* ``within noise`` -- the outcome flips across nudges; the evidence gives the share.
+* ``within noise`` -- the outcome flips across nudges; the evidence gives the share;
+* ``undecided`` -- too few independent units, or too wide an interval, to decide either way; the evidence gives
+  the effect and its interval (the generators side by side use it; no other family emits it).
 
 A beats B over units
 --------------------
-Every family that decides "A beats B" over independent units (pairs of paths, groups of clips) uses one rule,
-:func:`a_beats_b`: each unit votes for A, for B or for neither (:func:`unit_votes`: a unit votes only when it
-leans one way by at least the minimum effect); A *holds* when at least ``share`` of the units vote for it and a
-test of the votes gives ``p < alpha`` (the two-sided sign test, :func:`sign_test`, unless the family gives its own
-p -- compare passes a Holm-adjusted t-test of its group effects, and says why); *opposite* is the same for B; a
-significant test without the share *leans*; anything else is noise. Each family maps the outcome onto
-:data:`VOCABULARY` and says in its evidence how many units voted which way.
+Families that decide "A beats B" over independent units (pairs of paths) use one rule, :func:`a_beats_b`: each
+unit votes for A, for B or for neither (:func:`unit_votes`: a unit votes only when it leans one way by at least
+the minimum effect); A *holds* when at least ``share`` of the units vote for it and a test of the votes gives
+``p < alpha`` (the two-sided sign test, :func:`sign_test`, unless the family gives its own p); *opposite* is the
+same for B; a significant test without the share *leans*; anything else is noise. Each family maps the outcome
+onto :data:`VOCABULARY` and says in its evidence how many units voted which way. The generators side by side
+decide their declared claims over groups of clips by the mean group effect, an exact sign-flip test and its
+interval instead (:mod:`animsynth.compare.verdicts`), which is where ``undecided`` comes from.
 
 Whether a row ran on real or synthetic data is not part of the row: the data layer records it
 per family (``FAMILY_REAL`` of the workflow) and the report joins it, so no word in a text decides it.
@@ -51,7 +54,7 @@ __all__ = ["COLUMNS", "VOCABULARY", "OUTCOMES", "VerdictError", "row", "table", 
            "agreement_verdict", "holm", "unit_votes", "sign_test", "a_beats_b"]
 
 COLUMNS = ("claim", "paper_value", "ours", "data", "verdict", "evidence", "source")
-VOCABULARY = ("reproduced", "partly", "not reproduced", "contradicted", "within noise")
+VOCABULARY = ("reproduced", "partly", "not reproduced", "contradicted", "within noise", "undecided")
 #: What :func:`a_beats_b` decides (the families map these onto :data:`VOCABULARY`).
 OUTCOMES = ("holds", "opposite", "lean", "lean_opposite", "noise", "none")
 

@@ -148,6 +148,17 @@ rule compare_tables:
             category="The generators side by side",
         ),
         verdicts_md=R("compare/verdicts.md"),
+        claims_stats=report(
+            R("compare/claims_stats.csv"),
+            caption="../report/compare_claims_stats.rst",
+            category="The generators side by side",
+        ),
+        exploratory=report(
+            R("compare/exploratory.csv"),
+            caption="../report/compare_exploratory.rst",
+            category="The generators side by side",
+        ),
+        exploratory_md=R("compare/exploratory.md"),
         sanity=report(
             R("compare/sanity_checks.csv"),
             caption="../report/compare_sanity.rst",
@@ -169,7 +180,7 @@ rule compare_tables:
         generators=CMP_RUN,
         left_out=CMP_LEFT_OUT,
         cfg={k: CMP_ORDER if k == "generators" else CMP[k]
-             for k in ("generators", "seeds", "fps", "context", "length", "verdicts")},
+             for k in ("generators", "seeds", "fps", "context", "length", "verdicts", "claims", "seed")},
         source=SOURCE,
         sweep={"default": CMP["transitions_per_s"], "budgets": [float(b) for b in CMP_SWEEP], "generators": CMP_GRAPHS},
     threads: 1
@@ -323,6 +334,8 @@ COMPARE_TARGETS = [
     R("compare/cost_timing.csv"),
     R("compare/verdicts.csv"),
     R("compare/sanity_checks.csv"),
+    R("compare/claims_stats.csv"),
+    R("compare/exploratory.csv"),
     R("compare/skating_sensitivity.csv"),
     R("compare/summary.md"),
     R("compare/metrics.png"),

@@ -816,7 +816,9 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     """Assemble the family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``,
     ``timing`` lists; optional ``sweep``: the budget sweep's metrics files) into ``out``: ``metrics``,
     ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``), ``cost`` (+ ``cost_md``), ``verdicts``
-    (+ ``verdicts_md``), ``summary_md`` (the family's page).
+    (+ ``verdicts_md``; the declared claims, ``cfg["claims"]``), ``claims_stats`` (their numbers), ``exploratory``
+    (+ ``exploratory_md``; every other pair, no verdict), ``sanity`` (+ ``sanity_md``), ``sensitivity``
+    (+ ``sensitivity_md``), ``summary_md`` (the family's page).
 
     ``sweep``: ``{"default": transitions_per_s, "budgets": [...], "generators": [...]}`` describing
     ``inp["sweep"]`` (:func:`sweep_runs`); the claims against the peer quote the sweep as evidence."""
@@ -825,7 +827,7 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     from .generators import GENERATORS
     from .tables import (cost_table, data_label, sensitivity_table, summary_markdown, summary_table, sweep_table,
                          winners_table)
-    from .verdicts import build_verdicts, independent_groups, sanity_checks
+    from .verdicts import decide_claims, exploratory_table, independent_groups, sanity_checks
 
     order = list(cfg["generators"])
     metrics = read_metrics(inp["metrics"])
@@ -845,14 +847,20 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     if sweep and sweep.get("budgets") and inp.get("sweep"):
         sweep_tab = sweep_table(sweep_runs(metrics, inp["sweep"], sweep["default"], sweep["budgets"],
                                            sweep["generators"]), order)
-    verdicts = build_verdicts(own, cfg["verdicts"], data, left_out, clips_full, sweep=sweep_tab)
-    sanity = sanity_checks(own, cfg["verdicts"], data, left_out, clips_full)
+    seed = int(cfg.get("seed", 0))
+    declared = cfg.get("claims")
+    verdicts, claims_stats = decide_claims(own, cfg["verdicts"], data, left_out, clips_full, sweep=sweep_tab,
+                                           claims=declared, seed=seed)
+    exploratory = exploratory_table(own, cfg["verdicts"], clips_full, claims=declared, order=order, seed=seed)
+    sanity = sanity_checks(own, cfg["verdicts"], data, left_out, clips_full, seed=seed)
     write_table(metrics, out["metrics"], md=False)
     write_table(timing, out["metrics_timing"], md=False)
     write_table(summary, out["summary"], md=False)  # compare/summary.md is the family's page below
     write_table(winners, out["winners"], md=out["winners_md"])
     write_table(cost_table(timing, order), out["cost"], md=out["cost_md"])
     write_table(verdicts, out["verdicts"], md=out["verdicts_md"])
+    write_table(claims_stats, out["claims_stats"], md=False)
+    write_table(exploratory, out["exploratory"], md=out["exploratory_md"])
     write_table(sanity, out["sanity"], md=out["sanity_md"])
     write_table(sensitivity_table(metrics, order), out["sensitivity"], md=out["sensitivity_md"])
     not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()

@@ -199,8 +199,11 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
         cols = ["metric", "better", "best", "best_median", "second", "second_median", "margin", "beyond_spread",
                 "best_wins_share", "replay_median", "concat_median"]
         out += [to_markdown(winners[[c for c in cols if c in winners]]), ""]
-    out += ["## Verdicts", "", "Decided over independent groups of clips with a minimum effect per metric and "
-            "a Holm correction over the findings (docs/compare.md, Verdicts).", "",
+    out += ["## Verdicts", "", "The claims declared in advance (compare.claims), each decided over independent "
+            "groups of clips (subjects) by an exact sign-flip test of the mean group effect, its 95 % interval and "
+            "the claim's minimum effect, with a Holm correction over the declared claims only (docs/compare.md, "
+            "Verdicts; numbers: `claims_stats.csv`; every other pair of generators, without a verdict: "
+            "`exploratory.csv`).", "",
             to_markdown(verdicts[["claim", "ours", "verdict", "evidence"]]), ""]
     if sanity is not None and len(sanity):
         out += ["## Sanity checks", "", "Claims true by construction, decided the same way; not findings.", "",
@@ -251,6 +254,9 @@ def results_markdown(compare_dir) -> str:
            to_markdown(pd.DataFrame(rows)), ""]
     v = pd.read_csv(d / "verdicts.csv", keep_default_na=False)
     out += ["**Findings** (`verdicts.csv`):", "", to_markdown(v[["claim", "verdict", "ours", "evidence"]]), ""]
+    if (d / "claims_stats.csv").exists():
+        out += ["**The declared claims' numbers** (`claims_stats.csv`):", "",
+                to_markdown(pd.read_csv(d / "claims_stats.csv")), ""]
     if (d / "sanity_checks.csv").exists():
         sc = pd.read_csv(d / "sanity_checks.csv", keep_default_na=False)
         out += ["**Sanity checks** (`sanity_checks.csv`):", "", to_markdown(sc[["claim", "verdict", "evidence"]]), ""]

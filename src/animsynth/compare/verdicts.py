@@ -1,5 +1,16 @@
-"""The side-by-side claims, decided over independent groups of clips, in the common verdict format
-(:mod:`animsynth.verdicts`).
+"""The side-by-side claims, declared in advance and decided over independent groups of clips, in the common
+verdict format (:mod:`animsynth.verdicts`).
+
+Declared claims
+---------------
+The primary claims are a list fixed in advance (``compare.claims``; :data:`DEFAULT_CLAIMS` when none is given):
+each has an ``id``, the claim text, generators ``a`` and ``b`` (``b: "*"``: every generator of the run but the
+references, one intersection-union finding), a ``metric``, a ``direction`` (``lower`` / ``higher``: which value of
+``a`` the claim expects), a ``min_effect`` in the metric's units and, for skating metrics, ``skating: true``. Only
+these are findings (``verdicts.csv``, with their numbers in ``claims_stats.csv``) and Holm's correction runs over
+them alone. Every other pair of generators on the main metrics (:data:`EXPLORATORY_METRICS`), including a pair whose
+claim a user removed from the list, is **exploratory** (:func:`exploratory_table`, ``exploratory.csv``): numbers
+only, no verdict word, a Holm correction of its own, never a finding.
 
 Independent units
 -----------------
@@ -9,41 +20,61 @@ subject, and a re-sequencing clip may be a trial that a subset's clips use. The 
 
 * ``subject`` (default): every clip of one subject (the CMU subject id of its held-out trial), joined with every
   other group with which it shares a trial (held out or in a database): clips that share a subject or database
-  trials are one group. On the CMU protocol: subject 35 (w1, r1, run, walk), 16 (w2), 127 (r2), 05 (dance):
-  4 groups for 19 clips.
+  trials are one group. On the CMU protocol of the four subsets: subject 35 (w1, r1, run, walk), 16 (w2),
+  127 (r2), 05 (dance): 4 groups for 19 clips.
 * ``subset_subject``: the clips of one subset (or re-sequencing dataset) and one subject, joined where they
-  share a trial: w1, w2, r1 + run (trial 35_17), r2, walk, dance: 6 groups. It counts the subsets of one
-  subject as independent, which they are not for a claim about people's motion; kept as an option.
+  share a trial. It counts the subsets of one subject as independent, which they are not for a claim about
+  people's motion; kept as an option.
 
 A clip without a subject id (not a CMU trial name) is grouped by its subset.
 
-Inside a group, seeds vote inside each clip (its outcome is the majority of its seeds; seed ``i`` is the same
-seed for every generator) and clips vote inside the group. The group's **effect** is the median over its clips
-of each clip's median difference over seeds (``a - b``, signed so that positive favours the claim), in the
-metric's units. A group **holds** when more of its clips hold than not and its effect is at least the
-metric's minimum effect (``compare.verdicts.min_effect``); it holds the **opposite** for the reverse; otherwise
-it is within noise (no vote).
+A group's **effect** is the median over its clips of each clip's median over seeds of ``a - b`` (signed so that
+positive favours the claim), in the metric's units. A group **holds** when more of its clips hold than not and its
+effect is at least the claim's minimum effect, holds the **opposite** for the reverse, and votes neither way
+otherwise (:func:`group_outcomes`).
+
+The test
+--------
+Over the ``n`` group effects: the claim's effect is their **mean**, with a **95 % t interval** over the groups
+(mean +- t(0.975, n - 1) x standard deviation / sqrt(n); none for one group). Its p is an **exact sign-flip
+permutation test** of that mean (:func:`sign_flip_p`): under "no effect" each group's effect is as likely
+negative as positive, so the p is the share of the 2^n sign flips whose mean is at least as far from 0 as the
+observed one (two-sided; ``n > 16``: ``compare.verdicts.permutations`` seeded random flips, the seed
+``compare.seed``). Equal non-zero effects give p = 2 / 2^n, never 0; effects that are all 0 give 1. With 4 groups
+the smallest possible p is 2 / 2^4 = 0.125: four subjects cannot decide any claim, whatever its effect. Holm's
+step-down correction (Holm 1979) runs over the declared claims with a test.
+
+Per subject (for "partly" only): a two-sided exact sign test of the subject's clip x seed effects, Holm over the
+subjects of the claim; a subject is **significantly for** when its adjusted p is below ``alpha``, more of its
+clip x seed effects favour the claim and its effect is at least the minimum effect (**against** the reverse).
 
 The verdict of a claim
 ----------------------
-By the common rule for "A beats B over units" (:func:`animsynth.verdicts.a_beats_b`, the groups the units):
+In this order (:func:`decide`):
 
-* ``reproduced`` -- at least ``compare.verdicts.share`` of the groups hold (a group within noise does not),
-  there are at least ``compare.verdicts.min_groups`` groups, and a one-sample t-test of the group effects against zero gives
-  a Holm-adjusted p below ``compare.verdicts.alpha`` (Holm over every finding of the family: the claims of
-  :func:`build_verdicts`, not the sanity checks; the capture bound over every generator is one finding, an
-  intersection-union test whose p is the largest of its parts');
-* ``contradicted`` -- the same for the opposite;
-* ``partly`` -- neither, but some groups hold and others hold the opposite;
-* ``within noise`` -- anything else (the evidence gives the group counts, the effects and both p);
-* ``not reproduced`` -- no pair can be compared (a generator did not run: the evidence says why).
+* ``not reproduced`` -- a generator did not run (the evidence says why), or on a skating claim a generator's feet
+  do not touch the floor (its median ``contact_share`` below ``compare.verdicts.min_contact_share``): a generator
+  that never touches cannot win (or lose) a skating comparison;
+* significant (Holm-adjusted p < ``alpha``, at least ``min_groups`` groups): ``reproduced`` when the mean effect
+  is at least the minimum effect, ``contradicted`` when it is at most minus it, ``not reproduced`` (no material
+  effect) when it lies between;
+* ``partly`` -- a significant split between subjects: some subjects significantly for and some significantly
+  against by the per-subject test;
+* ``not reproduced`` (no material effect) -- the 95 % interval lies inside (-minimum effect, +minimum effect);
+* ``within noise`` -- the groups vote both ways (some hold, some hold the opposite, by the minimum effect)
+  without a significant split; the evidence gives the share;
+* ``undecided`` -- anything else: too few groups or too wide an interval to decide; the text reads
+  "undecided (n subjects)" with the mean effect, its interval, p and the Holm-adjusted p.
 
-A t-test of group effects rather than a sign test over groups: with 6 groups the smallest two-sided sign-test p
-is 2 / 2^6 = 0.031, which no Holm correction over several claims can pass, whatever the effect.
+The capture claim ("the held-out capture skates less than every generator") holds only if it holds against each
+generator: one finding whose p is the largest of its parts' (an intersection-union test needs no correction among
+its parts), decided by the rules above with the effect and interval of its weakest part (the generator against
+which the mean effect is smallest). Its parts show numbers (groups holding / opposite / neither, mean effect,
+interval, p), never a verdict word of their own. A generator whose feet do not touch is left out of it, named.
 
 Claims true by construction (re-sequencers copy database frames, so their novelty is 0; random concatenation
-is unblended, so a blended transition jumps less) are **sanity checks** (:func:`sanity_checks`): decided the
-same way, written to their own table and not counted among the findings or in the Holm correction.
+is unblended, so a blended transition jumps less) are **sanity checks** (:func:`sanity_checks`): decided by the
+same rules with the metric's ``compare.verdicts.min_effect``, Holm among themselves, in their own table.
 """
 
 from __future__ import annotations
@@ -57,8 +88,9 @@ from .. import verdicts as V
 from .generators import REFERENCES
 from .metrics import METRICS
 
-__all__ = ["independent_groups", "group_outcomes", "decide_groups", "pair_outcomes", "per_clip", "build_verdicts",
-           "sanity_checks"]
+__all__ = ["independent_groups", "group_outcomes", "pair_outcomes", "per_clip", "sign_flip_p", "t_interval", "Stats",
+           "decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks", "DEFAULT_CLAIMS",
+           "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
 
 _UNITS = {m: u for m, u, _b in METRICS}
 _TRIAL = re.compile(r"\d+_\d+")
@@ -154,8 +186,8 @@ def per_clip(j: pd.DataFrame) -> pd.DataFrame:
     the claim holds on more of its seeds than its opposite, -1 for the reverse, 0 for a tie), ``effect`` (the
     median over seeds) and the seed counts ``seeds_for, seeds_against``."""
     g = j.groupby("clip", sort=False)
-    out = pd.DataFrame({"seeds_for": g["outcome"].apply(lambda o: int((o > 0).sum())),
-                        "seeds_against": g["outcome"].apply(lambda o: int((o < 0).sum()))})
+    out = pd.DataFrame({"seeds_for": (j["outcome"] > 0).groupby(j["clip"], sort=False).sum().astype(int),
+                        "seeds_against": (j["outcome"] < 0).groupby(j["clip"], sort=False).sum().astype(int)})
     out["effect"] = g["effect"].median() if "effect" in j else np.nan
     out["outcome"] = np.sign(out["seeds_for"] - out["seeds_against"]).astype(int)
     return out.reset_index()
@@ -168,44 +200,11 @@ def group_outcomes(j: pd.DataFrame, groups: dict, min_effect: float) -> pd.DataF
     c = per_clip(j)
     c["unit"] = c["clip"].map(groups).fillna(c["clip"])
     g = c.groupby("unit", sort=False)
-    out = pd.DataFrame({"clips": g.size(), "clips_for": g["outcome"].apply(lambda o: int((o > 0).sum())),
-                        "clips_against": g["outcome"].apply(lambda o: int((o < 0).sum())),
+    out = pd.DataFrame({"clips": g.size(), "clips_for": (c["outcome"] > 0).groupby(c["unit"], sort=False).sum().astype(int),
+                        "clips_against": (c["outcome"] < 0).groupby(c["unit"], sort=False).sum().astype(int),
                         "effect": g["effect"].median()})
     out["vote"] = V.unit_votes(out["clips_for"] - out["clips_against"], out["effect"], min_effect)
     return out
-
-
-def _t_p(effects: np.ndarray) -> float:
-    """Two-sided one-sample t-test of the group effects against 0 (NaN for fewer than 2 groups; 0 when every
-    effect is the same non-zero number, 1 when all are 0)."""
-    from scipy.stats import ttest_1samp
-
-    e = np.asarray(effects, float)
-    e = e[np.isfinite(e)]
-    if e.size < 2:
-        return float("nan")
-    if np.ptp(e) == 0:
-        return 0.0 if e[0] != 0 else 1.0
-    return float(ttest_1samp(e, 0.0).pvalue)
-
-
-def decide_groups(per: pd.DataFrame, p_adj: float, vc: dict) -> str:
-    """The verdict from the group votes (:func:`group_outcomes`) and the Holm-adjusted p, by the common rule
-    :func:`animsynth.verdicts.a_beats_b`: the share is over every group with a value (a group within noise
-    counts and does not hold), at least ``min_groups`` groups."""
-    n = len(per)
-    h, f = int((per["vote"] > 0).sum()), int((per["vote"] < 0).sum())
-    outcome = V.a_beats_b(h, f, n - h - f, share=float(vc["share"]), alpha=float(vc["alpha"]), p=p_adj,
-                          min_units=int(vc["min_groups"]))
-    if outcome == "none":
-        return "not reproduced"
-    if outcome == "holds":
-        return "reproduced"
-    if outcome == "opposite":
-        return "contradicted"
-    if h and f:
-        return "partly"
-    return "within noise"
 
 
 def _spread(metrics: pd.DataFrame, g: str, metric: str) -> str:
@@ -215,153 +214,6 @@ def _spread(metrics: pd.DataFrame, g: str, metric: str) -> str:
         return "no value"
     q = np.percentile(x, [25, 50, 75])
     return f"{V.fmt(q[1])} (IQR {V.fmt(q[0])}-{V.fmt(q[2])})"
-
-
-class _Claim:
-    """One claim under test: its per-group outcomes, raw p, and how to write its row once Holm has run."""
-
-    def __init__(self, claim, data, *, paper_value="", ours="", missing="", per=None, j=None, metric="",
-                 min_effect=np.nan, lead="", caveat=""):
-        self.claim, self.data, self.paper_value, self.ours = claim, data, paper_value, ours
-        self.missing, self.per, self.j, self.metric = missing, per, j, metric
-        self.min_effect, self.lead, self.caveat = min_effect, lead, caveat
-        self.p = _t_p(per["effect"].to_numpy()) if per is not None and len(per) else float("nan")
-
-    def row(self, p_adj: float, vc: dict, correction: str) -> dict:
-        if self.missing:
-            return V.row(self.claim, "not reproduced", f"no pair to compare ({self.missing})",
-                         paper_value=self.paper_value, data=self.data, source="compare/metrics.csv")
-        per, j = self.per, self.j
-        verdict = decide_groups(per, p_adj, vc)
-        h, f = int((per["vote"] > 0).sum()), int((per["vote"] < 0).sum())
-        c = per_clip(j)
-        ch, cf = int((c["outcome"] > 0).sum()), int((c["outcome"] < 0).sum())
-        unit = _UNITS.get(self.metric, "")
-        groups = ", ".join(f"{g} {int(r.clips_for)}/{int(r.clips_for + r.clips_against)} clips, effect "
-                           f"{V.fmt(r.effect)} ({'holds' if r.vote > 0 else 'opposite' if r.vote < 0 else 'within noise'})"
-                           for g, r in per.iterrows())
-        text = (f"{self.lead}decided over {len(per)} independent groups ({GROUPINGS[vc.get('grouping', 'subject')]}): "
-                f"holds in {h}, opposite in "
-                f"{f}, within noise in {len(per) - h - f} (minimum effect {V.fmt(self.min_effect)} {unit}); "
-                f"t-test of the group effects p = {V.fmt(self.p, 2)}, {correction} p = {V.fmt(p_adj, 2)}; "
-                f"per group (clips holding / untied clips, median effect): {groups}; counted by clips instead: "
-                f"{ch} of {ch + cf} untied clips")
-        if self.caveat:
-            text += "; " + self.caveat
-        return V.row(self.claim, verdict, text, paper_value=self.paper_value, ours=self.ours, data=self.data,
-                     source="compare/metrics.csv")
-
-
-def _pair(metrics, groups, claim, a, b, metric, better, vc, data, left_out, paper_value="", caveat=""):
-    missing = [g for g in (a, b) if g not in set(metrics["generator"])]
-    if missing:
-        return _Claim(claim, data, paper_value=paper_value,
-                      missing="; ".join(f"{g}: {(left_out or {}).get(g, 'not in this run')}" for g in missing))
-    j = pair_outcomes(metrics, a, b, metric, better)
-    me = float(vc["min_effect"].get(metric, 0.0))
-    per = group_outcomes(j, groups, me)
-    ours = (f"{metric} ({_UNITS[metric]}) median {a} {_spread(metrics, a, metric)} vs {b} "
-            f"{_spread(metrics, b, metric)}")
-    # the hypothesis under test (what "holds" means below), not the finding
-    lead = f"tested: {a} {'lower' if better == 'lower' else 'higher'} than {b}; "
-    return _Claim(claim, data, paper_value=paper_value, ours=ours, per=per, j=j, metric=metric, min_effect=me,
-                  lead=lead, caveat=caveat)
-
-
-def _copy_claim(metrics, groups, vc, data):
-    claim = "re-sequencers copy database frames (novelty ~ 0) while field followers synthesise new poses"
-    copiers = [g for g in ("isomap", "stisomap") if g in set(metrics["generator"])]
-    makers = [g for g in ("delaunay", "knn") if g in set(metrics["generator"])]
-    tol = float(vc["novelty_copy_m"])
-    if not copiers or not makers:
-        return _Claim(claim, data, missing="a re-sequencer or a field follower did not run")
-    wide = metrics[metrics["generator"].isin(copiers + makers)].pivot_table(
-        index=["clip", "seed"], columns="generator", values="novelty_median_m", aggfunc="first").dropna()
-    # effect: how far the nearest field follower lies beyond the farthest re-sequencer (m)
-    eff = wide[makers].min(axis=1) - wide[copiers].max(axis=1)
-    ok = (wide[copiers].max(axis=1) <= tol) & (wide[makers].min(axis=1) > tol)
-    j = pd.DataFrame({"clip": [c for c, _s in wide.index], "effect": np.where(ok, np.abs(eff), -np.abs(eff)),
-                      "outcome": np.where(ok.to_numpy(), 1, -1)})
-    me = float(vc["min_effect"].get("novelty_median_m", 0.0))
-    per = group_outcomes(j, groups, me)
-    ours = "; ".join(f"{g} novelty median {_spread(metrics, g, 'novelty_median_m')} m" for g in copiers + makers)
-    return _Claim(claim, data, ours=ours, per=per, j=j, metric="novelty_median_m", min_effect=me,
-                  lead=f"every re-sequencer at most {V.fmt(tol)} m from the database and every field follower "
-                       "farther; ")
-
-
-def _capture_claims(metrics, groups, vc, data):
-    """'The held-out capture skates less than every generator': one sub-claim per generator (each a finding)."""
-    gens = [g for g in dict.fromkeys(metrics["generator"]) if g not in REFERENCES]
-    return [_pair(metrics, groups, f"the held-out capture skates less than {g}", "replay", g, "skate_share",
-                  "lower", vc, data, {}) for g in gens]
-
-
-def _iut_p(capture: list) -> float:
-    """The intersection-union test's p of the capture claim: the largest of its parts' (NaN if one has none)."""
-    ps = np.array([c.p for c in capture], float)
-    return float(np.max(ps)) if ps.size and np.all(np.isfinite(ps)) else float("nan")
-
-
-def _holm_rows(claims: list, vc: dict, correction_name: str, extra: list = ()) -> tuple[list, list]:
-    """Every claim's row with its Holm-adjusted p, Holm run over the claims' p and the ``extra`` p (findings
-    written elsewhere, e.g. the capture claim's); returns (rows, the extra p adjusted)."""
-    ps = [c.p for c in claims] + list(extra)
-    adj = V.holm(ps)
-    n = int(np.sum(np.isfinite(ps)))
-    rows = [c.row(a, vc, f"Holm-adjusted over the {n} {correction_name}") for c, a in zip(claims, adj)]
-    return rows, [float(a) for a in adj[len(claims):]]
-
-
-def _capture_rows(capture: list, p_adj: float, vc: dict, data: str, metrics: pd.DataFrame) -> dict | None:
-    """The capture claim over every generator as one intersection-union test.
-
-    "The capture skates less than every generator" holds only if it holds against each one, so it is one
-    finding: its p is the largest of the generators' p (the intersection-union test needs no correction among
-    its parts) and it enters the family's Holm correction once (``p_adj``). Each generator's part is decided
-    with its own p scaled by the same Holm factor (so every part is reproduced exactly when the claim's p and
-    every part's groups allow it). Verdict: reproduced when every part is, contradicted when every part is
-    contradicted, partly when some parts are reproduced and others contradicted, else within noise. The
-    evidence lists every part (groups holding / opposite / within noise, t-test p, verdict)."""
-    if not capture:
-        return None
-    claim = "the held-out capture skates less than every generator (the realism upper bound holds for this metric)"
-    p_iut = _iut_p(capture)
-    factor = p_adj / p_iut if np.isfinite(p_iut) and p_iut > 0 and np.isfinite(p_adj) else 1.0
-    parts, words = [], []
-    for c in capture:
-        gen = c.claim.removeprefix("the held-out capture skates less than ")
-        if c.missing:
-            words.append("not reproduced")
-            parts.append(f"{gen}: not compared ({c.missing})")
-            continue
-        per = c.per
-        w = decide_groups(per, min(1.0, c.p * factor) if np.isfinite(c.p) else float("nan"), vc)
-        words.append(w)
-        h, f = int((per["vote"] > 0).sum()), int((per["vote"] < 0).sum())
-        parts.append(f"{gen}: {h}/{f}/{len(per) - h - f}, p = {V.fmt(c.p, 2)}, {w}")
-    if all(w == "reproduced" for w in words):
-        verdict = "reproduced"
-    elif all(w == "contradicted" for w in words):
-        verdict = "contradicted"
-    elif "reproduced" in words and "contradicted" in words:
-        verdict = "partly"
-    else:
-        verdict = "within noise"
-    me = float(vc["min_effect"].get("skate_share", 0.0))
-    evidence = (f"one intersection-union test over the {len(capture)} generators (the claim holds only if it holds "
-                f"against each, so its p is the largest of theirs, p = {V.fmt(p_iut, 2)}, and it is one finding of "
-                f"the Holm correction: adjusted p = {V.fmt(p_adj, 2)}); each generator decided over the independent "
-                f"groups in which both have values ({GROUPINGS[vc.get('grouping', 'subject')]}, minimum effect {V.fmt(me)} "
-                f"{_UNITS['skate_share']}), its t-test p scaled by the claim's Holm factor; per generator (groups "
-                "holding / opposite / within noise, t-test p, verdict): " + "; ".join(parts))
-    med = (metrics[metrics["generator"] != "replay"].assign(x=pd.to_numeric(metrics["skate_share"], errors="coerce"))
-           .groupby("generator")["x"].median().dropna())
-    ours = f"skate_share median replay {_spread(metrics, 'replay', 'skate_share')}"
-    if len(med):
-        ours += (f" vs the generators' medians from {med.idxmin()} {V.fmt(med.min())} to {med.idxmax()} "
-                 f"{V.fmt(med.max())}")
-    return V.row(claim, verdict, evidence, ours=ours, data=data, source="compare/metrics.csv")
 
 
 def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> str:
@@ -385,83 +237,545 @@ def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> 
             f"{'; '.join(parts)}; {a} lower at {lower} of {len(parts)} budgets")
 
 
-def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
-                   clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None) -> pd.DataFrame:
-    """The findings of the comparison (the verdict table; the sanity checks: :func:`sanity_checks`).
+#: the skating metrics: a claim on one of them compares generators whose feet touch the floor
+SKATING_METRICS = ("skate_share", "transition_skate_share")
+#: ``b`` of the capture claim: every generator of the run but the references
+EVERY = "*"
+#: the metrics of the exploratory table (with every declared claim's metric)
+EXPLORATORY_METRICS = ("skate_share", "transition_skate_share", "velocity_jump_p95", "l2p", "coverage")
+#: the largest number of groups whose 2^n sign flips are all enumerated
+EXACT_MAX = 16
+_DIRECTION = {m: b for m, _u, b in METRICS}
+
+#: The declared primary claims of the comparison (``compare.claims`` of config/config.yaml repeats them; a test
+#: keeps the two equal): used when a caller gives none.
+DEFAULT_CLAIMS = (
+    {"id": "graph_vs_stisomap_skating", "claim": "the classic motion graph skates less than ST-Isomap re-sequencing",
+     "a": "motion_graph", "b": "stisomap", "metric": "skate_share", "direction": "lower", "min_effect": 0.02,
+     "skating": True},
+    {"id": "graph_vs_fairmotion_transitions",
+     "claim": "our motion graph's transitions skate less than fairmotion 0.0.4's as released (at its native 60 fps)",
+     "a": "motion_graph", "b": "fairmotion", "metric": "transition_skate_share", "direction": "lower",
+     "min_effect": 0.02, "skating": True,
+     "note": "fairmotion as released: its walk blends from a held pose and turns an appended piece without its path "
+             "(animsynth.compare.fairmotion_peer); both graphs keep the same transition budget"},
+    {"id": "graph_vs_fairmotion_fixed_transitions",
+     "claim": "our motion graph's transitions skate less than fairmotion's with upstream's walk fixes",
+     "a": "motion_graph", "b": "fairmotion_fixed", "metric": "transition_skate_share", "direction": "lower",
+     "min_effect": 0.02, "skating": True,
+     "note": "fairmotion with the fixes output_rate, blend_source, rigid_turn, cut_copy; both graphs keep the same "
+             "transition budget"},
+    {"id": "stisomap_vs_isomap_jumps",
+     "claim": "ST-Isomap re-sequencing jumps less than Isomap re-sequencing (95th percentile of the per-frame "
+              "velocity jump)",
+     "a": "stisomap", "b": "isomap", "metric": "velocity_jump_p95", "direction": "lower", "min_effect": 0.1,
+     "paper_value": "ST-Isomap re-sequences more smoothly than Isomap (the re-sequencing paper)"},
+    {"id": "delaunay_vs_knn_l2p",
+     "claim": "Delaunay field following stays closer to the held-out continuation than k-NN field following (L2P)",
+     "a": "delaunay", "b": "knn", "metric": "l2p", "direction": "lower", "min_effect": 0.25,
+     "paper_value": "Delaunay gives lower Error A/F than k-NN (Gauch & Peters Table II)"},
+    {"id": "mm_vs_graph_skating", "claim": "motion matching skates less than the motion graph",
+     "a": "motion_matching", "b": "motion_graph", "metric": "skate_share", "direction": "lower", "min_effect": 0.02,
+     "skating": True,
+     "note": "motion matching with the reference's foot locking and leg IK, its query a steady gamepad from the "
+             "start; deterministic, so inside a clip only the motion graph's seeds vary"},
+    {"id": "mm_traj_vs_graph_skating",
+     "claim": "motion matching (queried with the held-out future trajectory) skates less than the motion graph",
+     "a": "motion_matching_traj", "b": "motion_graph", "metric": "skate_share", "direction": "lower",
+     "min_effect": 0.02, "skating": True,
+     "note": "motion matching with the reference's foot locking and leg IK, its query the held-out future trajectory "
+             "(information no other generator is given)"},
+    {"id": "genmm_vs_graph_coverage", "claim": "GenMM covers more of the database than the motion graph",
+     "a": "genmm", "b": "motion_graph", "metric": "coverage", "direction": "higher", "min_effect": 0.02,
+     "note": "coverage: the share of the database's windows that a generated window comes within "
+             "compare.metrics.coverage_threshold_m of"},
+    {"id": "capture_skates_least",
+     "claim": "the held-out capture skates less than every generator (the realism upper bound holds for this metric)",
+     "a": "replay", "b": EVERY, "metric": "skate_share", "direction": "lower", "min_effect": 0.02, "skating": True},
+)
+#: the columns of ``claims_stats.csv``
+STATS_COLUMNS = ("claim_id", "a", "b", "metric", "direction", "n_groups", "mean_effect", "ci_low", "ci_high", "p",
+                 "p_holm", "min_effect", "verdict", "a_contact_share", "b_contact_share")
+#: the columns of ``exploratory.csv``
+EXPLORATORY_COLUMNS = ("label", "a", "b", "metric", "direction", "n_groups", "groups_holding", "groups_opposite",
+                       "mean_effect", "ci_low", "ci_high", "p", "p_holm", "min_effect")
+_SIGNS: dict = {}
+
+
+def _signs(n: int) -> np.ndarray:
+    """Every one of the 2^n sign vectors of length ``n`` (rows, +1 / -1), cached."""
+    if n not in _SIGNS:
+        bits = (np.arange(2 ** n)[:, None] >> np.arange(n)) & 1
+        _SIGNS[n] = (1 - 2 * bits).astype(float)
+    return _SIGNS[n]
+
+
+def sign_flip_p(effects, *, seed: int = 0, draws: int = 100000, exact_max: int = EXACT_MAX) -> float:
+    """Two-sided sign-flip permutation test of the mean of independent effects against 0.
+
+    Parameters
+    ----------
+    effects : array (n,)
+        One effect per independent unit (NaN dropped).
+    seed : int
+        Seed of the random flips when ``n > exact_max``.
+    draws : int
+        Random flips when ``n > exact_max``.
+    exact_max : int
+        Up to this many units every one of the 2^n flips is enumerated (the exact test).
+
+    Returns
+    -------
+    float
+        The share of flips whose mean is at least as far from 0 as the observed mean (exact: the observed sign
+        vector and its negation count, so the smallest p is 2 / 2^n; random flips: (1 + hits) / (1 + draws));
+        1 when every effect is 0; NaN without a unit.
+    """
+    e = np.asarray(effects, float)
+    e = e[np.isfinite(e)]
+    n = e.size
+    if n == 0:
+        return float("nan")
+    obs = abs(float(e.mean()))
+    if obs == 0.0:
+        return 1.0
+    tol = 1e-9 * obs  # flips that reach the observed mean up to rounding count as reaching it
+    if n <= exact_max:
+        return float(np.mean(np.abs(_signs(n) @ e) / n >= obs - tol))
+    rng = np.random.default_rng(int(seed))
+    hits, left = 0, int(draws)
+    while left > 0:
+        k = min(left, 20000)
+        s = rng.integers(0, 2, size=(k, n)) * 2 - 1
+        hits += int(np.sum(np.abs(s @ e) / n >= obs - tol))
+        left -= k
+    return (1 + hits) / (1 + int(draws))
+
+
+def t_interval(effects, level: float = 0.95) -> tuple[float, float]:
+    """The ``level`` t interval of the mean of ``effects`` (mean +- t(1 - (1 - level) / 2, n - 1) x sd / sqrt(n));
+    NaN for fewer than 2 values."""
+    from scipy.stats import t
+
+    e = np.asarray(effects, float)
+    e = e[np.isfinite(e)]
+    if e.size < 2:
+        return float("nan"), float("nan")
+    half = float(t.ppf(1 - (1 - level) / 2, e.size - 1)) * float(e.std(ddof=1)) / np.sqrt(e.size)
+    return float(e.mean() - half), float(e.mean() + half)
+
+
+class Stats:
+    """The subject-level statistics of one comparison ``a`` vs ``b`` on one metric.
+
+    Attributes
+    ----------
+    per : DataFrame, :func:`group_outcomes` (one row per group: clips, clip counts, ``effect``, ``vote``)
+    j : DataFrame, :func:`pair_outcomes` (clip x seed effects)
+    n, mean, lo, hi, p : the groups, their mean effect, its 95 % t interval, the sign-flip p
+    subjects : DataFrame per group: ``for``, ``against`` (clip x seed effects each way), ``p`` (sign test),
+        ``p_holm`` (Holm over the groups), ``side`` (+1 significantly for, -1 against, 0 neither); None when built
+        with ``subjects=False`` (the exploratory table, which decides nothing)
+    """
+
+    def __init__(self, j: pd.DataFrame, groups: dict, min_effect: float, vc: dict, seed: int, subjects: bool = True):
+        self.j, self.min_effect = j, float(min_effect)
+        self.per = group_outcomes(j, groups, min_effect)
+        eff = self.per["effect"].to_numpy(float)
+        self.n = int(np.isfinite(eff).sum())
+        self.mean = float(np.nanmean(eff)) if self.n else float("nan")
+        self.lo, self.hi = t_interval(eff)
+        self.p = sign_flip_p(eff, seed=seed, draws=int(vc.get("permutations", 100000)))
+        self.subjects = _subject_tests(j, groups, self.per, min_effect, float(vc["alpha"])) if subjects else None
+
+    @property
+    def holding(self) -> int:
+        return int((self.per["vote"] > 0).sum())
+
+    @property
+    def opposite(self) -> int:
+        return int((self.per["vote"] < 0).sum())
+
+    def numbers(self, unit: str = "") -> str:
+        """'mean effect 0.05 [95 % t interval 0.03, 0.07], p = 0.125' (the sign-flip p)."""
+        return (f"mean effect {V.fmt(self.mean)}{' ' + unit if unit else ''} [95 % t interval {V.fmt(self.lo)}, "
+                f"{V.fmt(self.hi)}], p = {V.fmt(self.p, 3)}")
+
+
+def _subject_tests(j: pd.DataFrame, groups: dict, per: pd.DataFrame, min_effect: float, alpha: float) -> pd.DataFrame:
+    """Per group: the two-sided exact sign test of its clip x seed effects, Holm over the groups, and its side."""
+    unit = j["clip"].map(groups).fillna(j["clip"])
+    out = pd.DataFrame({"for": (j["effect"] > 0).groupby(unit, sort=False).sum().astype(int),
+                        "against": (j["effect"] < 0).groupby(unit, sort=False).sum().astype(int)}).reindex(per.index)
+    out["p"] = [V.sign_test(w, f) for w, f in zip(out["for"], out["against"])]
+    out["p_holm"] = V.holm(out["p"])
+    sig = out["p_holm"] < alpha
+    eff = per["effect"]
+    out["side"] = np.where(sig & (out["for"] > out["against"]) & (eff >= min_effect), 1,
+                           np.where(sig & (out["against"] > out["for"]) & (eff <= -min_effect), -1, 0))
+    return out
+
+
+def _units(vc: dict, n: int | None = None) -> str:
+    word = "subject" if vc.get("grouping", "subject") == "subject" else "group"
+    return word + ("s" if n is None or n != 1 else "")
+
+
+def decide(st: Stats, p_holm: float, min_effect: float, vc: dict) -> tuple[str, str]:
+    """The verdict of a tested claim and its reason, by the rules of the module's docstring (in their order).
+
+    Parameters
+    ----------
+    st : the claim's statistics (for the capture claim: its weakest part's)
+    p_holm : its Holm-adjusted p
+    min_effect : its minimum effect (metric units)
+    vc : ``compare.verdicts`` (``alpha``, ``min_groups``)
+
+    Returns
+    -------
+    (verdict, reason): a word of :data:`animsynth.verdicts.VOCABULARY` and why, in words.
+    """
+    alpha, me = float(vc["alpha"]), float(min_effect)
+    if st.n >= int(vc.get("min_groups", 2)) and np.isfinite(p_holm) and p_holm < alpha:
+        if st.mean >= me:
+            return "reproduced", "significant and the mean effect at least the minimum effect"
+        if st.mean <= -me:
+            return "contradicted", "significant, the mean effect at least the minimum effect the other way"
+        return "not reproduced", "significant but the mean effect below the minimum effect (no material effect)"
+    n_for, n_against = int((st.subjects["side"] > 0).sum()), int((st.subjects["side"] < 0).sum())
+    if n_for and n_against:
+        return "partly", (f"a significant split: {n_for} {_units(vc, n_for)} significantly for and {n_against} "
+                          "significantly against (per-subject sign tests, Holm over the subjects)")
+    if np.isfinite(st.lo) and -me < st.lo and st.hi < me:
+        return "not reproduced", "the 95 % interval lies inside plus or minus the minimum effect (no material effect)"
+    if st.holding and st.opposite:
+        return "within noise", (f"not significant; the groups vote both ways: {st.holding} of {st.n} hold, "
+                                f"{st.opposite} of {st.n} the opposite (share holding {V.fmt(st.holding / st.n, 2)}), "
+                                "without a significant split")
+    return "undecided", (f"too few {_units(vc)} or too wide an interval to decide (with {st.n} the smallest "
+                         f"possible p is {V.fmt(2.0 / 2 ** st.n if st.n else float('nan'), 3)})")
+
+
+def _median(metrics: pd.DataFrame, g: str, metric: str) -> float:
+    x = pd.to_numeric(metrics.loc[metrics["generator"] == g, metric], errors="coerce") if metric in metrics else []
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    return float(np.median(x)) if x.size else float("nan")
+
+
+def _floats(metrics, g, vc) -> str:
+    """Why ``g`` cannot take part in a skating comparison ('' when its feet touch)."""
+    floor = float(vc.get("min_contact_share", 0.05))
+    c = _median(metrics, g, "contact_share")
+    if np.isfinite(c) and c < floor:
+        return (f"{g}'s feet do not touch the floor (median contact_share {V.fmt(c)} below "
+                f"compare.verdicts.min_contact_share {V.fmt(floor)}), so it cannot win or lose a skating comparison")
+    return ""
+
+
+class _Claim:
+    """One declared claim: its statistics (or why it has none) and how to write its row once Holm has run."""
+
+    def __init__(self, spec: dict, metrics: pd.DataFrame, groups: dict, vc: dict, data: str, left_out: dict,
+                 seed: int, sweep=None):
+        self.spec, self.data, self.vc = spec, data, vc
+        self.a, self.b, self.metric = spec["a"], spec["b"], spec["metric"]
+        self.better = spec.get("direction", "lower")
+        self.me = float(spec["min_effect"])
+        self.skating = bool(spec.get("skating", False))
+        self.missing, self.blocked, self.st, self.parts, self.left = "", "", None, [], []
+        self.metrics, self.sweep = metrics, sweep
+        present = set(metrics["generator"])
+        gone = [g for g in (self.a, self.b) if g != EVERY and g not in present]
+        if gone:
+            self.missing = "; ".join(f"{g} did not run: {(left_out or {}).get(g, 'not in this run')}" for g in gone)
+            return
+        if self.b == EVERY:
+            self._every(metrics, groups, seed)
+        else:
+            j = pair_outcomes(metrics, self.a, self.b, self.metric, self.better)
+            if not len(j):
+                self.missing = f"no clip x seed with a {self.metric} value for both {self.a} and {self.b}"
+                return
+            self.st = Stats(j, groups, self.me, vc, seed)
+            if self.skating:
+                self.blocked = "; ".join(w for w in (_floats(metrics, g, vc) for g in (self.a, self.b)) if w)
+
+    def _every(self, metrics, groups, seed):
+        """The capture claim: one part per generator (its feet touching), the weakest part deciding."""
+        if self.skating and (w := _floats(metrics, self.a, self.vc)):
+            self.blocked = w
+        for g in dict.fromkeys(metrics["generator"]):
+            if g in REFERENCES or g == self.a:
+                continue
+            why = _floats(metrics, g, self.vc) if self.skating else ""
+            j = pair_outcomes(metrics, self.a, g, self.metric, self.better)
+            if why or not len(j):
+                self.left.append(f"{g} left out: {why or 'no value shared with ' + self.a}")
+                continue
+            self.parts.append((g, Stats(j, groups, self.me, self.vc, seed)))
+        if not self.parts:
+            self.missing = "no generator to compare with" + (f" ({'; '.join(self.left)})" if self.left else "")
+            return
+        # the weakest part (smallest mean effect) carries the claim's effect; the claim's p is the largest
+        self.st = min((s for _g, s in self.parts), key=lambda s: (s.mean, -s.p))
+
+    @property
+    def p(self) -> float:
+        if self.st is None:
+            return float("nan")
+        if self.parts:
+            ps = np.array([s.p for _g, s in self.parts], float)
+            return float(ps.max()) if np.all(np.isfinite(ps)) else float("nan")
+        return self.st.p
+
+    def contact(self, g: str) -> float:
+        return _median(self.metrics, g, "contact_share")
+
+    def verdict(self, p_holm: float) -> tuple[str, str]:
+        if self.missing:
+            return "not reproduced", self.missing
+        if self.blocked:
+            return "not reproduced", self.blocked
+        return decide(self.st, p_holm, self.me, self.vc)
+
+    def stats_row(self, p_holm: float) -> dict:
+        word, _why = self.verdict(p_holm)
+        st = self.st
+        row = {"claim_id": self.spec["id"], "a": self.a, "b": "every generator" if self.b == EVERY else self.b,
+               "metric": self.metric, "direction": self.better, "n_groups": st.n if st else 0,
+               "mean_effect": st.mean if st else np.nan, "ci_low": st.lo if st else np.nan,
+               "ci_high": st.hi if st else np.nan, "p": self.p, "p_holm": p_holm, "min_effect": self.me,
+               "verdict": word, "a_contact_share": np.nan, "b_contact_share": np.nan}
+        if self.skating and not self.missing:
+            row["a_contact_share"] = self.contact(self.a)
+            bs = [self.contact(g) for g, _s in self.parts] if self.b == EVERY else [self.contact(self.b)]
+            row["b_contact_share"] = float(np.nanmin(bs)) if np.any(np.isfinite(bs)) else np.nan
+        return row
+
+    def _ours(self, word: str, p_holm: float) -> str:
+        st, vc = self.st, self.vc
+        unit = _UNITS.get(self.metric, "")
+        head = f"{word} ({st.n} {_units(vc, st.n)})" if word == "undecided" else f"{st.n} {_units(vc, st.n)}"
+        text = (f"{head}: {'weakest part ' if self.parts else ''}mean {_units(vc, 1)}-level effect "
+                f"{V.fmt(st.mean)} {unit} (95 % t interval over {_units(vc)} {V.fmt(st.lo)} to {V.fmt(st.hi)}), "
+                f"sign-flip p = {V.fmt(self.p, 3)}, Holm p = {V.fmt(p_holm, 3)}")
+        if self.b == EVERY:
+            med = {g: _median(self.metrics, g, self.metric) for g, _s in self.parts}
+            text += f"; {self.metric} median {self.a} {_spread(self.metrics, self.a, self.metric)}"
+            if med:
+                lo, hi = min(med, key=med.get), max(med, key=med.get)
+                text += (f" vs the generators' medians from {lo} {V.fmt(med[lo])} to {hi} {V.fmt(med[hi])}")
+        else:
+            text += (f"; {self.metric} ({unit}) median {self.a} {_spread(self.metrics, self.a, self.metric)} vs "
+                     f"{self.b} {_spread(self.metrics, self.b, self.metric)}")
+        if self.skating:
+            gens = [self.a] + ([g for g, _s in self.parts] if self.b == EVERY else [self.b])
+            text += "; contact_share (share of foot joint-frames) median " + ", ".join(
+                f"{g} {V.fmt(self.contact(g))}" for g in gens)
+        return text
+
+    def row(self, p_holm: float, m: int) -> dict:
+        spec, vc = self.spec, self.vc
+        word, why = self.verdict(p_holm)
+        if self.missing:
+            return V.row(spec["claim"], "not reproduced", f"no pair to compare ({self.missing})",
+                         paper_value=spec.get("paper_value", ""), data=self.data, source="compare/metrics.csv")
+        st = self.st
+        unit = _UNITS.get(self.metric, "")
+        grouping = GROUPINGS[vc.get("grouping", "subject")]
+        lead = (f"tested: {self.a} {self.better} than "
+                f"{'every generator' if self.b == EVERY else self.b} on {self.metric}; ")
+        text = f"{lead}{word} because {why}. "
+        test = (f"exact sign-flip permutation test of the mean of the {_units(vc)}' effects (all 2^n flips up to "
+                f"n = {EXACT_MAX}, else {int(vc.get('permutations', 100000))} seeded random flips; two-sided), Holm "
+                f"over the {m} declared claims with a test; 95 % t interval over the {_units(vc)}; minimum effect "
+                f"{V.fmt(self.me)} {unit}; independent {_units(vc)}: {grouping}")
+        if self.b == EVERY:
+            parts = "; ".join(f"{g}: {s.holding}/{s.opposite}/{s.n - s.holding - s.opposite}, {s.numbers()}"
+                              for g, s in self.parts)
+            text += (f"One intersection-union test over the {len(self.parts)} generators compared (the claim holds "
+                     f"only if it holds against each, so its p is the largest of theirs, p = {V.fmt(self.p, 3)}, and "
+                     f"it is one finding of the Holm correction: adjusted p = {V.fmt(p_holm, 3)}); {test}; per "
+                     f"generator (groups holding / opposite / neither, mean effect, interval, p): {parts}")
+            if self.left:
+                text += "; " + "; ".join(self.left)
+        else:
+            c = per_clip(st.j)
+            ch, cf = int((c["outcome"] > 0).sum()), int((c["outcome"] < 0).sum())
+            groups = ", ".join(f"{g} {int(r.clips_for)}/{int(r.clips_for + r.clips_against)} clips, effect "
+                               f"{V.fmt(r.effect)}" for g, r in st.per.iterrows())
+            subj = ", ".join(f"{g} {int(r['for'])}/{int(r['for'] + r['against'])} (Holm p {V.fmt(r.p_holm, 2)})"
+                             for g, r in st.subjects.iterrows())
+            text += (f"{st.n} independent {_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted p = "
+                     f"{V.fmt(p_holm, 3)}; {test}; holds in {st.holding}, opposite in {st.opposite}, neither in "
+                     f"{st.n - st.holding - st.opposite}; per group (clips holding / untied clips, median effect): "
+                     f"{groups}; per-subject sign tests (clip x seed effects for / untied): {subj}; counted by clips "
+                     f"instead: {ch} of {ch + cf} untied clips")
+        if spec.get("note"):
+            text += "; " + spec["note"]
+        if self.sweep is not None and len(self.sweep) and self.a == "motion_graph":
+            if self.b == "fairmotion":
+                text += "; the budget sweep runs the fixed row (the released row builds the same graph)"
+            elif ev := _sweep_evidence(self.sweep, self.a, self.b, self.metric):
+                text += "; " + ev
+        return V.row(spec["claim"], word, text, paper_value=spec.get("paper_value", ""),
+                     ours=self._ours(word, p_holm), data=self.data, source="compare/metrics.csv")
+
+
+def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
+                  clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None, claims=None,
+                  seed: int = 0) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The declared claims decided: the verdict table and ``claims_stats.csv`` (:data:`STATS_COLUMNS`).
 
     Parameters
     ----------
     metrics : DataFrame, ``compare/metrics.csv``
-    vc : the ``compare.verdicts`` block (``share``, ``alpha``, ``min_groups``, ``min_effect``,
-        ``novelty_copy_m``)
+    vc : the ``compare.verdicts`` block (``alpha``, ``min_groups``, ``grouping``, ``min_contact_share``,
+        ``permutations``)
     data : what the numbers ran on (e.g. "CMU: 19 held-out clips x 5 seeds")
     left_out : {generator: why it did not run}
     clips : DataFrame, ``compare/clips.csv`` (for :func:`independent_groups`; ``None``: each subset one group)
     sweep : DataFrame or None, the budget sweep table (:func:`animsynth.compare.tables.sweep_table`): quoted as
         evidence in the claims against the peer (decided at the default budget)
+    claims : the declared claims (``compare.claims``; ``None``: :data:`DEFAULT_CLAIMS`); every one gets a row
+        (a claim on a generator that did not run: "not reproduced", saying why)
+    seed : the seed of the random sign flips (more than :data:`EXACT_MAX` groups; ``compare.seed``)
     """
     groups = _groups(metrics, clips, vc)
-    present = set(metrics["generator"])
-    configured = present | set(left_out or {})
-    claims, capture = [], []
+    specs = list(DEFAULT_CLAIMS if claims is None else claims)
+    cs = [_Claim(dict(s), metrics, groups, vc, data, left_out or {}, seed, sweep) for s in specs]
+    ps = [c.p for c in cs]
+    adj = V.holm(ps)
+    m = int(np.sum(np.isfinite(ps)))
+    rows = [c.row(float(a), m) for c, a in zip(cs, adj)]
+    stats = pd.DataFrame([c.stats_row(float(a)) for c, a in zip(cs, adj)], columns=list(STATS_COLUMNS))
+    return V.table(rows), stats
 
-    def pair(claim, a, b, metric, better="lower", paper_value="", caveat=""):
-        if {a, b} <= configured:
-            claims.append(_pair(metrics, groups, claim, a, b, metric, better, vc, data, left_out, paper_value,
-                                caveat))
 
-    pair("the classic motion graph skates less than ST-Isomap re-sequencing", "motion_graph", "stisomap",
-         "skate_share")
-    pair("our motion graph's transitions skate less than fairmotion 0.0.4's as released (at its native 60 fps)",
-         "motion_graph", "fairmotion", "transition_skate_share",
-         caveat="fairmotion as released: its walk blends from a held pose and turns an appended piece without "
-                "its path (animsynth.compare.fairmotion_peer); both graphs keep the same transition budget"
-                + ("; the budget sweep runs the fixed row (the released row builds the same graph)"
-                   if sweep is not None and len(sweep) else ""))
-    pair("our motion graph's transitions skate less than fairmotion's with upstream's walk fixes",
-         "motion_graph", "fairmotion_fixed", "transition_skate_share",
-         caveat="fairmotion with the fixes output_rate, blend_source, rigid_turn, cut_copy; both graphs keep the same "
-                "transition budget" + (f"; {ev}" if (ev := _sweep_evidence(sweep, "motion_graph", "fairmotion_fixed",
-                                                                          "transition_skate_share")) else ""))
-    pair("ST-Isomap re-sequencing jumps less than Isomap re-sequencing (95th percentile of the per-frame velocity "
-         "jump)", "stisomap", "isomap", "velocity_jump_p95",
-         paper_value="ST-Isomap re-sequences more smoothly than Isomap (the re-sequencing paper)")
-    pair("Delaunay field following stays closer to the held-out continuation than k-NN field following (L2P)",
-         "delaunay", "knn", "l2p", paper_value="Delaunay gives lower Error A/F than k-NN (Gauch & Peters Table II)")
-    pair("motion matching skates less than the motion graph", "motion_matching", "motion_graph",
-         "skate_share", caveat="motion matching with the reference's foot locking and leg IK, its query a steady "
-                               "gamepad from the start; deterministic, so inside a clip only the motion graph's "
-                               "seeds vary")
-    pair("GenMM covers more of the database than the motion graph", "genmm", "motion_graph", "coverage",
-         better="higher", caveat="coverage: the share of the database's windows that a generated window comes within "
-                                 "compare.metrics.coverage_threshold_m of")
-    if "replay" in configured and "replay" in present:
-        capture = _capture_claims(metrics, groups, vc, data)
-    # the capture claim is one finding (an intersection-union test over the generators: its p the largest)
-    out, cap_adj = _holm_rows(claims, vc, "findings of this table", [_iut_p(capture)] if capture else [])
-    cap = _capture_rows(capture, cap_adj[0], vc, data, metrics) if capture else None
-    if cap is not None:
-        out.append(cap)
-    elif "replay" in configured:
-        out.append(V.row("the held-out capture skates less than every generator (the realism upper bound holds "
-                         "for this metric)", "not reproduced", "no pair to compare (replay or every generator "
-                         "missing)", data=data, source="compare/metrics.csv"))
-    return V.table(out)
+def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
+                   clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None, claims=None,
+                   seed: int = 0) -> pd.DataFrame:
+    """The findings of the comparison: the verdict table of :func:`decide_claims` (same parameters)."""
+    return decide_claims(metrics, vc, data, left_out, clips, sweep, claims, seed)[0]
+
+
+def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | None = None, claims=None,
+                      order=None, seed: int = 0) -> pd.DataFrame:
+    """Every pair of generators on the main metrics that no declared claim tests: numbers, no verdict.
+
+    Parameters
+    ----------
+    metrics : DataFrame, ``compare/metrics.csv``
+    vc : ``compare.verdicts`` (``min_effect`` per metric: the groups' votes; ``permutations``)
+    clips : ``compare/clips.csv`` (the groups)
+    claims : the declared claims (``None``: :data:`DEFAULT_CLAIMS`): their pairs and metrics are left out (and their
+        metrics join :data:`EXPLORATORY_METRICS`)
+    order : the generators' order (``a`` is the earlier of a pair; default the table's order)
+    seed : the random flips' seed
+
+    Returns
+    -------
+    DataFrame with :data:`EXPLORATORY_COLUMNS`: ``label`` "exploratory", the pair (effect positive favours ``a``
+    in the metric's direction), the groups, the groups holding / opposite by the metric's minimum effect, the mean
+    effect with its 95 % t interval, the sign-flip p and a Holm p over this table alone. Never a verdict.
+    """
+    groups = _groups(metrics, clips, vc)
+    specs = list(DEFAULT_CLAIMS if claims is None else claims)
+    present = list(dict.fromkeys(metrics["generator"]))
+    gens = [g for g in (order or present) if g in set(present)]
+    declared = set()
+    for s in specs:
+        bs = [g for g in gens if g not in REFERENCES and g != s["a"]] if s["b"] == EVERY else [s["b"]]
+        declared |= {(frozenset((s["a"], b)), s["metric"]) for b in bs}
+    mets = list(dict.fromkeys([*EXPLORATORY_METRICS, *(s["metric"] for s in specs)]))
+    rows = []
+    for metric in mets:
+        better = _DIRECTION.get(metric) or next((s["direction"] for s in specs if s["metric"] == metric), "")
+        if metric not in metrics or better not in ("lower", "higher"):
+            continue
+        me = float(vc.get("min_effect", {}).get(metric, 0.0))
+        for i, a in enumerate(gens):
+            for b in gens[i + 1:]:
+                if (frozenset((a, b)), metric) in declared:
+                    continue
+                j = pair_outcomes(metrics, a, b, metric, better)
+                if not len(j):
+                    continue
+                st = Stats(j, groups, me, vc, seed, subjects=False)
+                rows.append({"label": "exploratory", "a": a, "b": b, "metric": metric, "direction": better,
+                             "n_groups": st.n, "groups_holding": st.holding, "groups_opposite": st.opposite,
+                             "mean_effect": st.mean, "ci_low": st.lo, "ci_high": st.hi, "p": st.p, "min_effect": me})
+    out = pd.DataFrame(rows, columns=[c for c in EXPLORATORY_COLUMNS if c != "p_holm"])
+    out.insert(out.columns.get_loc("p") + 1, "p_holm", V.holm(out["p"]) if len(out) else [])
+    return out
+
+
+def _copy_claim(metrics, groups, vc, data, seed):
+    claim = "re-sequencers copy database frames (novelty ~ 0) while field followers synthesise new poses"
+    copiers = [g for g in ("isomap", "stisomap") if g in set(metrics["generator"])]
+    makers = [g for g in ("delaunay", "knn") if g in set(metrics["generator"])]
+    tol = float(vc["novelty_copy_m"])
+    if not copiers or not makers:
+        return None, V.row(claim, "not reproduced", "no pair to compare (a re-sequencer or a field follower did not "
+                           "run)", data=data, source="compare/metrics.csv")
+    wide = metrics[metrics["generator"].isin(copiers + makers)].pivot_table(
+        index=["clip", "seed"], columns="generator", values="novelty_median_m", aggfunc="first").dropna()
+    # effect: how far the nearest field follower lies beyond the farthest re-sequencer (m)
+    eff = wide[makers].min(axis=1) - wide[copiers].max(axis=1)
+    ok = (wide[copiers].max(axis=1) <= tol) & (wide[makers].min(axis=1) > tol)
+    j = pd.DataFrame({"clip": [c for c, _s in wide.index], "effect": np.where(ok, np.abs(eff), -np.abs(eff)),
+                      "outcome": np.where(ok.to_numpy(), 1, -1)})
+    me = float(vc["min_effect"].get("novelty_median_m", 0.0))
+    ours = "; ".join(f"{g} novelty median {_spread(metrics, g, 'novelty_median_m')} m" for g in copiers + makers)
+    lead = f"every re-sequencer at most {V.fmt(tol)} m from the database and every field follower farther"
+    if not len(j):
+        return None, V.row(claim, "not reproduced", "no pair to compare (no clip with every novelty value)", data=data,
+                           source="compare/metrics.csv")
+    return Stats(j, groups, me, vc, seed), (claim, ours, lead, me, "novelty_median_m")
 
 
 def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
-                  clips: pd.DataFrame | None = None) -> pd.DataFrame:
-    """Claims true by construction, decided the same way (Holm over the sanity checks alone): not findings."""
+                  clips: pd.DataFrame | None = None, seed: int = 0) -> pd.DataFrame:
+    """Claims true by construction, decided by the same rules (:func:`decide`; the metric's
+    ``compare.verdicts.min_effect``; Holm over the sanity checks alone): not findings."""
     groups = _groups(metrics, clips, vc)
     configured = set(metrics["generator"]) | set(left_out or {})
-    claims = []
+    present = set(metrics["generator"])
+    tests = []  # (stats or None, (claim, ours, lead, min effect, metric) or a finished row)
     if {"isomap", "stisomap", "delaunay", "knn"} & configured:
-        claims.append(_copy_claim(metrics, groups, vc, data))
+        tests.append(_copy_claim(metrics, groups, vc, data, seed))
     if {"motion_graph", "concat"} <= configured:
-        claims.append(_pair(metrics, groups, "the motion graph's blended transitions jump less than random "
-                            "concatenation's unblended seams (95th percentile of the per-frame velocity jump)",
-                            "motion_graph", "concat", "velocity_jump_p95", "lower", vc, data, left_out))
-    return V.table(_holm_rows(claims, vc, "sanity checks")[0])
+        claim = ("the motion graph's blended transitions jump less than random concatenation's unblended seams "
+                 "(95th percentile of the per-frame velocity jump)")
+        gone = [g for g in ("motion_graph", "concat") if g not in present]
+        j = pd.DataFrame() if gone else pair_outcomes(metrics, "motion_graph", "concat", "velocity_jump_p95")
+        me = float(vc["min_effect"].get("velocity_jump_p95", 0.0))
+        if gone or not len(j):
+            why = "; ".join(f"{g}: {(left_out or {}).get(g, 'not in this run')}" for g in gone) or "no shared value"
+            tests.append((None, V.row(claim, "not reproduced", f"no pair to compare ({why})", data=data,
+                                      source="compare/metrics.csv")))
+        else:
+            ours = (f"velocity_jump_p95 (m/s) median motion_graph {_spread(metrics, 'motion_graph', 'velocity_jump_p95')}"
+                    f" vs concat {_spread(metrics, 'concat', 'velocity_jump_p95')}")
+            tests.append((Stats(j, groups, me, vc, seed),
+                          (claim, ours, "motion_graph lower than concat on velocity_jump_p95", me, "velocity_jump_p95")))
+    ps = [st.p if st is not None else np.nan for st, _x in tests]
+    adj = V.holm(ps)
+    m = int(np.sum(np.isfinite(ps)))
+    rows = []
+    for (st, x), pa in zip(tests, adj):
+        if st is None:
+            rows.append(x)
+            continue
+        claim, ours, lead, me, metric = x
+        word, why = decide(st, float(pa), me, vc)
+        unit = _UNITS.get(metric, "")
+        rows.append(V.row(claim, word, f"tested: {lead}; {word} because {why}. {st.n} independent "
+                          f"{_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted over the {m} sanity checks p = "
+                          f"{V.fmt(pa, 3)}; holds in {st.holding}, opposite in {st.opposite} (minimum effect "
+                          f"{V.fmt(me)} {unit})", ours=ours, data=data, source="compare/metrics.csv"))
+    return V.table(rows)
 
 
 def _groups(metrics: pd.DataFrame, clips: pd.DataFrame | None, vc: dict) -> dict:
