@@ -4,7 +4,7 @@ import pandas as pd
 from animsynth.atomic import atomic_path
 from animsynth.resequencing.jobs import summarise_paths
 from animsynth.resequencing.tables import (PAPER_CMU_TRIALS, comparable_published, lee_weights_table,
-                                          min_k_table, paper_comparable, published_table2)
+                                          min_k_table, published_table2)
 from animsynth.resequencing.verdicts import build_verdicts
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
@@ -31,7 +31,7 @@ def csv(df, path):
 
 
 # the paper's values stand only beside the trials it measured (its CMU clips, or the synthetic stand-ins)
-comparable = paper_comparable(snakemake.config, trials)
+comparable = dict(snakemake.params.comparable)
 not_comparable = [d for d, ok in comparable.items() if not ok]
 for d in not_comparable:
     log.info("resequencing Table 2: %s trial %s is not the paper's CMU %s: the paper's min k is not shown beside it",
