@@ -1,4 +1,4 @@
-"""Render the README's cost table from runs' own ``rule_benchmarks_per_family.csv``.
+"""Render the cost tables of docs/cost.md from runs' own ``rule_benchmarks_per_family.csv``.
 
 Usage::
 
@@ -9,7 +9,7 @@ prints one Markdown table per run: per family the number of jobs, the summed
 wall time and CPU time of its jobs (Snakemake's ``benchmark:`` files) and the
 largest job's peak memory, then the total. Whole-run wall and CPU time (with
 the scheduler's own work and job start-up) are measured around the command
-itself (``/usr/bin/time -v``) and quoted beside these tables in the README.
+itself (``/usr/bin/time -v``) and quoted beside these tables in docs/cost.md.
 """
 
 from __future__ import annotations
