@@ -82,12 +82,38 @@ def test_three_equal_effects_do_not_give_p_zero():
 
 
 def test_partly_only_for_a_significant_split_between_subjects():
-    # 6 subjects for and 6 against, each with 4 clips x 5 seeds all one way: every per-subject sign test decides
-    row, _ = decide([0.05] * 6 + [-0.05] * 6, clips=4, seeds=5)
+    # 6 subjects for and 6 against, each with 10 clips all one way: every per-subject sign test over clips decides
+    # (2 / 2^10, Holm over 12 subjects 0.023)
+    row, _ = decide([0.05] * 6 + [-0.05] * 6, clips=10, seeds=2)
     assert row["verdict"] == "partly" and "significant split: 6 subjects significantly for and 6" in row["evidence"]
+    # 4 clips x 5 seeds per subject: 20 clip x seed effects one way would look significant, but the seeds of a clip
+    # are not independent: 4 clips give p = 0.125 at best, so no partly
+    row, _ = decide([0.05] * 6 + [-0.05] * 6, clips=4, seeds=5)
+    assert row["verdict"] == "within noise" and "6 of 12 hold, 6 of 12 the opposite" in row["evidence"]
     # the same split with one clip x 2 seeds per subject: no per-subject test can decide (p >= 0.5), so no partly
     row, _ = decide([0.05] * 6 + [-0.05] * 6, clips=1, seeds=2)
     assert row["verdict"] == "within noise" and "6 of 12 hold, 6 of 12 the opposite" in row["evidence"]
+
+
+def test_one_significant_opposite_part_contradicts_the_capture_claim():
+    """The capture skates less than motion_graph in no subject and more in all 12, while against stisomap it is
+    noise: "less than every generator" is refuted by the one significant opposite part (Bonferroni over the
+    parts), not hidden behind the largest p of the intersection-union test."""
+    claim = "the held-out capture skates less than every generator (the realism upper bound holds for this metric)"
+    row, stats = decide([0.0] * 12, claim=claim, pair=("replay", "stisomap"), extra={"motion_graph": -0.05},
+                        noise=0.01, seed=5)
+    s = stats.loc["capture_skates_least"]
+    assert row["verdict"] == "contradicted", row["evidence"]
+    assert "Tested for a contradiction" in row["evidence"] and s["p"] == pytest.approx(min(1.0, 2 * 2 / 2 ** 12))
+    assert s["mean_effect"] < -0.02
+
+
+def test_a_blocked_claim_does_not_enter_the_holm_correction():
+    """A skating claim blocked by floating feet is not a finding: its p is NaN and Holm counts one claim fewer."""
+    metrics, clips = build([0.05] * 12, contact={"stisomap": 0.01})
+    _, stats = CV.decide_claims(metrics, VC, "test data", {}, clips)
+    s = stats.set_index("claim_id").loc["graph_vs_stisomap_skating"]
+    assert s["verdict"] == "not reproduced" and not np.isfinite(s["p"]) and not np.isfinite(s["p_holm"])
 
 
 def test_a_significant_effect_below_the_minimum_and_an_interval_inside_it_are_not_reproduced():

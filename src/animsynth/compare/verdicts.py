@@ -20,8 +20,8 @@ subject, and a re-sequencing clip may be a trial that a subset's clips use. The 
 
 * ``subject`` (default): every clip of one subject (the CMU subject id of its held-out trial), joined with every
   other group with which it shares a trial (held out or in a database): clips that share a subject or database
-  trials are one group. On the CMU protocol of the four subsets: subject 35 (w1, r1, run, walk), 16 (w2),
-  127 (r2), 05 (dance): 4 groups for 19 clips.
+  trials are one group. On the paper run's CMU protocol: subject 35 (w1, r1, run, walk), 16 (w2), 127 (r2),
+  05 (dance) and the eight sets of ``compare.subjects`` (02, 09, 07, 12, 49, 17, 06, 10): 12 groups for 38 clips.
 * ``subset_subject``: the clips of one subset (or re-sequencing dataset) and one subject, joined where they
   share a trial. It counts the subsets of one subject as independent, which they are not for a claim about
   people's motion; kept as an option.
@@ -44,9 +44,10 @@ observed one (two-sided; ``n > 16``: ``compare.verdicts.permutations`` seeded ra
 the smallest possible p is 2 / 2^4 = 0.125: four subjects cannot decide any claim, whatever its effect. Holm's
 step-down correction (Holm 1979) runs over the declared claims with a test.
 
-Per subject (for "partly" only): a two-sided exact sign test of the subject's clip x seed effects, Holm over the
-subjects of the claim; a subject is **significantly for** when its adjusted p is below ``alpha``, more of its
-clip x seed effects favour the claim and its effect is at least the minimum effect (**against** the reverse).
+Per subject (for "partly" only): a two-sided exact sign test of the subject's clip outcomes (one vote per clip,
+the majority of its seeds: seeds share the clip's database and start, so they are not independent), Holm over
+the subjects of the claim; a subject is **significantly for** when its adjusted p is below ``alpha``, more of its
+clips favour the claim and its effect is at least the minimum effect (**against** the reverse).
 
 The verdict of a claim
 ----------------------
@@ -69,7 +70,9 @@ In this order (:func:`decide`):
 The capture claim ("the held-out capture skates less than every generator") holds only if it holds against each
 generator: one finding whose p is the largest of its parts' (an intersection-union test needs no correction among
 its parts), decided by the rules above with the effect and interval of its weakest part (the generator against
-which the mean effect is smallest). Its parts show numbers (groups holding / opposite / neither, mean effect,
+which the mean effect is smallest). One significant part the other way refutes it: when some parts lean the other
+way by the minimum effect, the claim is tested for a contradiction instead, its p the smallest p of those parts
+times the number of parts (Bonferroni), with that part's effect and interval. Its parts show numbers (groups holding / opposite / neither, mean effect,
 interval, p), never a verdict word of their own. A generator whose feet do not touch is left out of it, named.
 
 Claims true by construction (re-sequencers copy database frames, so their novelty is 0; random concatenation
@@ -373,7 +376,7 @@ class Stats:
     per : DataFrame, :func:`group_outcomes` (one row per group: clips, clip counts, ``effect``, ``vote``)
     j : DataFrame, :func:`pair_outcomes` (clip x seed effects)
     n, mean, lo, hi, p : the groups, their mean effect, its 95 % t interval, the sign-flip p
-    subjects : DataFrame per group: ``for``, ``against`` (clip x seed effects each way), ``p`` (sign test),
+    subjects : DataFrame per group: ``for``, ``against`` (clips each way, by the majority of their seeds), ``p`` (sign test),
         ``p_holm`` (Holm over the groups), ``side`` (+1 significantly for, -1 against, 0 neither); None when built
         with ``subjects=False`` (the exploratory table, which decides nothing)
     """
@@ -403,10 +406,17 @@ class Stats:
 
 
 def _subject_tests(j: pd.DataFrame, groups: dict, per: pd.DataFrame, min_effect: float, alpha: float) -> pd.DataFrame:
-    """Per group: the two-sided exact sign test of its clip x seed effects, Holm over the groups, and its side."""
-    unit = j["clip"].map(groups).fillna(j["clip"])
-    out = pd.DataFrame({"for": (j["effect"] > 0).groupby(unit, sort=False).sum().astype(int),
-                        "against": (j["effect"] < 0).groupby(unit, sort=False).sum().astype(int)}).reindex(per.index)
+    """Per group: the two-sided exact sign test of its clips' outcomes (one vote per clip, its seeds' majority:
+    :func:`per_clip`), Holm over the groups, and its side.
+
+    Clips, not clip x seed effects: the seeds of one clip share its database and start (and a deterministic
+    generator repeats itself over them), so counting them as independent would let two clips look like ten.
+    With the few clips a subject has, a subject is significant only when many of its clips agree; "partly" is
+    correspondingly rare, which is what the data can support."""
+    c = per_clip(j)
+    unit = c["clip"].map(groups).fillna(c["clip"])
+    out = pd.DataFrame({"for": (c["outcome"] > 0).groupby(unit, sort=False).sum().astype(int),
+                        "against": (c["outcome"] < 0).groupby(unit, sort=False).sum().astype(int)}).reindex(per.index)
     out["p"] = [V.sign_test(w, f) for w, f in zip(out["for"], out["against"])]
     out["p_holm"] = V.holm(out["p"])
     sig = out["p_holm"] < alpha
@@ -445,15 +455,17 @@ def decide(st: Stats, p_holm: float, min_effect: float, vc: dict) -> tuple[str, 
     n_for, n_against = int((st.subjects["side"] > 0).sum()), int((st.subjects["side"] < 0).sum())
     if n_for and n_against:
         return "partly", (f"a significant split: {n_for} {_units(vc, n_for)} significantly for and {n_against} "
-                          "significantly against (per-subject sign tests, Holm over the subjects)")
+                          "significantly against (per-subject sign tests over clips, Holm over the subjects)")
     if np.isfinite(st.lo) and -me < st.lo and st.hi < me:
         return "not reproduced", "the 95 % interval lies inside plus or minus the minimum effect (no material effect)"
     if st.holding and st.opposite:
         return "within noise", (f"not significant; the groups vote both ways: {st.holding} of {st.n} hold, "
                                 f"{st.opposite} of {st.n} the opposite (share holding {V.fmt(st.holding / st.n, 2)}), "
                                 "without a significant split")
+    floor = (2.0 / 2 ** st.n if st.n <= EXACT_MAX else 1.0 / (1 + int(vc.get("permutations", 100000)))) if st.n \
+        else float("nan")
     return "undecided", (f"too few {_units(vc)} or too wide an interval to decide (with {st.n} the smallest "
-                         f"possible p is {V.fmt(2.0 / 2 ** st.n if st.n else float('nan'), 3)})")
+                         f"possible p is {V.fmt(floor, 3)})")
 
 
 def _median(metrics: pd.DataFrame, g: str, metric: str) -> float:
@@ -484,6 +496,7 @@ class _Claim:
         self.me = float(spec["min_effect"])
         self.skating = bool(spec.get("skating", False))
         self.missing, self.blocked, self.st, self.parts, self.left = "", "", None, [], []
+        self.mode = "claim"
         self.metrics, self.sweep = metrics, sweep
         present = set(metrics["generator"])
         gone = [g for g in (self.a, self.b) if g != EVERY and g not in present]
@@ -517,14 +530,27 @@ class _Claim:
         if not self.parts:
             self.missing = "no generator to compare with" + (f" ({'; '.join(self.left)})" if self.left else "")
             return
-        # the weakest part (smallest mean effect) carries the claim's effect; the claim's p is the largest
-        self.st = min((s for _g, s in self.parts), key=lambda s: (s.mean, -s.p))
+        # One significant opposite part refutes "less than every generator": when some parts lean the other way
+        # by the minimum effect, the claim is tested for a contradiction (union-intersection: the smallest p of
+        # those parts times the number of parts, Bonferroni); otherwise for the claim (intersection-union: the
+        # largest p), the weakest part (smallest mean effect) carrying the claim's effect.
+        opposite = [s for _g, s in self.parts if s.mean <= -self.me]
+        if opposite:
+            self.mode = "contradiction"
+            self.st = min(opposite, key=lambda s: (s.p, s.mean))
+        else:
+            self.mode = "claim"
+            self.st = min((s for _g, s in self.parts), key=lambda s: (s.mean, -s.p))
 
     @property
     def p(self) -> float:
-        if self.st is None:
+        """The claim's p for Holm: NaN when it has no test or is blocked (a blocked claim is not a finding, so it
+        does not tighten the others' correction); the capture claim's by its mode (see :meth:`_every`)."""
+        if self.st is None or self.blocked:
             return float("nan")
         if self.parts:
+            if self.mode == "contradiction":
+                return float(min(1.0, len(self.parts) * self.st.p))
             ps = np.array([s.p for _g, s in self.parts], float)
             return float(ps.max()) if np.all(np.isfinite(ps)) else float("nan")
         return self.st.p
@@ -557,7 +583,9 @@ class _Claim:
         st, vc = self.st, self.vc
         unit = _UNITS.get(self.metric, "")
         head = f"{word} ({st.n} {_units(vc, st.n)})" if word == "undecided" else f"{st.n} {_units(vc, st.n)}"
-        text = (f"{head}: {'weakest part ' if self.parts else ''}mean {_units(vc, 1)}-level effect "
+        which = ("" if not self.parts else "weakest part " if self.mode == "claim" else
+                 "the most significant opposite part ")
+        text = (f"{head}: {which}mean {_units(vc, 1)}-level effect "
                 f"{V.fmt(st.mean)} {unit} (95 % t interval over {_units(vc)} {V.fmt(st.lo)} to {V.fmt(st.hi)}), "
                 f"sign-flip p = {V.fmt(self.p, 3)}, Holm p = {V.fmt(p_holm, 3)}")
         if self.b == EVERY:
@@ -589,15 +617,25 @@ class _Claim:
         text = f"{lead}{word} because {why}. "
         test = (f"exact sign-flip permutation test of the mean of the {_units(vc)}' effects (all 2^n flips up to "
                 f"n = {EXACT_MAX}, else {int(vc.get('permutations', 100000))} seeded random flips; two-sided), Holm "
-                f"over the {m} declared claims with a test; 95 % t interval over the {_units(vc)}; minimum effect "
+                f"over the {m} declared claims with a test; 95 % t interval over the {_units(vc)} (shown for the size of the "
+                f"effect; the verdict rests on the sign-flip p, so with skewed effects the two can disagree); minimum effect "
                 f"{V.fmt(self.me)} {unit}; independent {_units(vc)}: {grouping}")
         if self.b == EVERY:
             parts = "; ".join(f"{g}: {s.holding}/{s.opposite}/{s.n - s.holding - s.opposite}, {s.numbers()}"
                               for g, s in self.parts)
-            text += (f"One intersection-union test over the {len(self.parts)} generators compared (the claim holds "
-                     f"only if it holds against each, so its p is the largest of theirs, p = {V.fmt(self.p, 3)}, and "
-                     f"it is one finding of the Holm correction: adjusted p = {V.fmt(p_holm, 3)}); {test}; per "
-                     f"generator (groups holding / opposite / neither, mean effect, interval, p): {parts}")
+            if self.mode == "contradiction":
+                text += (f"Tested for a contradiction: {sum(s.mean <= -self.me for _g, s in self.parts)} of the "
+                         f"{len(self.parts)} generators compared lean the other way by the minimum effect, and one "
+                         f"significant such part refutes the claim (union-intersection test: the smallest p of those "
+                         f"parts times the {len(self.parts)} parts, Bonferroni, p = {V.fmt(self.p, 3)}; one finding of "
+                         f"the Holm correction: adjusted p = {V.fmt(p_holm, 3)}); {test}; per generator (groups "
+                         f"holding / opposite / neither, mean effect, interval, p): {parts}")
+            else:
+                text += (f"One intersection-union test over the {len(self.parts)} generators compared (the claim "
+                         f"holds only if it holds against each, so its p is the largest of theirs, p = "
+                         f"{V.fmt(self.p, 3)}, and it is one finding of the Holm correction: adjusted p = "
+                         f"{V.fmt(p_holm, 3)}); {test}; per generator (groups holding / opposite / neither, mean "
+                         f"effect, interval, p): {parts}")
             if self.left:
                 text += "; " + "; ".join(self.left)
         else:
@@ -610,7 +648,7 @@ class _Claim:
             text += (f"{st.n} independent {_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted p = "
                      f"{V.fmt(p_holm, 3)}; {test}; holds in {st.holding}, opposite in {st.opposite}, neither in "
                      f"{st.n - st.holding - st.opposite}; per group (clips holding / untied clips, median effect): "
-                     f"{groups}; per-subject sign tests (clip x seed effects for / untied): {subj}; counted by clips "
+                     f"{groups}; per-subject sign tests (clips for / untied clips): {subj}; counted by clips "
                      f"instead: {ch} of {ch + cf} untied clips")
         if spec.get("note"):
             text += "; " + spec["note"]
@@ -687,6 +725,8 @@ def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | Non
     declared = set()
     for s in specs:
         bs = [g for g in gens if g not in REFERENCES and g != s["a"]] if s["b"] == EVERY else [s["b"]]
+        if s["b"] == EVERY and s.get("skating"):  # a floating generator is no part of the claim: exploratory
+            bs = [g for g in bs if not _floats(metrics, g, vc)]
         declared |= {(frozenset((s["a"], b)), s["metric"]) for b in bs}
     mets = list(dict.fromkeys([*EXPLORATORY_METRICS, *(s["metric"] for s in specs)]))
     rows = []
