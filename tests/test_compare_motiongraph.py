@@ -718,3 +718,34 @@ def test_fairmotion_builds_on_the_sources_60_fps_frames_not_the_30_fps_clips_ups
 
 def positions_m_root(values, sk):
     return root_translation(sk, values) * sk.length_to_m
+
+
+def test_native_rate_clips_match_the_working_clips_through_wraps_branches_and_other_bone_lengths(sk):
+    """The native-rate clip is made like the working-rate one: a trial whose angles wrap (unwrapped), one on
+    another angle branch (shifted to the first database trial's) and one with other bone lengths (retargeted
+    onto the held-out trial's skeleton): every second 60 fps frame is the 30 fps clip's, start and database."""
+    import copy
+
+    from animsynth.compare import jobs
+
+    trials = _trials_120(sk)
+    col = trials["t1"].skeleton.columns().index("lfemur.rx")
+    v = trials["t1"].values.copy()
+    v[:, col] = (v[:, col] + 170.0 + 180.0) % 360.0 - 180.0  # sits near +-180: wraps as the leg swings
+    trials["t1"] = Motion(v, trials["t1"].skeleton, trials["t1"].fps, "t1")
+    v0 = trials["t0"].values.copy()
+    v0[:, col] += 360.0  # the same rotations on another branch
+    trials["t0"] = Motion(v0, trials["t0"].skeleton, trials["t0"].fps, "t0")
+    longer = copy.deepcopy(trials["t2"].skeleton)
+    for j in longer.joints[1:]:
+        j.offset = np.asarray(j.offset, float) * 1.1
+    trials["t2"] = Motion(trials["t2"].values, longer, trials["t2"].fps, "t2")
+    assert np.any(np.abs(np.diff(trials["t1"].values[:, col])) > 180)
+    clips = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {"split": "t1"}, dict(_CC, native_fps=[60.0]))
+    for c in clips:
+        nat = c.at_rate(60.0)
+        assert np.array_equal(nat.start.values[::2], c.start.values), c.clip
+        for d, n in zip(c.database, nat.database):
+            assert np.array_equal(n.values[::2][:d.n_frames], d.values), c.clip
+            assert n.skeleton is c.held_out.skeleton or n.skeleton.columns() == c.held_out.skeleton.columns()
+        assert np.abs(np.diff(nat.start.values[:, col])).max() < 180 and np.abs(np.diff(c.start.values[:, col])).max() < 180

@@ -205,15 +205,16 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
                 out.append(NativeRate(r, [], None, why))
                 continue
             (held, k), dbs = got[0], got[1:]
-            vals = np.asarray(held.values, float)
-            start = Motion(vals[first * k:first * k + (context - 1) * k + 1], held.skeleton, r,
-                           f"{trial}:start@{r:g}")
             if n_db is None:  # as the working-rate clip: on the held-out trial's skeleton and the database's branch
                 db = [Motion(np.asarray(retarget(m, held.skeleton, f"trial {o}", f"trial {trial}").values, float),
                              held.skeleton, r, name) for (m, _k), o, name in zip(dbs, db_trials, db_names)]
                 db = [align_angle_branches(d, db[0]) for d in db]
-                start = align_angle_branches(start, db[0])
-            else:
+                # the whole held-out trial shifted, as at the working rate, then its start cut: the same branch
+                held = align_angle_branches(held, db[0])
+            vals = np.asarray(held.values, float)
+            start = Motion(vals[first * k:first * k + (context - 1) * k + 1], held.skeleton, r,
+                           f"{trial}:start@{r:g}")
+            if n_db is not None:
                 db = [Motion(vals[:n_db * k], held.skeleton, r, db_names[0])]
             out.append(NativeRate(r, db, start))
         return out
