@@ -23,9 +23,9 @@ Synthesis (the paper's, with the reference's defaults):
   the last at full rate; clips and motion are resampled linearly; a clip shorter than a patch at a level
   gives no patch there;
 * at least ``min_levels`` (7) levels where the database allows (:func:`level_scales`): when that rule gives
-  fewer (a longest clip under ``coarse_patches * patch_size / pyramid_factor ** (min_levels - 1)`` frames,
-  275 at the defaults; under 55 frames the rule alone gives the full rate only, as the reference's own
-  ``_get_pyramid_lengths`` does), the coarsest scale is lowered to ``pyramid_factor ** (min_levels - 1)``,
+  fewer (a longest clip under 232 frames at the defaults, as :func:`level_scales` counts; under 55 frames the
+  rule alone gives the full rate only, as the reference's own ``_get_pyramid_lengths`` does), the coarsest
+  scale is lowered to ``pyramid_factor ** (min_levels - 1)``,
   but never below ``min_coarse_patches * patch_size / longest clip`` (3 patches, 33 frames: every level
   at least three patches long); the finer levels follow by the same factor. Why 3 and not 1: with the
   coarsest level one patch long, the synthesised motion's coarsest level is one patch choosing among one

@@ -401,24 +401,21 @@ class MotionMatching(Generator):
         foot locking ``contact_targets`` (length, 2, 3) (where each foot's contact point was sent, m),
         ``contact_locked`` and ``contact_states`` (length, 2) (locked; the played frame's label).
 
-        Deterministic, so the last gamepad rollout is kept and a call with the same start and length (the
+        Deterministic, so the last rollout is kept and a call with the same start, length and trajectory (the
         family's other seeds) returns a copy of it instead of computing it again.
         """
         self._check_start(start, length)
-        key = None
-        if trajectory is None:
-            key = (int(length), np.asarray(start.values, float).tobytes())
-            memo = getattr(self, "_memo_", None)
-            if memo is not None and memo[0] == key:
-                m = memo[1]
-                return Motion(m.values.copy(), m.skeleton, m.fps, m.name,
-                              {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in m.meta.items()})
+        traj = b"" if trajectory is None else np.asarray(trajectory.values, float).tobytes()
+        key = (int(length), np.asarray(start.values, float).tobytes(), traj)
+        memo = getattr(self, "_memo_", None)
+        if memo is not None and memo[0] == key:
+            m = memo[1]
+            return Motion(m.values.copy(), m.skeleton, m.fps, m.name,
+                          {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in m.meta.items()})
         out = self._rollout(start, length, trajectory)
-        if key is not None:
-            self._memo_ = (key, out)
-            return Motion(out.values.copy(), out.skeleton, out.fps, out.name,
-                          {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in out.meta.items()})
-        return out
+        self._memo_ = (key, out)
+        return Motion(out.values.copy(), out.skeleton, out.fps, out.name,
+                      {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in out.meta.items()})
 
     def _rollout(self, start: Motion, length: int, trajectory: Motion | None) -> Motion:
         db, length = self.db_, int(length)

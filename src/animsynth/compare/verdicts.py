@@ -72,8 +72,9 @@ generator: one finding whose p is the largest of its parts' (an intersection-uni
 its parts), decided by the rules above with the effect and interval of its weakest part (the generator against
 which the mean effect is smallest). One significant part the other way refutes it: when some parts lean the other
 way by the minimum effect, the claim is tested for a contradiction instead, its p the smallest p of those parts
-times the number of parts (Bonferroni), with that part's effect and interval. Its parts show numbers (groups holding / opposite / neither, mean effect,
-interval, p), never a verdict word of their own. A generator whose feet do not touch is left out of it, named.
+times the number of parts (Bonferroni), with that part's effect and interval. Its parts show numbers (groups
+holding / opposite / neither, mean effect, interval, p), never a verdict word of their own. A generator whose
+feet do not touch is left out of it, named.
 
 Claims true by construction (re-sequencers copy database frames, so their novelty is 0; random concatenation
 is unblended, so a blended transition jumps less) are **sanity checks** (:func:`sanity_checks`): decided by the
