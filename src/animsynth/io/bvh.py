@@ -235,15 +235,21 @@ def bvh_frame_rate(path) -> float:
             text = line.strip()
             if text.startswith("Frame Time:"):
                 ft_s = text.split(":", 1)[1].strip()
-                ftime = parse_float(ft_s, path, ln, "frame time")
-                if ftime <= 0:
-                    raise MotionFormatError(path, ln, f"frame time must be positive (seconds per frame), got {ft_s!r}")
-                try:
-                    _check_frame_time(ftime, "frame time")
-                except ValueError as exc:
-                    raise MotionFormatError(path, ln, str(exc).replace("frame time: ", "")) from None
-                return _frame_rate(ft_s, ftime)
+                return _frame_rate(ft_s, _parse_frame_time(ft_s, path, ln))
     raise MotionFormatError(path, None, "no 'Frame Time:' line")
+
+
+def _parse_frame_time(ft_s: str, path, line: int) -> float:
+    """The ``Frame Time:`` value ``ft_s`` (seconds per frame) of ``path`` at ``line``, checked: a positive number
+    in the accepted range, else :class:`MotionFormatError` naming the file and line."""
+    ftime = parse_float(ft_s, path, line, "frame time")
+    if ftime <= 0:
+        raise MotionFormatError(path, line, f"frame time must be positive (seconds per frame), got {ft_s!r}")
+    try:
+        _check_frame_time(ftime, "frame time")
+    except ValueError as exc:
+        raise MotionFormatError(path, line, str(exc).replace("frame time: ", "")) from None
+    return ftime
 
 
 def read_bvh(path, fps: float | None = None) -> Motion:
@@ -395,13 +401,7 @@ def read_bvh(path, fps: float | None = None) -> Motion:
         raise MotionFormatError(path, lnf, f"bad frame count {nf_s!r}") from None
     if nframes < 1:
         raise MotionFormatError(path, lnf, f"frame count must be at least 1, got {nframes}")
-    ftime = parse_float(ft_s, path, lnt, "frame time")
-    if ftime <= 0:
-        raise MotionFormatError(path, lnt, f"frame time must be positive (seconds per frame), got {ft_s!r}")
-    try:
-        _check_frame_time(ftime, "frame time")
-    except ValueError as exc:
-        raise MotionFormatError(path, lnt, str(exc).replace("frame time: ", "")) from None
+    ftime = _parse_frame_time(ft_s, path, lnt)
     ncols = sum(len(r["channels"]) for r in joints)
     rows = []
     for k in range(i, len(raw)):
