@@ -25,7 +25,8 @@ from animsynth.kinematics import (align_angle_branches, continuous_clips, forwar
                                   unwrap_angles, wrap_count)
 from animsynth.motion import Motion
 from animsynth.simplicial import generate_from_trials
-from animsynth.skeleton import SAME_SKELETON_TOL_M, compare_skeletons, retarget
+from animsynth.kinematics import retarget
+from animsynth.skeleton import SAME_SKELETON_TOL_M, compare_skeletons
 from animsynth.synth.mocap import generate_motion
 from bvh_classes import Z_UP, bandai_with_wraps, hips_motion, turned_world
 

@@ -311,7 +311,7 @@ def cmd_generate(a) -> None:
     if any(bvh) and not all(bvh):
         raise UsageError("train", "give .bvh files or .amc files (with --asf), not both")
     if all(bvh):
-        from .skeleton import retarget
+        from .kinematics import retarget
 
         train = [_load_bvh(a, p) for p in a.train]
         sk = train[0].skeleton

@@ -30,7 +30,7 @@ from scipy.spatial.transform import Rotation
 import copy
 import logging
 
-from .skeleton import ROT_DOFS, TRANS_DOFS, Skeleton
+from .skeleton import RETARGET_MAX_ANGLE_DEG, ROT_DOFS, SAME_SKELETON_TOL_M, TRANS_DOFS, Skeleton, compare_skeletons
 
 log = logging.getLogger("animsynth.kinematics")
 
@@ -895,3 +895,81 @@ def continuous_clips(motions, reference=None) -> list:
         return out
     ref = out[0] if reference is None else unwrap_angles(reference)
     return [align_angle_branches(m, ref) for m in out]
+
+
+def retarget(motion, reference: Skeleton, what: str = "", reference_name: str = "", tol_m: float = SAME_SKELETON_TOL_M):
+    """``motion`` on the ``reference`` skeleton, by joint name.
+
+    * The same skeleton (:func:`compare_skeletons` within ``tol_m``, no rest-frame turn) with the same DOF
+      columns: the values as they are, on ``reference`` (bit for bit).
+    * The same skeleton otherwise (other channels or channel orders, or its rest pose turned, as in a Z-up
+      re-export): the local rotations read onto ``reference``'s DOF (``L' = Q L Q^-1``, the root's world
+      rotation ``W Q^-1``): every joint's world position is unchanged. One info line.
+    * Other rest offsets (bone lengths, or directions within :data:`RETARGET_MAX_ANGLE_DEG`): retargeted, the
+      local rotations kept (after the rest-frame turn) and the root's world translation kept, on
+      ``reference``'s offsets. One warning names both and the largest offset difference.
+    * Refused (ValueError naming both and the largest difference): other joint names or parents, or a bone
+      whose rest direction differs by more than :data:`RETARGET_MAX_ANGLE_DEG` (another rest pose: keeping the
+      local rotations would not carry the motion over).
+
+    Translation DOF of non-root joints the reference lacks are dropped; rotation DOF the reference lacks must be
+    zero (:func:`animsynth.kinematics.dof_values_from_local`). The result's angles are made continuous
+    (:func:`animsynth.kinematics.unwrap_angles`).
+
+    Parameters
+    ----------
+    motion : Motion, ``(frames, n_dof)``
+    reference : Skeleton
+    what, reference_name : str, name the motion and the reference in messages
+    tol_m : float, metres
+
+    Returns
+    -------
+    Motion, ``(frames, reference.n_dof)`` on ``reference``
+    """
+    from .motion import Motion
+
+    what = what or motion.name or "motion"
+    ref_name = reference_name or reference.name
+    sk = motion.skeleton
+    diff = compare_skeletons(sk, reference, tol_m)
+    if not diff.joints_match:
+        raise ValueError(f"{what}: its joints differ from the reference's ({ref_name}): {diff.why}; "
+                         "give motions on the same skeleton")
+    values = np.asarray(motion.values, float)
+    same_cols = sk.columns() == reference.columns()
+    turned = diff.turn_deg > 0
+    if diff.same and same_cols and not turned:
+        return Motion(values, reference, motion.fps, motion.name, dict(motion.meta))
+    if diff.largest_angle_deg > RETARGET_MAX_ANGLE_DEG:
+        raise ValueError(f"{what} and {ref_name}: another rest pose (rest offsets differ by up to "
+                         f"{diff.largest_m * 1000:.1f} mm at joint {diff.joint!r}, a bone's rest direction by "
+                         f"{diff.largest_angle_deg:.0f} degrees > {RETARGET_MAX_ANGLE_DEG:g}); retargeting by joint "
+                         "name would not carry the motion over: give motions on one skeleton")
+    Q = diff.turn
+    L = local_rotations(sk, values)
+    T = joint_translations(sk, values)
+    n = values.shape[0]
+    rots, trans = [], np.empty((n, len(reference.joints), 3))
+    for i, j in enumerate(reference.joints):
+        k = sk.index(j.name)
+        rots.append(L[k] * Q.inv() if j.parent < 0 else Q * L[k] * Q.inv())
+        if j.parent >= 0:
+            moved = (T[:, k] - np.asarray(sk.joints[k].offset, float)) * (sk.length_to_m / reference.length_to_m)
+            trans[:, i] = np.asarray(j.offset, float) + Q.apply(moved)
+    root_t = root_translation(sk, values) * (sk.length_to_m / reference.length_to_m)
+    trans[:, 0] = root_t
+    out = Motion(dof_values_from_local(reference, rots, root_t, trans), reference, motion.fps, motion.name,
+                 dict(motion.meta))
+    if diff.same:
+        log.info("%s: the skeleton of %s%s (rest offsets within %g mm); its rotations are read onto %s's DOF "
+                 "(every joint's position unchanged)", what, ref_name,
+                 f" with its rest pose turned by {diff.turn_deg:.0f} degrees" if turned else "", tol_m * 1000,
+                 ref_name)
+    else:
+        log.warning("%s and %s: rest offsets differ by up to %.1f mm (joint %r; tolerance %g mm)%s; %s is "
+                    "retargeted onto %s's skeleton by joint name (local rotations kept, %s's offsets)", what,
+                    ref_name, diff.largest_m * 1000, diff.joint, tol_m * 1000,
+                    f" after turning the rest pose by {diff.turn_deg:.0f} degrees" if turned else "", what, ref_name,
+                    ref_name)
+    return unwrap_angles(out, what)

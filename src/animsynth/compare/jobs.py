@@ -162,7 +162,7 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
     Every trial's angles are made continuous at its own rate, before resampling
     (:func:`animsynth.kinematics.unwrap_angles`: a fast joint may turn by more than 180 degrees between two
     working frames without wrapping, so the working frames are not unwrapped again). A leave-one-out clip's
-    database trials are put on the held-out trial's skeleton (:func:`animsynth.skeleton.retarget`: the same
+    database trials are put on the held-out trial's skeleton (:func:`animsynth.kinematics.retarget`: the same
     skeleton is kept as it is; other rest offsets are retargeted with a logged warning, or refused naming
     both trials) and every one of them, the held-out trial too, on the angle branch of the database's first
     trial (:func:`animsynth.kinematics.align_angle_branches`). A temporal split's database and held-out part
@@ -170,7 +170,7 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
     the unwrapped trials.
     """
     from ..kinematics import align_angle_branches, unwrap_angles
-    from ..skeleton import retarget
+    from ..kinematics import retarget
 
     fps, context = float(cfg["fps"]), int(cfg["context"])
     length, min_length = int(cfg["length"]), int(cfg["min_length"])
