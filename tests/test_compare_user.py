@@ -242,7 +242,8 @@ def test_tables_show_a_user_row_and_leave_the_claims_unchanged(tmp_path, clips_f
         out = {k: str(folder / f"{k}.{ext}") for k, ext in (
             ("metrics", "csv"), ("metrics_timing", "csv"), ("summary", "csv"), ("winners", "csv"), ("winners_md", "md"),
             ("cost", "csv"), ("cost_md", "md"), ("verdicts", "csv"), ("verdicts_md", "md"), ("sanity", "csv"),
-            ("sanity_md", "md"), ("sensitivity", "csv"), ("sensitivity_md", "md"), ("summary_md", "md"))}
+            ("sanity_md", "md"), ("sensitivity", "csv"), ("sensitivity_md", "md"), ("summary_md", "md"),
+            ("claims_stats", "csv"), ("exploratory", "csv"), ("exploratory_md", "md"))}
         users = [g for g in gens if g not in own]
         jobs.tables_job({"clips": str(tmp_path / "clips.csv"), "metrics": [runs[g]["metrics"] for g in gens],
                            "timing": [runs[g]["timing"] for g in gens]}, out, gens, {},
