@@ -21,10 +21,6 @@ from animsynth.verdicts import VOCABULARY, VerdictError
 
 from conftest import default_config
 
-ST = {"temporal_window": 1, "c_atn": 10.0, "c_ctn": 10.0, "ctn_neighbors": 4, "ctn_min_gap_s": 0.25,
-      "ctn_tolerance": 2, "ctn_reach_s": 0.05}
-
-
 _config = default_config
 
 
