@@ -74,6 +74,40 @@ def vlasic_dir():
     return need(VLASIC)
 
 
+@pytest.fixture(scope="module")
+def cfg():
+    """The comparison's generator-job config from the default config (config/config.yaml): every generator's
+    block at once (the workflow's ``job_cfg``), the clips job's keys, and ``seeds=2``."""
+    from animsynth.compare import settings
+
+    config = default_config()
+    return dict(settings.job_cfg(config), **settings.clips_cfg(config), seeds=2)
+
+
+def _walks_30fps(subject: str, seed: int) -> list:
+    """Four synthetic ``walk_straight`` trials (seeds 0-3, named w0-w3) of the CMU-like skeleton ``(subject, seed)``,
+    240 frames at 120 fps resampled to 30 fps (every 4th frame: 60 frames each)."""
+    from animsynth.compare import jobs
+    from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+    sk = cmu_like_skeleton(subject, seed)
+    return [jobs.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
+
+
+@pytest.fixture(scope="module")
+def walks():
+    """The comparison tests' database: four short synthetic walks of one subject (skeleton ``("cmp", 3)``) at
+    30 fps, 60 frames each (:func:`_walks_30fps`)."""
+    return _walks_30fps("cmp", 3)
+
+
+@pytest.fixture(scope="module")
+def est_walks():
+    """The estimator tests' walks: built as :func:`walks` but on another subject (skeleton ``("est", 2)``). The
+    golden values of tests/test_estimators.py were recorded on exactly these, so they must not change."""
+    return _walks_30fps("est", 2)
+
+
 def copy_workflow(dest: Path) -> Path:
     """Copy what a workflow run needs (not results/, resources/, .venv) into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)

@@ -17,30 +17,14 @@ from animsynth.config import ConfigError
 from animsynth.kinematics import unwrap_angles
 from animsynth.kinematics import heading, root_translation
 from animsynth.motion import Motion
-from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 from animsynth.verdicts import VOCABULARY, VerdictError
 
 from conftest import default_config
 
-ST = {"temporal_window": 1, "c_atn": 10.0, "c_ctn": 10.0, "ctn_neighbors": 4, "ctn_min_gap_s": 0.25,
-      "ctn_tolerance": 2, "ctn_reach_s": 0.05}
-
-
 _config = default_config
 
 
-@pytest.fixture(scope="module")
-def cfg():
-    config = _config()
-    # the generator jobs' config (the workflow's, every generator at once) plus the clips job's keys
-    return dict(settings.job_cfg(config), **settings.clips_cfg(config), seeds=2)
-
-
-@pytest.fixture(scope="module")
-def walks():
-    """Four short synthetic walks of one subject at 30 fps (120 fps trials, every 4th frame)."""
-    sk = cmu_like_skeleton("cmp", 3)
-    return [jobs.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
+# the fixtures cfg (the generator jobs' config) and walks (the synthetic database) live in conftest.py
 
 
 def _start(m: Motion, n: int = 8) -> Motion:

@@ -22,11 +22,7 @@ INF = float("inf")
 DATA = Path(__file__).parent / "data"
 
 
-@pytest.fixture(scope="module")
-def walks():
-    """Four synthetic walks of one subject at 30 fps (60 frames each)."""
-    sk = cmu_like_skeleton("cmp", 3)
-    return [jobs.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
+# the fixture walks (the synthetic database) lives in conftest.py
 
 
 def _cut(m: Motion, a: int, b: int, name: str = "part") -> Motion:

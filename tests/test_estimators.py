@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from animsynth.compare import generators as G
-from animsynth.compare import jobs as cjobs
 from animsynth.compare import settings
 from animsynth.motion import Motion
 from animsynth.resequencing import jobs as rjobs
@@ -23,19 +22,10 @@ from animsynth.simplicial.generate import generate_from_trials
 from animsynth.simplicial.generator import FieldFollower
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
-from conftest import config_block, default_config
+from conftest import config_block
 
 
-@pytest.fixture(scope="module")
-def cfg():
-    config = default_config()
-    return dict(settings.job_cfg(config), **settings.clips_cfg(config), seeds=2)
-
-
-@pytest.fixture(scope="module")
-def walks():
-    sk = cmu_like_skeleton("est", 2)
-    return [cjobs.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
+# the fixtures cfg (the generator jobs' config) and est_walks (the synthetic walks) live in conftest.py
 
 
 @pytest.fixture(scope="module")
@@ -51,16 +41,16 @@ def _start(m: Motion, n: int = 8) -> Motion:
 
 
 @pytest.mark.parametrize("method", ["delaunay", "knn"])
-def test_compare_row_and_the_cli_route_give_the_same_poses(walks, cfg, method):
+def test_compare_row_and_the_cli_route_give_the_same_poses(est_walks, cfg, method):
     """The comparison's delaunay / knn row (no jitter) and generate_from_trials (the CLI) from the same start:
     the same PCA, field and steps, so the same joint angles, bit for bit."""
     field = dict(cfg["field"], jitter=0.0)
-    gen = G.make_generator(method, dict(cfg, field=field)).fit(walks[1:])
+    gen = G.make_generator(method, dict(cfg, field=field)).fit(est_walks[1:])
     assert isinstance(gen, FieldFollower)
-    start, length = _start(walks[0]), 20
+    start, length = _start(est_walks[0]), 20
     out = gen.generate(start, length, seed=3)
     n_root = 6
-    angles, _ = generate_from_trials([w.without_root() for w in walks[1:]], method=method, k=field["k"],
+    angles, _ = generate_from_trials([w.without_root() for w in est_walks[1:]], method=method, k=field["k"],
                                      latent_dim=field["latent_dim"], derivative=field["derivative"],
                                      steps=length * gen.steps_per_frame_, start=start.values[-1, n_root:])
     spf = gen.steps_per_frame_
@@ -69,9 +59,9 @@ def test_compare_row_and_the_cli_route_give_the_same_poses(walks, cfg, method):
 
 @pytest.mark.parametrize("variant", [fl.Variant("delaunay"), fl.Variant("knn", method="knn", k=4),
                                      fl.Variant("fw", derivative="forward", weights="barycentric", latent_dim=3)])
-def test_a_paper_fold_follows_the_estimator(walks, variant):
+def test_a_paper_fold_follows_the_estimator(est_walks, variant):
     """run_fold's latent path, field and training vectors are those of the estimator fitted on the training trials."""
-    trials = [w.without_root() for w in walks]
+    trials = [w.without_root() for w in est_walks]
     res = fl.run_fold(trials[1:], trials[0], variant)
     est = FieldFollower(variant.method, variant.latent_dim, variant.k, variant.derivative,
                         weights=variant.weights).fit_angles(trials[1:])
@@ -82,18 +72,18 @@ def test_a_paper_fold_follows_the_estimator(walks, variant):
     np.testing.assert_array_equal(res.path.fallback, path.fallback)
 
 
-def test_the_compare_pca_is_the_family_pca(walks):
+def test_the_compare_pca_is_the_family_pca(est_walks):
     """fit(database) fits PCA on the stacked joint angles: an independent scikit-learn PCA written out here."""
     from sklearn.decomposition import PCA
 
-    est = FieldFollower().fit(walks)
-    pca = PCA(n_components=est.latent_dim, svd_solver="full").fit(np.vstack([w.without_root() for w in walks]))
+    est = FieldFollower().fit(est_walks)
+    pca = PCA(n_components=est.latent_dim, svd_solver="full").fit(np.vstack([w.without_root() for w in est_walks]))
     np.testing.assert_array_equal(est.pca_.components_, pca.components_)
     np.testing.assert_array_equal(est.pca_.mean_, pca.mean_)
 
 
-def test_a_shared_latent_space_must_have_the_same_dimension(walks):
-    space = FieldFollower(latent_dim=2).fit_latent([w.without_root() for w in walks])
+def test_a_shared_latent_space_must_have_the_same_dimension(est_walks):
+    space = FieldFollower(latent_dim=2).fit_latent([w.without_root() for w in est_walks])
     with pytest.raises(ValueError, match="latent_dim 3"):
         FieldFollower(latent_dim=3).fit_field(space=space)
 
@@ -145,39 +135,39 @@ def test_the_sparse_and_dense_graphs_agree_on_the_smallest_k_of_one_capture(capt
     assert sparse.min_k_ == dense.min_k_
 
 
-def test_dense_needs_one_clip_and_sparse_needs_l2(walks):
+def test_dense_needs_one_clip_and_sparse_needs_l2(est_walks):
     with pytest.raises(ValueError, match="one capture"):
-        Resequencer(neighbours="dense").fit(walks[:2])
+        Resequencer(neighbours="dense").fit(est_walks[:2])
     with pytest.raises(ValueError, match="l2 metric"):
-        Resequencer(metric="lee").fit(walks[:2])
+        Resequencer(metric="lee").fit(est_walks[:2])
 
 
 # ----------------------------------------------------------------------------- the conventions
 
 
-def _unfitted(name, cfg, walks):
-    return G.make_generator(name, cfg, held_out=walks[0])
+def _unfitted(name, cfg, est_walks):
+    return G.make_generator(name, cfg, held_out=est_walks[0])
 
 
 @pytest.mark.parametrize("name", [n for n in G.GENERATORS if n not in G.FAIRMOTION_ROWS] + ["fairmotion"])
-def test_estimator_conventions(name, cfg, walks):
+def test_estimator_conventions(name, cfg, est_walks):
     """Parameters stored as given in __init__, fit returns self, everything fit adds ends in ``_`` (a private
     fitted attribute is ``_name_``)."""
     if settings.unavailable(name):
         pytest.skip(f"{name}: {settings.unavailable(name)}")
-    gen = _unfitted(name, cfg, walks)
+    gen = _unfitted(name, cfg, est_walks)
     params = [p for p in inspect.signature(type(gen).__init__).parameters if p != "self"]
     for p in params:
         assert hasattr(gen, p), f"{name}: parameter {p!r} is not stored on the estimator"
     before = set(vars(gen))
-    assert gen.fit(walks[1:]) is gen
+    assert gen.fit(est_walks[1:]) is gen
     added = sorted(set(vars(gen)) - before)
     assert added and all(a.endswith("_") for a in added), (name, added)
 
 
-def test_the_family_estimators_add_only_trailing_underscore_attributes(walks, capture):
-    for est, data in ((FieldFollower(), walks), (Resequencer("stisomap", stisomap=config_block("resequencing")
-                                                              ["stisomap"]), walks),
+def test_the_family_estimators_add_only_trailing_underscore_attributes(est_walks, capture):
+    for est, data in ((FieldFollower(), est_walks), (Resequencer("stisomap", stisomap=config_block("resequencing")
+                                                              ["stisomap"]), est_walks),
                       (Resequencer(neighbours="dense", metric="lee"), [capture])):
         before = set(vars(est))
         est.fit(data)
@@ -196,8 +186,8 @@ def test_the_registry_holds_no_method_code():
 # ----------------------------------------------------------------------------- golden numbers
 
 # Integer results (frame paths, source frames, k, nearest-frame indices, step counts) of the code before the
-# one-estimator refactor (commit ffbda55) on this file's synthetic walks: the refactor keeps them exactly. Only
-# integers are pinned (docs/testing.md: no float pinned across machines).
+# one-estimator refactor (commit ffbda55) on this file's synthetic walks (est_walks, conftest.py): the refactor keeps
+# them exactly. Only integers are pinned (docs/testing.md: no float pinned across machines).
 GOLDEN_RESEQUENCE = {  # resequence_motion(capture, 150, 20, method, metric="l2")
     "isomap": (
         150, 149, 148, 147, 146, 145, 144, 143, 142, 141, 140, 139, 138, 137, 136, 135, 134, 133, 132, 131, 130,
@@ -205,8 +195,8 @@ GOLDEN_RESEQUENCE = {  # resequence_motion(capture, 150, 20, method, metric="l2"
         15, 16, 17, 18, 19, 20),
     "stisomap": list(range(150, 19, -1)),
 }
-GOLDEN_MIN_K = {"isomap": 3, "stisomap": 1}  # compare's rows on walks[1:]
-GOLDEN_SOURCES = {  # compare's rows on walks[1:]: generate(walks[0][:8], 20, seed) source_frames
+GOLDEN_MIN_K = {"isomap": 3, "stisomap": 1}  # compare's rows on est_walks[1:]
+GOLDEN_SOURCES = {  # compare's rows on est_walks[1:]: generate(est_walks[0][:8], 20, seed) source_frames
     ("isomap", 0): (
         [1, 15], [1, 13], [1, 11], [1, 9], [1, 8], [1, 7], [1, 6], [1, 4], [1, 2], [0, 0], [2, 1], [2, 2], [2, 31],
         [2, 58], [2, 32], [2, 33], [2, 34], [2, 7], [2, 8], [2, 9]),
@@ -220,7 +210,7 @@ GOLDEN_SOURCES = {  # compare's rows on walks[1:]: generate(walks[0][:8], 20, se
         [1, 17], [1, 18], [1, 19], [1, 20], [1, 21], [1, 22], [1, 23], [1, 24], [1, 25], [1, 26], [1, 27], [1, 28],
         [1, 29], [1, 30], [1, 31], [1, 32], [1, 33], [1, 34], [1, 35], [1, 36]),
 }
-GOLDEN_FOLD_NEAREST = {  # run_fold(walks[1:], walks[0]): nearest training latent frame of every 6th path point,
+GOLDEN_FOLD_NEAREST = {  # run_fold(est_walks[1:], est_walks[0]): nearest training latent frame of every 6th path point,
     # and the fallback steps
     "delaunay": ([156, 62, 67, 70, 75, 84, 88, 93, 96, 99, 102], 0),
     "fw": ([156, 160, 164, 117, 47, 22, 160, 165, 117, 175, 155], 1),
@@ -234,20 +224,20 @@ def test_golden_resequence_motion_paths(capture, method):
 
 
 @pytest.mark.parametrize("method", ["isomap", "stisomap"])
-def test_golden_compare_rows(walks, cfg, method):
-    gen = G.make_generator(method, cfg).fit(walks[1:])
+def test_golden_compare_rows(est_walks, cfg, method):
+    gen = G.make_generator(method, cfg).fit(est_walks[1:])
     assert gen.min_k_ == GOLDEN_MIN_K[method]
     for seed in (0, 1):
-        out = gen.generate(_start(walks[0]), 20, seed=seed)
+        out = gen.generate(_start(est_walks[0]), 20, seed=seed)
         assert out.meta["source_frames"].tolist() == [list(p) for p in GOLDEN_SOURCES[method, seed]], seed
 
 
 @pytest.mark.parametrize("variant", [fl.Variant("delaunay"),
                                      fl.Variant("fw", derivative="forward", weights="barycentric", latent_dim=3)])
-def test_golden_fold_paths(walks, variant):
+def test_golden_fold_paths(est_walks, variant):
     from scipy.spatial import cKDTree
 
-    trials = [w.without_root() for w in walks]
+    trials = [w.without_root() for w in est_walks]
     res = fl.run_fold(trials[1:], trials[0], variant)
     nearest = cKDTree(np.vstack(res.train_latent)).query(res.path.points[::6])[1]
     assert (nearest.tolist(), int(res.path.fallback_steps)) == (GOLDEN_FOLD_NEAREST[variant.name][0],

@@ -4,6 +4,7 @@ import pandas as pd
 import pytest
 
 from animsynth import verdicts as v
+from animsynth.families import names
 
 
 def test_row_refuses_a_word_outside_the_vocabulary():
@@ -76,7 +77,7 @@ def test_a_beats_b_share_test_and_minimum_units():
     assert v.a_beats_b(4, 0, 1, **rule, p=float("nan")) == "noise"          # no test, no decision
 
 
-@pytest.mark.parametrize("family", ["simplicial", "resequencing", "facegraph", "meshdetail", "compare"])
+@pytest.mark.parametrize("family", names())
 def test_every_family_builds_its_verdicts_with_build_verdicts(family):
     import importlib
 

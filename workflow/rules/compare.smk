@@ -8,8 +8,8 @@
 # out at parse time with one line, and the tables and docs say why. Every job gets only the config keys it
 # uses. Resources: measured on CMU (the paper run) with headroom.
 from animsynth.compare.generators import FAIRMOTION_ROWS
-from animsynth.compare.settings import (clip_ids, clips_cfg, generator_order, groups, job_cfg, run_generators,
-                                        showcase, user_generators)
+from animsynth.compare.settings import (clips_cfg, generator_order, groups, job_cfg, run_generators, showcase,
+                                        user_generators)
 
 CMP = config["compare"]
 # the leave-one-out groups and temporal splits (the Table I subsets, the re-sequencing clips, then the comparison's

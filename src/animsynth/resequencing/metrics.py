@@ -37,9 +37,6 @@ log = logging.getLogger("animsynth.resequencing")
 __all__ = ["joint_quats", "transitions", "pass_jumps", "classify_path", "TransitionReference", "transition_measures",
            "pose_steps", "jerk_magnitude", "root_reversals", "foot_ground", "foot_skate", "Reference", "smoothness"]
 
-#: The CMU joints of :data:`animsynth.joints.FOOT_ROLES` (the roles of the foot metrics).
-FOOT_JOINTS = ("lfoot", "ltoes", "rfoot", "rtoes")
-
 
 def joint_quats(motion) -> np.ndarray:
     """Local quaternions (frames, joints, 4) of the non-root joints with rotational DOF."""
