@@ -185,6 +185,10 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
           roles: dict | None = None) -> tuple[dict, np.ndarray]:
     """Every per-seed metric of one generated motion; returns the row and its pose features.
 
+    The row has one value per record of :data:`~animsynth.compare.metric_table.METRICS` but those a run gives
+    (``needs`` ``"generator"``, ``"seeds"``: the transitions kept and the diversity over seeds, which the runner
+    adds).
+
     The start and the generated frames are scored together where a measure needs frames before the
     first generated one (foot speed at the first frame, the jump at the entry seam); the entry
     (generated frame 0) is a seam for every generator but ``replay``.
