@@ -1,11 +1,11 @@
 """compare: foot skating of motion matching with and without the reference's foot locking, on the paper run's clips.
 
 A measurement, not a timed test: the paper run's comparison clips built as its ``compare_clips`` rule builds them
-(:func:`animsynth.compare.jobs.prepare_clips` with ``config/config.yaml``'s ``compare`` block under
+(:func:`animsynth.compare.protocol.prepare_clips` with ``config/config.yaml``'s ``compare`` block under
 ``config/cmu.yaml``'s and ``config/paper.yaml``'s: the Table I subsets w1 w2 r1 r2 left one out, the
 re-sequencing clips walk / run / dance with their end held out; 30 fps, 8 start frames, 60 generated), the
 trials read from ``../shared/data/cmu_mocap`` (``ANIMSYNTH_SHARED_DATA`` overrides ``../shared/data``). Every
-clip is scored by :func:`animsynth.compare.jobs.score` (the family's metrics: ``skate_share`` over the start's
+clip is scored by :func:`animsynth.compare.scoring.score` (the family's metrics: ``skate_share`` over the start's
 last frame and the generated ones, the database's floor, contact below 0.05 m, skating above 0.5 m/s).
 
 Rows: ``motion_matching`` (the reference's defaults: foot locking and leg IK on), ``motion_matching_no_lock``
@@ -32,7 +32,7 @@ import pandas as pd
 import yaml
 from threadpoolctl import threadpool_limits
 
-from animsynth.compare import jobs
+from animsynth.compare import protocol, scoring
 from animsynth.compare.generators import make_generator
 from animsynth.compare.motionmatching import make_motion_matching
 from animsynth.io import read_amc, read_asf
@@ -63,7 +63,7 @@ def clips() -> tuple[list, dict]:
         m = read_amc(CMU / trials[i]["amc"], read_asf(CMU / trials[i]["asf"]))
         m.name = i
         motions[i] = m
-    return jobs.prepare_clips(motions, subsets, reseq, cfg), cfg
+    return protocol.prepare_clips(motions, subsets, reseq, cfg), cfg
 
 
 def _by_lock(clip, ref, motion, mcfg) -> dict:
@@ -104,7 +104,7 @@ def run(out: str | None = None) -> pd.DataFrame:
         mcfg = cfg["metrics"]
         rows = []
         for clip in cl:
-            ref = jobs.reference(clip, mcfg)
+            ref = scoring.reference(clip, mcfg)
             gens = {"motion_matching": (make_motion_matching({}), 1),
                     "motion_matching_no_lock": (make_motion_matching({}, foot_lock=False,
                                                                      name="motion_matching_no_lock"), 1),
@@ -112,12 +112,12 @@ def run(out: str | None = None) -> pd.DataFrame:
                     "replay": (make_generator("replay", cfg, held_out=clip.held_out), 1)}
             for name, (gen, n_seeds) in gens.items():
                 gen.fit(clip.database)
-                seeds = jobs.clip_seeds(cfg["master_seed"], cfg["seed"], clip.clip, n_seeds)
+                seeds = protocol.clip_seeds(cfg["master_seed"], cfg["seed"], clip.clip, n_seeds)
                 for i, s in enumerate(seeds):
                     c0 = time.process_time()
                     m = gen.generate(clip.start, clip.length, s)
                     cpu = time.process_time() - c0
-                    row, _ = jobs.score(clip, ref, m, name, mcfg)
+                    row, _ = scoring.score(clip, ref, m, name, mcfg)
                     rows.append({"clip": clip.clip, "group": clip.group, "generator": name, "seed": i,
                                  "skate_share": row["skate_share"], "contact_share": row["contact_share"],
                                  "transition_skate_share": row["transition_skate_share"],

@@ -87,11 +87,11 @@ def cfg():
 def _walks_30fps(subject: str, seed: int) -> list:
     """Four synthetic ``walk_straight`` trials (seeds 0-3, named w0-w3) of the CMU-like skeleton ``(subject, seed)``,
     240 frames at 120 fps resampled to 30 fps (every 4th frame: 60 frames each)."""
-    from animsynth.compare import jobs
+    from animsynth.compare import protocol
     from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
     sk = cmu_like_skeleton(subject, seed)
-    return [jobs.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
+    return [protocol.resample(generate_motion("walk_straight", 240, s, sk, name=f"w{s}"), 30.0) for s in range(4)]
 
 
 @pytest.fixture(scope="module")

@@ -240,7 +240,7 @@ def test_multi_file_generate_reads_a_z_up_copy_onto_the_first_skeleton(pair, tmp
 def test_compare_databases_and_simplicial_subsets_share_one_skeleton(pair, tmp_path):
     """A database trial re-exported Z up is read onto the held-out trial's rest pose (its joint positions
     unchanged); the simplicial subset's trials onto the first trial's."""
-    from animsynth.compare.jobs import prepare_clips
+    from animsynth.compare.protocol import prepare_clips
     from animsynth.simplicial.jobs import load_trials
 
     y, z = pair

@@ -9,7 +9,7 @@ import logging
 import pandas as pd
 import pytest
 
-from animsynth.compare import cost, jobs, settings
+from animsynth.compare import cost, jobs, protocol, runner, settings
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 from conftest import default_config
@@ -19,11 +19,11 @@ from conftest import default_config
 def clips_file(tmp_path_factory):
     """Three short synthetic walks, leave one out (3 clips), 12 generated frames at 30 fps."""
     sk = cmu_like_skeleton("cmp", 3)
-    walks = {f"t{s}": jobs.resample(generate_motion("walk_straight", 200, s, sk, name=f"t{s}"), 30.0) for s in range(3)}
+    walks = {f"t{s}": protocol.resample(generate_motion("walk_straight", 200, s, sk, name=f"t{s}"), 30.0) for s in range(3)}
     cfg = default_config()["compare"]
     cc = {k: cfg[k] for k in settings.CLIP_KEYS}
     path = tmp_path_factory.mktemp("cost_clips") / "clips.npz"
-    jobs.save_clips(path, jobs.prepare_clips(walks, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=12)))
+    protocol.save_clips(path, protocol.prepare_clips(walks, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=12)))
     return path
 
 
@@ -75,7 +75,7 @@ def test_a_database_over_the_limit_is_not_run_and_names_the_key(tmp_path, clips_
     assert len(m) == 6 and m["skate_share"].isna().all()
     assert m["note"].str.startswith("not run: concat on w1/").all()
     assert m["note"].str.contains("compare.cost_guard.max_cpu_s").all()
-    shown = jobs.load_shown(out["shown"])  # the job completes: the showcase is the start alone
+    shown = runner.load_shown(out["shown"])  # the job completes: the showcase is the start alone
     assert shown.n_frames == shown.meta["context"] and shown.meta["note"].startswith("not run: ")
 
 

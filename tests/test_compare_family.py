@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from animsynth.compare import generators as G
-from animsynth.compare import jobs
+from animsynth.compare import jobs, metric_table, protocol, runner, scoring
 from animsynth.compare import tables
 from animsynth.compare import settings
 from animsynth.compare import verdicts as CV
@@ -134,7 +134,7 @@ def test_unknown_generator_names_the_key(cfg):
 def test_clips_leave_one_out_and_temporal_split(walks):
     trials = {f"t{i}": Motion(w.values, w.skeleton, 30.0, f"t{i}") for i, w in enumerate(walks)}
     cc = {"fps": 15, "context": 4, "length": 40, "min_length": 6, "holdout_fraction": 0.3}
-    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
+    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
     assert [c.clip for c in clips] == ["w1/t0", "w1/t1", "w1/t2", "walk/t3"]
     c0 = clips[0]
     assert [d.name for d in c0.database] == ["t1", "t2"] and c0.held_out.fps == 15.0
@@ -153,15 +153,15 @@ def test_clips_leave_one_out_and_temporal_split(walks):
 def test_clips_round_trip_and_table(tmp_path, walks):
     trials = {f"t{i}": w for i, w in enumerate(walks)}
     cc = {"fps": 30, "context": 6, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
-    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1"]}, {"walk": "t2"}, cc)
-    jobs.save_clips(tmp_path / "c.npz", clips)
-    back = jobs.load_clips(tmp_path / "c.npz")
+    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1"]}, {"walk": "t2"}, cc)
+    protocol.save_clips(tmp_path / "c.npz", clips)
+    back = protocol.load_clips(tmp_path / "c.npz")
     for a, b in zip(clips, back):
         assert (a.clip, a.protocol, a.length, a.context) == (b.clip, b.protocol, b.length, b.context)
         assert np.array_equal(a.held_out.values, b.held_out.values)
         assert all(np.array_equal(x.values, y.values) for x, y in zip(a.database, b.database))
         assert b.held_out.skeleton.columns() == a.held_out.skeleton.columns()
-    table = jobs.clips_table(back)
+    table = protocol.clips_table(back)
     assert list(table["protocol"]) == ["leave one out", "leave one out", "temporal split"]
 
 
@@ -169,15 +169,15 @@ def test_clip_errors_name_the_keys(walks):
     trials = {"a": walks[0], "b": walks[1]}
     cc = {"fps": 30, "context": 8, "length": 20, "min_length": 200, "holdout_fraction": 0.3}
     with pytest.raises(ValueError, match="compare.min_length"):
-        jobs.prepare_clips(trials, {"w1": ["a", "b"]}, {}, cc)
+        protocol.prepare_clips(trials, {"w1": ["a", "b"]}, {}, cc)
     with pytest.raises(ValueError, match="compare.fps"):
-        jobs.prepare_clips(trials, {"w1": ["a", "b"]}, {}, dict(cc, fps=7, min_length=6))
+        protocol.prepare_clips(trials, {"w1": ["a", "b"]}, {}, dict(cc, fps=7, min_length=6))
 
 
 def test_seeds_are_the_same_for_every_generator_and_differ_by_clip():
-    assert jobs.clip_seeds(1, 11, "w1/a", 3) == jobs.clip_seeds(1, 11, "w1/a", 3)
-    assert jobs.clip_seeds(1, 11, "w1/a", 3) != jobs.clip_seeds(1, 11, "w1/b", 3)
-    assert len(set(jobs.clip_seeds(1, 11, "w1/a", 5))) == 5
+    assert protocol.clip_seeds(1, 11, "w1/a", 3) == protocol.clip_seeds(1, 11, "w1/a", 3)
+    assert protocol.clip_seeds(1, 11, "w1/a", 3) != protocol.clip_seeds(1, 11, "w1/b", 3)
+    assert len(set(protocol.clip_seeds(1, 11, "w1/a", 5))) == 5
 
 
 def test_run_generator_scores_every_clip_and_seed_and_writes_a_bvh_our_reader_reads(tmp_path, walks, cfg):
@@ -186,18 +186,18 @@ def test_run_generator_scores_every_clip_and_seed_and_writes_a_bvh_our_reader_re
 
     trials = {f"t{i}": w for i, w in enumerate(walks)}
     cc = {k: cfg[k] for k in settings.CLIP_KEYS}
-    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
-    jobs.save_clips(tmp_path / "clips.npz", clips)
+    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
+    protocol.save_clips(tmp_path / "clips.npz", clips)
     out = {k: str(tmp_path / f"{k}{ext}") for k, ext in
            (("metrics", ".csv"), ("timing", "_timing.csv"), ("shown", ".npz"), ("bvh", ".bvh"))}
     jobs.run_job(tmp_path / "clips.npz", "stisomap", cfg, 7, None, ("w1/t1", 1), out)
     m = pd.read_csv(out["metrics"])
-    assert len(m) == 3 * cfg["seeds"] and list(m.columns) == jobs.KEY_COLUMNS + jobs.METRIC_NAMES + ["note"]
+    assert len(m) == 3 * cfg["seeds"] and list(m.columns) == metric_table.KEY_COLUMNS + metric_table.METRIC_NAMES + ["note"]
     assert (m["n_seams"] >= 1).all()  # the entry is a seam
     assert m["copy_share"].between(0.99, 1).all()  # a re-sequencer copies database poses
     t = pd.read_csv(out["timing"])
     assert len(t) == 3 and (t["peak_rss_mb"] > 10).all() and t["peak_rss_mb"].is_monotonic_increasing
-    shown = jobs.load_shown(out["shown"])
+    shown = runner.load_shown(out["shown"])
     assert shown.n_frames == clips[1].context + clips[1].length and shown.meta["context"] == clips[1].context
     back = read_bvh(out["bvh"])
     assert back.n_frames == shown.n_frames and np.isclose(back.fps, shown.fps)
@@ -216,7 +216,7 @@ def _metrics(values: dict) -> pd.DataFrame:
         for i, v in enumerate(vals):
             row = {"clip": f"{'ab'[i % 2]}/c{i // 4}", "group": "ab"[i % 2], "protocol": "leave one out",
                    "generator": g, "seed": i // 2 % 2}
-            row.update({m: np.nan for m in jobs.METRIC_NAMES})
+            row.update({m: np.nan for m in metric_table.METRIC_NAMES})
             row.update(skate_share=v, transition_skate_share=v, velocity_jump=v, l2p=v, novelty_median_m=v)
             rows.append(row)
     return pd.DataFrame(rows)
@@ -251,7 +251,7 @@ def _grouped(group_effects: list[list[float]], seeds: int = 2, pair=("motion_gra
             for s in range(seeds):
                 for g, v in ((pair[0], 0.2), (pair[1], 0.2 + e)):
                     row = {"clip": clip, "group": subset, "protocol": "leave one out", "generator": g, "seed": s}
-                    row.update({m: np.nan for m in jobs.METRIC_NAMES})
+                    row.update({m: np.nan for m in metric_table.METRIC_NAMES})
                     row[metric] = v + 0.001 * s
                     rows.append(row)
     return pd.DataFrame(rows), pd.DataFrame(crow)
@@ -339,9 +339,9 @@ def test_the_modern_rows_from_the_config(cfg):
 def test_motion_matching_rows_have_seed_diversity_zero_and_genmm_does_not(walks, cfg):
     trials = {f"t{i}": w for i, w in enumerate(walks)}
     cc = {k: cfg[k] for k in settings.CLIP_KEYS}
-    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
+    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
     for name, zero in (("motion_matching", True), ("genmm", False)):
-        metrics, timing, _ = jobs.run_generator(clips, name, cfg, 7)
+        metrics, timing, _ = runner.run_generator(clips, name, cfg, 7)
         assert len(metrics) == 3 * cfg["seeds"] and (metrics["note"] == "").all()
         assert ((metrics["seed_diversity_m"] == 0).all() if zero else (metrics["seed_diversity_m"] > 0).all()), name
         assert np.isfinite(timing["generate_cpu_s"]).all() and (timing["frames_generated"] == 20 * cfg["seeds"]).all()
@@ -475,17 +475,17 @@ def test_settings_lists_clips_and_showcase():
 def test_a_generator_not_built_on_a_clip_keeps_its_rows_with_the_reason(walks, cfg):
     trials = {"a": walks[0], "b": walks[1], "c": Motion(walks[2].values[:18], walks[2].skeleton, 30.0, "c")}
     cc = {k: cfg[k] for k in settings.CLIP_KEYS}
-    clips = jobs.prepare_clips(trials, {"w1": ["a", "b"], "w2": ["b", "c"]}, {}, dict(cc, length=10))
+    clips = protocol.prepare_clips(trials, {"w1": ["a", "b"], "w2": ["b", "c"]}, {}, dict(cc, length=10))
     # the w2/b clip's database is c alone: 18 frames, too short for windows of 20 frames
     mg = dict(cfg, motion_graph=dict(cfg["motion_graph"], window=20))
-    metrics, timing, _ = jobs.run_generator(clips, "motion_graph", mg, 7)
+    metrics, timing, _ = runner.run_generator(clips, "motion_graph", mg, 7)
     bad = metrics[metrics["clip"] == "w2/b"]
     assert len(bad) == cfg["seeds"] and bad["note"].str.startswith("not built: ").all()
-    assert bad[jobs.METRIC_NAMES].isna().all().all()
+    assert bad[metric_table.METRIC_NAMES].isna().all().all()
     assert (metrics.loc[metrics["clip"] != "w2/b", "note"] == "").all()
     assert timing.set_index("clip").loc["w2/b", "frames_generated"] == 0
     with pytest.raises(ValueError, match="compare.showcase.clip"):
-        jobs.run_generator(clips, "motion_graph", mg, 7, showcase=("w2/b", 0))
+        runner.run_generator(clips, "motion_graph", mg, 7, showcase=("w2/b", 0))
 
 
 def test_root_rotation_is_the_root_of_local_rotations(walks):
@@ -557,13 +557,13 @@ def test_the_jobs_shared_kinematics_give_the_references_of_separate_computations
 
     trials = {f"t{i}": Motion(w.values, w.skeleton, 30.0, f"t{i}") for i, w in enumerate(walks)}
     cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
-    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
+    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
     mcfg = cfg["metrics"]
-    kin = jobs.DatabaseKinematics()
-    std = jobs.run_stats(clips, mcfg, None, kin)
-    assert np.array_equal(std, jobs.run_stats(clips, mcfg))
+    kin = scoring.DatabaseKinematics()
+    std = scoring.run_stats(clips, mcfg, None, kin)
+    assert np.array_equal(std, scoring.run_stats(clips, mcfg))
     for c in clips:
-        shared, alone = jobs.reference(c, mcfg, None, std, kin), jobs.reference(c, mcfg, None, std)
+        shared, alone = scoring.reference(c, mcfg, None, std, kin), scoring.reference(c, mcfg, None, std)
         for name in ("floor", "std", "truth_pos", "truth_q", "truth_forward", "capture_max"):
             assert np.array_equal(getattr(shared, name), getattr(alone, name)), (c.clip, name)
         assert all(np.array_equal(a, b) for a, b in zip(shared.features, alone.features))
@@ -679,7 +679,7 @@ def test_a_subject_set_is_left_one_out_or_split_in_time_by_its_size(walks):
     assert settings.clip_ids(cfg)[-1] == f"one/{ids[2]}"
     trials = {t: Motion(w.values, w.skeleton, 30.0, t) for t, w in zip(ids, walks)}
     cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
-    clips = jobs.prepare_clips(trials, {"pair": ids[:2]}, {"one": ids[2]}, cc)
+    clips = protocol.prepare_clips(trials, {"pair": ids[:2]}, {"one": ids[2]}, cc)
     assert [(c.clip, c.protocol) for c in clips] == [(f"pair/{ids[0]}", "leave one out"),
                                                      (f"pair/{ids[1]}", "leave one out"),
                                                      (f"one/{ids[2]}", "temporal split")]
@@ -706,7 +706,7 @@ def test_the_runner_gives_the_held_out_future_to_a_generator_whose_query_is_it(w
 
     trials = {f"t{i}": w for i, w in enumerate(walks)}
     cc = {k: cfg[k] for k in settings.CLIP_KEYS}
-    clips = jobs.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
+    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
     seen = []
     real = MotionMatchingTrajectory.generate
 
@@ -715,17 +715,17 @@ def test_the_runner_gives_the_held_out_future_to_a_generator_whose_query_is_it(w
         return real(self, start, length, seed, trajectory=trajectory)
 
     monkeypatch.setattr(MotionMatchingTrajectory, "generate", spy)
-    metrics, _, _ = jobs.run_generator(clips, "motion_matching_traj", cfg, 7)
+    metrics, _, _ = runner.run_generator(clips, "motion_matching_traj", cfg, 7)
     assert len(seen) == 3 * cfg["seeds"] and (metrics["note"] == "").all()
     assert (metrics["seed_diversity_m"] == 0).all()
     for i, c in enumerate(clips):
         got = seen[i * cfg["seeds"]]
         assert np.array_equal(got.values, c.held_out.values[c.context:])
         assert np.array_equal(got.values[:c.length], c.truth.values)
-    assert Generator.query == "start" and jobs.generation_query(G.make_generator("motion_matching", cfg), clips[0]) == {}
+    assert Generator.query == "start" and runner.generation_query(G.make_generator("motion_matching", cfg), clips[0]) == {}
 
     class Odd(Generator):
         query = "the answer"
 
     with pytest.raises(ValueError, match="unknown query"):
-        jobs.generation_query(Odd(), clips[0])
+        runner.generation_query(Odd(), clips[0])

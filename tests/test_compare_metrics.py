@@ -60,7 +60,7 @@ def test_facing_of_the_zero_pose_and_a_quarter_turn(cmu):
 
 def test_facing_follows_the_walking_direction(cmu):
     _, _, pos, fwd = cmu
-    travel = pos[0][-1, 0, M._HORIZONTAL] - pos[0][0, 0, M._HORIZONTAL]
+    travel = pos[0][-1, 0, M.HORIZONTAL] - pos[0][0, 0, M.HORIZONTAL]
     assert np.dot(fwd[0].mean(axis=0), travel / np.linalg.norm(travel)) > 0.95
 
 
@@ -69,7 +69,7 @@ def test_pose_features_ignore_where_the_body_stands_and_faces(cmu):
     R = _yaw(73.0)
     moved = R.apply(pos[2].reshape(-1, 3)).reshape(pos[2].shape) + np.array([4.0, 0.0, -7.0])
     fwd3 = np.c_[fwd[2][:, 0], np.zeros(len(fwd[2])), fwd[2][:, 1]]
-    moved_fwd = R.apply(fwd3)[:, M._HORIZONTAL]
+    moved_fwd = R.apply(fwd3)[:, M.HORIZONTAL]
     np.testing.assert_allclose(M.pose_features(moved, moved_fwd), M.pose_features(pos[2], fwd[2]), atol=1e-9)
     # a body raised by h is h away (RMS joint distance) from itself
     raised = pos[2] + np.array([0.0, 0.3, 0.0])
@@ -258,7 +258,7 @@ def test_position_stats_do_not_depend_on_where_the_clips_are(cmu):
     assert mean.shape == std.shape == (pos[0].shape[1], 3) and np.all(std > 0)
     R = _yaw(-121.0)
     moved = [R.apply(p.reshape(-1, 3)).reshape(p.shape) + [30.0, 0.0, 2.0] for p in pos]
-    moved_fwd = [R.apply(np.c_[f[:, 0], np.zeros(len(f)), f[:, 1]])[:, M._HORIZONTAL] for f in fwd]
+    moved_fwd = [R.apply(np.c_[f[:, 0], np.zeros(len(f)), f[:, 1]])[:, M.HORIZONTAL] for f in fwd]
     mean2, std2 = M.position_stats(moved, moved_fwd, window=50, stride=20, context=10)
     np.testing.assert_allclose(mean2, mean, atol=1e-9)
     np.testing.assert_allclose(std2, std, atol=1e-9)

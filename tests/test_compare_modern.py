@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from animsynth.compare import generators as G
-from animsynth.compare import jobs
+from animsynth.compare import protocol
 from animsynth.compare.footlock import contact_points, leg_chains, lock_contacts, place_feet, two_bone_ik
 from animsynth.compare.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
 from animsynth.compare.motionmatching import (MotionMatching, decay_spring, make_motion_matching, spring_angle,
@@ -424,9 +424,9 @@ def test_motion_matching_traj_follows_the_held_out_path_closer_than_the_gamepad(
     follows the capture's root path closer than the steady gamepad from the start (``motion_matching``), which
     walks on in the start's direction; without the future it refuses to run."""
     sk = cmu_like_skeleton("cmp", 3)
-    db = [jobs.resample(generate_motion(k, 480, s, sk, name=f"{k}{s}"), 30.0)
+    db = [protocol.resample(generate_motion(k, 480, s, sk, name=f"{k}{s}"), 30.0)
           for k, s in (("walk_straight", 1), ("walk_turn", 2), ("walk_turn", 3), ("walk_straight", 4))]
-    held = jobs.resample(generate_motion("walk_turn", 480, 9, sk, name="held"), 30.0)
+    held = protocol.resample(generate_motion("walk_turn", 480, 9, sk, name="held"), 30.0)
     c, length = 10, 90
     start, future = _cut(held, 0, c, "start"), _cut(held, c, held.n_frames, "future")
     truth = root_translation(sk, held.values[c:c + length])[:, [0, 2]]

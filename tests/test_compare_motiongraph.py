@@ -609,11 +609,11 @@ _CC = {"fps": 30, "context": 8, "length": 20, "min_length": 6, "holdout_fraction
 
 
 def test_clips_carry_the_native_rate_database_and_start_from_the_source(sk, tmp_path):
-    from animsynth.compare import jobs
+    from animsynth.compare import protocol
     from animsynth.kinematics import unwrap_angles
 
     trials = _trials_120(sk)
-    clips = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {"split": "t1"}, dict(_CC, native_fps=[60.0]))
+    clips = protocol.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {"split": "t1"}, dict(_CC, native_fps=[60.0]))
     trials = {t: unwrap_angles(m) for t, m in trials.items()}  # the clips hold the unwrapped trials
     for c in clips:
         assert len(c.native) == 1
@@ -632,17 +632,17 @@ def test_clips_carry_the_native_rate_database_and_start_from_the_source(sk, tmp_
             assert np.array_equal(nat.database[0].values, src[:2 * n_db])  # nothing of the held-out part
             assert np.array_equal(nat.start.values, src[2 * n_db:2 * n_db + nat.start.n_frames])
     # stored and read back; a file written before the native clips loads with none
-    jobs.save_clips(tmp_path / "c.npz", clips)
-    back = jobs.load_clips(tmp_path / "c.npz")
+    protocol.save_clips(tmp_path / "c.npz", clips)
+    back = protocol.load_clips(tmp_path / "c.npz")
     for a, b in zip(clips, back):
         x, y = a.at_rate(60.0), b.at_rate(60.0)
         assert np.array_equal(x.start.values, y.start.values) and y.start.fps == 60.0
         assert all(np.array_equal(p.values, q.values) and p.name == q.name for p, q in zip(x.database, y.database))
-    table = jobs.clips_table(back)
+    table = protocol.clips_table(back)
     assert list(table["native_fps"]) == ["60"] * 4 and list(table["note"]) == [""] * 4
-    old = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, _CC)
+    old = protocol.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, _CC)
     assert all(c.native == [] for c in old)
-    jobs.save_clips(tmp_path / "old.npz", old)
+    protocol.save_clips(tmp_path / "old.npz", old)
     with np.load(tmp_path / "old.npz") as z:
         arrays = {k: z[k] for k in z.files}
     import json
@@ -652,19 +652,19 @@ def test_clips_carry_the_native_rate_database_and_start_from_the_source(sk, tmp_
         del m["native"]
     arrays["manifest"] = np.array(json.dumps(manifest))
     np.savez_compressed(tmp_path / "older.npz", **arrays)
-    assert all(c.native == [] for c in jobs.load_clips(tmp_path / "older.npz"))
+    assert all(c.native == [] for c in protocol.load_clips(tmp_path / "older.npz"))
 
 
 def test_a_source_rate_that_is_no_multiple_of_the_native_rate_falls_back_with_a_note(sk, caplog):
-    from animsynth.compare import jobs
+    from animsynth.compare import protocol
 
     trials = {k: Motion(v.values, v.skeleton, 90.0, k) for k, v in _trials_120(sk).items()}  # 90 fps: 60 does not divide it
-    with caplog.at_level("INFO", logger="animsynth.compare.jobs"):
-        clips = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))
+    with caplog.at_level("INFO", logger="animsynth.compare.protocol"):
+        clips = protocol.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))
     nat = clips[0].at_rate(60.0)
     assert nat.database == [] and nat.start is None and "not a whole multiple of 60" in nat.note
     assert "upsample" in nat.note and "no 60 fps database" in caplog.text
-    assert all("not a whole multiple" in n for n in jobs.clips_table(clips)["note"])
+    assert all("not a whole multiple" in n for n in protocol.clips_table(clips)["note"])
 
 
 @pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
@@ -672,17 +672,17 @@ def test_fairmotion_builds_on_the_sources_60_fps_frames_not_the_30_fps_clips_ups
     """Given the clips' 60 fps database (the runner passes it), fairmotion's loaded frames are the source trial's
     every second frame, not an interpolation of the 30 fps clip; without it, the upsampled clip as before."""
     from animsynth.compare import fairmotion_peer as fp
-    from animsynth.compare import jobs
+    from animsynth.compare import protocol, runner
 
     trials = _trials_120(sk)
-    clips = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))
+    clips = protocol.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))
     clip = clips[0]
 
     def root_m(loaded):  # fairmotion's root positions (metres, the BVH is written in metres)
         return np.array([np.asarray(p.data)[0, :3, 3] for p in loaded.poses])
 
     gen = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0, fixes=fp.FIXES)
-    fit_kw, gen_kw = jobs.native_inputs(gen, clip)
+    fit_kw, gen_kw = runner.native_inputs(gen, clip)
     assert set(fit_kw) == {"native_clips"} and set(gen_kw) == {"native_start"}
     gen.fit(clip.database, **fit_kw)
     assert gen.native_input_ == "source" and gen.upsample_ == 2
@@ -712,7 +712,7 @@ def test_fairmotion_builds_on_the_sources_60_fps_frames_not_the_30_fps_clips_ups
     config = default_config()
     cfg = dict(settings.job_cfg(config, "fairmotion_fixed"), seeds=1)
     cfg["fairmotion"] = dict(cfg["fairmotion"], base=8, blend=4, compare=4)
-    jobs.run_generator(clips[:1], "fairmotion_fixed", cfg, 7)
+    runner.run_generator(clips[:1], "fairmotion_fixed", cfg, 7)
     assert seen and seen[0] is clip.at_rate(60.0).database
 
 
@@ -726,7 +726,7 @@ def test_native_rate_clips_match_the_working_clips_through_wraps_branches_and_ot
     onto the held-out trial's skeleton): every second 60 fps frame is the 30 fps clip's, start and database."""
     import copy
 
-    from animsynth.compare import jobs
+    from animsynth.compare import protocol
 
     trials = _trials_120(sk)
     col = trials["t1"].skeleton.columns().index("lfemur.rx")
@@ -741,7 +741,7 @@ def test_native_rate_clips_match_the_working_clips_through_wraps_branches_and_ot
         j.offset = np.asarray(j.offset, float) * 1.1
     trials["t2"] = Motion(trials["t2"].values, longer, trials["t2"].fps, "t2")
     assert np.any(np.abs(np.diff(trials["t1"].values[:, col])) > 180)
-    clips = jobs.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {"split": "t1"}, dict(_CC, native_fps=[60.0]))
+    clips = protocol.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {"split": "t1"}, dict(_CC, native_fps=[60.0]))
     for c in clips:
         nat = c.at_rate(60.0)
         assert np.array_equal(nat.start.values[::2], c.start.values), c.clip

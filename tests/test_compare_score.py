@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from animsynth import cli
-from animsynth.compare import jobs, settings
+from animsynth.compare import jobs, metric_table, protocol, runner, settings
 from animsynth.compare.scoring import DATABASE_METRICS, SKATING_METRICS, UNSCORED
 from animsynth.io.bvh import read_bvh, write_bvh
 from animsynth.motion import Motion
@@ -32,10 +32,10 @@ def run(tmp_path_factory):
                                "        return self\n\n    def generate(self, start, length, seed):\n"
                                "        return self.g.generate(start, length, seed)\n")
     cfg = dict(settings.job_cfg(_config()), user_generators={"mine": f"{d / 'mine.py'}:Mine"})
-    walk = jobs.resample(generate_motion("walk_straight", 480, 0, SK, name="t0"), 30.0)
+    walk = protocol.resample(generate_motion("walk_straight", 480, 0, SK, name="t0"), 30.0)
     cc = settings.clips_cfg(_config())
-    clips = jobs.prepare_clips({"t0": walk}, {}, {"walk": "t0"}, cc)
-    jobs.save_clips(d / "clips.npz", clips)
+    clips = protocol.prepare_clips({"t0": walk}, {}, {"walk": "t0"}, cc)
+    protocol.save_clips(d / "clips.npz", clips)
     for g in ("knn", "replay", "mine"):
         out = {k: str(d / f"{g}{ext}") for k, ext in (("metrics", ".csv"), ("timing", "_timing.csv"),
                                                       ("shown", ".npz"), ("bvh", ".bvh"))}
@@ -54,7 +54,7 @@ def test_scoring_the_comparisons_own_bvh_gives_its_metrics(run, tmp_path, genera
     d, clip = run
     bvh = read_bvh(d / f"{generator}.bvh")
     # what the showcase BVH holds: the start (the held-out clip's first context frames), then the generated frames
-    shown = jobs.load_shown(d / f"{generator}.npz")
+    shown = runner.load_shown(d / f"{generator}.npz")
     assert bvh.n_frames == clip.context + clip.length == shown.n_frames and shown.meta["context"] == clip.context
     assert np.allclose(shown.values[:clip.context], clip.held_out.values[:clip.context])
     assert _score(d / f"{generator}.bvh", "--reference", d / "held_out.bvh", "--database", d / "database.bvh",
@@ -63,8 +63,8 @@ def test_scoring_the_comparisons_own_bvh_gives_its_metrics(run, tmp_path, genera
     m = pd.read_csv(d / f"{generator}.csv")
     assert list(s.columns) == list(m.columns)
     row = m[m["seed"] == 1].iloc[0]  # the showcase seed
-    scored = [c for c in jobs.METRIC_NAMES if c not in UNSCORED]
-    assert set(UNSCORED) < set(jobs.METRIC_NAMES) and len(scored) == len(jobs.METRIC_NAMES) - len(UNSCORED)
+    scored = [c for c in metric_table.METRIC_NAMES if c not in UNSCORED]
+    assert set(UNSCORED) < set(metric_table.METRIC_NAMES) and len(scored) == len(metric_table.METRIC_NAMES) - len(UNSCORED)
     for c in scored:  # every metric a file gives equals the run's (BVH keeps 6 decimals)
         assert np.isclose(s[c].iloc[0], row[c], rtol=1e-4, atol=1e-6, equal_nan=True), (c, s[c].iloc[0], row[c])
         assert np.isfinite(s[c].iloc[0]) or not np.isfinite(row[c]), c
@@ -169,7 +169,7 @@ def test_joint_roles_are_resolved_as_everywhere_else(run, tmp_path, capsys):
     assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--database", d / "database.bvh",
                   "--out", tmp_path / "b.csv") == 0
     a, b = pd.read_csv(tmp_path / "a.csv"), pd.read_csv(tmp_path / "b.csv")
-    pd.testing.assert_frame_equal(a[jobs.METRIC_NAMES], b[jobs.METRIC_NAMES])
+    pd.testing.assert_frame_equal(a[metric_table.METRIC_NAMES], b[metric_table.METRIC_NAMES])
 
 
 def test_without_a_database_no_foot_roles_are_needed(run, tmp_path, capsys):
@@ -181,7 +181,7 @@ def test_without_a_database_no_foot_roles_are_needed(run, tmp_path, capsys):
     assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--out", tmp_path / "b.csv") == 0
     a, b = pd.read_csv(tmp_path / "a.csv"), pd.read_csv(tmp_path / "b.csv")
     assert a[list(SKATING_METRICS)].isna().all().all()
-    pd.testing.assert_frame_equal(a[jobs.METRIC_NAMES], b[jobs.METRIC_NAMES])
+    pd.testing.assert_frame_equal(a[metric_table.METRIC_NAMES], b[metric_table.METRIC_NAMES])
     # a floor height asks for the feet again: one line naming the role
     assert _score(files[0], "--reference", files[1], "--floor-m", "0", "--out", tmp_path / "c.csv") == 2
     assert "left_toe" in capsys.readouterr().err
@@ -206,4 +206,20 @@ def test_a_file_with_an_extra_end_joint_is_read_joint_by_joint(run, tmp_path, ca
         capsys.readouterr().err
     assert _score(d / "knn.bvh", "--reference", d / "held_out.bvh", "--out", tmp_path / "b.csv") == 0
     a, b = pd.read_csv(tmp_path / "a.csv"), pd.read_csv(tmp_path / "b.csv")
-    pd.testing.assert_frame_equal(a[jobs.METRIC_NAMES], b[jobs.METRIC_NAMES], rtol=1e-6)
+    pd.testing.assert_frame_equal(a[metric_table.METRIC_NAMES], b[metric_table.METRIC_NAMES], rtol=1e-6)
+
+
+@pytest.mark.parametrize("generator", ["replay", "any_generator"])
+def test_score_writes_exactly_the_metrics_of_the_table_that_one_motion_gives(generator):
+    """Every key :func:`score` writes is a record of the metric table, and every record is written by it but those
+    that a run gives (the generator's count, the spread over seeds: the runner adds them)."""
+    from animsynth.compare import scoring
+
+    mcfg = settings.job_cfg(_config())["metrics"]
+    walk = protocol.resample(generate_motion("walk_straight", 480, 0, SK, name="t0"), 30.0)
+    clip = protocol.prepare_clips({"t0": walk}, {}, {"walk": "t0"}, settings.clips_cfg(_config()))[0]
+    row, _f = scoring.score(clip, scoring.reference(clip, mcfg), clip.truth, generator, mcfg)
+    by_runner = {m.name for m in metric_table.METRICS if m.needs in ("generator", "seeds")}
+    assert by_runner == {"transitions_kept", "seed_diversity_m"}
+    assert set(row) == set(metric_table.METRIC_NAMES) - by_runner
+    assert len(metric_table.METRIC_NAMES) == len(set(metric_table.METRIC_NAMES))

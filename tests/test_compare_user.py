@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from animsynth.compare import jobs, settings
+from animsynth.compare import jobs, metric_table, protocol, runner, settings
 from animsynth.config import ConfigError, validate_config
 from animsynth.io.bvh import read_bvh
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
@@ -28,12 +28,12 @@ _config = default_config
 def clips_file(tmp_path_factory):
     """Three short synthetic walks, leave one out (3 clips), 12 generated frames at 30 fps."""
     sk = cmu_like_skeleton("cmp", 3)
-    walks = {f"t{s}": jobs.resample(generate_motion("walk_straight", 200, s, sk, name=f"t{s}"), 30.0) for s in range(3)}
+    walks = {f"t{s}": protocol.resample(generate_motion("walk_straight", 200, s, sk, name=f"t{s}"), 30.0) for s in range(3)}
     cfg = _config()["compare"]
     cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
-    clips = jobs.prepare_clips(walks, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=12))
+    clips = protocol.prepare_clips(walks, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=12))
     path = tmp_path_factory.mktemp("user_clips") / "clips.npz"
-    jobs.save_clips(path, clips)
+    protocol.save_clips(path, clips)
     return path
 
 
@@ -74,7 +74,7 @@ def test_a_user_generator_runs_on_the_clips_seeds_and_metrics_of_ours(tmp_path, 
     assert theirs["note"].isna().all() and len(theirs) == 3 * 2
     # the same clips, seeds and metrics: the wrapped concatenation scores exactly as the family's own row
     pd.testing.assert_frame_equal(theirs.drop(columns="generator"), ours.drop(columns="generator"))
-    shown = jobs.load_shown(out["shown"])
+    shown = runner.load_shown(out["shown"])
     assert shown.n_frames == 8 + 12 and "note" not in shown.meta
     assert read_bvh(out["bvh"]).n_frames == 20
 
@@ -156,11 +156,11 @@ def test_every_failure_is_one_error_line_and_empty_rows(tmp_path, clips_file, ca
     assert f"user generator 'mine' ({path}:{cls})" in line and says in line, line  # ... naming generator, file, class
     assert "Traceback" not in line
     m = pd.read_csv(out["metrics"], keep_default_na=False, na_values=[""])
-    assert len(m) == 3 * 2 and m[jobs.METRIC_NAMES].isna().all().all()  # every row empty ...
+    assert len(m) == 3 * 2 and m[metric_table.METRIC_NAMES].isna().all().all()  # every row empty ...
     assert (m["note"] == "failed: " + line.removeprefix("animsynth: ERROR: ")).all()  # ... and says why
     t = pd.read_csv(out["timing"])
     assert len(t) == 3 and (t["frames_generated"] == 0).all() and t["build_cpu_s"].isna().all()
-    shown = jobs.load_shown(out["shown"])  # the showcase: the start alone, with the reason
+    shown = runner.load_shown(out["shown"])  # the showcase: the start alone, with the reason
     assert shown.n_frames == shown.meta["context"] == 8 and shown.meta["note"].startswith("failed: ")
     assert read_bvh(out["bvh"]).n_frames == 8
 
@@ -231,8 +231,8 @@ def test_tables_show_a_user_row_and_leave_the_claims_unchanged(tmp_path, clips_f
     cfg = _cfg(wrapped=f"{tmp_path / 'mine.py'}:Wrapped", broken=f"{tmp_path / 'none.py'}:X")
     own = ["knn", "motion_graph", "replay", "concat"]
     runs = {g: _run(tmp_path, g, cfg, clips_file) for g in own + ["wrapped", "broken"]}
-    clips = jobs.load_clips(clips_file)
-    jobs_clips = jobs.clips_table(clips)
+    clips = protocol.load_clips(clips_file)
+    jobs_clips = protocol.clips_table(clips)
     jobs_clips.to_csv(tmp_path / "clips.csv", index=False)
     tcfg = {"generators": list(_config()["compare"]["generators"]), "seeds": 2, "fps": 30, "context": 8, "length": 12,
             "verdicts": _config()["compare"]["verdicts"]}
@@ -272,7 +272,7 @@ def test_the_strips_figure_shows_a_failed_generator_by_its_start(tmp_path, clips
     from animsynth.compare.plots import strips_figure
 
     runs = {g: _run(tmp_path, g, _cfg(broken=f"{tmp_path / 'none.py'}:X"), clips_file) for g in ("concat", "broken")}
-    strips_figure(tmp_path / "strips.png", {g: jobs.load_shown(r["shown"]) for g, r in runs.items()})
+    strips_figure(tmp_path / "strips.png", {g: runner.load_shown(r["shown"]) for g, r in runs.items()})
     assert (tmp_path / "strips.png").stat().st_size > 0
 
 
@@ -386,7 +386,7 @@ def test_an_exit_inside_the_class_is_blamed_on_it_and_the_job_completes(tmp_path
     assert "on clip w1/t0" in err[0] and says in err[0]
     m = pd.read_csv(out["metrics"], keep_default_na=False, na_values=[""])
     assert len(m) == 6 and m["skate_share"].isna().all() and m["note"].str.contains(says).all()
-    assert jobs.load_shown(out["shown"]).meta["note"].startswith("failed: ")
+    assert runner.load_shown(out["shown"]).meta["note"].startswith("failed: ")
 
 
 def test_a_user_job_reads_the_time_limit_and_the_route():

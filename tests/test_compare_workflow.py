@@ -2,7 +2,7 @@
 import pandas as pd
 import pytest
 
-from animsynth.compare.jobs import KEY_COLUMNS, METRIC_NAMES
+from animsynth.compare.metric_table import KEY_COLUMNS, METRIC_NAMES
 from animsynth.verdicts import VOCABULARY
 
 
@@ -85,7 +85,7 @@ def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp
     import numpy as np
 
     from animsynth import cli
-    from animsynth.compare import jobs
+    from animsynth.compare import protocol
     from animsynth.compare.scoring import DATABASE_METRICS
     from animsynth.io.bvh import read_bvh
     from conftest import copy_finished_run, run_snakemake
@@ -124,7 +124,7 @@ def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp
     page = (r / "summary.md").read_text()
     assert "Your own generators (compare.user_generators): **toy**, **broken**" in page and "**broken**: user generator" in page
     assert (wd / "results" / "summary.md").stat().st_mtime_ns > summary_before  # the report is rebuilt with them
-    clips = jobs.load_clips(r / "clips.npz")
+    clips = protocol.load_clips(r / "clips.npz")
     show = clips[0]
     assert read_bvh(r / "bvh" / "toy.bvh").n_frames == show.context + show.length
     assert read_bvh(r / "bvh" / "broken.bvh").n_frames == show.context  # the start alone

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from animsynth.compare import jobs
+from animsynth.compare import metric_table
 from animsynth.compare import verdicts as CV
 from animsynth.scoreboard import VERDICT_COLOURS, scoreboard_counts
 from animsynth.verdicts import VOCABULARY
@@ -38,7 +38,7 @@ def build(effects, clips: int = 3, seeds: int = 2, pair=("motion_graph", "stisom
             for s in range(seeds):
                 for g, e in gens.items():
                     row = {"clip": clip, "group": f"s{si}", "protocol": "leave one out", "generator": g, "seed": s}
-                    row.update({m: np.nan for m in jobs.METRIC_NAMES})
+                    row.update({m: np.nan for m in metric_table.METRIC_NAMES})
                     value = 0.2 + (eff if e is None else e) + noise * rng.standard_normal()
                     row[metric] = value
                     row["contact_share"] = (contact or {}).get(g, 0.4)

@@ -1,8 +1,7 @@
 """Every held-out clip of the comparison (database, start, length) at the working rate, and its database and start
 at the native rate of the generators that run at one (fairmotion's 60 fps) -> clips.npz, clips.csv."""
-from animsynth.compare.jobs import clips_table, prepare_clips, save_clips
+from animsynth.compare.jobs import clips_job
 from animsynth.motion import Motion
-from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)
@@ -10,7 +9,5 @@ p = snakemake.params
 trials = {t: Motion.load_npz(f) for t, f in zip(p.trials, snakemake.input)}
 for t, m in trials.items():
     m.name = t
-clips = prepare_clips(trials, dict(p.subsets), dict(p.resequencing), dict(p.cfg))
-save_clips(snakemake.output.clips, clips)
-write_table(clips_table(clips), snakemake.output.table, md=snakemake.output.table_md)
+clips = clips_job(trials, dict(p.subsets), dict(p.resequencing), dict(p.cfg), dict(snakemake.output))
 log.info("%d held-out clips", len(clips))

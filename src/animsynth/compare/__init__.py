@@ -20,15 +20,22 @@ motionmatching  motion matching with inertialization and foot locking (Clavet 20
 genmm           generative motion matching (Li et al. 2023)
 poses           the pose representation the two share; footlock: motion matching's foot locking and leg IK
 fairmotion_peer fairmotion's motion graph on the same clips (the peer row), when it can be imported
-metrics         the metric list (``METRICS``) and the metrics (pure numpy; metres, m/s)
-jobs            every workflow step: the protocol (held-out clips, starts, seeds), one generator over every
-                clip, scored; the family's tables; the budget sweep
-tables          medians and spreads, which generator wins which metric, cost, the family's summary page
+metric_table    the metric table (``METRICS``: one record per column of metrics.csv, its unit, which way is
+                better, what it needs, its label) and the selections that read it
+metrics         the metrics (pure numpy; metres, m/s), gathered from positions (positions, facing, pose features),
+                skating (foot skating), jumps (seam and per-frame jumps), smoothness, ground_truth (LAFAN1's
+                L2P / L2Q / NPSS) and windows (coverage, diversity, novelty)
+protocol        the protocol: held-out clips, their databases, starts and seeds; the clips file
+scoring         one generated motion's metrics against its clip (``score``), also for motion files from any tool
+                (``animsynth score``)
+runner          one generator over every clip and seed, scored, with its cost; the showcase file
+jobs            one function per workflow step (clips, one generator's run, the tables, the budget sweep, figures)
+tables          the family's tables: medians and spreads, which generator wins which metric, cost, the sweep, the
+                family's summary page
 verdicts        the side-by-side claims, decided over clips x seeds
 plots           metrics per generator with spreads, one skeleton strip per generator
 settings        config checks and what the workflow reads of the ``compare`` block
 user            your own generator in the comparison (``compare.user_generators``: a file and a class)
-scoring         motion files from any tool scored with the metrics (``animsynth score``)
 """
 
 from .._lazy import lazy_exports
@@ -39,11 +46,11 @@ _EXPORTS = {
     "Concat": ".references",
     "Database": ".generators",
     "GENERATORS": ".generators",
-    "METRICS": ".metrics",
+    "METRICS": ".metric_table",
     "MotionGraph": ".motiongraph",
     "Replay": ".references",
     "make_generator": ".generators",
-    "prepare_clips": ".jobs",
-    "run_generator": ".jobs",
+    "prepare_clips": ".protocol",
+    "run_generator": ".runner",
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

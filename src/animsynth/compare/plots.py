@@ -7,25 +7,9 @@ import pandas as pd
 
 from ..atomic import atomic_path
 from .generators import REFERENCES
-from .metrics import METRICS
+from .metric_table import FIGURE_METRICS, SWEEP_PANELS, metric
 
-__all__ = ["FIGURE_METRICS", "metrics_figure", "strips_figure", "sweep_figure"]
-
-#: the panels of metrics.png: (column, title)
-FIGURE_METRICS = (
-    ("skate_share", "foot skating: share of contact frames"),
-    ("transition_skate_share", "skating near seams: share"),
-    ("velocity_jump_p95", "per-frame velocity jump: 95th percentile (m/s)"),
-    ("velocity_jump_over_capture", "share of frames jumping more than the capture's largest"),
-    ("skating_ratio_gmd", "skating ratio (GMD-style)"),
-    ("ldlj", "smoothness: log dimensionless jerk (higher smoother)"),
-    ("l2p", "L2P vs held-out continuation"),
-    ("npss", "NPSS vs held-out continuation"),
-    ("coverage", "coverage of database windows"),
-    ("novelty_median_m", "novelty: distance to nearest database frame (m)"),
-    ("seed_diversity_m", "diversity across seeds (m)"),
-)
-_BETTER = {m: b for m, _u, b in METRICS}
+__all__ = ["metrics_figure", "strips_figure", "sweep_figure"]
 
 
 def _save(fig, path, title: str) -> None:
@@ -41,7 +25,8 @@ def _save(fig, path, title: str) -> None:
 
 
 def metrics_figure(path, metrics: pd.DataFrame, order, title: str = "") -> None:
-    """One panel per metric of :data:`FIGURE_METRICS`: every generator's values over clips x seeds as a box
+    """One panel per metric of :data:`~animsynth.compare.metric_table.FIGURE_METRICS`, titled by its record's
+    ``title``: every generator's values over clips x seeds as a box
     (median, IQR, whiskers at 5-95 %); the reference rows (replay, concat) in grey."""
     import matplotlib.pyplot as plt
 
@@ -50,7 +35,8 @@ def metrics_figure(path, metrics: pd.DataFrame, order, title: str = "") -> None:
     cols = 3
     rows = int(np.ceil(n / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.1 * rows), dpi=100, squeeze=False)
-    for ax, (m, label) in zip(axes.ravel(), FIGURE_METRICS):
+    for ax, m in zip(axes.ravel(), FIGURE_METRICS):
+        label = metric(m).title
         data, names, colours = [], [], []
         for g in gens:
             x = pd.to_numeric(metrics.loc[metrics["generator"] == g, m], errors="coerce").to_numpy(float)
@@ -69,7 +55,7 @@ def metrics_figure(path, metrics: pd.DataFrame, order, title: str = "") -> None:
             ax.set_xticks(range(1, len(names) + 1), names, rotation=40, ha="right", fontsize=8)
         else:
             ax.text(0.5, 0.5, "no values", ha="center", va="center", transform=ax.transAxes)
-        better = _BETTER.get(m, "")
+        better = metric(m).better
         ax.set_title(label + (f" ({better} is better)" if better and "higher" not in label else ""), fontsize=8.5)
         ax.tick_params(axis="y", labelsize=8)
         ax.grid(axis="y", alpha=0.3)
@@ -129,16 +115,12 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
 
 def sweep_figure(table: pd.DataFrame, path, default_budget: float) -> None:
     """The transition budget sweep (:func:`animsynth.compare.tables.sweep_table`): one panel per metric, one line
-    per graph generator against the budget (transitions per second of database, log scale); the default
+    per graph generator against the budget (transitions per second of database, log scale), one panel per metric of
+    :data:`~animsynth.compare.metric_table.SWEEP_PANELS` titled by its record's ``title``; the default
     budget, at which the claims are decided, dashed."""
     import matplotlib.pyplot as plt
 
-    panels = (("transitions_kept_median", "transitions kept (before pruning)"),
-              ("transition_skate_share_median", "skating near seams: share"),
-              ("skate_share_median", "foot skating: share"),
-              ("velocity_jump_p95_median", "per-frame velocity jump p95 (m/s)"),
-              ("velocity_jump_median", "velocity jump at reported seams (m/s)"),
-              ("l2p_median", "L2P"))
+    panels = [(f"{m}_median", metric(m).title) for m in SWEEP_PANELS]
     fig, axes = plt.subplots(2, 3, figsize=(13.5, 6.4), dpi=100, squeeze=False)
     for ax, (col, label) in zip(axes.ravel(), panels):
         for g, sub in table.groupby("generator", sort=False):

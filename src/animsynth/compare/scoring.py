@@ -1,45 +1,256 @@
-"""Score motions made anywhere with the compare family's metrics (``animsynth score``).
+"""Scoring: every metric of one generated motion against the held-out clip it continues.
 
-A generated motion (a BVH file from any tool) is scored against the held-out capture it should continue, as a
-generator's motion is scored in the comparison (:func:`animsynth.compare.jobs.score`): its first ``context``
+The comparison scores each generator's motion with :func:`score` (its clip's database side computed once,
+:func:`reference`; L2P normalised by the whole run's database, :func:`run_stats`). ``animsynth score`` scores motions
+made anywhere (a BVH file from any tool) the same way (:func:`score_motions`): a generated motion is scored against
+the held-out capture it should continue, as a generator's motion is scored in the comparison: its first ``context``
 frames are the start (the frames the generator was given, as in the protocol: the same frames as the
 reference's first ``context``), the frames after them are the generated ones, compared with the reference's
 frames after its start.
 
-What a BVH file cannot give is left empty (:data:`UNSCORED`): the generator's seams (and so every metric at
-seams), its transition count and the spread over seeds. The metrics that read the database (:data:`DATABASE_METRICS`:
-the floor of foot skating, L2P's normalisation, coverage, novelty, the capture's jump percentiles) are left
-empty without one; foot skating is scored without a database when the floor height is given
-(``compare.metrics.floor_m``). With the database and the settings of a compare run, a motion of that run's BVH
-folder scores as in its ``metrics.csv`` (L2P: when the run's database is this clip's, as in a run of one clip;
-the comparison normalises L2P by the whole run's database).
+What a scored file cannot give is left empty, by what each metric needs (:attr:`~.metric_table.Metric.needs`):
+:data:`UNSCORED`, the generator's seams (and so every metric at seams), its transition count and the spread over
+seeds. The metrics that read the database (:data:`DATABASE_METRICS`: L2P's normalisation, coverage, novelty) and
+foot skating (:data:`SKATING_METRICS`: the floor from the database's feet) are left empty without one; foot skating
+is scored without a database when the floor height is given (``compare.metrics.floor_m``). With the database and
+the settings of a compare run, a motion of that run's BVH folder scores as in its ``metrics.csv`` (L2P: when the
+run's database is this clip's, as in a run of one clip; the comparison normalises L2P by the whole run's database).
 """
 
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from ..motion import Motion
-from .jobs import KEY_COLUMNS, Clip, reference, run_stats, score
-from .metrics import METRIC_NAMES, SENSITIVITY_SPEEDS
+from .metric_table import KEY_COLUMNS, METRIC_NAMES, PER_RUN, SENSITIVITY_SPEEDS, names_needing
+from .protocol import Clip
 
 log = logging.getLogger("animsynth.compare.scoring")
 
-__all__ = ["SKATING_METRICS", "DATABASE_METRICS", "UNSCORED", "score_motions", "on_skeleton"]
+__all__ = ["Reference", "DatabaseKinematics", "run_stats", "run_stats_by_skeleton", "joint_count", "reference",
+           "score", "SKATING_METRICS", "DATABASE_METRICS", "UNSCORED", "score_motions", "on_skeleton"]
 
 #: foot skating: needs the floor (the database's foot heights, or compare.metrics.floor_m)
-SKATING_METRICS = ("contact_share", "skate_share", "skate_m_per_contact_frame", "skating_ratio_gmd",
-                   *(f"skate_share_at_{v:g}" for v in SENSITIVITY_SPEEDS),
-                   *(f"skating_ratio_gmd_at_{v:g}" for v in SENSITIVITY_SPEEDS))
+SKATING_METRICS = names_needing("floor")
 #: the other metrics that read the database
-DATABASE_METRICS = ("l2p", "coverage", "local_diversity_m", "novelty_median_m", "copy_share")
+DATABASE_METRICS = names_needing("database")
 #: never scored from a file: the generator's seams, its transitions, the spread over seeds of one start
-UNSCORED = ("transition_skate_share", "n_seams", "seams_per_s", "transitions_kept", "velocity_jump",
-            "velocity_jump_ratio", "velocity_jump_pct", "accel_jump", "accel_jump_ratio", "accel_jump_pct",
-            "seed_diversity_m")
+UNSCORED = names_needing(*PER_RUN)
+
+
+# ----------------------------------------------------------------------------- one motion against its clip
+
+
+@dataclass
+class Reference:
+    """What scoring needs from one clip's database (computed once per clip).
+
+    Attributes
+    ----------
+    foot_idx : int array, the foot joints
+    floor : float, the floor height (m)
+    jumps : metrics.JumpReference, the database's own frame-to-frame jumps
+    std : ndarray (J, 3), LAFAN1 position statistics of the whole run's database windows (:func:`run_stats`)
+    capture_max : (float, float), the held-out capture's largest velocity and acceleration jump
+    features : list of ndarray, the database clips' pose features
+    truth_pos, truth_q : the ground truth's positions (m) and global quaternions
+    truth_forward : ndarray (2,), the ground truth's facing at the last start frame
+    """
+
+    foot_idx: np.ndarray
+    floor: float
+    jumps: object
+    std: np.ndarray
+    features: list
+    truth_pos: np.ndarray
+    truth_q: np.ndarray
+    truth_forward: np.ndarray
+    capture_max: tuple = (np.nan, np.nan)
+
+
+class DatabaseKinematics:
+    """Positions (m, :func:`animsynth.compare.metrics.positions`) and facing (:func:`~animsynth.compare.metrics.facing`)
+    of each database motion, computed once per job for every clip and metric that reads them.
+
+    A database clip is shared by several held-out clips (leave one out) and read by the run's L2P statistics and
+    by each clip's reference: calling an instance with a motion returns its ``(positions, facing)``, computed on
+    the first call (keyed by the motion's name, checked by its values: two motions of one name and other values
+    are computed apart). The arrays are read-only (a metric that wrote into them would change the others').
+    """
+
+    def __init__(self, roles: dict | None = None):
+        self.roles = roles
+        self._memo: dict[str, tuple] = {}
+
+    def __call__(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+        from . import metrics as M
+
+        hit = self._memo.get(motion.name)
+        if hit is not None and (hit[0] is motion.values or np.array_equal(hit[0], motion.values)):
+            return hit[1], hit[2]
+        pos, fwd = M.positions(motion), M.facing(motion, self.roles)
+        pos.setflags(write=False)
+        fwd.setflags(write=False)
+        if hit is None:
+            self._memo[motion.name] = (motion.values, pos, fwd)
+        return pos, fwd
+
+
+def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None,
+              kin: DatabaseKinematics | None = None) -> np.ndarray:
+    """LAFAN1's position statistics (std, (J, 3)) over the whole run's database: every distinct database clip
+    of every held-out clip (by name), as LAFAN1 normalises by its whole training set. Windows of
+    ``context + length`` frames (the longest of the run's clips; shorter if a database clip is shorter),
+    every ``compare.metrics.l2p_stride`` frames, aligned at the last context frame (``kin``: the job's
+    :class:`DatabaseKinematics`, made here if not given)."""
+    from . import metrics as M
+
+    kin = kin or DatabaseKinematics(roles)
+
+    seen = {}
+    for c in clips:
+        for d in c.database:
+            seen.setdefault(d.name, d)
+    db = list(seen.values())
+    joints = {len(d.skeleton.joints) for d in db}
+    if len(joints) != 1:
+        raise ValueError(f"the run's database clips have different joint counts ({sorted(joints)}): no common L2P "
+                         "statistics")
+    window = min(max(c.context + c.length for c in clips), min(d.n_frames for d in db))
+    context = min(min(c.context for c in clips), window)
+    pos, fwd = zip(*(kin(d) for d in db))
+    return M.position_stats(pos, fwd, window, int(mcfg["l2p_stride"]), context)[1]
+
+
+def joint_count(clip: Clip) -> int:
+    """The joints of the clip's skeleton: the key of :func:`run_stats_by_skeleton`."""
+    return len(clip.held_out.skeleton.joints)
+
+
+def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = None,
+                          kin: DatabaseKinematics | None = None) -> dict:
+    """:func:`run_stats` per skeleton: {joint count: std (J, 3)}. A run of one skeleton (CMU, the demo) has one
+    entry, the whole run's database; a run mixing skeletons (a user's BVH files of several sources) normalises
+    each clip's L2P by the database clips of its own skeleton, logged (positions of different joint sets have no
+    common statistics)."""
+    groups: dict[int, list[Clip]] = {}
+    for c in clips:
+        groups.setdefault(joint_count(c), []).append(c)
+    if len(groups) > 1:
+        log.warning("the run mixes skeletons of %s joints: each clip's L2P is normalised by the database clips of "
+                    "its own skeleton", sorted(groups))
+    kin = kin or DatabaseKinematics(roles)
+    return {n: run_stats(cs, mcfg, roles, kin) for n, cs in groups.items()}
+
+
+def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray | None = None,
+              kin: DatabaseKinematics | None = None) -> Reference:
+    """The database side of every metric of ``clip`` (``mcfg``: the ``compare.metrics`` block; ``std``: the
+    run's L2P statistics, :func:`run_stats`; ``None``: this clip's database only; ``kin``: the job's
+    :class:`DatabaseKinematics`, made here if not given).
+
+    Forward kinematics runs once per database motion of the job (``kin``) and once for the held-out clip
+    (positions and the ground truth's world rotations from one pass)."""
+    from . import metrics as M
+
+    from ..kinematics import forward_kinematics
+
+    kin = kin or DatabaseKinematics(roles)
+    sk = clip.held_out.skeleton
+    fps = clip.held_out.fps
+    foot = M.foot_indices(sk, roles)
+    db_pos, db_fwd = (list(x) for x in zip(*(kin(d) for d in clip.database)))
+    floor = (M.floor_height(db_pos, foot, float(mcfg["floor_percentile"])) if mcfg["floor_m"] is None
+             else float(mcfg["floor_m"]))
+    if std is None:
+        window = min(clip.context + clip.length, max(p.shape[0] for p in db_pos))
+        std = M.position_stats(db_pos, db_fwd, window, int(mcfg["l2p_stride"]), min(clip.context, window))[1]
+    # one pass over the held-out clip: its positions (M.positions) and the ground truth's world rotations
+    # (M.global_quaternions of the frames after the start)
+    held_pos, W = forward_kinematics(sk, clip.held_out.values, ends=True, world_rotations=True)
+    held_pos = held_pos * float(sk.length_to_m)
+    truth = slice(clip.context, clip.context + clip.length)
+    truth_q = M.align_quaternions(np.stack([r.as_quat() for r in W], axis=1)[truth])
+    held_fwd = M.facing(clip.held_out, roles)
+    return Reference(foot, floor, M.jump_reference(db_pos, fps), std,
+                     [M.pose_features(p, f) for p, f in zip(db_pos, db_fwd)],
+                     held_pos[truth], truth_q, held_fwd[clip.context - 1], M.capture_max_jumps(held_pos, fps))
+
+
+def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict,
+          roles: dict | None = None) -> tuple[dict, np.ndarray]:
+    """Every per-seed metric of one generated motion; returns the row and its pose features.
+
+    The row has one value per record of :data:`~animsynth.compare.metric_table.METRICS` but those a run gives
+    (``needs`` ``"generator"``, ``"seeds"``: the transitions kept and the diversity over seeds, which the runner
+    adds).
+
+    The start and the generated frames are scored together where a measure needs frames before the
+    first generated one (foot speed at the first frame, the jump at the entry seam); the entry
+    (generated frame 0) is a seam for every generator but ``replay``.
+    """
+    from . import metrics as M
+
+    from ..kinematics import forward_kinematics
+
+    fps = float(motion.fps)
+    start = clip.start
+    joined = Motion(np.vstack([start.values, motion.values]), motion.skeleton, fps, motion.name)
+    c = clip.context
+    # one forward kinematics pass for positions (M.positions) and world rotations (M.global_quaternions)
+    pos, W = forward_kinematics(joined.skeleton, joined.values, ends=True, world_rotations=True)
+    pos = pos * float(joined.skeleton.length_to_m)
+    q = M.align_quaternions(np.stack([r.as_quat() for r in W], axis=1)[c:])
+    gen_pos = pos[c:]
+    seams = np.asarray(motion.meta.get("seams", []), np.int64)
+    if generator != "replay":
+        seams = np.union1d(seams, [0])
+    row = {}
+    height, speed = float(mcfg["contact_height_m"]), float(mcfg["skate_speed_m_s"])
+    row.update(M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, speed, ref.floor))
+    gmd_feet = ref.foot_idx[[0, 2]]  # left_ankle, right_ankle: the balls of the feet
+    row["skating_ratio_gmd"] = M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, speed, ref.floor)
+    for v in SENSITIVITY_SPEEDS:
+        row[f"skate_share_at_{v:g}"] = M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, v,
+                                                      ref.floor)["skate_share"]
+        row[f"skating_ratio_gmd_at_{v:g}"] = M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, v, ref.floor)
+    # skating near seams: frames within transition_window of a seam, pooled over seams
+    w = int(mcfg["transition_window"])
+    n_contact = n_skate = 0.0
+    for s in seams:
+        lo, hi = c + max(int(s) - w, 0), c + min(int(s) + w, motion.n_frames - 1)
+        part = M.foot_skating(pos[lo - 1:hi + 1], fps, ref.foot_idx, height, speed, ref.floor)
+        nc = part["contact_share"] * (hi - lo + 1) * len(ref.foot_idx)
+        n_contact += nc
+        n_skate += (part["skate_share"] * nc) if nc else 0.0
+    row["transition_skate_share"] = n_skate / n_contact if n_contact else np.nan
+    jumps = M.seam_jumps(pos, fps, seams + c, ref.jumps)
+    row.update(M.frame_jumps(pos, fps, c, ref.capture_max))
+    row["n_seams"] = int(seams.size)
+    row["seams_per_s"] = seams.size / (motion.n_frames / fps)
+    for k in ("velocity_jump", "velocity_jump_ratio", "velocity_jump_pct", "accel_jump", "accel_jump_ratio",
+              "accel_jump_pct"):
+        row[k] = jumps[k]
+    row["ldlj"] = M.ldlj(gen_pos, fps)
+    row["sparc"] = M.sparc(gen_pos, fps)
+    row["l2p"] = M.l2p(gen_pos, ref.truth_pos, ref.std, forward=ref.truth_forward)
+    row["l2p_m"] = M.l2p(gen_pos, ref.truth_pos, None)
+    row["l2q"] = M.l2q(q, ref.truth_q)
+    row["npss"] = M.npss(q, ref.truth_q, spectrum=mcfg["npss_spectrum"], quaternions=True)
+    feats = M.pose_features(gen_pos, M.facing(joined, roles)[c:])
+    win = M.window_scores(feats, ref.features, min(int(mcfg["window"]), motion.n_frames),
+                          float(mcfg["coverage_threshold_m"]))
+    row["coverage"] = win["coverage"]
+    row["local_diversity_m"] = win["local_diversity"]
+    row.update(M.novelty(feats, ref.features, float(mcfg["copy_tolerance_m"])))
+    return row, feats
+
+
+# ----------------------------------------------------------------------------- motion files
 
 
 def on_skeleton(motion: Motion, skeleton, what: str, reference_name: str = "the reference") -> Motion:
@@ -106,7 +317,7 @@ def _without_joints(motion: Motion, drop: set) -> Motion:
 
 def score_motions(generated: dict, reference_motion: Motion, database: dict | None, context: int, mcfg: dict,
                   reference_name: str = "reference") -> pd.DataFrame:
-    """Every metric of :mod:`animsynth.compare.jobs` that a motion file gives, one row per generated motion.
+    """Every metric of :func:`score` that a motion file gives, one row per generated motion.
 
     Parameters
     ----------
@@ -122,8 +333,8 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
 
     Returns
     -------
-    DataFrame with the columns of ``compare/metrics.csv`` (:data:`~animsynth.compare.jobs.KEY_COLUMNS`,
-    :data:`~animsynth.compare.jobs.METRIC_NAMES`, ``note``): ``generator`` the name, ``protocol`` "scored file",
+    DataFrame with the columns of ``compare/metrics.csv`` (:data:`~animsynth.compare.metric_table.KEY_COLUMNS`,
+    :data:`~animsynth.compare.metric_table.METRIC_NAMES`, ``note``): ``generator`` the name, ``protocol`` "scored file",
     ``seed`` empty, ``note`` what was left empty for want of a database.
     """
     ref = reference_motion
@@ -174,7 +385,6 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
         std = run_stats([clip], mcfg) if db else np.ones((len(sk.joints), 3))
         row, _f = score(clip, reference(clip, mcfg, roles, std),
                         Motion(np.asarray(m.values[context:], float), sk, fps, name), name, mcfg, roles)
-        row["transitions_kept"] = np.nan
         row.update({k: np.nan for k in blank})
         rows.append({"clip": reference_name, "group": "", "protocol": "scored file", "generator": name, "seed": "",
                      **row, "note": note})

@@ -1,5 +1,6 @@
-"""The comparison's tables: medians and spreads, which generator wins which metric, the cost, the family's
-summary page (``compare/summary.md``), assembled from the generator jobs' files."""
+"""The comparison's tables: the generator jobs' metrics read back, medians and spreads, which generator wins which
+metric, the cost, the skating sensitivity, the budget sweep, the claims' tables and the family's summary page
+(``compare/summary.md``), assembled from the generator jobs' files (:func:`family_tables`)."""
 
 from __future__ import annotations
 
@@ -9,25 +10,93 @@ import numpy as np
 import pandas as pd
 
 from .generators import GENERATORS, REFERENCES
-from .metrics import METRIC_NAMES, METRICS, SENSITIVITY_SPEEDS
+from .metric_table import METRIC_NAMES, RESULT_METRICS, SENSITIVITY_SPEEDS, SWEEP_METRICS, metric
 from .verdicts import pair_outcomes
 
 log = logging.getLogger("animsynth.compare.tables")
 
-__all__ = ["summary_table", "winners_table", "cost_table", "data_label", "summary_markdown", "sensitivity_table",
-           "sweep_table", "results_markdown"]
-
-#: the columns of the budget sweep table (medians over clips x seeds)
-SWEEP_METRICS = ("transitions_kept", "skate_share", "transition_skate_share", "skating_ratio_gmd", "velocity_jump_p95",
-                 "velocity_jump_over_capture", "velocity_jump", "l2p")
+__all__ = ["read_metrics", "sweep_runs", "family_tables", "summary_table", "winners_table", "cost_table",
+           "data_label", "summary_markdown", "sensitivity_table", "sweep_table", "results_markdown"]
 
 
-def _better(metric: str) -> str:
-    return {m: b for m, _u, b in METRICS}[metric]
+def _better(name: str) -> str:
+    return metric(name).better
 
 
-def _unit(metric: str) -> str:
-    return {m: u for m, u, _b in METRICS}[metric]
+def _unit(name: str) -> str:
+    return metric(name).unit
+
+
+def read_metrics(paths) -> pd.DataFrame:
+    """The generator jobs' metrics files as one table (``note``: '' where a row has none)."""
+    m = pd.concat([pd.read_csv(p, dtype={"note": str}, keep_default_na=False, na_values=[""]) for p in paths],
+                  ignore_index=True)
+    m["note"] = m["note"].fillna("")
+    return m
+
+
+def sweep_runs(default: pd.DataFrame, paths, default_budget: float, budgets, generators) -> dict:
+    """``{budget: metrics of the graph generators}``: the default run's rows of ``generators`` at
+    ``default_budget`` and one metrics file per further budget and generator (``paths``, in the order of
+    ``budgets`` x ``generators``)."""
+    runs = {float(default_budget): default[default["generator"].isin(generators)]}
+    paths = list(paths)
+    if len(paths) != len(list(budgets)) * len(list(generators)):
+        raise ValueError(f"budget sweep: {len(paths)} metrics files for {len(list(budgets))} budgets x "
+                         f"{len(list(generators))} generators")
+    k = 0
+    for b in budgets:
+        runs[float(b)] = read_metrics(paths[k:k + len(generators)])
+        k += len(generators)
+    return runs
+
+
+def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str, sweep: dict | None = None) -> dict:
+    """The family's tables from the generator jobs' files (``inp``: ``clips``, ``metrics``, ``timing`` lists;
+    optional ``sweep``: the budget sweep's metrics files).
+
+    Returns ``{name: DataFrame}``: ``metrics`` (every row, in the clips' and the config's generator order),
+    ``metrics_timing``, ``summary``, ``winners``, ``cost``, ``verdicts`` (the declared claims, ``cfg["claims"]``),
+    ``claims_stats`` (their numbers), ``exploratory`` (every other pair, no verdict), ``sanity``, ``sensitivity``;
+    and ``summary_md``: the family's page (text).
+
+    ``sweep``: ``{"default": transitions_per_s, "budgets": [...], "generators": [...]}`` describing
+    ``inp["sweep"]`` (:func:`sweep_runs`); the claims against the peer quote the sweep as evidence."""
+    from .verdicts import decide_claims, exploratory_table, independent_groups, sanity_checks
+
+    order = list(cfg["generators"])
+    metrics = read_metrics(inp["metrics"])
+    metrics["_g"] = metrics["generator"].map({g: i for i, g in enumerate(order)})
+    clips = pd.read_csv(inp["clips"], dtype={"held_out": str})
+    metrics["_c"] = metrics["clip"].map({c: i for i, c in enumerate(clips["clip"])})
+    metrics = metrics.sort_values(["_c", "_g", "seed"], kind="stable").drop(columns=["_g", "_c"])
+    timing = pd.concat([pd.read_csv(p) for p in inp["timing"]], ignore_index=True)
+    summary = summary_table(metrics, order)
+    winners = winners_table(metrics, summary, order)
+    clips_full = pd.read_csv(inp["clips"], dtype=str)
+    n_groups = len(set(independent_groups(clips_full, cfg["verdicts"].get("grouping", "subject")).values()))
+    data = data_label(source, clips, cfg["seeds"]) + f" in {n_groups} independent groups"
+    # the claims are the family's own: a user generator (compare.user_generators) is in every table, not in them
+    own = metrics[metrics["generator"].isin(GENERATORS)]
+    sweep_tab = None
+    if sweep and sweep.get("budgets") and inp.get("sweep"):
+        sweep_tab = sweep_table(sweep_runs(metrics, inp["sweep"], sweep["default"], sweep["budgets"],
+                                           sweep["generators"]), order)
+    seed = int(cfg.get("seed", 0))
+    declared = cfg.get("claims")
+    verdicts, claims_stats = decide_claims(own, cfg["verdicts"], data, left_out, clips_full, sweep=sweep_tab,
+                                           claims=declared, seed=seed)
+    exploratory = exploratory_table(own, cfg["verdicts"], clips_full, claims=declared, order=order, seed=seed)
+    sanity = sanity_checks(own, cfg["verdicts"], data, left_out, clips_full, seed=seed)
+    not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
+    log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
+             metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
+             len(verdicts), ", ".join(verdicts["verdict"]))
+    return {"metrics": metrics, "metrics_timing": timing, "summary": summary, "winners": winners,
+            "cost": cost_table(timing, order), "verdicts": verdicts, "claims_stats": claims_stats,
+            "exploratory": exploratory, "sanity": sanity, "sensitivity": sensitivity_table(metrics, order),
+            "summary_md": summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg, not_built,
+                                           sanity)}
 
 
 def order_generators(names, order) -> list[str]:
@@ -99,8 +168,6 @@ def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
                      if t["generate_wall_s"].sum() > 0 else np.nan,
                      "peak_rss_mb": float(pd.to_numeric(t["peak_rss_mb"], errors="coerce").max())})
     return pd.DataFrame(rows)
-
-
 
 
 def sensitivity_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
@@ -221,15 +288,6 @@ def _num(x) -> str:
     return fmt(x, 4)
 
 
-#: the columns of the results section of docs/compare.md (metric, heading)
-RESULT_COLUMNS = (("skate_share", "skate share"), ("skating_ratio_gmd", "GMD skating ratio"),
-                  ("transition_skate_share", "skate share near seams"), ("velocity_jump", "seam velocity jump (m/s)"),
-                  ("velocity_jump_p95", "per-frame velocity jump p95 (m/s)"),
-                  ("velocity_jump_over_capture", "frames above the capture's largest jump"),
-                  ("ldlj", "LDLJ"), ("l2p", "L2P"), ("l2p_m", "L2P (m)"), ("coverage", "coverage"),
-                  ("novelty_median_m", "novelty (m)"))
-
-
 def results_markdown(compare_dir) -> str:
     """The results section of docs/compare.md, generated from a run's tables (``compare_dir``: e.g.
     ``results/paper/compare``): medians (IQR) per generator, the findings, the sanity checks, the skating
@@ -245,7 +303,8 @@ def results_markdown(compare_dir) -> str:
     rows = []
     for g in gens:
         row = {"generator": g + (" (bound)" if g in REFERENCES else "")}
-        for m, head in RESULT_COLUMNS:
+        for m in RESULT_METRICS:
+            head = metric(m).label
             r = summary[(summary["generator"] == g) & (summary["metric"] == m)]
             row[head] = (f"{fmt(r['median'].iloc[0])} ({fmt(r['q25'].iloc[0])}-{fmt(r['q75'].iloc[0])})"
                          if len(r) and r["n"].iloc[0] > 0 else "-")

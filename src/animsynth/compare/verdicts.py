@@ -96,7 +96,7 @@ __all__ = ["independent_groups", "group_outcomes", "pair_outcomes", "per_clip", 
            "decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks", "DEFAULT_CLAIMS",
            "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
 
-_UNITS = {m: u for m, u, _b in METRICS}
+_UNITS = {m.name: m.unit for m in METRICS}
 _TRIAL = re.compile(r"\d+_\d+")
 #: how the evidence names each grouping (``compare.verdicts.grouping``)
 GROUPINGS = {
@@ -242,14 +242,14 @@ def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> 
 
 
 #: the skating metrics: a claim on one of them compares generators whose feet touch the floor
-SKATING_METRICS = ("skate_share", "transition_skate_share")
+SKATING_METRICS = tuple(m.name for m in METRICS if m.skating_claim)
 #: ``b`` of the capture claim: every generator of the run but the references
 EVERY = "*"
 #: the metrics of the exploratory table (with every declared claim's metric)
-EXPLORATORY_METRICS = ("skate_share", "transition_skate_share", "velocity_jump_p95", "l2p", "coverage")
+EXPLORATORY_METRICS = tuple(m.name for m in METRICS if m.exploratory)
 #: the largest number of groups whose 2^n sign flips are all enumerated
 EXACT_MAX = 16
-_DIRECTION = {m: b for m, _u, b in METRICS}
+_DIRECTION = {m.name: m.better for m in METRICS}
 
 #: The declared primary claims of the comparison (``compare.claims`` of config/config.yaml repeats them; a test
 #: keeps the two equal): used when a caller gives none.
