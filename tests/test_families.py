@@ -59,3 +59,36 @@ def test_each_scaled_familys_point_calls_its_steps_with_arguments_they_take(fami
 def test_scale_points_of_other_families_are_refused():
     with pytest.raises(ValueError, match="does not measure family 'compare'"):
         scale.point_kwargs("compare", _scale_cfg(), 100, 0)
+
+
+def _dotted_names() -> list[str]:
+    """Every ``module:function`` and dotted ``animsynth.`` name written in the family registry's source."""
+    import re
+
+    text = inspect.getsource(families)
+    return sorted(set(re.findall(r"animsynth(?:\.\w+)+(?::\w+)?", text)))
+
+
+@pytest.mark.parametrize("dotted", _dotted_names())
+def test_every_dotted_name_of_the_registry_is_where_it_says(dotted):
+    """A ``module:function`` names the module the function is defined in (not one that re-exports it); a dotted
+    module or ``module.attribute`` resolves."""
+    if ":" in dotted:
+        module, name = dotted.split(":")
+        fn = getattr(importlib.import_module(module), name)
+        assert fn.__module__ == module, f"{dotted}: {name} lives in {fn.__module__}"
+        return
+    parts = dotted.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:i]))
+        except ModuleNotFoundError:
+            continue
+        for attr in parts[i:]:
+            obj = getattr(obj, attr)
+        return
+    pytest.fail(f"{dotted} does not resolve")
+
+
+def test_the_registry_names_dotted_names_at_all():
+    assert any(":" in d for d in _dotted_names())

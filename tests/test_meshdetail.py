@@ -250,14 +250,14 @@ def test_single_frame_prediction_matches_batch(skirt_data):
 def test_verdict_is_within_noise_when_blocks_disagree():
     import pandas as pd
 
-    from animsynth.meshdetail.verdicts import _compare_verdict, block_margin
+    from animsynth.meshdetail.verdicts import block_margin, block_verdict
 
     block = np.repeat(np.arange(5), 4)
     clear = pd.DataFrame({"block": block, "a": 1.0, "b": 2.0 + 0.01 * block})
     m, sd, share, k = block_margin(clear, "a", "b")
-    assert k == 5 and share == 1.0 and _compare_verdict(m, sd, share) == "reproduced"
+    assert k == 5 and share == 1.0 and block_verdict(m, sd, share, k) == "reproduced"
     mixed = pd.DataFrame({"block": block, "a": 1.0, "b": np.where(block == 2, 0.5, 1.1)})
-    m, sd, share, _ = block_margin(mixed, "a", "b")
-    assert m < 0.1 and share == 0.8 and _compare_verdict(m, sd, share) == "within noise"
+    m, sd, share, k = block_margin(mixed, "a", "b")
+    assert m < 0.1 and share == 0.8 and block_verdict(m, sd, share, k) == "within noise"
     worse = pd.DataFrame({"block": block, "a": 3.0, "b": 1.0})
-    assert _compare_verdict(*block_margin(worse, "a", "b")[:3]) == "contradicted"
+    assert block_verdict(*block_margin(worse, "a", "b")) == "contradicted"

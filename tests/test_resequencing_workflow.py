@@ -10,6 +10,7 @@ from sklearn.neighbors import kneighbors_graph
 
 from animsynth.io import read_amc, read_asf
 from animsynth.resequencing.jobs import base_distances, method_distances, prepare_motion
+from animsynth.resequencing.settings import method_params
 from animsynth.resequencing.embedding import min_connected_k
 from animsynth.resequencing.features import motion_features
 from conftest import config_block
@@ -78,8 +79,8 @@ def test_exact_min_k_on_real_cmu_trials(cmu_dir, trial):
     f = motion_features(m)
     for metric in ("l2", "lee"):
         for g in (False, True):
-            D = base_distances(f, metric, g, cfg)
-            Dm, _, _ = method_distances(D, "isomap", cfg, m.fps)
+            D = base_distances(f, metric, g, method_params(cfg))
+            Dm, _, _ = method_distances(D, "isomap", method_params(cfg), m.fps)
             assert min_connected_k(Dm) == _brute_min_k(Dm), (metric, g)
     assert np.isfinite(D).all()
 

@@ -119,7 +119,7 @@ FAMILIES: tuple[Family, ...] = (
                             {"steps": "simplicial.path_steps", "trial_frames": "simplicial.trial_frames"})),
     Family("resequencing", "Isomap / ST-Isomap re-sequencing", "ST-Isomap", "R", "Isomap / ST-Isomap re-sequencing",
            "mocap", 2,
-           scale=ScaleStudy("animsynth.resequencing.jobs:scale_steps", "frames",
+           scale=ScaleStudy("animsynth.resequencing.cost:scale_steps", "frames",
                             {k: f"resequencing.{k}" for k in ("metric", "method", "n_candidates", "k", "embedding",
                                                               "exact_max_frames", "n_landmarks", "landmarks")}
                             | {"trial_frames": "trial_frames"}, mirror="cmu_mirror")),

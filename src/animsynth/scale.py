@@ -13,7 +13,7 @@ earlier steps still held). Where the reset is not possible the value is
 ``getrusage(RUSAGE_SELF).ru_maxrss`` of the child, the peak since it started
 (column ``peak_kind`` says which).
 
-Each family owns the steps it measures (``scale_steps`` in its workflow-step module, named by its
+Each family owns the steps it measures (``scale_steps`` in its workflow-step or cost module, named by its
 :class:`animsynth.families.ScaleStudy` in the family registry, with the config keys they read); this module only
 measures them:
 

@@ -32,9 +32,16 @@ A beats B over units
 Families that decide "A beats B" over independent units (pairs of paths) use one rule, :func:`a_beats_b`: each
 unit votes for A, for B or for neither (:func:`unit_votes`: a unit votes only when it leans one way by at least
 the minimum effect); A *holds* when at least ``share`` of the units vote for it and a test of the votes gives
-``p < alpha`` (the two-sided sign test, :func:`sign_test`, unless the family gives its own p); *opposite* is the
-same for B; a significant test without the share *leans*; anything else is noise. Each family maps the outcome
-onto :data:`VOCABULARY` and says in its evidence how many units voted which way. The generators side by side
+``p < alpha`` (the two-sided sign test, :func:`sign_test`, unless the family gives its own p, or its own test's
+decision as ``significant``); *opposite* is the same for B; a significant test without the share *leans*;
+anything else is noise. A family whose lead for A must also survive resampling passes ``stable``. Each family
+maps the outcome onto :data:`VOCABULARY` and says in its evidence how many units voted which way.
+
+Holds on all, some or none
+--------------------------
+A claim checked on several cases (configurations, edits, sequences) is ``reproduced`` when it holds on every
+case, ``partly`` on some and otherwise the family's word for none (``not reproduced`` or ``contradicted``):
+:func:`share_verdict`. The generators side by side
 decide their declared claims over groups of clips by the mean group effect, an exact sign-flip test and its
 interval instead (:mod:`animsynth.compare.verdicts`), which is where ``undecided`` comes from.
 
@@ -51,7 +58,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = ["COLUMNS", "VOCABULARY", "OUTCOMES", "VerdictError", "row", "table", "read", "check", "fmt",
-           "agreement_verdict", "holm", "unit_votes", "sign_test", "a_beats_b"]
+           "agreement_verdict", "share_verdict", "holm", "unit_votes", "sign_test", "a_beats_b"]
 
 COLUMNS = ("claim", "paper_value", "ours", "data", "verdict", "evidence", "source")
 VOCABULARY = ("reproduced", "partly", "not reproduced", "contradicted", "within noise", "undecided")
@@ -145,6 +152,29 @@ def agreement_verdict(share: float) -> str:
     return "within noise"
 
 
+def share_verdict(ok, none: str = "not reproduced") -> str:
+    """Verdict of a claim checked case by case: ``reproduced`` when it holds on every case, ``partly`` on some,
+    ``none`` on none.
+
+    Parameters
+    ----------
+    ok : array-like of bool (cases,)
+        Whether the claim holds on each case (no case: ``reproduced``, as ``all`` of nothing).
+    none : str
+        The word when it holds on no case: a word of :data:`VOCABULARY` (``not reproduced``, ``contradicted``,
+        or ``within noise`` when every case said so).
+
+    Raises
+    ------
+    VerdictError
+        when ``none`` is not a word of :data:`VOCABULARY`.
+    """
+    if none not in VOCABULARY:
+        raise VerdictError(f"verdict {none!r} is not one of {list(VOCABULARY)}")
+    ok = np.asarray(ok, bool)
+    return "reproduced" if ok.all() else ("partly" if ok.any() else none)
+
+
 def holm(pvalues) -> np.ndarray:
     """Holm's step-down adjustment of a family of p-values (Holm 1979): the ``i``-th smallest is multiplied by
     ``m - i`` (``i`` from 0, ``m`` the finite p-values), made monotone and capped at 1. A claim is significant
@@ -196,7 +226,8 @@ def sign_test(wins: int, losses: int) -> float:
     return float(binomtest(wins, wins + losses, 0.5).pvalue)
 
 
-def a_beats_b(wins: int, losses: int, undecided: int = 0, *, share: float, alpha: float, p: float | None = None,
+def a_beats_b(wins: int, losses: int, undecided: int = 0, *, share: float, alpha: float | None = None,
+              p: float | None = None, significant: bool | None = None, stable: bool = True,
               min_units: int = 0) -> str:
     """The one rule for "A beats B over units": a word of :data:`OUTCOMES`.
 
@@ -209,26 +240,44 @@ def a_beats_b(wins: int, losses: int, undecided: int = 0, *, share: float, alpha
         family drops (exact ties) are not passed.
     share : float
         The share of the counted units (``wins + losses + undecided``) that must vote one way.
-    alpha : float
-        The test's level.
+    alpha : float, optional
+        The test's level (needed unless ``significant`` is given).
     p : float, optional
         The test's p; default the sign test of ``wins`` against ``losses`` (:func:`sign_test`). A NaN p is
         never significant.
+    significant : bool, optional
+        The decision of a family's own test that gives no p (e.g. "the mean margin exceeds the spread of the
+        units' margins"), in place of ``p < alpha``; ``p`` and ``alpha`` are then not given.
+    stable : bool
+        Whether A's lead survives the family's resampling (e.g. a bootstrap share of at least 95 %); when
+        False, a significant lead for A with the share reached is ``lean``, not ``holds``. B's side needs no
+        resampling: a significant lead for B with the share reached is ``opposite`` either way.
     min_units : int
         Fewer counted units than this are never significant.
 
     Returns
     -------
-    ``"holds"`` (A: share reached, p < alpha), ``"opposite"`` (the same for B), ``"lean"`` / ``"lean_opposite"``
-    (p < alpha, the share not reached; by which side has more votes), ``"noise"`` (otherwise), ``"none"`` (no
-    unit counted).
+    ``"holds"`` (A: share reached, significant, stable), ``"opposite"`` (the same for B), ``"lean"`` /
+    ``"lean_opposite"`` (significant, the share not reached or A's lead not stable; by which side has more
+    votes), ``"noise"`` (otherwise), ``"none"`` (no unit counted).
+
+    Raises
+    ------
+    ValueError
+        when neither ``alpha`` nor ``significant`` is given, or ``significant`` comes with ``p`` or ``alpha``.
     """
+    if significant is None and alpha is None:
+        raise ValueError("a_beats_b needs the test's level alpha or the family's own test decision significant")
+    if significant is not None and (p is not None or alpha is not None):
+        raise ValueError("a_beats_b: give either significant or p / alpha, not both")
     n = int(wins) + int(losses) + int(undecided)
     if n == 0:
         return "none"
-    p = sign_test(wins, losses) if p is None else float(p)
-    significant = n >= int(min_units) and bool(np.isfinite(p)) and p < float(alpha)
-    if significant and wins / n >= float(share):
+    if significant is None:
+        p = sign_test(wins, losses) if p is None else float(p)
+        significant = bool(np.isfinite(p)) and p < float(alpha)
+    significant = n >= int(min_units) and bool(significant)
+    if significant and stable and wins / n >= float(share):
         return "holds"
     if significant and losses / n >= float(share):
         return "opposite"

@@ -26,7 +26,9 @@ subject, and a re-sequencing clip may be a trial that a subset's clips use. The 
   share a trial. It counts the subsets of one subject as independent, which they are not for a claim about
   people's motion; kept as an option.
 
-A clip without a subject id (not a CMU trial name) is grouped by its subset.
+A clip without a subject id (not a CMU trial name) is grouped by its subset. The grouping lives in
+:mod:`animsynth.compare.groups`; the per-clip and per-group effects, the t interval and the per-subject tests in
+:mod:`animsynth.compare.claim_stats`.
 
 A group's **effect** is the median over its clips of each clip's median over seeds of ``a - b`` (signed so that
 positive favours the claim), in the metric's units. A group **holds** when more of its clips hold than not and its
@@ -83,12 +85,13 @@ same rules with the metric's ``compare.verdicts.min_effect``, Holm among themsel
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pandas as pd
 
 from .. import verdicts as V
+from .claim_stats import floating_reason, group_outcomes, metric_median, pair_outcomes, per_clip, spread, \
+    subject_tests, t_interval
+from .groups import GROUPINGS, clip_groups, independent_groups
 from .generators import REFERENCES
 from .metrics import METRICS
 
@@ -97,127 +100,6 @@ __all__ = ["independent_groups", "group_outcomes", "pair_outcomes", "per_clip", 
            "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
 
 _UNITS = {m.name: m.unit for m in METRICS}
-_TRIAL = re.compile(r"\d+_\d+")
-#: how the evidence names each grouping (``compare.verdicts.grouping``)
-GROUPINGS = {
-    "subject": "subject, joined where clips share a trial (held out or in a database)",
-    "subset_subject": ("subset (or re-sequencing dataset) x subject, joined where clips share a trial (held out or "
-                       "in a database)"),
-}
-
-
-def independent_groups(clips: pd.DataFrame, by: str = "subject") -> dict:
-    """``{clip: group label}`` from the clips table (``clip``, ``group``, ``held_out``, ``database``).
-
-    A clip's trials are its held-out trial and its database trials (CMU ids ``<subject>_<trial>`` found in the
-    clip id and the ``held_out`` and ``database`` columns; other names: the clip's trial and the database's
-    names); its subject is the held-out trial's subject (the text before ``_``; none for other names, so the
-    subset alone makes the group). ``by="subject"``: the clips of one subject form a group (a clip without a
-    subject: its subset); ``by="subset_subject"``: the clips of one subset and subject. Groups sharing a trial
-    are joined. The label names the subsets / datasets joined (``r1 + run``) and, when one subset holds several
-    groups, the subject; by subject, ``subject 35 (w1, r1, run, walk)``.
-    """
-    if by not in GROUPINGS:
-        raise ValueError(f"config key 'compare.verdicts.grouping': {by!r} is not one of {list(GROUPINGS)}")
-    rows = list(clips.itertuples(index=False))
-    trials, base = {}, {}
-    for r in rows:
-        own = str(r.clip).split("/", 1)[-1]
-        text = f"{own} {r.held_out} {r.database}"
-        ts = set(_TRIAL.findall(text))
-        if not ts:  # not CMU ids: the clip's trial and the database's names (without a temporal split's range)
-            ts = {own} | {t for t in str(r.database).split() if t != "frames" and not re.fullmatch(r"\d+-\d+", t)}
-        trials[r.clip] = ts
-        held = _TRIAL.findall(own) or _TRIAL.findall(str(r.held_out))
-        subject = held[0].split("_")[0] if held else ""  # no subject id: the subset is the group
-        base[r.clip] = ("", subject) if by == "subject" and subject else (str(r.group), subject)
-    parent = {k: k for k in set(base.values())}
-
-    def find(x):
-        while parent[x] != x:
-            parent[x] = parent[parent[x]]
-            x = parent[x]
-        return x
-
-    owner = {}
-    for r in rows:
-        for t in trials[r.clip]:
-            if t in owner:
-                parent[find(base[r.clip])] = find(owner[t])
-            else:
-                owner[t] = base[r.clip]
-    members = {}
-    for r in rows:
-        members.setdefault(find(base[r.clip]), []).append(base[r.clip])
-    per_subset = {}
-    for g, s in set(base.values()):
-        per_subset[g] = per_subset.get(g, 0) + 1
-    labels = {}
-    subsets = {}
-    for r in rows:
-        subsets.setdefault(find(base[r.clip]), []).append(str(r.group))
-    for root, keys in members.items():
-        keys = list(dict.fromkeys(keys))
-        if by == "subject" and any(not g for g, _s in keys):
-            subj = " + ".join(dict.fromkeys(f"subject {s}" for g, s in keys if not g))
-            others = [g for g, _s in keys if g]
-            labels[root] = f"{subj} ({', '.join(dict.fromkeys(subsets[root] + others))})"
-            continue
-        parts = [g if per_subset[g] == 1 else f"{g} subject {s}" for g, s in keys]
-        labels[root] = " + ".join(dict.fromkeys(parts))
-    return {r.clip: labels[find(base[r.clip])] for r in rows}
-
-
-def pair_outcomes(metrics: pd.DataFrame, a: str, b: str, metric: str, better: str = "lower") -> pd.DataFrame:
-    """Per clip x seed where both ``a`` and ``b`` have a finite ``metric``: ``group``, ``a``, ``b``, ``effect``
-    (the difference signed so that positive favours ``a``, in the metric's units) and ``outcome`` (+1: ``a``
-    better, -1: ``b`` better, 0: tie)."""
-    key = ["clip", "seed"]
-    A = metrics[metrics["generator"] == a].set_index(key)[["group", metric]]
-    B = metrics[metrics["generator"] == b].set_index(key)[metric]
-    j = A.join(B.rename("b"), how="inner").rename(columns={metric: "a"})
-    j["a"] = pd.to_numeric(j["a"], errors="coerce")
-    j["b"] = pd.to_numeric(j["b"], errors="coerce")
-    j = j[np.isfinite(j["a"]) & np.isfinite(j["b"])]
-    d = j["a"] - j["b"]
-    j["effect"] = -d if better == "lower" else d
-    j["outcome"] = np.sign(j["effect"]).astype(int)
-    return j.reset_index()
-
-
-def per_clip(j: pd.DataFrame) -> pd.DataFrame:
-    """Clip x seed outcomes (``clip, outcome[, effect]``) -> one row per clip: ``clip``, ``outcome`` (+1 when
-    the claim holds on more of its seeds than its opposite, -1 for the reverse, 0 for a tie), ``effect`` (the
-    median over seeds) and the seed counts ``seeds_for, seeds_against``."""
-    g = j.groupby("clip", sort=False)
-    out = pd.DataFrame({"seeds_for": (j["outcome"] > 0).groupby(j["clip"], sort=False).sum().astype(int),
-                        "seeds_against": (j["outcome"] < 0).groupby(j["clip"], sort=False).sum().astype(int)})
-    out["effect"] = g["effect"].median() if "effect" in j else np.nan
-    out["outcome"] = np.sign(out["seeds_for"] - out["seeds_against"]).astype(int)
-    return out.reset_index()
-
-
-def group_outcomes(j: pd.DataFrame, groups: dict, min_effect: float) -> pd.DataFrame:
-    """Per group: ``clips_for``, ``clips_against`` (clip outcomes, :func:`per_clip`), ``effect`` (median of its
-    clips' effects) and ``vote`` (:func:`animsynth.verdicts.unit_votes`): +1 (holds: more clips for than against
-    and effect >= ``min_effect``), -1 (the opposite), 0 (within noise)."""
-    c = per_clip(j)
-    c["unit"] = c["clip"].map(groups).fillna(c["clip"])
-    g = c.groupby("unit", sort=False)
-    out = pd.DataFrame({"clips": g.size(), "clips_for": (c["outcome"] > 0).groupby(c["unit"], sort=False).sum().astype(int),
-                        "clips_against": (c["outcome"] < 0).groupby(c["unit"], sort=False).sum().astype(int),
-                        "effect": g["effect"].median()})
-    out["vote"] = V.unit_votes(out["clips_for"] - out["clips_against"], out["effect"], min_effect)
-    return out
-
-
-def _spread(metrics: pd.DataFrame, g: str, metric: str) -> str:
-    x = pd.to_numeric(metrics.loc[metrics["generator"] == g, metric], errors="coerce")
-    x = x[np.isfinite(x)].to_numpy(float)
-    if not x.size:
-        return "no value"
-    q = np.percentile(x, [25, 50, 75])
-    return f"{V.fmt(q[1])} (IQR {V.fmt(q[0])}-{V.fmt(q[2])})"
 
 
 def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> str:
@@ -356,19 +238,6 @@ def sign_flip_p(effects, *, seed: int = 0, draws: int = 100000, exact_max: int =
     return (1 + hits) / (1 + int(draws))
 
 
-def t_interval(effects, level: float = 0.95) -> tuple[float, float]:
-    """The ``level`` t interval of the mean of ``effects`` (mean +- t(1 - (1 - level) / 2, n - 1) x sd / sqrt(n));
-    NaN for fewer than 2 values."""
-    from scipy.stats import t
-
-    e = np.asarray(effects, float)
-    e = e[np.isfinite(e)]
-    if e.size < 2:
-        return float("nan"), float("nan")
-    half = float(t.ppf(1 - (1 - level) / 2, e.size - 1)) * float(e.std(ddof=1)) / np.sqrt(e.size)
-    return float(e.mean() - half), float(e.mean() + half)
-
-
 class Stats:
     """The subject-level statistics of one comparison ``a`` vs ``b`` on one metric.
 
@@ -390,7 +259,7 @@ class Stats:
         self.mean = float(np.nanmean(eff)) if self.n else float("nan")
         self.lo, self.hi = t_interval(eff)
         self.p = sign_flip_p(eff, seed=seed, draws=int(vc.get("permutations", 100000)))
-        self.subjects = _subject_tests(j, groups, self.per, min_effect, float(vc["alpha"])) if subjects else None
+        self.subjects = subject_tests(j, groups, self.per, min_effect, float(vc["alpha"])) if subjects else None
 
     @property
     def holding(self) -> int:
@@ -404,27 +273,6 @@ class Stats:
         """'mean effect 0.05 [95 % t interval 0.03, 0.07], p = 0.125' (the sign-flip p)."""
         return (f"mean effect {V.fmt(self.mean)}{' ' + unit if unit else ''} [95 % t interval {V.fmt(self.lo)}, "
                 f"{V.fmt(self.hi)}], p = {V.fmt(self.p, 3)}")
-
-
-def _subject_tests(j: pd.DataFrame, groups: dict, per: pd.DataFrame, min_effect: float, alpha: float) -> pd.DataFrame:
-    """Per group: the two-sided exact sign test of its clips' outcomes (one vote per clip, its seeds' majority:
-    :func:`per_clip`), Holm over the groups, and its side.
-
-    Clips, not clip x seed effects: the seeds of one clip share its database and start (and a deterministic
-    generator repeats itself over them), so counting them as independent would let two clips look like ten.
-    With the few clips a subject has, a subject is significant only when many of its clips agree; "partly" is
-    correspondingly rare, which is what the data can support."""
-    c = per_clip(j)
-    unit = c["clip"].map(groups).fillna(c["clip"])
-    out = pd.DataFrame({"for": (c["outcome"] > 0).groupby(unit, sort=False).sum().astype(int),
-                        "against": (c["outcome"] < 0).groupby(unit, sort=False).sum().astype(int)}).reindex(per.index)
-    out["p"] = [V.sign_test(w, f) for w, f in zip(out["for"], out["against"])]
-    out["p_holm"] = V.holm(out["p"])
-    sig = out["p_holm"] < alpha
-    eff = per["effect"]
-    out["side"] = np.where(sig & (out["for"] > out["against"]) & (eff >= min_effect), 1,
-                           np.where(sig & (out["against"] > out["for"]) & (eff <= -min_effect), -1, 0))
-    return out
 
 
 def _units(vc: dict, n: int | None = None) -> str:
@@ -469,23 +317,6 @@ def decide(st: Stats, p_holm: float, min_effect: float, vc: dict) -> tuple[str, 
                          f"possible p is {V.fmt(floor, 3)})")
 
 
-def _median(metrics: pd.DataFrame, g: str, metric: str) -> float:
-    x = pd.to_numeric(metrics.loc[metrics["generator"] == g, metric], errors="coerce") if metric in metrics else []
-    x = np.asarray(x, float)
-    x = x[np.isfinite(x)]
-    return float(np.median(x)) if x.size else float("nan")
-
-
-def _floats(metrics, g, vc) -> str:
-    """Why ``g`` cannot take part in a skating comparison ('' when its feet touch)."""
-    floor = float(vc.get("min_contact_share", 0.05))
-    c = _median(metrics, g, "contact_share")
-    if np.isfinite(c) and c < floor:
-        return (f"{g}'s feet do not touch the floor (median contact_share {V.fmt(c)} below "
-                f"compare.verdicts.min_contact_share {V.fmt(floor)}), so it cannot win or lose a skating comparison")
-    return ""
-
-
 class _Claim:
     """One declared claim: its statistics (or why it has none) and how to write its row once Holm has run."""
 
@@ -513,16 +344,16 @@ class _Claim:
                 return
             self.st = Stats(j, groups, self.me, vc, seed)
             if self.skating:
-                self.blocked = "; ".join(w for w in (_floats(metrics, g, vc) for g in (self.a, self.b)) if w)
+                self.blocked = "; ".join(w for w in (floating_reason(metrics, g, vc) for g in (self.a, self.b)) if w)
 
     def _every(self, metrics, groups, seed):
         """The capture claim: one part per generator (its feet touching), the weakest part deciding."""
-        if self.skating and (w := _floats(metrics, self.a, self.vc)):
+        if self.skating and (w := floating_reason(metrics, self.a, self.vc)):
             self.blocked = w
         for g in dict.fromkeys(metrics["generator"]):
             if g in REFERENCES or g == self.a:
                 continue
-            why = _floats(metrics, g, self.vc) if self.skating else ""
+            why = floating_reason(metrics, g, self.vc) if self.skating else ""
             j = pair_outcomes(metrics, self.a, g, self.metric, self.better)
             if why or not len(j):
                 self.left.append(f"{g} left out: {why or 'no value shared with ' + self.a}")
@@ -557,7 +388,7 @@ class _Claim:
         return self.st.p
 
     def contact(self, g: str) -> float:
-        return _median(self.metrics, g, "contact_share")
+        return metric_median(self.metrics, g, "contact_share")
 
     def verdict(self, p_holm: float) -> tuple[str, str]:
         if self.missing:
@@ -590,14 +421,14 @@ class _Claim:
                 f"{V.fmt(st.mean)} {unit} (95 % t interval over {_units(vc)} {V.fmt(st.lo)} to {V.fmt(st.hi)}), "
                 f"sign-flip p = {V.fmt(self.p, 3)}, Holm p = {V.fmt(p_holm, 3)}")
         if self.b == EVERY:
-            med = {g: _median(self.metrics, g, self.metric) for g, _s in self.parts}
-            text += f"; {self.metric} median {self.a} {_spread(self.metrics, self.a, self.metric)}"
+            med = {g: metric_median(self.metrics, g, self.metric) for g, _s in self.parts}
+            text += f"; {self.metric} median {self.a} {spread(self.metrics, self.a, self.metric)}"
             if med:
                 lo, hi = min(med, key=med.get), max(med, key=med.get)
                 text += (f" vs the generators' medians from {lo} {V.fmt(med[lo])} to {hi} {V.fmt(med[hi])}")
         else:
-            text += (f"; {self.metric} ({unit}) median {self.a} {_spread(self.metrics, self.a, self.metric)} vs "
-                     f"{self.b} {_spread(self.metrics, self.b, self.metric)}")
+            text += (f"; {self.metric} ({unit}) median {self.a} {spread(self.metrics, self.a, self.metric)} vs "
+                     f"{self.b} {spread(self.metrics, self.b, self.metric)}")
         if self.skating:
             gens = [self.a] + ([g for g, _s in self.parts] if self.b == EVERY else [self.b])
             text += "; contact_share (share of foot joint-frames) median " + ", ".join(
@@ -681,7 +512,7 @@ def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
         (a claim on a generator that did not run: "not reproduced", saying why)
     seed : the seed of the random sign flips (more than :data:`EXACT_MAX` groups; ``compare.seed``)
     """
-    groups = _groups(metrics, clips, vc)
+    groups = clip_groups(metrics, clips, vc)
     specs = list(DEFAULT_CLAIMS if claims is None else claims)
     cs = [_Claim(dict(s), metrics, groups, vc, data, left_out or {}, seed, sweep) for s in specs]
     ps = [c.p for c in cs]
@@ -719,7 +550,7 @@ def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | Non
     in the metric's direction), the groups, the groups holding / opposite by the metric's minimum effect, the mean
     effect with its 95 % t interval, the sign-flip p and a Holm p over this table alone. Never a verdict.
     """
-    groups = _groups(metrics, clips, vc)
+    groups = clip_groups(metrics, clips, vc)
     specs = list(DEFAULT_CLAIMS if claims is None else claims)
     present = list(dict.fromkeys(metrics["generator"]))
     gens = [g for g in (order or present) if g in set(present)]
@@ -727,7 +558,7 @@ def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | Non
     for s in specs:
         bs = [g for g in gens if g not in REFERENCES and g != s["a"]] if s["b"] == EVERY else [s["b"]]
         if s["b"] == EVERY and s.get("skating"):  # a floating generator is no part of the claim: exploratory
-            bs = [g for g in bs if not _floats(metrics, g, vc)]
+            bs = [g for g in bs if not floating_reason(metrics, g, vc)]
         declared |= {(frozenset((s["a"], b)), s["metric"]) for b in bs}
     mets = list(dict.fromkeys([*EXPLORATORY_METRICS, *(s["metric"] for s in specs)]))
     rows = []
@@ -768,7 +599,7 @@ def _copy_claim(metrics, groups, vc, data, seed):
     j = pd.DataFrame({"clip": [c for c, _s in wide.index], "effect": np.where(ok, np.abs(eff), -np.abs(eff)),
                       "outcome": np.where(ok.to_numpy(), 1, -1)})
     me = float(vc["min_effect"].get("novelty_median_m", 0.0))
-    ours = "; ".join(f"{g} novelty median {_spread(metrics, g, 'novelty_median_m')} m" for g in copiers + makers)
+    ours = "; ".join(f"{g} novelty median {spread(metrics, g, 'novelty_median_m')} m" for g in copiers + makers)
     lead = f"every re-sequencer at most {V.fmt(tol)} m from the database and every field follower farther"
     if not len(j):
         return None, V.row(claim, "not reproduced", "no pair to compare (no clip with every novelty value)", data=data,
@@ -780,7 +611,7 @@ def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
                   clips: pd.DataFrame | None = None, seed: int = 0) -> pd.DataFrame:
     """Claims true by construction, decided by the same rules (:func:`decide`; the metric's
     ``compare.verdicts.min_effect``; Holm over the sanity checks alone): not findings."""
-    groups = _groups(metrics, clips, vc)
+    groups = clip_groups(metrics, clips, vc)
     configured = set(metrics["generator"]) | set(left_out or {})
     present = set(metrics["generator"])
     tests = []  # (stats or None, (claim, ours, lead, min effect, metric) or a finished row)
@@ -797,8 +628,8 @@ def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
             tests.append((None, V.row(claim, "not reproduced", f"no pair to compare ({why})", data=data,
                                       source="compare/metrics.csv")))
         else:
-            ours = (f"velocity_jump_p95 (m/s) median motion_graph {_spread(metrics, 'motion_graph', 'velocity_jump_p95')}"
-                    f" vs concat {_spread(metrics, 'concat', 'velocity_jump_p95')}")
+            ours = (f"velocity_jump_p95 (m/s) median motion_graph {spread(metrics, 'motion_graph', 'velocity_jump_p95')}"
+                    f" vs concat {spread(metrics, 'concat', 'velocity_jump_p95')}")
             tests.append((Stats(j, groups, me, vc, seed),
                           (claim, ours, "motion_graph lower than concat on velocity_jump_p95", me, "velocity_jump_p95")))
     ps = [st.p if st is not None else np.nan for st, _x in tests]
@@ -817,9 +648,3 @@ def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
                           f"{V.fmt(pa, 3)}; holds in {st.holding}, opposite in {st.opposite} (minimum effect "
                           f"{V.fmt(me)} {unit})", ours=ours, data=data, source="compare/metrics.csv"))
     return V.table(rows)
-
-
-def _groups(metrics: pd.DataFrame, clips: pd.DataFrame | None, vc: dict) -> dict:
-    if clips is not None and {"clip", "group", "held_out", "database"} <= set(clips.columns):
-        return independent_groups(clips, vc.get("grouping", "subject"))
-    return dict(metrics.drop_duplicates("clip").set_index("clip")["group"])

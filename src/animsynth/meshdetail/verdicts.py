@@ -3,10 +3,12 @@
 Common verdict format (:mod:`animsynth.verdicts`; every row built with :func:`animsynth.verdicts.row`):
 ``claim, paper_value, ours, data, verdict, evidence, source`` with ``verdict`` one of ``reproduced``,
 ``partly``, ``not reproduced``, ``contradicted``, ``within noise``. Model comparisons are keyed on held-out
-frames of the blocked cross-validation: the margin is the mean over blocks of
+frames of the blocked cross-validation and decided by the common "A beats B" rule
+(:func:`animsynth.verdicts.a_beats_b`, :func:`block_verdict`): the margin is the mean over blocks of
 the per-block difference, and it counts only when every block agrees and the
 margin exceeds the spread (SD) of the per-block differences; otherwise the
-verdict is ``within noise`` with the share of blocks that agree.
+verdict is ``within noise`` with the share of blocks that agree. Claims checked case by case (edits,
+sequences) are decided by :func:`animsynth.verdicts.share_verdict`.
 """
 
 from __future__ import annotations
@@ -26,12 +28,25 @@ def block_margin(fig5c: pd.DataFrame, better: str, worse: str):
     return float(diff.mean()), sd, float(np.mean(diff > 0)), len(diff)
 
 
-def _compare_verdict(margin, sd, share):
-    if margin > 0 and share == 1.0 and (np.isnan(sd) or margin > sd):
-        return "reproduced"
-    if margin < 0 and share == 0.0 and (np.isnan(sd) or -margin > sd):
-        return "contradicted"
-    return "within noise"
+def block_verdict(margin: float, sd: float, share: float, blocks: int) -> str:
+    """Verdict of "A beats B" over the blocks of the cross-validation (:func:`animsynth.verdicts.a_beats_b`).
+
+    Each block is a unit voting for A when A's held-out error is lower there, against it otherwise; the claim
+    needs every block (share 1). The test is the margin's size: significant when the mean margin is non-zero
+    and exceeds the per-block SD (``sd`` NaN, one block: any non-zero margin).
+
+    Parameters
+    ----------
+    margin, sd, share, blocks : the outputs of :func:`block_margin`
+
+    Returns
+    -------
+    ``reproduced`` (holds), ``contradicted`` (the opposite) or ``within noise``.
+    """
+    wins = int(round(share * blocks)) if blocks else 0
+    significant = bool(np.isfinite(margin) and margin != 0 and (np.isnan(sd) or abs(margin) > sd))
+    outcome = common.a_beats_b(wins, int(blocks) - wins, share=1.0, significant=significant)
+    return {"holds": "reproduced", "opposite": "contradicted"}.get(outcome, "within noise")
 
 
 SKIN_NOTE = {
@@ -58,7 +73,7 @@ def build_verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame
         if lost and len(lost) < k:
             note = f"; not better on block(s) {lost} (block 0 holds the rest frame, where LBS is exact)" \
                 if better != "lbs_mm" and worse == "lbs_mm" and 0 in lost else f"; not better on block(s) {lost}" + note
-        v = _compare_verdict(m, sd, share)
+        v = block_verdict(m, sd, share, k)
         rows.append(common.row(
             claim, v, f"held-out mean vertex error {f(b)} vs {f(w)} mm; margin {f(m)} mm, per-block spread "
                       f"(SD) {f(sd)} mm; better on {100 * share:.0f}% of {k} blocks" + note + SKIN_NOTE[cv_rig],
@@ -78,7 +93,7 @@ def build_verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame
     ok_te = a_te.detail_only_mm.mean() < a_te.full_deformation_mm.mean() if len(a_te) else ok_tr
     rows.append(common.row(
         "Learning only the fine detail is more accurate than learning the full deformation (Fig. 5a)",
-        "reproduced" if ok_tr and ok_te else ("partly" if ok_tr or ok_te else "contradicted"),
+        common.share_verdict([ok_tr, ok_te], none="contradicted"),
         f"training {f(a_tr.detail_only_mm.mean())} vs {f(a_tr.full_deformation_mm.mean())} mm; "
         f"held-out {f(a_te.detail_only_mm.mean())} vs {f(a_te.full_deformation_mm.mean())} mm",
         paper_value="plotted only (Fig. 5a)",
@@ -89,7 +104,7 @@ def build_verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame
         better = int(np.sum(ed.hybrid_mm < ed.lbs_mm))
         rows.append(common.row(
             "The learned detail transfers to edited motions (beats LBS against re-simulated truth)",
-            "reproduced" if better == len(ed) else ("partly" if better else "not reproduced"),
+            common.share_verdict(ed.hybrid_mm < ed.lbs_mm),
             "; ".join(f"{c.split(': ')[-1]}: {f(h)} ± {f(hs)} vs {f(lb)} mm (mean ± SD over folds)"
                       for c, h, hs, lb in zip(ed.case, ed.hybrid_mm, ed.hybrid_fold_sd_mm, ed.lbs_mm)),
             paper_value="shown qualitatively", ours=f"hybrid better on {better} of {len(ed)} edits", data=data,
@@ -119,15 +134,19 @@ def holds_on(verdicts_by_seq: dict) -> tuple[str, str]:
     names = list(verdicts_by_seq)
     held = [n for n in names if verdicts_by_seq[n] == "reproduced"]
     n = len(names)
-    if len(held) == n:
-        words = "holds on both" if n == 2 else ("holds on its one sequence" if n == 1 else f"holds on all {n}")
-        return words, "reproduced"
-    if held:
-        return (f"holds on one ({held[0]})" if n == 2 and len(held) == 1 else
-                f"holds on {len(held)} of {n} ({', '.join(held)})"), "partly"
     kinds = set(verdicts_by_seq.values())
-    words = "holds on neither" if n == 2 else ("does not hold" if n == 1 else f"holds on none of {n}")
-    return words, (kinds.pop() if len(kinds) == 1 and kinds <= {"contradicted", "within noise"} else "not reproduced")
+    verdict = common.share_verdict([n in held for n in names],
+                                   none=kinds.pop() if len(kinds) == 1 and kinds <= {"contradicted", "within noise"}
+                                   else "not reproduced")
+    n = len(names)
+    if verdict == "reproduced":
+        words = "holds on both" if n == 2 else ("holds on its one sequence" if n == 1 else f"holds on all {n}")
+    elif verdict == "partly":
+        words = (f"holds on one ({held[0]})" if n == 2 and len(held) == 1 else
+                 f"holds on {len(held)} of {n} ({', '.join(held)})")
+    else:
+        words = "holds on neither" if n == 2 else ("does not hold" if n == 1 else f"holds on none of {n}")
+    return words, verdict
 
 
 def combine_verdicts(per_seq: dict) -> pd.DataFrame:

@@ -12,7 +12,9 @@ flips; :func:`resequence` makes and measures the re-sequenced motions and
 
 The configuration dictionary ``cfg`` is the ``resequencing`` block of the
 workflow config as validated by ``config/schema.yaml`` (every key present; the
-schema holds the defaults, ``docs/config_resequencing.md`` the meanings).
+schema holds the defaults, ``docs/config_resequencing.md`` the meanings). Each
+step reads the methods' arguments from it once (:func:`.settings.method_params`)
+and passes them on; the helpers below take those, not the block.
 
 The family's other concerns live beside this module: the config adapters
 (method and metric names, global-DOF wildcards, sign mode, ST-Isomap
@@ -24,8 +26,8 @@ paths), :class:`~.generator.Resequencer`, in :mod:`.generator`: :func:`resequenc
 :func:`~.quick.resequence_motion` in :mod:`.quick`, and the comparison's rows. The minimum-k scans and
 embeddings of :func:`analyse` and :func:`explain` read the same distances (:func:`base_distances`,
 :func:`method_distances`) and stay here: no generator scans k or embeds. The cost curves of
-:mod:`animsynth.scale` in :mod:`.cost` (:func:`scale_steps` is named here too,
-where the scale harness reads every family's measured steps).
+:mod:`animsynth.scale` in :mod:`.cost` (:func:`~.cost.scale_steps`, named by the family registry,
+:mod:`animsynth.families`).
 """
 
 from __future__ import annotations
@@ -38,7 +40,6 @@ import pandas as pd
 
 from ..limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
 from ..motion import Motion
-from .cost import scale_steps  # noqa: F401  (animsynth.scale reads each family's measured steps from its jobs)
 from .embedding import (PrecomputedIsomap, graph_components, knn_graph, min_connected_k, neighbor_ranks,
                         residual_variance)
 from .generator import Resequencer, frame_distances, method_matrix
@@ -47,7 +48,7 @@ from .features import matrix_naive_quaternions, motion_features, sign_flips
 from .metrics import (Reference, TransitionReference, classify_path, jerk_magnitude, joint_quats, pass_jumps,
                       transition_measures)
 from .paths import pad_path, play_path, resolve_frame
-from .settings import METHODS, METRICS, gdof_name, sign_mode_of, st_parameters
+from .settings import METHODS, METRICS, MethodParams, gdof_name, method_params
 
 log = logging.getLogger("animsynth.resequencing")
 
@@ -94,29 +95,23 @@ def prepare_motion(motion: Motion, max_frames: int | None = None, frame_step: in
     return Motion(v, motion.skeleton, motion.fps / frame_step, motion.name, dict(motion.meta))
 
 
-def base_distances(features, metric: str, include_global: bool, cfg: dict, sign_mode: str | None = None) -> np.ndarray:
-    """The frame distance matrix of one metric (``cfg``: the resequencing block, with defaults):
-    :func:`.generator.frame_distances`, the distances the study's :class:`~.generator.Resequencer` builds its
-    graph on.
+def base_distances(features, metric: str, include_global: bool, params: MethodParams,
+                   sign_mode: str | None = None) -> np.ndarray:
+    """The frame distance matrix of one metric (``params``: :func:`.settings.method_params` of the resequencing
+    block): :func:`.generator.frame_distances`, the distances the study's :class:`~.generator.Resequencer` builds
+    its graph on.
 
-    ``sign_mode`` (default: ``linearisation.sign_mode``) applies to the L2
+    ``sign_mode`` (default: ``params.sign_mode``) applies to the L2
     features only; the Lee metric is sign-invariant."""
     if metric not in METRICS:
         raise ValueError(f"unknown metric {metric!r} (expected one of {METRICS})")
-    scale = float(cfg["linearisation"]["translation_scale"])
-    mode = (sign_mode_of(cfg) if sign_mode is None else sign_mode) if metric == "l2" else "continuous"  # Lee: unused
-    return frame_distances(features, metric, include_global, mode, scale, lee_kwargs(cfg))
+    mode = (params.sign_mode if sign_mode is None else sign_mode) if metric == "l2" else "continuous"  # Lee: unused
+    return frame_distances(features, metric, include_global, mode, params.translation_scale, params.lee)
 
 
-def lee_kwargs(cfg: dict) -> dict:
-    """Keyword arguments of :func:`.distances.lee_distances` from the ``lee`` block."""
-    lee = cfg["lee"]
-    return {"weights": lee["weights"], "nu": float(lee["nu"]), "sqrt": bool(lee["sqrt"])}
-
-
-def method_distances(D: np.ndarray, method: str, cfg: dict, fps: float):
+def method_distances(D: np.ndarray, method: str, params: MethodParams, fps: float):
     """The matrix a method builds its k-NN graph on, and the edges it always keeps
-    (:func:`.generator.method_matrix` with the config's ST-Isomap block at ``fps``).
+    (:func:`.generator.method_matrix` with the ST-Isomap parameters of ``params`` at ``fps``).
 
     Isomap: ``(D, None, 0)``. ST-Isomap: the spatio-temporally adjusted ``D``,
     the adjacent-temporal-neighbour matrix (always in the neighbourhood) and
@@ -124,7 +119,7 @@ def method_distances(D: np.ndarray, method: str, cfg: dict, fps: float):
     if method == "isomap":
         return D, None, 0
     if method == "stisomap":
-        Dst, atn, ctn = method_matrix(D, method, st_parameters(cfg["stisomap"], fps))
+        Dst, atn, ctn = method_matrix(D, method, params.st(fps))
         return Dst, atn, int(np.count_nonzero(np.triu(ctn)))
     raise ValueError(f"unknown method {method!r} (expected one of {METHODS})")
 
@@ -203,19 +198,20 @@ def analyse(motion: Motion, dataset: str, trial: str, include_global: bool, cfg:
         The distance matrices would exceed ``budget_gib`` (:func:`check_distance_budget`).
     """
     check_distance_budget(motion.n_frames, trial, budget_gib)
+    params = method_params(cfg)
     feats = motion_features(motion)
     n = feats.n_frames
-    gap = st_parameters(cfg["stisomap"], motion.fps)["ctn_min_gap"]
-    mode = sign_mode_of(cfg)
+    gap = params.st(motion.fps)["ctn_min_gap"]
+    mode = params.sign_mode
     rows, rv_rows, t_rows, emb = [], [], [], {}
     max_dim = min(int(cfg["max_dim"]), n - 2)
     for metric in cfg["metrics"]:
         t0 = time.perf_counter()
-        D = base_distances(feats, metric, include_global, cfg)
+        D = base_distances(feats, metric, include_global, params)
         t_dist = time.perf_counter() - t0
         for method in cfg["methods"]:
             t0 = time.perf_counter()
-            Dm, always, n_ctn = method_distances(D, method, cfg, motion.fps)
+            Dm, always, n_ctn = method_distances(D, method, params, motion.fps)
             kmin, below, at, R = checked_min_k(Dm, always, f"{dataset}/{method}/{metric}")
             t_mink = time.perf_counter() - t0
             t0, c0 = time.perf_counter(), time.process_time()
@@ -281,6 +277,7 @@ def explain(motion: Motion, dataset: str, trial: str, cfg: dict, budget_gib: flo
     ex = cfg["explanations"]
     check_distance_budget(prepare_motion(motion, cfg["max_frames"], int(min(ex["frame_steps"]))).n_frames, trial,
                           budget_gib)
+    params = method_params(cfg)
     rows, flip_rows = [], []
     for step in ex["frame_steps"]:
         m = prepare_motion(motion, cfg["max_frames"], int(step))
@@ -297,11 +294,11 @@ def explain(motion: Motion, dataset: str, trial: str, cfg: dict, budget_gib: flo
             g = bool(g)
             for metric in cfg["metrics"]:
                 modes = ex["sign_modes"]
-                D_lee = base_distances(feats, "lee", g, cfg) if metric == "lee" else None
+                D_lee = base_distances(feats, "lee", g, params) if metric == "lee" else None
                 for mode in modes:
-                    D = D_lee if metric == "lee" else base_distances(feats, "l2", g, cfg, sign_mode=mode)
+                    D = D_lee if metric == "lee" else base_distances(feats, "l2", g, params, sign_mode=mode)
                     for method in cfg["methods"]:
-                        Dm, always, _ = method_distances(D, method, cfg, m.fps)
+                        Dm, always, _ = method_distances(D, method, params, m.fps)
                         kmin, below, at, _ = checked_min_k(Dm, always, f"{dataset}/{step}/{g}/{mode}/{method}/{metric}")
                         rows.append({"dataset": dataset, "trial": trial, "frame_step": int(step), "fps": m.fps,
                                      "frames": m.n_frames, "global_dof": g, "sign_mode": mode, "method": method,
@@ -355,13 +352,13 @@ def splice(path, n: int, context: int) -> np.ndarray:
 
 
 def config_resequencer(motion: Motion, include_global: bool, method: str, metric: str, k: int,
-                       cfg: dict) -> Resequencer:
+                       params: MethodParams) -> Resequencer:
     """The fitted :class:`~.generator.Resequencer` of a configuration: the dense graph of ``motion`` under its
-    metric, global DOF, sign mode and ST-Isomap block, at ``k`` (checked: the graph must connect)."""
-    return Resequencer(method, k=int(k), stisomap=cfg["stisomap"] if method == "stisomap" else None,
-                       neighbours="dense", metric=metric, global_dof=include_global, sign_mode=sign_mode_of(cfg),
-                       translation_scale=float(cfg["linearisation"]["translation_scale"]),
-                       lee=lee_kwargs(cfg)).fit([motion])
+    metric, global DOF, sign mode and ST-Isomap block (``params``: :func:`.settings.method_params`), at ``k``
+    (checked: the graph must connect)."""
+    return Resequencer(method, k=int(k), stisomap=params.stisomap if method == "stisomap" else None,
+                       neighbours="dense", metric=metric, global_dof=include_global, sign_mode=params.sign_mode,
+                       translation_scale=params.translation_scale, lee=params.lee).fit([motion])
 
 
 #: Per-transition measures (ratios to the capture; 1 = an ordinary step of the capture, larger = rougher).
@@ -397,7 +394,8 @@ def resequence(motion: Motion, include_global: bool, method: str, metric: str, k
     """
     n = motion.n_frames
     check_distance_budget(n, motion.name, budget_gib)
-    est = config_resequencer(motion, include_global, method, metric, k, cfg)
+    params = method_params(cfg)
+    est = config_resequencer(motion, include_global, method, metric, k, params)
     pc = cfg["path"]
     mode = pc["root_playback"]
     if mode not in ("absolute", "integrate"):
@@ -407,7 +405,7 @@ def resequence(motion: Motion, include_global: bool, method: str, metric: str, k
     tref = TransitionReference(motion, float(sm["contact_height_m"]))
     context = int(round(float(pc["context_s"]) * motion.fps))
     window = max(1, int(round(float(pc["transition_window_s"]) * motion.fps)))
-    same_pass = st_parameters(cfg["stisomap"], motion.fps)["ctn_min_gap"]  # frames closer in time: the same pass
+    same_pass = params.st(motion.fps)["ctn_min_gap"]  # frames closer in time: the same pass
     paths, rows, trows = [], [], []
     for p, (a, b) in enumerate(path_pairs(n, pc, seed)):
         path, cost = est.path(a, b, return_cost=True)

@@ -1,15 +1,21 @@
 """The ``resequencing`` config block: cross-key checks (beyond the JSON Schema, which holds the defaults) and the
 adapters that turn its keys and the workflow's wildcards into the methods' arguments.
 
+The config is read here once: :func:`method_params` turns the block into :class:`MethodParams` (sign mode,
+translation scale, Lee weights, ST-Isomap block), which the workflow steps (:mod:`.jobs`) pass to the methods;
+nothing here reads a step's results.
+
 Imported when the workflow is parsed (:func:`check`): nothing here loads the numeric modules at import time.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from ..config import ConfigError
 
 __all__ = ["METHODS", "METRICS", "GDOF", "METHOD_LABEL", "METRIC_LABEL", "check", "left_out", "gdof_flag", "gdof_name",
-           "sign_mode_of", "st_parameters"]
+           "sign_mode_of", "st_parameters", "lee_kwargs", "MethodParams", "method_params"]
 
 #: The methods and metrics of the study, the global-DOF wildcard values and the figures' labels.
 METHODS = ("isomap", "stisomap")
@@ -92,3 +98,40 @@ def sign_mode_of(cfg: dict) -> str:
     if mode not in SIGN_MODES:
         raise ValueError(f"config key 'resequencing.linearisation.sign_mode': {mode!r} is not one of {SIGN_MODES}")
     return mode
+
+
+def lee_kwargs(lee: dict) -> dict:
+    """Keyword arguments of :func:`~animsynth.resequencing.distances.lee_distances` from the ``lee`` block."""
+    return {"weights": lee["weights"], "nu": float(lee["nu"]), "sqrt": bool(lee["sqrt"])}
+
+
+@dataclass(frozen=True)
+class MethodParams:
+    """The methods' arguments from the ``resequencing`` block, read once (:func:`method_params`).
+
+    Attributes
+    ----------
+    sign_mode : str
+        The L2 features' quaternion sign mode (``linearisation.sign_mode``, checked).
+    translation_scale : float
+        Weight of the root translation in the L2 features (``linearisation.translation_scale``).
+    lee : dict
+        Keyword arguments of the Lee distances (:func:`lee_kwargs`).
+    stisomap : dict
+        The ``stisomap`` block (durations in seconds; :meth:`st` gives frames).
+    """
+
+    sign_mode: str
+    translation_scale: float
+    lee: dict
+    stisomap: dict
+
+    def st(self, fps: float) -> dict:
+        """ST-Isomap's keyword arguments at ``fps`` frames per second (:func:`st_parameters`)."""
+        return st_parameters(self.stisomap, fps)
+
+
+def method_params(cfg: dict) -> MethodParams:
+    """:class:`MethodParams` of the ``resequencing`` block ``cfg`` (validated by the schema, defaults filled in)."""
+    return MethodParams(sign_mode=sign_mode_of(cfg), translation_scale=float(cfg["linearisation"]["translation_scale"]),
+                        lee=lee_kwargs(cfg["lee"]), stisomap=dict(cfg["stisomap"]))
