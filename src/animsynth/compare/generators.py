@@ -39,7 +39,7 @@ Generators (``GENERATORS``):
     (:func:`animsynth.compare.settings.unavailable` gives the reason when not).
 ``fairmotion_fixed``
     the same with upstream's later fixes of its walk (output rate, blend source, rigid turn of the
-    appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.fairmotion_peer.FIXES`).
+    appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.fairmotion_fixes.FIXES`).
 
 The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare.transitions_per_s``
 (:func:`animsynth.compare.motiongraph.budget_count`).
@@ -120,7 +120,8 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
 
         return MotionGraph(**cfg["motion_graph"], transitions_per_s=cfg.get("transitions_per_s"))
     if name in FAIRMOTION_ROWS:
-        from .fairmotion_peer import FIXES, FairmotionGraph
+        from .fairmotion_fixes import FIXES
+        from .fairmotion_peer import FairmotionGraph
 
         return FairmotionGraph(**cfg["fairmotion"], transitions_per_s=cfg.get("transitions_per_s"),
                                fixes=FIXES if name == "fairmotion_fixed" else ())
