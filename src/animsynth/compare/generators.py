@@ -71,7 +71,7 @@ from __future__ import annotations
 
 import logging
 
-from ..generator import Database, Generator, align_root, check_generated
+from ..generator import Generator
 from ..motion import Motion
 from ..resequencing.generator import Resequencer
 from ..simplicial.generator import FieldFollower
@@ -79,9 +79,7 @@ from .references import Concat, Replay
 
 log = logging.getLogger("animsynth.compare.generators")
 
-__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINISTIC", "Database", "Generator",
-           "FieldFollower", "Resequencer", "Replay", "Concat", "make_generator", "align_root",
-           "check_generated"]
+__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINISTIC", "make_generator"]
 
 #: every generator name, in the order of the tables
 GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "fairmotion_fixed",
