@@ -14,6 +14,7 @@ from animsynth.compare import tables
 from animsynth.compare import settings
 from animsynth.compare import verdicts as CV
 from animsynth.config import ConfigError
+from animsynth.generator import Database, align_root
 from animsynth.kinematics import unwrap_angles
 from animsynth.kinematics import heading, root_translation
 from animsynth.motion import Motion
@@ -79,7 +80,7 @@ def test_replay_is_the_held_out_continuation_and_refuses_another_start(fitted, w
 
 
 def test_resequencers_copy_database_frames_and_record_their_sources(fitted, walks):
-    db = G.Database(walks[1:])
+    db = Database(walks[1:])
     for name in ("isomap", "stisomap"):
         m = fitted[name].generate(_start(walks[0]), 25, 1)
         src = m.meta["source_frames"]
@@ -104,7 +105,7 @@ def test_concat_segments_keep_their_heading_and_continue_the_root_position(fitte
 def test_align_root_puts_the_frame_on_the_anchor(walks):
     sk, v = walks[1].skeleton, walks[1].values[:20]
     anchor = walks[2].values[5]
-    out = G.align_root(sk, v, anchor, index=3)
+    out = align_root(sk, v, anchor, index=3)
     assert np.allclose(root_translation(sk, out[3:4])[0, [0, 2]], root_translation(sk, anchor[None])[0, [0, 2]])
     assert np.isclose(heading(sk, out[3:4])[0], heading(sk, anchor[None])[0])
     assert np.allclose(out[:, 6:], v[:, 6:])  # joint angles untouched
@@ -116,8 +117,8 @@ def test_align_root_puts_the_frame_on_the_anchor(walks):
 def test_database_refuses_mixed_rates_and_counts_seams(walks):
     other = Motion(walks[1].values, walks[1].skeleton, 60.0, "fast")
     with pytest.raises(ValueError, match="fps"):
-        G.Database([walks[0], other])
-    db = G.Database(walks[:2])
+        Database([walks[0], other])
+    db = Database(walks[:2])
     n0 = walks[0].n_frames
     path = [0, 1, 2, 5, 6, n0 - 2, n0 - 1, n0, n0 + 1]  # a skip, a jump, then from clip 0's end into clip 1
     assert list(db.seams(path)) == [3, 5, 7]
@@ -729,3 +730,35 @@ def test_the_runner_gives_the_held_out_future_to_a_generator_whose_query_is_it(w
 
     with pytest.raises(ValueError, match="unknown query"):
         runner.generation_query(Odd(), clips[0])
+
+
+def test_the_runner_records_transitions_kept_from_the_generators_run_notes(walks, cfg, monkeypatch):
+    """The ``transitions_kept`` column is what :meth:`Generator.run_notes` gives (NaN where it gives none), for
+    every generator: no generator's own attribute is read."""
+    from animsynth.compare.motiongraph import MotionGraph
+    from animsynth.compare.references import Concat
+    from animsynth.generator import Generator
+
+    assert Generator().run_notes() == {}
+    trials = {f"t{i}": w for i, w in enumerate(walks)}
+    cc = {k: cfg[k] for k in settings.CLIP_KEYS}
+    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))[:1]
+    metrics, _, _ = runner.run_generator(clips, "concat", cfg, 7)
+    assert metrics["transitions_kept"].isna().all()
+    monkeypatch.setattr(Concat, "run_notes", lambda self: {"transitions_kept": 3})
+    metrics, _, _ = runner.run_generator(clips, "concat", cfg, 7)
+    assert (metrics["transitions_kept"] == 3.0).all()
+    kept = []
+    real = MotionGraph.run_notes
+
+    def spy(self):
+        kept.append(self.n_below_threshold_)
+        return real(self)
+
+    monkeypatch.setattr(MotionGraph, "run_notes", spy)
+    metrics, _, _ = runner.run_generator(clips, "motion_graph", cfg, 7)
+    assert kept and (metrics["transitions_kept"] == float(kept[0])).all()
+    monkeypatch.setattr(MotionGraph, "n_below_threshold_", -5, raising=False)  # the class's attribute, not read
+    monkeypatch.setattr(MotionGraph, "run_notes", lambda self: {})
+    metrics, _, _ = runner.run_generator(clips, "motion_graph", cfg, 7)
+    assert metrics["transitions_kept"].isna().all()

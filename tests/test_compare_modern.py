@@ -14,6 +14,7 @@ from animsynth.compare.genmm import GenMM, extract_patches, make_genmm, match_pa
 from animsynth.compare.motionmatching import (MotionMatching, decay_spring, make_motion_matching, spring_angle,
                                               spring_position)
 from animsynth.compare.poses import decode, encode
+from animsynth.compare.references import Replay
 from animsynth.kinematics import bone_lengths, forward_kinematics, root_translation
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
@@ -93,7 +94,7 @@ def test_motion_matching_on_a_clip_of_its_database_with_the_true_trajectory_is_t
     assert tuple(m.meta["source_frames"][0]) == (2, c)  # ... so its next frame plays first
     assert np.all(costs < 1e-12) and m.meta["seams"].size == 0 and m.meta["switches"] == 1  # the entry only
     assert np.array_equal(m.meta["source_frames"][:, 1], np.arange(c, c + length))
-    replay = G.Replay(held_out=clip).fit(db).generate(start, length, 0)
+    replay = Replay(held_out=clip).fit(db).generate(start, length, 0)
     assert _angle_diff(m.values, replay.values) < 1e-8
     locked = MotionMatching().fit(db).generate(start, length, 0, trajectory=truth)
     assert np.array_equal(locked.meta["source_frames"], m.meta["source_frames"])

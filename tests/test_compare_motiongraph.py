@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from animsynth.compare.motiongraph import (MotionGraph, apply_floor_transform, floor_alignment, kovar_alpha,
-                                           pair_terms, window_clouds)
+from animsynth.compare.fairmotion_fixes import FIXES
+from animsynth.compare.motiongraph import MotionGraph, kovar_alpha
+from animsynth.compare.point_clouds import apply_floor_transform, floor_alignment, pair_terms, window_clouds
+from animsynth.generator import check_generated
 from animsynth.kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
@@ -242,11 +244,30 @@ def test_bad_input_is_refused(sk):
         MotionGraph(window=8).fit([a, generate_motion("walk_straight", 60, 2, sk, fps=60.0)])
     with pytest.raises(ValueError, match="blend"):
         MotionGraph(window=8, blend=9).fit([a])
-    with pytest.raises(RuntimeError, match="not fitted"):
+    with pytest.raises(RuntimeError, match=r"call fit\(database\) before generate"):  # the interface's error
         MotionGraph().generate(a, 10, 0)
     g = MotionGraph(window=8).fit([a, generate_motion("walk_straight", 60, 3, sk, fps=FPS)])
     with pytest.raises(ValueError, match="fps"):
         g.generate(Motion(a.values[:5], sk, 120.0), 10, 0)
+
+
+def test_the_motion_graph_is_a_generator_of_the_interface(sk):
+    """fit sets ``db_`` (the interface's Database); generate and search refuse what the interface refuses (a start
+    of one frame) and their output passes the interface's check; run_notes gives the transitions kept."""
+    from animsynth.generator import Database, Generator
+
+    a = generate_motion("walk_straight", 60, 1, sk, fps=FPS)
+    g = MotionGraph(window=8).fit([a, generate_motion("walk_straight", 60, 3, sk, fps=FPS)])
+    assert isinstance(g, Generator) and isinstance(g.db_, Database) and g.db_.n_frames == 120
+    assert g.db_.skeleton is g.skeleton_ and g.db_.fps == g.fps_
+    with pytest.raises(ValueError, match="the start needs >= 2 frames"):
+        g.generate(Motion(a.values[:1], sk, FPS), 10, 0)
+    with pytest.raises(ValueError, match="the start needs >= 2 frames"):
+        g.search(Motion(a.values[:1], sk, FPS), a.values[30], 10)
+    start = Motion(a.values[:10], sk, FPS, "start")
+    for out in (g.generate(start, 25, 0), g.search(start, a.values[30], 25)):
+        assert check_generated(out, 25, g.db_.skeleton) is out and out.values.shape == (25, sk.n_dof)
+    assert g.run_notes() == {"transitions_kept": float(g.n_below_threshold_)}
 
 
 # ---------------------------------------------------------------- the fairmotion peer
@@ -395,7 +416,7 @@ def test_fairmotion_cut_copy_fix_keeps_the_walks_clips_in_place(sk, monkeypatch)
         return np.array([np.asarray(p.data) for p in m.poses])
 
     worst, moved = {}, {}
-    for fixes in ((), fp.FIXES[:3], fp.FIXES):
+    for fixes in ((), FIXES[:3], FIXES):
         g, clips, start = _fm(sk, fixes=fixes, native_fps=60.0, turn=True)
         db_step = max(np.linalg.norm(np.diff(_positions(c)[:, 0], axis=0), axis=-1).max() for c in clips)
         ratios, n_moved = [], 0
@@ -407,8 +428,8 @@ def test_fairmotion_cut_copy_fix_keeps_the_walks_clips_in_place(sk, monkeypatch)
             assert view._copies
             n_moved += sum(not np.array_equal(poses(m), poses(g._loaded_[i])) for i, m in view._copies.items())
         worst[fixes], moved[fixes] = max(ratios), n_moved
-    assert moved[fp.FIXES] == 0 and worst[fp.FIXES] < 1.5
-    assert moved[fp.FIXES[:3]] > 0 and worst[fp.FIXES[:3]] > 5.0  # the other three fixes alone
+    assert moved[FIXES] == 0 and worst[FIXES] < 1.5
+    assert moved[FIXES[:3]] > 0 and worst[FIXES[:3]] > 5.0  # the other three fixes alone
     assert moved[()] > 0 and worst[()] > 5.0  # the released row: as released
 
 
@@ -449,7 +470,7 @@ def test_budget_gives_every_graph_generator_the_same_transition_count(sk):
         ours = MotionGraph(window=6, transitions_per_s=budget).fit([a, b])
         counts[("ours", budget)] = ours.n_below_threshold_
         if not _fairmotion_reason():
-            from animsynth.compare.fairmotion_peer import FIXES, FairmotionGraph
+            from animsynth.compare.fairmotion_peer import FairmotionGraph
 
             fm = FairmotionGraph(base=8, blend=4, compare=4, transitions_per_s=budget, fixes=FIXES,
                                  native_fps=60.0).fit([a, b])  # both rows build this graph (fixes: the walk)
@@ -475,7 +496,7 @@ def test_fairmotion_loads_a_shared_trial_once_and_builds_what_a_fresh_load_build
 
     def build(db):
         g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
-                               fixes=fp.FIXES).fit(db)
+                               fixes=FIXES).fit(db)
         return g, g.transitions_.to_numpy(), [g.generate(start, 30, seed=s).values for s in (1, 2)]
 
     fp._LOADED.clear()
@@ -505,7 +526,7 @@ def test_fairmotion_reuses_its_construction_across_rows_and_budgets(sk):
         return g, g.transitions_.to_numpy(), [g.generate(start, 30, seed=s).values for s in (1, 2)]
 
     cold = {}
-    for budget, fixes in ((2.0, ()), (2.0, fp.FIXES), (4.0, fp.FIXES)):
+    for budget, fixes in ((2.0, ()), (2.0, FIXES), (4.0, FIXES)):
         fp._CONSTRUCTED.clear()
         fp._LOADED.clear()
         g, tr, walks = build(budget, fixes)
@@ -513,7 +534,7 @@ def test_fairmotion_reuses_its_construction_across_rows_and_budgets(sk):
         cold[budget, fixes] = (g.threshold_, g.n_nodes_, tr, walks)
     fp._CONSTRUCTED.clear()
     reused = []
-    for budget, fixes in ((2.0, ()), (2.0, fp.FIXES), (4.0, fp.FIXES)):
+    for budget, fixes in ((2.0, ()), (2.0, FIXES), (4.0, FIXES)):
         g, tr, walks = build(budget, fixes)
         reused.append(g.construct_reused_)
         t, n, tr0, w0 = cold[budget, fixes]
@@ -542,7 +563,7 @@ def test_fairmotion_construct_in_process_equals_its_pool(sk):
         fp._CONSTRUCTED.clear()
         fp._LOADED.clear()
         g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
-                               fixes=fp.FIXES, pool=pool).fit([a, b, c])
+                               fixes=FIXES, pool=pool).fit([a, b, c])
         assert not g.construct_reused_
         key = next(iter(fp._CONSTRUCTED))
         graphs[pool] = (fp._CONSTRUCTED[key], g.transitions_.to_numpy(),
@@ -567,7 +588,7 @@ def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
              (("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5), ("walk_turn", 3))]
     start = Motion(clips[0].values[:10], sk, FPS, "start")
     g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
-                           fixes=fp.FIXES).fit(clips)
+                           fixes=FIXES).fit(clips)
     before = [np.array([np.asarray(p.data) for p in m.poses]) for m in g._loaded_]
     lazy = [g.generate(start, 40, seed=s).values for s in (1, 2, 3)]
     assert all(np.array_equal(x, np.array([np.asarray(p.data) for p in m.poses]))
@@ -681,7 +702,7 @@ def test_fairmotion_builds_on_the_sources_60_fps_frames_not_the_30_fps_clips_ups
     def root_m(loaded):  # fairmotion's root positions (metres, the BVH is written in metres)
         return np.array([np.asarray(p.data)[0, :3, 3] for p in loaded.poses])
 
-    gen = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0, fixes=fp.FIXES)
+    gen = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0, fixes=FIXES)
     fit_kw, gen_kw = runner.native_inputs(gen, clip)
     assert set(fit_kw) == {"native_clips"} and set(gen_kw) == {"native_start"}
     gen.fit(clip.database, **fit_kw)
@@ -714,6 +735,38 @@ def test_fairmotion_builds_on_the_sources_60_fps_frames_not_the_30_fps_clips_ups
     cfg["fairmotion"] = dict(cfg["fairmotion"], base=8, blend=4, compare=4)
     runner.run_generator(clips[:1], "fairmotion_fixed", cfg, 7)
     assert seen and seen[0] is clip.at_rate(60.0).database
+
+
+@pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
+def test_the_fairmotion_peer_is_a_generator_of_the_interface_on_what_it_is_given(sk):
+    """fit sets ``db_`` (the working clips) and ``native_db_`` (the 60 fps clips fairmotion is given); generate
+    refuses an unfitted peer and a start of one frame, at the working and at the native rate, with the interface's
+    errors; its output passes the interface's check; run_notes gives the node pairs kept."""
+    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare import protocol, runner
+    from animsynth.generator import Database, Generator
+
+    clip = protocol.prepare_clips(_trials_120(sk), {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))[0]
+    gen = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0, fixes=FIXES)
+    assert isinstance(gen, Generator)
+    with pytest.raises(RuntimeError, match=r"call fit\(database\) before generate"):
+        gen.generate(clip.start, clip.length, 0)
+    fit_kw, gen_kw = runner.native_inputs(gen, clip)
+    gen.fit(clip.database, **fit_kw)
+    assert isinstance(gen.db_, Database) and isinstance(gen.native_db_, Database)
+    assert (gen.db_.fps, gen.native_db_.fps) == (30.0, 60.0) and gen.native_db_.clips == list(fit_kw["native_clips"])
+    one = clip.start.values[-1:]
+    with pytest.raises(ValueError, match="the start needs >= 2 frames"):
+        gen.generate(Motion(one, sk, 30.0, "one"), clip.length, 0, **gen_kw)
+    native_one = Motion(gen_kw["native_start"].values[-1:], sk, 60.0, "one")
+    with pytest.raises(ValueError, match="the start needs >= 2 frames"):
+        gen.generate(clip.start, clip.length, 0, native_start=native_one)
+    out = gen.generate(clip.start, clip.length, 3, **gen_kw)
+    assert check_generated(out, clip.length, gen.db_.skeleton) is out
+    assert gen.run_notes() == {"transitions_kept": float(gen.n_below_threshold_)}
+    upsampled = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0).fit(
+        clip.database)
+    assert upsampled.native_db_ is None and upsampled.db_.fps == 30.0
 
 
 def positions_m_root(values, sk):

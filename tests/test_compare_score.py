@@ -27,7 +27,7 @@ def run(tmp_path_factory):
     """A comparison of one clip (a temporal split of one walk, so the run's database is the clip's) with the
     project's defaults: knn, replay and a user's generator run by the family's job, each writing its BVH."""
     d = tmp_path_factory.mktemp("score_run")
-    (d / "mine.py").write_text("from animsynth.compare.generators import Concat\n\n\nclass Mine:\n"
+    (d / "mine.py").write_text("from animsynth.compare.references import Concat\n\n\nclass Mine:\n"
                                "    def fit(self, database):\n        self.g = Concat().fit(database.clips)\n"
                                "        return self\n\n    def generate(self, start, length, seed):\n"
                                "        return self.g.generate(start, length, seed)\n")

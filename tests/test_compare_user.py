@@ -50,7 +50,7 @@ def _run(tmp_path, name, cfg, clips_file):
 
 #: a user's class that runs the family's own random concatenation through the public interface only
 CONCAT_WRAPPER = """
-from animsynth.compare.generators import Concat
+from animsynth.compare.references import Concat
 
 
 class Wrapped:

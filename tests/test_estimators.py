@@ -183,6 +183,32 @@ def test_the_registry_holds_no_method_code():
     assert G.FieldFollower is FieldFollower and G.Resequencer is Resequencer
 
 
+def test_the_interface_has_one_import_path():
+    """Generator, Database, align_root, check_generated, play_path and the queries are imported from
+    animsynth.generator alone: there is no compare.base, and nothing imports a name from the registry
+    (compare.generators) that the registry does not export; it exports none of the interface."""
+    import re
+
+    import animsynth.generator as interface
+
+    root = Path(__file__).resolve().parents[1]
+    assert not (root / "src" / "animsynth" / "compare" / "base.py").exists()
+    assert not set(interface.__all__) & set(G.__all__)
+    files = [p for d in ("src", "tests", "workflow", "benchmarks", "docs") for p in sorted((root / d).rglob("*"))
+             if p.suffix in (".py", ".smk", ".md", ".rst") and p.is_file() and p != Path(__file__).resolve()]
+    files += [p for p in (root / "README.md", root / "Snakefile") if p.exists()]
+    bad = []
+    for p in files:
+        text = p.read_text(errors="replace")
+        if re.search(r"compare\.base\b|from \.base import|compare import [^\n]*\bbase\b", text):
+            bad.append((str(p.relative_to(root)), "compare.base"))
+        for m in re.finditer(r"from (?:animsynth\.compare|\.)?\.?generators import (?:\(([^)]*)\)|([\w ,]+))", text):
+            names = {n.strip() for n in (m.group(1) or m.group(2)).split(",") if n.strip()}
+            if names - set(G.__all__):
+                bad.append((str(p.relative_to(root)), sorted(names - set(G.__all__))))
+    assert not bad
+
+
 # ----------------------------------------------------------------------------- golden numbers
 
 # Integer results (frame paths, source frames, k, nearest-frame indices, step counts) of the code before the

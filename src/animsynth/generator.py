@@ -161,6 +161,9 @@ class Generator:
     generator by default: the start alone) or :data:`QUERY_FUTURE_TRAJECTORY` (``"future_trajectory"``: its
     ``generate`` takes ``trajectory=``, the held-out frames after the start, and the compare family's runner
     passes them; information the other generators do not see).
+
+    :meth:`run_notes` gives the values of a fitted generator that a run records besides its motion (empty by
+    default; the graph generators: the transitions they kept).
     """
 
     name = "generator"
@@ -172,12 +175,23 @@ class Generator:
     def generate(self, start: Motion, length: int, seed: int) -> Motion:  # pragma: no cover
         raise NotImplementedError
 
-    def _check_start(self, start: Motion, length: int) -> None:
+    def run_notes(self) -> dict:
+        """Values of the fitted generator that a run records with its metrics, ``{name: number}``; a name a
+        generator does not give is recorded as NaN (:meth:`Generator.run_notes` itself gives none).
+
+        ``transitions_kept``: the candidate transitions a graph generator keeps before pruning.
+        """
+        return {}
+
+    def _check_start(self, start: Motion, length: int, database: Database | None = None) -> None:
+        """Refuse a generator that is not fitted, a start of fewer than 2 frames or of other DOF columns than
+        ``database`` (``db_`` unless given: the clips a generator that runs on other clips than ``db_`` really
+        receives), and a ``length`` below 1."""
         if not hasattr(self, "db_"):
             raise RuntimeError(f"{self.name}: call fit(database) before generate")
         if start.n_frames < 2:
             raise ValueError(f"{self.name}: the start needs >= 2 frames, has {start.n_frames}")
-        if start.columns != self.db_.skeleton.columns():
+        if start.columns != (self.db_ if database is None else database).skeleton.columns():
             raise ValueError(f"{self.name}: the start's DOF columns differ from the database's")
         if int(length) < 1:
             raise ValueError(f"{self.name}: length must be >= 1, got {length}")

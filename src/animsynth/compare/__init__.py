@@ -4,22 +4,24 @@ The same held-out clips (CMU's Gauch & Peters subsets by leave one out, the re-s
 temporal split), the same starts and seeds, one set of metrics (foot skating, seam jumps, smoothness,
 LAFAN1's L2P / L2Q / NPSS, coverage, diversity, novelty) and the cost of each generator. This package
 sits above the four families: it fits and runs their estimators (the registry, :mod:`.generators`)
-to score them; no family imports it.
+to score them; no family imports it. Every generator, the graphs included, is a
+:class:`animsynth.generator.Generator`: the interface (Generator, Database, root placement) has the one import
+path :mod:`animsynth.generator`.
 
 Modules
 -------
-base            the one interface (``fit(database)``, ``generate(start, length, seed)``: Generator, Database,
-                root placement), re-exported from :mod:`animsynth.generator`, where every generator builds on it
 generators      the registry: names -> estimators and their settings (``make_generator``), no method code:
                 delaunay, knn (the simplicial family's FieldFollower), isomap, stisomap (the resequencing
                 family's Resequencer), motion_graph, fairmotion, fairmotion_fixed, motion_matching,
                 motion_matching_pose, motion_matching_traj (its query: the held-out future), genmm, replay, concat
 references      the two reference rows: replay (the held-out capture) and concat (random segments)
 motiongraph     the classic motion graph (Kovar, Gleicher & Pighin 2002)
+point_clouds    joint-position point clouds and their closed-form floor alignment (both graphs compare with it)
 motionmatching  motion matching with inertialization and foot locking (Clavet 2016; Holden et al. 2020)
 genmm           generative motion matching (Li et al. 2023)
 poses           the pose representation the two share; footlock: motion matching's foot locking and leg IK
 fairmotion_peer fairmotion's motion graph on the same clips (the peer row), when it can be imported
+fairmotion_fixes the named fixes of fairmotion's walk (the row fairmotion_fixed) and the recorder of its walk
 metric_table    the metric table (``METRICS``: one record per column of metrics.csv, its unit, which way is
                 better, what it needs, its label) and the selections that read it
 metrics         the metrics (pure numpy; metres, m/s), gathered from positions (positions, facing, pose features),
@@ -44,7 +46,6 @@ from .._lazy import lazy_exports
 # their families: animsynth.simplicial, animsynth.resequencing)
 _EXPORTS = {
     "Concat": ".references",
-    "Database": ".generators",
     "GENERATORS": ".generators",
     "METRICS": ".metric_table",
     "MotionGraph": ".motiongraph",

@@ -46,7 +46,7 @@ Its native rate
 fairmotion's walk assumes 60 fps (its output motion is built at its default 60 fps whatever the data's rate).
 The peer is therefore fed its native rate, ``native_fps`` = 60 (default; a whole multiple ``k`` of the working
 rate). In the comparison the clips carry the database and the start at that rate taken by frame step from the
-source trials (CMU's 120 fps: every second frame; :class:`animsynth.compare.jobs.NativeRate`), and the runner
+source trials (CMU's 120 fps: every second frame; :class:`animsynth.compare.protocol.NativeRate`), and the runner
 passes them (``fit(database, native_clips=...)``, ``generate(..., native_start=...)``; the class attribute
 ``input_rate = "native"`` says the peer takes them): fairmotion builds its graph and walks on the captured 60 fps
 frames, and the start node is chosen by the 60 fps start. Without them (a source rate that is not a whole multiple
@@ -60,35 +60,7 @@ Defects of the release, and the fixes (``fixes``)
 -------------------------------------------------
 Four defects of 0.0.4's walk were changed upstream after the release (never released). The peer runs as
 released (``fixes=()``, the row ``fairmotion``) and with each fix applied as a small patch of the walk
-(``fixes=FIXES``, the row ``fairmotion_fixed``); each patch swaps one thing for the duration of one walk and is
-undone afterwards:
-
-``output_rate``
-    ``create_random_motion`` builds its output at fairmotion's default 60 fps, so away from 60 fps the cut
-    before each appended piece lands at the wrong frame. Patch: the empty output motion takes the appended
-    pieces' frame rate before the first append (upstream passes the graph's rate to the output motion).
-``blend_source``
-    ``append_and_blend`` starts the blend's source time at ``fps * frame`` instead of ``frame / fps``, so every
-    blend draws its source from past the end of the previous piece: its last pose, held still. Patch: for
-    each append, the previous motion's ``get_pose_by_time`` is offset by the difference of the two times, so
-    the source plays on from the blend's first frame (the overlap frames the walk cuts for it), as upstream's
-    "overlapping" blend does.
-``rigid_turn``
-    ``append_and_blend`` turns the appended piece with ``ops.motion.rotate`` (``transform(local=False)``), which
-    rotates every pose's orientation about the vertical but leaves its root path where it was, so a piece
-    walks sideways or backwards after a turn. Patch: ``ops.motion.rotate`` turns the piece rigidly about its
-    first pose's root (orientation and path), as upstream's ``transform(..., pivot=0)`` does.
-``cut_copy``
-    ``ops.motion.cut`` deep-copies the clip but hands back the Pose objects of the loaded clip itself
-    (``motion.poses[start:end]``), and ``append_and_blend`` moves the appended piece's poses in place
-    (``translate``, ``rotate``). The walk cuts each node with ``frames_blend`` extra frames, so consecutive
-    pieces of one clip share those frames: placing one piece displaces the first frames of the next piece read
-    from the same clip (and of any later visit), which then jumps back where its own frames were not moved
-    (the paper run of 2026-12-05, this fix and the 60 fps source together, on the 19 clips of the run before:
-    the fixed row's median 95th percentile of the per-frame velocity jump 1.69 -> 1.22 m/s, the largest jump
-    over every clip and seed 96.7 -> 25.3 m/s; docs/compare.md, "Results on CMU"). Patch: ``cut`` returns the
-    poses of its own deep copy (``cut_motion.poses[start:end]``, and its velocities cut alike), as upstream's
-    fix in the same commit as the three above does; the loaded clips are then never moved by a walk.
+(``fixes=FIXES``, the row ``fairmotion_fixed``; :mod:`animsynth.compare.fairmotion_fixes` names and describes them).
 
 Released (the row ``fairmotion``), ``cut`` shares the poses and a walk displaces poses that later pieces of the
 same walk reuse. Between walks we step in for both rows: every :meth:`FairmotionGraph.generate` walks a fresh
@@ -112,15 +84,17 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
+from ..generator import Database, Generator, check_generated
 from ..io.bvh import write_bvh
 from ..kinematics import dof_values_from_local
 from ..motion import Motion
 from ..skeleton import Skeleton
 from ..kinematics import local_rotations, root_translation
-from .motiongraph import (pair_terms, positions_m, transform_from_terms, window_clouds, apply_floor_transform,
-                          budget_keep)
+from .fairmotion_fixes import check_fixes, walk_patches
+from .motiongraph import budget_keep
+from .point_clouds import apply_floor_transform, pair_terms, positions_m, transform_from_terms, window_clouds
 
-__all__ = ["FairmotionGraph", "FairmotionUnavailable", "INSTALL_COMMAND", "FAIRMOTION_VERSION", "FIXES", "NATIVE_FPS",
+__all__ = ["FairmotionGraph", "FairmotionUnavailable", "INSTALL_COMMAND", "FAIRMOTION_VERSION", "NATIVE_FPS",
            "upsample"]
 
 #: The fairmotion release this peer is written for (the only one on the package index).
@@ -128,8 +102,6 @@ FAIRMOTION_VERSION = "0.0.4"
 #: How to install it (and the two small libraries its motion-graph module imports) without its requirements.
 INSTALL_COMMAND = "pip install --no-deps fairmotion==0.0.4 networkx==3.6.1 tqdm==4.70.1"
 
-#: The fixes of the walk that upstream made after 0.0.4 (module docstring), in the order they are named.
-FIXES = ("output_rate", "blend_source", "rigid_turn", "cut_copy")
 #: The frame rate fairmotion's walk assumes (its Motion's default).
 NATIVE_FPS = 60.0
 
@@ -318,7 +290,7 @@ def _run_serially(func, iterable, num_cpus=1, **kwargs):
     return [func(x, **kwargs) for x in iterable]
 
 
-class FairmotionGraph:
+class FairmotionGraph(Generator):
     """fairmotion 0.0.4's motion graph behind the compare generator interface (see the module docstring).
 
     ``input_rate = "native"``: :meth:`fit` and :meth:`generate` also take the database and the start at
@@ -345,8 +317,8 @@ class FairmotionGraph:
         The rate the walk runs at (fairmotion's native 60 fps; an integer multiple of the database's rate);
         ``None``: the database's rate.
     fixes : sequence of str
-        Which of :data:`FIXES` to apply to the walk (``()``: as released). They change the walk, not the
-        graph: read at every :meth:`generate`.
+        Which of :data:`animsynth.compare.fairmotion_fixes.FIXES` to apply to the walk (``()``: as released).
+        They change the walk, not the graph: read at every :meth:`generate`.
     w_joint_pos, w_joint_vel, w_root_pos, w_root_vel, w_ee_pos, w_ee_vel, w_trajectory : float
         fairmotion's similarity weights.
     num_comparison : int
@@ -371,6 +343,11 @@ class FairmotionGraph:
     native_fps_ : float
         The rate fairmotion ran at; ``upsample_`` = native_fps_ / fps_.
     fixes_ : tuple of str
+    n_below_threshold_ : int
+        Node pairs that are not a clip playing on kept at the threshold (before the reduction).
+    db_ : Database, the clips at the working rate (:class:`animsynth.generator.Database`)
+    native_db_ : Database or None, the native-rate clips fairmotion was given (``native_clips``); ``None`` when it
+        was given the working clips upsampled
     construct_reused_ : bool
         Whether ``construct`` ran in this fit or its graph came from the process's memo (an earlier fit on the
         same clips with the same lengths, weights and comparison count: the other row, another budget).
@@ -383,6 +360,7 @@ class FairmotionGraph:
         every source pose a blend drew, in order).
     """
 
+    name = "fairmotion"
     input_rate = "native"
 
     def __init__(self, base: int = 15, stride: int | None = None, blend: int = 10, compare: int = 10,
@@ -443,6 +421,7 @@ class FairmotionGraph:
             if c.skeleton.columns() != first.skeleton.columns() or not np.isclose(c.fps, first.fps):
                 raise ValueError(f"fairmotion graph: clip {c.name!r} differs from {first.name!r} in DOF columns or "
                                  "frame rate")
+        db = Database(clips)
         fixes = self._fixes()
         fps = float(first.fps)
         native = fps if self.native_fps is None else float(self.native_fps)
@@ -461,6 +440,7 @@ class FairmotionGraph:
                         or n.n_frames < (c.n_frames - 1) * up + 1):
                     raise ValueError(f"fairmotion graph: native clip {n.name!r} is not clip {c.name!r} at {native:g} fps "
                                      f"(its rate {n.fps:g}, {n.n_frames} frames, need >= {(c.n_frames - 1) * up + 1})")
+        native_db = Database(src) if src is not clips else None  # the clips fairmotion is given, when not upsampled
         # each clip's memo key, hashed once: the loading memo's and, together, the construction memo's below
         keys = [_native_key(c, load_up, None if i == 0 else (src[0], None)) for i, c in enumerate(src)]
         loaded = [_load_native(src[0], load_up, bvh, velocity, key=keys[0])]
@@ -557,16 +537,18 @@ class FairmotionGraph:
         self.native_fps_ = native
         self.upsample_ = up
         self.fixes_ = fixes
+        self.db_, self.native_db_ = db, native_db
         return self
+
+    def run_notes(self) -> dict:
+        """``transitions_kept``: the node pairs kept at the threshold (``n_below_threshold_``, before the
+        reduction)."""
+        return {"transitions_kept": float(self.n_below_threshold_)}
 
     def _start(self, start: Motion, native_start: Motion | None = None):
         """The reduced graph's node whose preceding frames are nearest the end of ``start``, and its placement;
         with ``native_start`` (and native-rate clips fitted), compared at the native rate: its last ``blend * k``
         frames against the native frames before each node."""
-        if not hasattr(self, "_graph_"):
-            raise RuntimeError("FairmotionGraph is not fitted: call fit(database) first")
-        if not isinstance(start, Motion) or start.n_frames < 1:
-            raise ValueError("start must be a Motion with at least one frame")
         if not np.isclose(start.fps, self.fps_):
             raise ValueError(f"start {start.name!r} is at {start.fps:g} fps, the database at {self.fps_:g} fps")
         up = self.upsample_
@@ -592,72 +574,7 @@ class FairmotionGraph:
         return ids[best], tuple(float(x) for x in place)
 
     def _fixes(self) -> tuple:
-        fixes = tuple(self.fixes)
-        unknown = [f for f in fixes if f not in FIXES]
-        if unknown:
-            raise ValueError(f"fairmotion fixes {unknown} unknown; choose from {list(FIXES)}")
-        return fixes
-
-    def _patches(self, motion_ops, blend_sources: list):
-        """The walk's patches: ``(recorder wrapping append_and_blend, {name: replacement} of ops.motion)``.
-        The fixes act on the walk only (read from ``fixes`` at every :meth:`generate`; the graph is the same
-        for both rows)."""
-        from fairmotion.ops import conversions
-
-        fixes = self.fixes_ = self._fixes()
-        original = motion_ops.append_and_blend
-        original_blend = motion_ops.blend
-        pieces = []
-
-        def recorder(motion1, motion2, blend_length=0):
-            if "output_rate" in fixes and motion1.num_frames() == 0:
-                # fix: the empty output motion takes the appended pieces' rate (released: its default 60 fps)
-                motion1.fps, motion1.fps_inv = motion2.fps, 1.0 / motion2.fps
-            if "blend_source" in fixes and motion1.num_frames() > 0:
-                # fix: the blend's source time starts at frame_source / fps (released: fps * frame_source)
-                frame_source = motion1.time_to_frame(motion1.length() - blend_length)
-                shift = motion1.fps * frame_source - frame_source / motion1.fps
-                by_time = motion1.get_pose_by_time
-                motion1.get_pose_by_time = lambda t: by_time(t - shift)
-            try:
-                out = original(motion1, motion2, blend_length=blend_length)
-            finally:
-                motion1.__dict__.pop("get_pose_by_time", None)
-            out.__dict__.pop("get_pose_by_time", None)
-            pieces.append((out.num_frames() - motion2.num_frames(), motion2.num_frames(), motion1.num_frames() > 0))
-            return out
-
-        def blend_recorder(pose1, pose2, alpha=0.5):
-            blend_sources.append(np.array(conversions.T2p(pose1.get_root_transform()), float))
-            return original_blend(pose1, pose2, alpha)
-
-        def rigid_rotate(motion, R, local=False):
-            # fix: turn the piece rigidly about its first pose's root, orientation and path (released: the
-            # orientation only, ``transform(local=False)``)
-            if local or not motion.poses:
-                return motion_ops.transform(motion, conversions.R2T(R), local)
-            pivot = np.array(conversions.T2p(motion.poses[0].get_root_transform()), float)
-            for pose in motion.poses:
-                R0, p0 = conversions.T2Rp(pose.get_root_transform())
-                pose.set_root_transform(conversions.Rp2T(np.dot(R, R0), pivot + np.dot(R, p0 - pivot)), local=False)
-            return motion
-
-        def copying_cut(motion, frame_start, frame_end):
-            # fix: the cut piece's poses are its own copy's (released: the loaded clip's Pose objects themselves,
-            # which append_and_blend then moves in place)
-            cut_motion = copy.deepcopy(motion)
-            cut_motion.name = f"{motion.name}_{frame_start}_{frame_end}"
-            cut_motion.poses = cut_motion.poses[frame_start:frame_end]
-            if hasattr(cut_motion, "vels"):
-                cut_motion.vels = cut_motion.vels[frame_start:frame_end]
-            return cut_motion
-
-        swap = {"append_and_blend": recorder, "blend": blend_recorder}
-        if "rigid_turn" in fixes:
-            swap["rotate"] = rigid_rotate
-        if "cut_copy" in fixes:
-            swap["cut"] = copying_cut
-        return pieces, swap
+        return check_fixes(self.fixes)
 
     def generate(self, start: Motion, length: int, seed: int, native_start: Motion | None = None) -> Motion:
         """fairmotion's ``create_random_motion`` from the node nearest the end of ``start``, ``length`` frames.
@@ -675,6 +592,9 @@ class FairmotionGraph:
         appended piece starts: the first output frame at or after it), ``source_frames`` ((length, 2): clip and
         frame, -1 for blended frames), ``start_node`` (clip, frame), ``fairmotion_version``, ``fixes``.
         """
+        self._check_start(start, length)
+        if native_start is not None and self.native_db_ is not None:
+            self._check_start(native_start, length, self.native_db_)  # the start fairmotion is given
         if isinstance(length, bool) or not isinstance(length, (int, np.integer)) or length < 1:
             raise ValueError(f"length must be an integer >= 1 (frames), got {length!r}")
         length = int(length)
@@ -689,7 +609,8 @@ class FairmotionGraph:
         graph = self._graph_
         nodes = graph.graph.nodes
         blend_sources = []
-        pieces, swap = self._patches(motion_ops, blend_sources)
+        self.fixes_ = self._fixes()  # the fixes act on the walk only: read at every walk (one graph for both rows)
+        pieces, swap = walk_patches(motion_ops, self.fixes_, blend_sources)
         saved = {name: getattr(motion_ops, name) for name in swap}
         state = random.getstate()
         for name, f in swap.items():
@@ -754,4 +675,5 @@ class FairmotionGraph:
         meta = {"seams": seams, "source_frames": src, "generator": "fairmotion",
                 "start_node": (int(nodes[node]["motion_idx"]), int(nodes[node]["frame_start"]) // up),
                 "fairmotion_version": self.fairmotion_version_, "fixes": self.fixes_}
-        return Motion(values, self.skeleton_, self.fps_, f"fairmotion_walk_seed{seed}", meta)
+        return check_generated(Motion(values, self.skeleton_, self.fps_, f"fairmotion_walk_seed{seed}", meta), length,
+                               self.db_.skeleton, self.name)

@@ -15,7 +15,7 @@ frame ``t`` does not follow frame ``t - 1`` in the source (a transition or a ble
 for a generator without seams), ``meta["source_frames"]`` the ``(clip, frame)`` of the database frame
 each output frame plays (``-1`` where the frame is synthesised). The entry from the start into the
 generated frames is scored as a seam by the family for every generator but ``replay``
-(:mod:`animsynth.compare.jobs`), whatever a generator records.
+(:func:`animsynth.compare.scoring.score`), whatever a generator records.
 
 Generators (``GENERATORS``):
 
@@ -39,7 +39,7 @@ Generators (``GENERATORS``):
     (:func:`animsynth.compare.settings.unavailable` gives the reason when not).
 ``fairmotion_fixed``
     the same with upstream's later fixes of its walk (output rate, blend source, rigid turn of the
-    appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.fairmotion_peer.FIXES`).
+    appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.fairmotion_fixes.FIXES`).
 
 The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare.transitions_per_s``
 (:func:`animsynth.compare.motiongraph.budget_count`).
@@ -71,7 +71,7 @@ from __future__ import annotations
 
 import logging
 
-from ..generator import Database, Generator, align_root, check_generated
+from ..generator import Generator
 from ..motion import Motion
 from ..resequencing.generator import Resequencer
 from ..simplicial.generator import FieldFollower
@@ -79,9 +79,7 @@ from .references import Concat, Replay
 
 log = logging.getLogger("animsynth.compare.generators")
 
-__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINISTIC", "Database", "Generator",
-           "FieldFollower", "Resequencer", "Replay", "Concat", "make_generator", "align_root",
-           "check_generated"]
+__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINISTIC", "make_generator"]
 
 #: every generator name, in the order of the tables
 GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "fairmotion_fixed",
@@ -120,7 +118,8 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
 
         return MotionGraph(**cfg["motion_graph"], transitions_per_s=cfg.get("transitions_per_s"))
     if name in FAIRMOTION_ROWS:
-        from .fairmotion_peer import FIXES, FairmotionGraph
+        from .fairmotion_fixes import FIXES
+        from .fairmotion_peer import FairmotionGraph
 
         return FairmotionGraph(**cfg["fairmotion"], transitions_per_s=cfg.get("transitions_per_s"),
                                fixes=FIXES if name == "fairmotion_fixed" else ())

@@ -19,7 +19,7 @@ Candidate transitions. Frame ``i`` of clip A and frame ``j`` of clip B are compa
     ``B_{j-k+1} .. B_j`` (the window that *ends* at B_j). The points are the joint positions of every frame
     of the window (forward kinematics, metres). ``D(A_i, B_j) = min_{theta, x0, z0} sum_n w_n
     |p_n - T(theta, x0, z0) p'_n|^2``, ``T`` a rotation by ``theta`` about the vertical (y) axis followed by
-    the floor translation ``(x0, 0, z0)``, solved in closed form (:func:`floor_alignment`). With
+    the floor translation ``(x0, 0, z0)``, solved in closed form (:func:`animsynth.compare.point_clouds.floor_alignment`). With
     ``sum w_n = 1`` D is a weighted mean squared distance (m^2); we report and threshold ``sqrt(D)``, the
     RMS point distance in metres (monotone in D: the same minima).
 Transition points: the local minima of D over ``(i, j)`` below a threshold.
@@ -68,15 +68,17 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 from scipy.spatial.transform import Rotation
 
+from ..generator import Database, Generator, check_generated
 from ..kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation
 from ..motion import Motion
+from .point_clouds import (apply_floor_transform, compose_floor_transforms, normalised_weights, pair_terms,
+                           positions_m, transform_from_terms, window_clouds)
 
-__all__ = ["MotionGraph", "apply_floor_transform", "floor_alignment", "kovar_alpha", "compose_floor_transforms",
-           "budget_count", "budget_keep", "positions_m", "window_clouds", "pair_terms", "transform_from_terms"]
+__all__ = ["MotionGraph", "kovar_alpha", "budget_count", "budget_keep"]
 
 
 # --------------------------------------------------------------------------------------------------
-# the closed-form alignment
+# the transition budget and the blend
 # --------------------------------------------------------------------------------------------------
 def budget_count(transitions_per_s: float, database_seconds: float) -> int:
     """Transitions a graph keeps under the transition budget: ``round(transitions_per_s * database_seconds)``,
@@ -103,89 +105,6 @@ def budget_keep(distances, transitions_per_s: float, database_seconds: float) ->
     return keep
 
 
-def _normalised_weights(weights, n: int) -> np.ndarray:
-    w = np.ones(n) if weights is None else np.asarray(weights, float).reshape(-1)
-    if w.shape != (n,):
-        raise ValueError(f"weights must have one value per point ({n}), got {w.shape[0]}")
-    if not np.all(np.isfinite(w)) or np.any(w < 0) or w.sum() <= 0:
-        raise ValueError("weights must be finite, >= 0 and not all 0")
-    return w / w.sum()
-
-
-def apply_floor_transform(points, theta, x0, z0) -> np.ndarray:
-    """Rotate ``points`` by ``theta`` about the vertical y axis, then translate by ``(x0, 0, z0)``.
-
-    Parameters
-    ----------
-    points : array (..., n, 3)
-    theta, x0, z0 : float or array (...)
-        Radians and the points' length unit. ``theta`` turns +z towards +x (the right-handed rotation
-        about +y, ``Rotation.from_euler("y", theta)``).
-
-    Returns
-    -------
-    array (..., n, 3)
-    """
-    p = np.asarray(points, float)
-    th = np.asarray(theta, float)[..., None]
-    c, s = np.cos(th), np.sin(th)
-    out = p.copy()
-    out[..., 0] = c * p[..., 0] + s * p[..., 2] + np.asarray(x0, float)[..., None]
-    out[..., 2] = -s * p[..., 0] + c * p[..., 2] + np.asarray(z0, float)[..., None]
-    return out
-
-
-def floor_alignment(p, q, weights=None):
-    """The rotation about y and floor translation that best map point cloud ``q`` onto ``p`` (closed form).
-
-    Minimises ``sum_n w_n |p_n - T q_n|^2`` over ``T`` = rotation by ``theta`` about the vertical y axis
-    followed by ``(x0, 0, z0)`` (the closed form of Kovar, Gleicher & Pighin 2002). With ``xb = sum w x`` etc.
-    (weights normalised to sum 1)::
-
-        theta = atan2(sum w (x z' - x' z) - (xb zb' - xb' zb), sum w (x x' + z z') - (xb xb' + zb zb'))
-        x0 = xb - xb' cos(theta) - zb' sin(theta)
-        z0 = zb + xb' sin(theta) - zb' cos(theta)
-
-    (``atan2`` rather than the paper's ``arctan`` of the quotient, which is ambiguous by pi: atan2 picks the
-    minimum, not the maximum.)
-
-    Parameters
-    ----------
-    p, q : array (..., n, 3)
-        Corresponding points; y is up.
-    weights : array (n,), optional
-        Non-negative point weights (uniform if omitted), normalised to sum 1.
-
-    Returns
-    -------
-    theta, x0, z0, d2 : arrays (...)
-        The transform and the weighted mean squared distance ``sum w |p - T q|^2`` after it.
-    """
-    p = np.asarray(p, float)
-    q = np.asarray(q, float)
-    if p.shape != q.shape or p.ndim < 2 or p.shape[-1] != 3:
-        raise ValueError(f"p and q must both have shape (..., n, 3), got {p.shape} and {q.shape}")
-    w = _normalised_weights(weights, p.shape[-2])
-    x, z, xq, zq = p[..., 0], p[..., 2], q[..., 0], q[..., 2]
-    xb, zb, xqb, zqb = x @ w, z @ w, xq @ w, zq @ w
-    a = (x * xq + z * zq) @ w - (xb * xqb + zb * zqb)
-    b = (x * zq - xq * z) @ w - (xb * zqb - xqb * zb)
-    theta = np.arctan2(b, a)
-    c, s = np.cos(theta), np.sin(theta)
-    x0 = xb - xqb * c - zqb * s
-    z0 = zb + xqb * s - zqb * c
-    d2 = (((p - apply_floor_transform(q, theta, x0, z0)) ** 2).sum(-1)) @ w
-    return theta, x0, z0, d2
-
-
-def compose_floor_transforms(outer, inner):
-    """``outer o inner`` of two floor transforms ``(theta, x0, z0)`` (apply ``inner`` first)."""
-    th_o, xo, zo = outer
-    th_i, xi, zi = inner
-    c, s = np.cos(th_o), np.sin(th_o)
-    return th_o + th_i, c * xi + s * zi + xo, -s * xi + c * zi + zo
-
-
 def kovar_alpha(n: int) -> np.ndarray:
     """Blend weights of the source clip over an ``n``-frame transition: ``2((p+1)/n)^3 - 3((p+1)/n)^2 + 1``.
 
@@ -195,75 +114,10 @@ def kovar_alpha(n: int) -> np.ndarray:
     return 2.0 * u**3 - 3.0 * u**2 + 1.0
 
 
-def window_clouds(pos: np.ndarray, k: int) -> np.ndarray:
-    """The point cloud of every window of ``k`` frames, frame-major (the points of the window's first frame,
-    then its second's, ...).
-
-    Parameters
-    ----------
-    pos : array (T, J, 3), joint positions of ``T`` frames
-    k : int, frames per window (``1 <= k <= T``)
-
-    Returns
-    -------
-    array (T-k+1, k*J, 3); row ``t`` is the window ``pos[t:t+k]``
-    """
-    v = np.lib.stride_tricks.sliding_window_view(pos, k, axis=0)  # (T-k+1, J, 3, k)
-    return np.ascontiguousarray(np.moveaxis(v, -1, 1)).reshape(v.shape[0], k * pos.shape[1], 3)
-
-
-def pair_terms(P: np.ndarray, Q: np.ndarray, w: np.ndarray):
-    """Closed-form terms of the floor alignment (:func:`floor_alignment`) for every pair (row of P, row of Q) of
-    point clouds, as matrix products.
-
-    Centring x and z per cloud first (the optimal translation removes them anyway) keeps the differences of
-    large numbers out of the products.
-
-    Parameters
-    ----------
-    P : array (m, n, 3), Q : array (l, n, 3), point clouds of ``n`` corresponding points (y up)
-    w : array (n,), point weights summing to 1
-
-    Returns
-    -------
-    d2 : array (m, l), the aligned weighted mean squared distance (Q moved onto P)
-    a, b : arrays (m, l), ``theta = atan2(b, a)`` is the aligning rotation about y (:func:`transform_from_terms`)
-    cp, cq : ``(x, z)`` weighted centroids of P (two arrays (m,)) and of Q (two arrays (l,))
-    """
-    xp, yp, zp = P[..., 0], P[..., 1], P[..., 2]
-    xq, yq, zq = Q[..., 0], Q[..., 1], Q[..., 2]
-    xpb, zpb, xqb, zqb = xp @ w, zp @ w, xq @ w, zq @ w
-    xp, zp = xp - xpb[:, None], zp - zpb[:, None]
-    xq, zq = xq - xqb[:, None], zq - zqb[:, None]
-    left = np.hstack([xp * w, zp * w])
-    a = left @ np.hstack([xq, zq]).T  # sum w (x x' + z z')
-    b = left @ np.hstack([zq, -xq]).T  # sum w (x z' - z x')
-    cyy = (yp * w) @ yq.T
-    sp = (yp**2 + xp**2 + zp**2) @ w
-    sq = (yq**2 + xq**2 + zq**2) @ w
-    d2 = sp[:, None] + sq[None, :] - 2.0 * cyy - 2.0 * np.hypot(a, b)
-    return np.maximum(d2, 0.0), a, b, (xpb, zpb), (xqb, zqb)
-
-
-def transform_from_terms(a, b, cp, cq):
-    """The floor transform ``(theta, x0, z0)`` moving Q onto P (:func:`apply_floor_transform`), from the terms of
-    :func:`pair_terms`: ``a``, ``b`` and the centroids ``cp = (x, z)``, ``cq = (x, z)`` of the pairs wanted
-    (arrays of one shape, or scalars); returns three arrays of that shape."""
-    theta = np.arctan2(b, a)
-    c, s = np.cos(theta), np.sin(theta)
-    (xpb, zpb), (xqb, zqb) = cp, cq
-    return theta, xpb - xqb * c - zqb * s, zpb + xqb * s - zqb * c
-
-
-def positions_m(motion: Motion) -> np.ndarray:
-    """World joint positions (segment ends, forward kinematics) of ``motion`` in metres: array (T, J, 3)."""
-    return forward_kinematics(motion.skeleton, motion.values, ends=True) * motion.skeleton.length_to_m
-
-
 # --------------------------------------------------------------------------------------------------
 # the graph
 # --------------------------------------------------------------------------------------------------
-class MotionGraph:
+class MotionGraph(Generator):
     """Kovar et al.'s motion graph on a database of clips (see the module docstring for the method).
 
     Parameters
@@ -308,7 +162,10 @@ class MotionGraph:
     skeleton_, fps_ : the output skeleton (the first clip's) and frame rate.
     window_, blend_ : int
     clip_names_ : list of str
+    db_ : Database, the clips (:class:`animsynth.generator.Database`)
     """
+
+    name = "motion_graph"
 
     def __init__(self, window: int = 10, threshold: float | None = None, threshold_quantile: float = 0.5,
                  blend: int | None = None, minima_radius: int = 1, joint_weights=None,
@@ -357,7 +214,7 @@ class MotionGraph:
         n_joints = pos[0].shape[1]
         if any(p.shape[1] != n_joints for p in pos):
             raise ValueError("motion graph: the clips' skeletons have different joint counts")
-        jw = _normalised_weights(self.joint_weights, n_joints)
+        jw = normalised_weights(self.joint_weights, n_joints)
         lengths = np.array([c.n_frames for c in clips])
         rows, cols, cand, terms = self._candidates(pos, lengths, np.tile(jw, k) / k, k, r)
         keep = self._threshold(cand, float(lengths.sum()) / float(clips[0].fps))
@@ -368,7 +225,12 @@ class MotionGraph:
         del terms, a, bb
         self._prune(lengths, rows, cols, cand, (theta, x0, z0), k, b)
         self._store_frames(clips, pos, jw, k, b)
+        self.db_ = Database(clips)
         return self
+
+    def run_notes(self) -> dict:
+        """``transitions_kept``: the candidates at or below the threshold (``n_below_threshold_``, before pruning)."""
+        return {"transitions_kept": float(self.n_below_threshold_)}
 
     @staticmethod
     def _check_database(database, k: int) -> list:
@@ -521,10 +383,6 @@ class MotionGraph:
         self.clip_names_ = [c.name for c in clips]
 
     # ---------------------------------------------------------------- queries
-    def _check_fitted(self):
-        if not hasattr(self, "_graph_"):
-            raise RuntimeError("MotionGraph is not fitted: call fit(database) first")
-
     def _check_length(self, length) -> int:
         if isinstance(length, bool) or not isinstance(length, (int, np.integer)) or length < 1:
             raise ValueError(f"length must be an integer >= 1 (frames), got {length!r}")
@@ -532,8 +390,6 @@ class MotionGraph:
 
     def _start_node(self, start: Motion):
         """Graph node after the database frame nearest the end of ``start``, and the transform placing it."""
-        if not isinstance(start, Motion) or start.n_frames < 1:
-            raise ValueError("start must be a Motion with at least one frame")
         if not np.isclose(start.fps, self.fps_):
             raise ValueError(f"start {start.name!r} is at {start.fps:g} fps, the database at {self.fps_:g} fps")
         q = positions_m(start)
@@ -594,7 +450,7 @@ class MotionGraph:
         where a transition's blend starts), ``source_frames`` ((length, 2) int: database clip and frame of
         every output frame, -1 for blended frames), ``start_node`` (clip, frame), ``n_transitions``.
         """
-        self._check_fitted()
+        self._check_start(start, length)
         length = self._check_length(length)
         node, place = self._start_node(start)
         rng = np.random.default_rng(seed)
@@ -604,8 +460,8 @@ class MotionGraph:
             return None if nat and pick == 0 else int(trs[pick - nat])
 
         steps, _ = self._play_on(node, [], 0, length, uniform)
-        return self._assemble(steps, place, length, f"motion_graph_walk_seed{seed}",
-                              {"start_node": self._source(node)})
+        return check_generated(self._assemble(steps, place, length, f"motion_graph_walk_seed{seed}",
+                                              {"start_node": self._source(node)}), length, self.db_.skeleton, self.name)
 
     def search(self, start: Motion, target, length: int) -> Motion:
         """Shortest playback (Dijkstra over frames) from the start node to the node nearest ``target``.
@@ -627,7 +483,7 @@ class MotionGraph:
         frame that plays the goal frame, -1 if the path is longer than ``length``), ``path_frames`` (frames
         of the shortest path up to and including the goal).
         """
-        self._check_fitted()
+        self._check_start(start, length)
         length = self._check_length(length)
         node, place = self._start_node(start)
         tgt = np.asarray(target, float).reshape(-1)
@@ -664,9 +520,10 @@ class MotionGraph:
             return None if nat else int(trs[np.argmin(self._tr_dist_[trs])])
 
         steps, n_out = self._play_on(goal, steps, n_out, length, nearest)
-        return self._assemble(steps, place, length, "motion_graph_search",
-                              {"start_node": self._source(node), "target_node": self._source(goal),
-                               "target_frame": target_frame, "path_frames": path_frames})
+        found = self._assemble(steps, place, length, "motion_graph_search",
+                               {"start_node": self._source(node), "target_node": self._source(goal),
+                                "target_frame": target_frame, "path_frames": path_frames})
+        return check_generated(found, length, self.db_.skeleton, self.name)
 
     def _source(self, g: int) -> tuple[int, int]:
         return int(self._clip_of_[g]), int(self._frame_of_[g])

@@ -208,7 +208,7 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
             gen_cpu += cpu_seconds() - c0 + float(getattr(gen, "child_cpu_s_", 0.0))
             gen_wall += time.perf_counter() - w0
             row, f = score(clip, ref, m, generator, mcfg, roles)
-            row["transitions_kept"] = float(getattr(gen, "n_below_threshold_", np.nan))
+            row["transitions_kept"] = float(gen.run_notes().get("transitions_kept", np.nan))
             feats.append(f)
             rows.append({**key, "seed": i, **row, "note": ""})
             if showcase is not None and (clip.clip, i) == tuple(showcase):
