@@ -14,7 +14,7 @@ from animsynth.compare import tables
 from animsynth.compare import settings
 from animsynth.compare import verdicts as CV
 from animsynth.config import ConfigError
-from animsynth.kinematics import unwrap_angles
+from animsynth.retarget import unwrap_angles
 from animsynth.kinematics import heading, root_translation
 from animsynth.motion import Motion
 from animsynth.verdicts import VOCABULARY, VerdictError

@@ -27,7 +27,7 @@ import numpy as np
 from scipy import sparse
 from scipy.spatial.transform import Rotation
 
-from .kinematics import forward_kinematics
+from .kinematics import forward_kinematics, tree_forward
 from .skeleton import Joint, Skeleton
 
 #: The 18 joints, parents before children.
@@ -146,7 +146,8 @@ def matrix_to_euler(R: np.ndarray) -> np.ndarray:
 
 
 def forward(rig: Rig, root_t: np.ndarray, angles: np.ndarray):
-    """World rotations and joint starts for every frame.
+    """World rotations and joint starts for every frame: :func:`animsynth.kinematics.tree_forward` on rotation
+    matrices (the rig's offsets the same in every frame).
 
     Parameters
     ----------
@@ -164,16 +165,9 @@ def forward(rig: Rig, root_t: np.ndarray, angles: np.ndarray):
         L = euler_to_matrix(L)
     F, J = L.shape[:2]
     off = rig.offsets
-    W = np.empty((F, J, 3, 3))
-    S = np.empty((F, J, 3))
-    for j, p in enumerate(rig.parents):
-        if p < 0:
-            W[:, j] = L[:, j]
-            S[:, j] = root_t
-        else:
-            W[:, j] = W[:, p] @ L[:, j]
-            S[:, j] = S[:, p] + W[:, p] @ off[j]
-    return W, S
+    T = [np.broadcast_to(root_t, (F, 3)) if p < 0 else off[j] for j, p in enumerate(rig.parents)]
+    W, S = tree_forward(rig.parents, [L[:, j] for j in range(J)], T)
+    return np.stack(W, axis=1), np.stack(S, axis=1)
 
 
 def joint_transforms(rig: Rig, W: np.ndarray, S: np.ndarray) -> np.ndarray:
