@@ -12,7 +12,7 @@ from animsynth.kinematics import (continuous_euler, continuous_sign, decay_sprin
                                   forward_kinematics, from_rot6d, halflife_to_damping, heading, hip_forward,
                                   joint_euler, joint_starts, local_rotations, nearest_euler, other_euler_branch, qexp,
                                   qinv, qlog, qmul, rest_forward, root_rotation, root_translation, rot6d, set_root,
-                                  rotation_heading, tree_forward, wrap_degrees, yaw_rotation)
+                                  rotation_heading, tree_forward, tree_local, wrap_degrees, yaw_rotation)
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 
@@ -208,3 +208,10 @@ def test_joint_starts_is_forward_kinematics_along_a_chain(walk):
     sk, v = walk.skeleton, walk.values
     idx = [sk.index("ltoes"), sk.index("head")]
     assert np.array_equal(joint_starts(sk, v, idx), forward_kinematics(sk, v, ends=False)[:, idx])
+
+
+def test_tree_local_inverts_tree_forward_on_the_rig():
+    rig = skinning.default_rig()
+    angles = np.random.default_rng(2).uniform(-1.0, 1.0, (4, rig.n_joints, 3))
+    W, _ = skinning.forward(rig, np.zeros((4, 3)), angles)
+    assert np.allclose(tree_local(rig.parents, W), skinning.euler_to_matrix(angles), atol=1e-12)

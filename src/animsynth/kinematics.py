@@ -153,6 +153,15 @@ def tree_forward(parents, local, translations, joints=None) -> tuple[list, list]
     return W, S
 
 
+def tree_local(parents, W: np.ndarray) -> np.ndarray:
+    """Local rotation matrices ``(F, J, 3, 3)`` of world rotation matrices ``W (F, J, 3, 3)`` on a tree: the inverse
+    of :func:`tree_forward`'s rotations, ``L_j = W_parent^T W_j`` (the root's ``W``)."""
+    L = np.empty_like(W)
+    for j, p in enumerate(parents):
+        L[:, j] = W[:, j] if p < 0 else np.swapaxes(W[:, p], -1, -2) @ W[:, j]
+    return L
+
+
 def forward_kinematics(skeleton: Skeleton, values, ends: bool = True, world_rotations: bool = False):
     """World positions of every joint, per frame.
 

@@ -27,7 +27,7 @@ import numpy as np
 from scipy import sparse
 from scipy.spatial.transform import Rotation
 
-from .kinematics import forward_kinematics, tree_forward
+from .kinematics import forward_kinematics, tree_forward, tree_local
 from .skeleton import Joint, Skeleton
 
 #: The 18 joints, parents before children.
@@ -280,10 +280,7 @@ def cmu_motion_to_rig(motion, rig: Rig | None = None):
     starts, Wc = forward_kinematics(sk, motion.values, ends=False, world_rotations=True)
     idx = [sk.index(CMU_MAP[n]) for n in JOINTS]
     Wm = np.stack([Wc[i].as_matrix() for i in idx], axis=1)  # (F, 18, 3, 3)
-    L = np.empty_like(Wm)
-    for j, p in enumerate(rig.parents):
-        L[:, j] = Wm[:, j] if p < 0 else np.swapaxes(Wm[:, p], -1, -2) @ Wm[:, j]
-    angles = np.unwrap(matrix_to_euler(L), axis=0)
+    angles = np.unwrap(matrix_to_euler(tree_local(rig.parents, Wm)), axis=0)
     root_t = starts[:, idx[0]] * sk.length_to_m
     return rig, root_t, angles
 
@@ -304,10 +301,7 @@ def rebase_pose(rig: Rig, root_t: np.ndarray, angles: np.ndarray, angles0: np.nd
     W, _ = forward(rig, root_t, angles)
     W0, _ = forward(rig, np.zeros((1, 3)), np.asarray(angles0)[None])
     Wn = W @ np.swapaxes(W0, -1, -2)  # new world rotations: W_j(t) W_j(0)^T
-    L = np.empty_like(Wn)
-    for j, p in enumerate(rig.parents):
-        L[:, j] = Wn[:, j] if p < 0 else np.swapaxes(Wn[:, p], -1, -2) @ Wn[:, j]
-    return np.unwrap(matrix_to_euler(L), axis=0)
+    return np.unwrap(matrix_to_euler(tree_local(rig.parents, Wn)), axis=0)
 
 
 # --------------------------------------------------------------------------- inside test
