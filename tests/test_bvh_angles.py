@@ -21,11 +21,11 @@ from scipy.spatial.transform import Rotation
 from animsynth.cli import main
 from animsynth.data import load_trial
 from animsynth.io.bvh import read_bvh, write_bvh
-from animsynth.kinematics import (align_angle_branches, continuous_clips, forward_kinematics, rotation_columns,
-                                  unwrap_angles, wrap_count)
+from animsynth.kinematics import forward_kinematics
 from animsynth.motion import Motion
 from animsynth.simplicial import generate_from_trials
-from animsynth.kinematics import retarget
+from animsynth.retarget import (align_angle_branches, continuous_clips, retarget, rotation_columns, unwrap_angles,
+                                wrap_count)
 from animsynth.skeleton import SAME_SKELETON_TOL_M, compare_skeletons
 from animsynth.synth.mocap import generate_motion
 from bvh_classes import Z_UP, bandai_with_wraps, hips_motion, turned_world

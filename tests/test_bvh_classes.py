@@ -13,7 +13,8 @@ import pytest
 from animsynth.config import ConfigError, check_config, normalise_resequencing_trials, trial_setting
 from animsynth.data import load_trial
 from animsynth.io.bvh import read_bvh
-from animsynth.kinematics import facing, forward_kinematics, standing_height
+from animsynth.axes import standing_height
+from animsynth.kinematics import facing, forward_kinematics
 from bvh_classes import BIP_ROLES
 from test_bvh_wild import DATA, _independent_fk
 

@@ -11,7 +11,8 @@ import pytest
 
 from animsynth.data import load_trial
 from animsynth.io.bvh import read_bvh, write_bvh
-from animsynth.kinematics import detect_up_axis, forward_kinematics, standing_height
+from animsynth.axes import detect_up_axis, standing_height
+from animsynth.kinematics import forward_kinematics
 from bvh_classes import Z_UP, turned_world
 from test_bvh_wild import DATA, _independent_fk
 

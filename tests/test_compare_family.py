@@ -15,7 +15,7 @@ from animsynth.compare import settings
 from animsynth.compare import verdicts as CV
 from animsynth.config import ConfigError
 from animsynth.generator import Database, align_root
-from animsynth.kinematics import unwrap_angles
+from animsynth.retarget import unwrap_angles
 from animsynth.kinematics import heading, root_translation
 from animsynth.motion import Motion
 from animsynth.verdicts import VOCABULARY, VerdictError

@@ -631,7 +631,7 @@ _CC = {"fps": 30, "context": 8, "length": 20, "min_length": 6, "holdout_fraction
 
 def test_clips_carry_the_native_rate_database_and_start_from_the_source(sk, tmp_path):
     from animsynth.compare import protocol
-    from animsynth.kinematics import unwrap_angles
+    from animsynth.retarget import unwrap_angles
 
     trials = _trials_120(sk)
     clips = protocol.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {"split": "t1"}, dict(_CC, native_fps=[60.0]))

@@ -291,7 +291,7 @@ def cmd_preview(a) -> None:
     _check_frames(a, m.n_frames, len(m.skeleton.joints), "frames of " + src)
     # titled by the input file; plays in real time, or a long clip evenly subsampled with its speed-up stated
     motion_previews(m, gif_path=a.out, titles=[os.path.basename(src)], max_frames=PREVIEW_MAX_FRAMES)
-    from .kinematics import standing_height
+    from .axes import standing_height
 
     height = standing_height(m.skeleton, m.values) * float(m.skeleton.length_to_m)
     print(f"wrote {a.out}: {src} stands {height:.3g} m tall (median over frames along its up axis; check "
@@ -300,7 +300,7 @@ def cmd_preview(a) -> None:
 
 def cmd_generate(a) -> None:
     from .io import read_amc, read_asf
-    from .kinematics import continuous_clips
+    from .retarget import continuous_clips
     from .motion import Motion
     from .simplicial import generate_from_trials
 
@@ -311,7 +311,7 @@ def cmd_generate(a) -> None:
     if any(bvh) and not all(bvh):
         raise UsageError("train", "give .bvh files or .amc files (with --asf), not both")
     if all(bvh):
-        from .kinematics import retarget
+        from .retarget import retarget
 
         train = [_load_bvh(a, p) for p in a.train]
         sk = train[0].skeleton
@@ -354,7 +354,7 @@ def cmd_generate(a) -> None:
 
 
 def cmd_resequence(a) -> None:
-    from .kinematics import unwrap_angles
+    from .retarget import unwrap_angles
     from .resequencing.quick import resequence_motion
 
     files, a.out = _split_motion_args(a.files, a.out, MOTION_OUTPUTS)

@@ -140,10 +140,10 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     up_axis, forward_axis : str or None
         The file's world axes (``"+z"``, ...), or ``"auto"``/None. For BVH,
         ``auto`` detects the up axis from the motion
-        (:func:`animsynth.kinematics.detect_up_axis`) and takes the forward
+        (:func:`animsynth.axes.detect_up_axis`) and takes the forward
         axis that the smallest turn to +y brings to +z; the motion is then
         turned into the canonical frame
-        (:func:`animsynth.kinematics.to_canonical_frame`). ASF/AMC is +y up by
+        (:func:`animsynth.axes.to_canonical_frame`). ASF/AMC is +y up by
         the format's convention (CMU): ``auto`` keeps it, logging a warning
         if the motion looks otherwise.
     source_files : dict, optional
@@ -158,29 +158,29 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         and ``bvh_length_to_m`` (default :data:`CONFIG_SETTING_NAMES`, the
         config keys; the command line passes its options).
 
-    Up axis: detected by :func:`animsynth.kinematics.detect_up_axis` (a biped
+    Up axis: detected by :func:`animsynth.axes.detect_up_axis` (a biped
     by its joint roles, another body by its legs). A warning names the file
     and the ``up_axis`` setting when the body is not a biped, when the answer
     is ambiguous (for a body that is not a biped the file's own axes are then
     kept, +y up), and when a given ``up_axis`` leaves the body lying down or on
-    its head (:func:`animsynth.kinematics.lying_down`). A joint that plays two
+    its head (:func:`animsynth.axes.lying_down`). A joint that plays two
     roles is warned about.
 
     The standing height (median over frames of the extent along the up axis,
-    :func:`animsynth.kinematics.standing_height`) in metres outside
+    :func:`animsynth.axes.standing_height`) in metres outside
     :data:`HEIGHT_RANGE_M` is logged as a warning (the unit is probably
     wrong). One log line gives the axes used and how they were found.
 
     Every rotational DOF is made continuous along time
-    (:func:`animsynth.kinematics.unwrap_angles`: an angle that wraps past 180
+    (:func:`animsynth.retarget.unwrap_angles`: an angle that wraps past 180
     degrees gets the multiple of 360 that removes the jump; logged when it
     happens), so no method sees a wrap. Translations are untouched.
     """
     from .errors import MotionFormatError
     from .joints import check_role_overrides
-    from .kinematics import (CANONICAL_FORWARD, CANONICAL_UP, default_forward, detect_forward_axis, detect_up_axis,
-                             lying_down, parse_axis, standing_height, to_canonical_frame, translated_joints,
-                             unwrap_angles)
+    from .axes import default_forward, detect_forward_axis, detect_up_axis, lying_down, standing_height, to_canonical_frame
+    from .kinematics import CANONICAL_FORWARD, CANONICAL_UP, parse_axis, translated_joints
+    from .retarget import unwrap_angles
 
     files = {"amc": amc, "asf": asf, "bvh": bvh}
     shown = dict(source_files or {})

@@ -1,25 +1,24 @@
-"""Forward kinematics, joint rotations and the world axes for :class:`~animsynth.skeleton.Skeleton`.
+"""Pose math for :class:`~animsynth.skeleton.Skeleton`: forward kinematics, joint rotations, Euler angles,
+quaternions, heading, springs.
 
 All functions are vectorised over frames. See :mod:`animsynth.skeleton` for the
 conventions (``L = C M C^-1``, extrinsic DOF order, offsets in world axes,
 translation DOF on any joint).
 
-World axes: the one place
--------------------------
+World axes
+----------
 Every study works in the *canonical* world frame: ``+y`` up
 (:data:`UP`, :data:`HORIZONTAL`), ``+z`` forward. The height check, the
 floor, foot contacts, facing, heading, root alignment and the figures all read
-the up axis from here. A file in another frame (Z up, as Blender and 3ds Max
-write it) is turned into the canonical one when it is loaded
-(:func:`to_canonical_frame`, called by :func:`animsynth.data.load_trial`),
-with the up axis detected from the motion (:func:`detect_up_axis`: for a
-biped by its joint roles, the head above the feet; for another body, a
-quadruped or a crab, by its legs standing on the floor; when that is
-ambiguous for a body that is not a biped, the file's own +y is kept) or given
-(config ``up_axis`` / ``forward_axis``; :func:`lying_down` checks a given one). A rest pose lying along X
-(LAFAN1) is not a different frame: the up axis comes from the frames, not the
-rest pose, and facing from the hips (:func:`facing`), so such a file needs no
-change.
+the up axis from here. A file in another frame is turned into the canonical
+one when it is loaded (:mod:`animsynth.axes` detects its up and forward axes
+and turns it). Facing comes from the hips (:func:`facing`), so a rest pose lying
+along X (LAFAN1) needs no change.
+
+Heading (radians about +y, 0 = +z) has two sources: the body's, from the hips
+of every frame (:func:`facing`, :func:`heading`), and a root rotation's, the
+yaw of a forward vector turned by it (:func:`rotation_heading`: the root's own
++z, or the hips' forward in the zero pose, :func:`rest_forward`).
 """
 
 from __future__ import annotations
@@ -27,12 +26,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-import copy
-import logging
-
-from .skeleton import RETARGET_MAX_ANGLE_DEG, ROT_DOFS, SAME_SKELETON_TOL_M, TRANS_DOFS, Skeleton, compare_skeletons
-
-log = logging.getLogger("animsynth.kinematics")
+from .skeleton import ROT_DOFS, TRANS_DOFS, Skeleton
 
 #: Index of the canonical up axis (+y).
 UP = 1
@@ -44,7 +38,8 @@ AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
 CANONICAL_UP, CANONICAL_FORWARD = "+y", "+z"
 
 
-def _check_values(skeleton: Skeleton, values: np.ndarray) -> np.ndarray:
+def check_values(skeleton: Skeleton, values) -> np.ndarray:
+    """``values`` as a float array (frames, n_dof) of finite numbers for ``skeleton``; ValueError otherwise."""
     values = np.atleast_2d(np.asarray(values, float))
     if values.shape[1] != skeleton.n_dof:
         raise ValueError(f"motion has {values.shape[1]} DOF columns, skeleton {skeleton.name!r} has {skeleton.n_dof}")
@@ -54,54 +49,51 @@ def _check_values(skeleton: Skeleton, values: np.ndarray) -> np.ndarray:
     return values
 
 
+def _joint_local(joint, cols: np.ndarray, n: int) -> Rotation:
+    """``C M C^-1`` of one joint from its DOF columns ``cols (n, len(joint.dofs))``."""
+    rdofs = [(k, d) for k, d in enumerate(joint.dofs) if d in ROT_DOFS]
+    if rdofs:
+        M = Rotation.from_euler("".join(d[1] for _, d in rdofs), cols[:, [k for k, _ in rdofs]], degrees=True)
+    else:
+        M = Rotation.identity(n)
+    C = joint.axis_rotation()
+    return C * M * C.inv()
+
+
+def _joint_translation(joint, cols: np.ndarray, n: int) -> np.ndarray:
+    """The joint's ``offset`` plus its translation DOF, ``(n, 3)``."""
+    t = np.tile(np.asarray(joint.offset, float), (n, 1))
+    for k, d in enumerate(joint.dofs):
+        if d in TRANS_DOFS:
+            a = TRANS_DOFS.index(d)
+            t[:, a] = cols[:, k] + joint.offset[a]
+    return t
+
+
 def local_rotations(skeleton: Skeleton, values) -> list[Rotation]:
     """Local rotation ``L_j = C_j M_j C_j^-1`` of every joint, per frame.
 
     Returns a list (one entry per joint) of ``Rotation`` objects of length
     ``frames``.
     """
-    values = _check_values(skeleton, values)
-    n = values.shape[0]
-    out = []
+    values = check_values(skeleton, values)
     sl = skeleton.dof_slices()
-    for j in skeleton.joints:
-        cols = values[:, sl[j.name]]
-        rdofs = [(k, d) for k, d in enumerate(j.dofs) if d in ROT_DOFS]
-        if rdofs:
-            seq = "".join(d[1] for _, d in rdofs)
-            M = Rotation.from_euler(seq, cols[:, [k for k, _ in rdofs]], degrees=True)
-        else:
-            M = Rotation.identity(n)
-        C = j.axis_rotation()
-        out.append(C * M * C.inv())
-    return out
+    return [_joint_local(j, values[:, sl[j.name]], values.shape[0]) for j in skeleton.joints]
 
 
 def root_rotation(skeleton: Skeleton, values) -> Rotation:
     """The root joint's local rotation per frame: ``local_rotations(skeleton, values)[0]`` without the others
     (placing and turning a motion on the floor needs only the root)."""
-    values = _check_values(skeleton, values)
+    values = check_values(skeleton, values)
     root = skeleton.joints[0]
-    cols = values[:, skeleton.dof_slices()[root.name]]
-    rdofs = [(k, d) for k, d in enumerate(root.dofs) if d in ROT_DOFS]
-    if rdofs:
-        M = Rotation.from_euler("".join(d[1] for _, d in rdofs), cols[:, [k for k, _ in rdofs]], degrees=True)
-    else:
-        M = Rotation.identity(values.shape[0])
-    C = root.axis_rotation()
-    return C * M * C.inv()
+    return _joint_local(root, values[:, skeleton.dof_slices()[root.name]], values.shape[0])
 
 
 def root_translation(skeleton: Skeleton, values) -> np.ndarray:
     """Root translation per frame (frames, 3), skeleton length units."""
-    values = _check_values(skeleton, values)
+    values = check_values(skeleton, values)
     root = skeleton.joints[0]
-    t = np.tile(np.asarray(root.offset, float), (values.shape[0], 1))
-    sl = skeleton.dof_slices()[root.name]
-    for k, d in enumerate(root.dofs):
-        if d in TRANS_DOFS:
-            t[:, TRANS_DOFS.index(d)] = values[:, sl][:, k] + root.offset[TRANS_DOFS.index(d)]
-    return t
+    return _joint_translation(root, values[:, skeleton.dof_slices()[root.name]], values.shape[0])
 
 
 def joint_translations(skeleton: Skeleton, values) -> np.ndarray:
@@ -115,23 +107,59 @@ def joint_translations(skeleton: Skeleton, values) -> np.ndarray:
     -------
     ndarray (frames, joints, 3), skeleton length units
     """
-    values = _check_values(skeleton, values)
-    n = values.shape[0]
-    out = np.empty((n, len(skeleton.joints), 3))
+    values = check_values(skeleton, values)
     sl = skeleton.dof_slices()
-    for i, j in enumerate(skeleton.joints):
-        out[:, i] = np.asarray(j.offset, float)
-        cols = values[:, sl[j.name]]
-        for k, d in enumerate(j.dofs):
-            if d in TRANS_DOFS:
-                a = TRANS_DOFS.index(d)
-                out[:, i, a] = cols[:, k] + j.offset[a]
-    return out
+    return np.stack([_joint_translation(j, values[:, sl[j.name]], values.shape[0]) for j in skeleton.joints], axis=1)
 
 
 def translated_joints(skeleton: Skeleton) -> list[str]:
     """Names of the non-root joints that have translation DOF."""
     return [j.name for j in skeleton.joints[1:] if any(d in TRANS_DOFS for d in j.dofs)]
+
+
+def tree_forward(parents, local, translations, joints=None) -> tuple[list, list]:
+    """World rotations and joint starts of a kinematic tree: ``W_j = W_parent L_j``,
+    ``s_j = s_parent + W_parent t_j``; the root's ``W = L`` and ``s = t`` (world).
+
+    The one forward kinematics of the package: :func:`forward_kinematics` (``Rotation`` objects) and the
+    skinning rig (:func:`animsynth.skinning.forward`, rotation matrices) run it.
+
+    Parameters
+    ----------
+    parents : sequence of int (J,), every parent before its children, -1 for the root
+    local : list of J local rotations, each a ``Rotation`` of F frames or an ndarray (F, 3, 3) of matrices
+    translations : list of J ndarrays (F, 3) or (3,), each joint's start from its parent's start in the
+        parent's frame (the root's: its world position)
+    joints : sorted sequence of int, optional
+        Only these joints (every parent of one included); the others stay ``None``.
+
+    Returns
+    -------
+    W : list of J world rotations (the type of ``local``)
+    S : list of J ndarrays (F, 3) (or (3,) where a root translation is), world joint starts
+    """
+    J = len(parents)
+    W: list = [None] * J
+    S: list = [None] * J
+    for i in range(J) if joints is None else joints:
+        p = parents[i]
+        if p < 0:
+            W[i], S[i] = local[i], translations[i]
+        elif isinstance(local[i], Rotation):
+            W[i], S[i] = W[p] * local[i], S[p] + W[p].apply(translations[i])
+        else:
+            t = translations[i]
+            W[i], S[i] = W[p] @ local[i], S[p] + (W[p] @ t if t.ndim == 1 else (W[p] @ t[..., None])[..., 0])
+    return W, S
+
+
+def tree_local(parents, W: np.ndarray) -> np.ndarray:
+    """Local rotation matrices ``(F, J, 3, 3)`` of world rotation matrices ``W (F, J, 3, 3)`` on a tree: the inverse
+    of :func:`tree_forward`'s rotations, ``L_j = W_parent^T W_j`` (the root's ``W``)."""
+    L = np.empty_like(W)
+    for j, p in enumerate(parents):
+        L[:, j] = W[:, j] if p < 0 else np.swapaxes(W[:, p], -1, -2) @ W[:, j]
+    return L
 
 
 def forward_kinematics(skeleton: Skeleton, values, ends: bool = True, world_rotations: bool = False):
@@ -154,32 +182,42 @@ def forward_kinematics(skeleton: Skeleton, values, ends: bool = True, world_rota
     """
     L = local_rotations(skeleton, values)
     T = joint_translations(skeleton, values)
-    n = T.shape[0]
-    nj = len(skeleton.joints)
-    starts = np.empty((n, nj, 3))
-    endpos = np.empty((n, nj, 3))
-    W: list[Rotation] = [None] * nj  # type: ignore[list-item]
-    for i, j in enumerate(skeleton.joints):
-        if j.parent < 0:
-            starts[:, i] = T[:, i]
-            W[i] = L[i]
-        else:
-            p = j.parent
-            starts[:, i] = starts[:, p] + W[p].apply(T[:, i])
-            W[i] = W[p] * L[i]
-        endpos[:, i] = starts[:, i] + W[i].apply(j.tail)
-    pos = endpos if ends else starts
+    W, S = tree_forward([j.parent for j in skeleton.joints], L, [T[:, i] for i in range(T.shape[1])])
+    if ends:
+        pos = np.stack([S[i] + W[i].apply(j.tail) for i, j in enumerate(skeleton.joints)], axis=1)
+    else:
+        pos = np.stack(S, axis=1)
     return (pos, W) if world_rotations else pos
+
+
+def joint_starts(skeleton: Skeleton, values, joints) -> np.ndarray:
+    """World start positions (frames, len(joints), 3) of a few joints: forward kinematics along their chains
+    to the root only (the hips need the root and the hip joints, not the whole body)."""
+    values = check_values(skeleton, values)
+    need: set[int] = set()
+    for i in joints:
+        while i >= 0 and i not in need:
+            need.add(i)
+            i = skeleton.joints[i].parent
+    sl = skeleton.dof_slices()
+    n = values.shape[0]
+    L: list = [None] * len(skeleton.joints)
+    T: list = [None] * len(skeleton.joints)
+    for i in need:
+        j = skeleton.joints[i]
+        L[i], T[i] = _joint_local(j, values[:, sl[j.name]], n), _joint_translation(j, values[:, sl[j.name]], n)
+    _, S = tree_forward([j.parent for j in skeleton.joints], L, T, sorted(need))
+    return np.stack([S[i] for i in joints], axis=1)
 
 
 def quaternions(skeleton: Skeleton, values) -> np.ndarray:
     """Local joint rotations as unit quaternions, shape (frames, joints, 4), scalar-last (x, y, z, w).
 
-    The sign is made continuous over time (q and -q are the same rotation).
+    The sign is made continuous over time (q and -q are the same rotation): each frame is flipped when its
+    dot product with the frame before (as already flipped) is negative.
     """
     L = local_rotations(skeleton, values)
     q = np.stack([r.as_quat() for r in L], axis=1)
-    # temporal sign continuity
     for t in range(1, q.shape[0]):
         flip = np.sum(q[t] * q[t - 1], axis=-1) < 0
         q[t, flip] *= -1
@@ -199,6 +237,78 @@ def bone_lengths(skeleton: Skeleton, values) -> np.ndarray:
     return np.linalg.norm(ends - starts, axis=-1)[:, 1:]
 
 
+# ---------------------------------------------------------------------------------------------------------------
+# quaternions (x, y, z, w, scalar last, as scipy's Rotation) and the 6D representation
+# ---------------------------------------------------------------------------------------------------------------
+def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products ``a b`` of quaternions ``(..., 4)`` (x, y, z, w; ``b`` applied first, as ``Rotation``
+    products), broadcasting, *without* any sign normalisation (scipy's composition may return either sign)."""
+    ax, ay, az, aw = np.moveaxis(np.asarray(a, float), -1, 0)
+    bx, by, bz, bw = np.moveaxis(np.asarray(b, float), -1, 0)
+    return np.stack([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz], axis=-1)
+
+
+def qinv(q: np.ndarray) -> np.ndarray:
+    """Inverse of unit quaternions (x, y, z, w)."""
+    q = np.array(q, float, copy=True)
+    q[..., :3] *= -1.0
+    return q
+
+
+def qlog(q: np.ndarray) -> np.ndarray:
+    """Rotation vectors (radians) of unit quaternions, the shorter way round: ``(..., 3)``."""
+    q = np.asarray(q, float)
+    q = np.where(q[..., 3:] < 0, -q, q)
+    v = q[..., :3]
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    angle = 2.0 * np.arctan2(n, q[..., 3:])
+    small = n < 1e-12
+    return v * np.where(small, 2.0 / np.maximum(q[..., 3:], 1e-12), angle / np.where(small, 1.0, n))
+
+
+def qexp(r: np.ndarray) -> np.ndarray:
+    """Unit quaternions of rotation vectors ``(..., 3)`` (radians)."""
+    r = np.asarray(r, float)
+    a = np.linalg.norm(r, axis=-1, keepdims=True)
+    small = a < 1e-12
+    k = np.where(small, 0.5, np.sin(0.5 * a) / np.where(small, 1.0, a))
+    return np.concatenate([r * k, np.cos(0.5 * a)], axis=-1)
+
+
+def continuous_sign(q: np.ndarray) -> np.ndarray:
+    """Quaternions ``(T, ..., 4)`` with signs flipped so that consecutive frames have a non-negative dot product
+    (the running product of the raw consecutive signs); a new array."""
+    q = np.array(q, float, copy=True)
+    if q.shape[0] > 1:
+        s = np.where(np.sum(q[1:] * q[:-1], axis=-1) < 0, -1.0, 1.0)
+        q[1:] *= np.cumprod(s, axis=0)[..., None]
+    return q
+
+
+def rot6d(q: np.ndarray) -> np.ndarray:
+    """Quaternions ``(..., 4)`` (x, y, z, w) to the 6D representation of Zhou et al. 2019: the first two
+    columns of the rotation matrix, ``(..., 6)``."""
+    q = np.asarray(q, float)
+    m = Rotation.from_quat(q.reshape(-1, 4)).as_matrix()
+    return m[:, :, :2].transpose(0, 2, 1).reshape(q.shape[:-1] + (6,))
+
+
+def from_rot6d(x: np.ndarray) -> np.ndarray:
+    """The 6D representation ``(..., 6)`` back to quaternions ``(..., 4)`` by Gram-Schmidt."""
+    x = np.asarray(x, float)
+    a, b = x[..., :3], x[..., 3:]
+    c1 = a / np.maximum(np.linalg.norm(a, axis=-1, keepdims=True), 1e-12)
+    b = b - np.sum(c1 * b, axis=-1, keepdims=True) * c1
+    c2 = b / np.maximum(np.linalg.norm(b, axis=-1, keepdims=True), 1e-12)
+    c3 = np.cross(c1, c2)
+    m = np.stack([c1, c2, c3], axis=-1)
+    return Rotation.from_matrix(m.reshape(-1, 3, 3)).as_quat().reshape(x.shape[:-1] + (4,))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Euler angles (degrees) and DOF values
+# ---------------------------------------------------------------------------------------------------------------
 def wrap_degrees(a):
     """Angles in degrees wrapped to [-180, 180): ``(a + 180) % 360 - 180``, elementwise (any shape)."""
     return (a + 180.0) % 360.0 - 180.0
@@ -209,51 +319,102 @@ def wrap_radians(a):
     return (np.asarray(a, float) + np.pi) % (2.0 * np.pi) - np.pi
 
 
-def _continuous_euler(ang: np.ndarray) -> np.ndarray:
-    """Pick, frame by frame, the Tait-Bryan solution closest to the previous frame.
+def other_euler_branch(ang: np.ndarray) -> np.ndarray:
+    """The other Tait-Bryan triple of the same rotations, ``(a + 180, 180 - b, c + 180)`` for ``ang (T, 3)``
+    (degrees, not wrapped): every rotation has these two, scipy returns the one with ``|b| <= 90``."""
+    return np.stack([ang[:, 0] + 180.0, 180.0 - ang[:, 1], ang[:, 2] + 180.0], axis=1)
 
-    Every rotation has two Euler triples ``(a, b, c)`` and
-    ``(a + 180, 180 - b, c + 180)``; scipy returns the one with ``|b| <= 90``.
-    A motion whose middle angle crosses 90 degrees (e.g. a CMU root yaw) is
-    continuous only if we switch to the other branch, as the original data did.
+
+def nearest_euler(ang: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """Euler triples ``ang (T, 3)`` (degrees) each put on the branch and 360-degree turn nearest ``ref (T, 3)``:
+    of ``ang`` and :func:`other_euler_branch`, each turned to ``ref + wrap_degrees(. - ref)``, the one with the
+    smaller sum of absolute differences to ``ref`` (a tie keeps ``ang``'s)."""
+    best = None
+    for cand in (ang, other_euler_branch(ang)):
+        c = ref + wrap_degrees(cand - ref)
+        d = np.abs(c - ref).sum(axis=1)
+        best = (c, d) if best is None else (np.where((d < best[1])[:, None], c, best[0]), np.minimum(d, best[1]))
+    return best[0]
+
+
+def continuous_euler(ang: np.ndarray, anchor=None) -> np.ndarray:
+    """Euler triples ``ang (T, 3)`` (degrees, scipy's branch) made continuous along time.
+
+    ``anchor=None``: frame 0 is kept; every later frame takes the branch (``ang`` or
+    :func:`other_euler_branch`, wrapped) whose wrapped differences to the frame before sum smaller; angles
+    stay in [-180, 180) (a motion whose middle angle crosses 90 degrees, e.g. a CMU root yaw, is continuous
+    only on the other branch, as the original data was).
+
+    ``anchor (3,)``: the triples continue the pose ``anchor``: frame after frame, :func:`nearest_euler` to the
+    frame before (the first: to ``anchor``), so the branch and the 360-degree turns of the anchor carry on.
+    A loop over plain floats (it runs per generated sample).
     """
-    alt = wrap_degrees(np.stack([ang[:, 0] + 180.0, 180.0 - ang[:, 1], ang[:, 2] + 180.0], axis=1))
-    out = ang.copy()
-    for t in range(1, len(ang)):
-        d0 = np.abs(wrap_degrees(ang[t] - out[t - 1])).sum()
-        d1 = np.abs(wrap_degrees(alt[t] - out[t - 1])).sum()
-        if d1 < d0:
-            out[t] = alt[t]
+    if anchor is None:
+        alt = wrap_degrees(other_euler_branch(ang))
+        out = ang.copy()
+        for t in range(1, len(ang)):
+            d0 = np.abs(wrap_degrees(ang[t] - out[t - 1])).sum()
+            d1 = np.abs(wrap_degrees(alt[t] - out[t - 1])).sum()
+            if d1 < d0:
+                out[t] = alt[t]
+        return out
+    out = np.empty_like(ang)
+    pa, pb, pc = (float(v) for v in anchor)
+    for t, (a, b, c) in enumerate(ang.tolist()):
+        best = None
+        for x, y, z in ((a, b, c), (a + 180.0, 180.0 - b, c + 180.0)):
+            x = pa + wrap_degrees(x - pa)
+            y = pb + wrap_degrees(y - pb)
+            z = pc + wrap_degrees(z - pc)
+            d = abs(x - pa) + abs(y - pb) + abs(z - pc)
+            if best is None or d < best[0]:
+                best = (d, x, y, z)
+        _, pa, pb, pc = best
+        out[t] = (pa, pb, pc)
     return out
 
 
+def joint_euler(joint, rotations: Rotation) -> np.ndarray:
+    """Euler angles (degrees, scipy's branch) of a joint's local rotations, ``(T, k)`` for its ``k`` rotational
+    DOF in their order: ``C^-1 L C`` in the DOF's axis order, the missing axes appended (applied last) and
+    dropped (they come out ~0 when the rotation is representable)."""
+    C = joint.axis_rotation()
+    axes = [d[1] for d in joint.dofs if d in ROT_DOFS]
+    full = axes + [a for a in "xyz" if a not in axes]
+    return (C.inv() * rotations * C).as_euler("".join(full), degrees=True)[:, :len(axes)]
+
+
 def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t: np.ndarray,
-                          translations: np.ndarray | None = None) -> np.ndarray:
+                          translations: np.ndarray | None = None, anchor=None) -> np.ndarray:
     """Inverse of :func:`local_rotations`: DOF values (degrees) from local rotations.
 
     For a joint with fewer than three rotational DOF the missing axes are
     appended (applied last) and must come out ~0 if the rotation is
-    representable; their values are dropped. ``translations`` (frames,
+    representable; their values are dropped (:func:`joint_euler`). ``translations`` (frames,
     joints, 3; :func:`joint_translations`) gives the translation DOF of
     non-root joints; without it they are 0 (the joint at its ``offset``).
+
+    ``anchor (n_dof,)``: the pose before the first frame (generated frames continue it): three-DOF joints by
+    :func:`continuous_euler` from it, the others' angles turned to the 360-degree turn nearest it and
+    unwrapped from it. Without: three-DOF joints by :func:`continuous_euler` from their own first frame.
     """
     n = root_t.shape[0]
     values = np.zeros((n, skeleton.n_dof))
     sl = skeleton.dof_slices()
+    if anchor is not None:
+        anchor = np.asarray(anchor, float)
     for i, j in enumerate(skeleton.joints):
-        C = j.axis_rotation()
-        M = C.inv() * rotations[i] * C
-        rd = [d for d in j.dofs if d in ROT_DOFS]
         block = np.zeros((n, len(j.dofs)))
-        if rd:
-            axes = [d[1] for d in rd]
-            full = axes + [a for a in "xyz" if a not in axes]
-            ang = M.as_euler("".join(full), degrees=True)
-            if len(axes) == 3:
-                ang = _continuous_euler(ang)
-            for k, d in enumerate(j.dofs):
-                if d in ROT_DOFS:
-                    block[:, k] = ang[:, axes.index(d[1])]
+        rk = [k for k, d in enumerate(j.dofs) if d in ROT_DOFS]
+        if rk:
+            ang = joint_euler(j, rotations[i])
+            a0 = None if anchor is None else anchor[sl[j.name]][rk]
+            if len(rk) == 3:
+                ang = continuous_euler(ang, a0)
+            elif a0 is not None:
+                ang = a0 + wrap_degrees(ang - a0)
+                ang = np.rad2deg(np.unwrap(np.deg2rad(np.vstack([a0[None, :], ang])), axis=0))[1:]
+            block[:, rk] = ang
         for k, d in enumerate(j.dofs):
             if d in TRANS_DOFS:
                 a = TRANS_DOFS.index(d)
@@ -305,8 +466,36 @@ def set_root(skeleton: Skeleton, values, R: Rotation, pos: np.ndarray) -> np.nda
     return out
 
 
+
 # ---------------------------------------------------------------------------------------------------------------
-# world axes (see the module docstring: the one place the up and forward axes are defined)
+# springs (critically damped, as in Holden's motion-matching reference)
+# ---------------------------------------------------------------------------------------------------------------
+LN2 = float(np.log(2.0))
+
+
+def halflife_to_damping(halflife: float) -> float:
+    """Damping of the reference's critically damped spring of half-life ``halflife`` seconds: ``4 ln 2 / halflife``
+    (its envelope ``e^(-damping t / 2)`` halves in half a half-life; from rest the offset is 0.597 of its start
+    after one half-life, :func:`decay_spring`)."""
+    return 4.0 * LN2 / float(halflife)
+
+
+def decay_spring(x, v, halflife: float, dt: float):
+    """A critically damped spring towards zero after ``dt`` seconds: ``(x, v)`` of offset and its velocity.
+
+    With ``y = damping / 2`` and ``j = v0 + y x0``: ``x(t) = e^(-y t) (x0 + j t)``, ``v(t) = e^(-y t) (v0 - j y t)``.
+    After one half-life from rest the offset is ``(1 + 2 ln 2) / 4 = 0.597`` of where it started.
+    """
+    y = halflife_to_damping(halflife) / 2.0
+    x = np.asarray(x, float)
+    v = np.asarray(v, float)
+    j = v + x * y
+    e = np.exp(-y * dt)
+    return e * (x + j * dt), e * (v - j * y * dt)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# axes, facing and heading
 # ---------------------------------------------------------------------------------------------------------------
 def parse_axis(axis) -> str:
     """A signed axis name (``"+y"``, ``"-z"``, ``"y"``; any case) as one of :data:`AXES`.
@@ -332,7 +521,7 @@ def axis_vector(axis) -> np.ndarray:
     return v
 
 
-def _role_index(skeleton: Skeleton, roles, overrides=None):
+def role_indices(skeleton: Skeleton, roles, overrides=None):
     """Joint indices of ``roles``, or None when one does not resolve."""
     from .joints import JointRoleError, resolve_roles
 
@@ -366,36 +555,6 @@ def hip_forward(skeleton: Skeleton, values, up="+y", overrides: dict | None = No
         across = starts[:, a] - starts[:, b]
     return np.cross(across, axis_vector(up))
 
-
-def joint_starts(skeleton: Skeleton, values, joints) -> np.ndarray:
-    """World start positions (frames, len(joints), 3) of a few joints: forward kinematics along their chains
-    to the root only (the hips need the root and the hip joints, not the whole body)."""
-    values = _check_values(skeleton, values)
-    need: set[int] = set()
-    for i in joints:
-        while i >= 0 and i not in need:
-            need.add(i)
-            i = skeleton.joints[i].parent
-    sl = skeleton.dof_slices()
-    n = values.shape[0]
-    starts, W = {}, {}
-    for i in sorted(need):
-        j = skeleton.joints[i]
-        cols = values[:, sl[j.name]]
-        T = np.tile(np.asarray(j.offset, float), (n, 1))
-        for k, d in enumerate(j.dofs):
-            if d in TRANS_DOFS:
-                T[:, TRANS_DOFS.index(d)] += cols[:, k]
-        rdofs = [(k, d) for k, d in enumerate(j.dofs) if d in ROT_DOFS]
-        M = (Rotation.from_euler("".join(d[1] for _, d in rdofs), cols[:, [k for k, _ in rdofs]], degrees=True)
-             if rdofs else Rotation.identity(n))
-        C = j.axis_rotation()
-        L = C * M * C.inv()
-        if j.parent < 0:
-            starts[i], W[i] = T, L
-        else:
-            starts[i], W[i] = starts[j.parent] + W[j.parent].apply(T), W[j.parent] * L
-    return np.stack([starts[i] for i in joints], axis=1)
 
 
 def facing(skeleton: Skeleton, values, overrides: dict | None = None, starts: np.ndarray | None = None,
@@ -432,544 +591,60 @@ def facing(skeleton: Skeleton, values, overrides: dict | None = None, starts: np
     return f / n[:, None]
 
 
+
 def heading(skeleton: Skeleton, values, overrides: dict | None = None) -> np.ndarray:
     """Heading (radians about +y, 0 = +z) per frame: :func:`facing` as an angle.
 
     Falls back to the root's local +z axis projected on the floor when the
     skeleton has no hip roles.
     """
-    if _role_index(skeleton, ("left_hip", "right_hip"), overrides) is not None:
+    if role_indices(skeleton, ("left_hip", "right_hip"), overrides) is not None:
         f = facing(skeleton, values, overrides)
         return np.arctan2(f[:, 0], f[:, 1])
     return rotation_heading(root_rotation(skeleton, values))
 
 
-def rotation_heading(R: Rotation) -> np.ndarray:
-    """Heading (radians about +y, 0 = +z) of the local +z axis turned by ``R``, shape ``(len(R),)``.
+def rotation_heading(R: Rotation, forward: np.ndarray | None = None, hold_vertical: bool = False) -> np.ndarray:
+    """Heading (radians about +y, 0 = +z) of ``forward`` turned by ``R``, shape ``(len(R),)``.
 
-    The root's own forward axis, not the body's (:func:`heading` reads the hips where it can): the right
-    measure of how much a root *turns* between two frames, whatever its rest pose.
+    ``forward`` (3,): by default the local +z axis, the root's own forward axis, not the body's
+    (:func:`heading` reads the hips where it can): the right measure of how much a root *turns* between two
+    frames, whatever its rest pose. :func:`rest_forward` gives the body's forward in the zero pose, so the
+    heading does not depend on a file's forward-axis convention. ``hold_vertical``: a frame whose turned
+    vector is within 1e-6 of vertical (no horizontal direction) takes the heading of the frame before (the
+    first frame: 0).
     """
-    f = R.apply(np.array([0.0, 0.0, 1.0]))
-    return np.arctan2(f[:, 0], f[:, 2])
+    f = R.apply(np.array([0.0, 0.0, 1.0]) if forward is None else forward)
+    yaw = np.arctan2(f[:, 0], f[:, 2])
+    if hold_vertical:
+        for t in np.flatnonzero(np.hypot(f[:, 0], f[:, 2]) < 1e-6):
+            yaw[t] = yaw[t - 1] if t else 0.0
+    return yaw
 
 
-def standing_height(skeleton: Skeleton, values, up="+y", positions: np.ndarray | None = None) -> float:
-    """Median over frames of the body's extent along ``up`` (skeleton units): segment starts and ends."""
-    if positions is None:
-        positions = np.concatenate([forward_kinematics(skeleton, values, ends=False),
-                                    forward_kinematics(skeleton, values, ends=True)], axis=1)
-    h = positions @ axis_vector(up)
-    return float(np.median(h.max(axis=1) - h.min(axis=1)))
-
-
-#: A body is read as a biped when it has a head and two feet by joint role and at most this many leg-like chains
-#: (three would be a person with a hand on the floor, or a contorted pose: still a biped; four, an animal).
-MAX_BIPED_LEGS = 3
-#: A leaf chain is leg-like when its end is this share of the body's largest extent from the floor or closer
-#: in a quarter of the frames at least (a foot stands in part of a gait) ...
-LEG_FLOOR_SHARE = 0.05
-#: ... and it points down: the cosine between its start-to-end vector and the down direction is at least this.
-LEG_DOWN_COS = 0.3
-#: Second best over best above this (by leg count for a non-biped, by the head-to-feet vector's components for
-#: a biped, by extent between the tallest axes) makes the up axis ambiguous.
-AMBIGUOUS_RATIO = 0.7
-
-
-def _leaf_chains(skeleton: Skeleton) -> list[tuple[int, int]]:
-    """``(first joint, leaf joint)`` of every chain that runs without branching from just below a branching
-    joint (or the root) to a leaf of at least two segments: the limbs, tails, necks of a skeleton."""
-    kids: dict[int, list[int]] = {i: [] for i in range(len(skeleton.joints))}
-    for i, j in enumerate(skeleton.joints):
-        if j.parent >= 0:
-            kids[j.parent].append(i)
-    out = []
-    for leaf in (i for i, k in kids.items() if not k and i > 0):
-        first, n = leaf, 1
-        while True:
-            p = skeleton.joints[first].parent
-            if p <= 0 or len(kids[p]) > 1:
-                break
-            first, n = p, n + 1
-        if n >= 2:
-            out.append((first, leaf))
-    return out
-
-
-def count_legs(skeleton: Skeleton, starts: np.ndarray, ends: np.ndarray, up) -> int:
-    """How many leg-like chains :func:`leg_chains` finds."""
-    return len(leg_chains(skeleton, starts, ends, up))
-
-
-def leg_chains(skeleton: Skeleton, starts: np.ndarray, ends: np.ndarray, up) -> list[set[int]]:
-    """Leg-like chains of a body for the signed axis ``up``: leaf chains (:func:`_leaf_chains`) that point
-    down (:data:`LEG_DOWN_COS`, median over frames) and end on the floor (within :data:`LEG_FLOOR_SHARE` of
-    the body's largest extent above its lowest point, in a quarter of the frames at least).
-
-    Parameters
-    ----------
-    skeleton : Skeleton
-    starts, ends : ndarray (frames, joints, 3)
-        Joint starts and segment ends (:func:`forward_kinematics`).
-    up : str
-        A signed axis (:data:`AXES`).
-
-    Returns
-    -------
-    list of set of int
-        The joint indices of each leg-like chain.
-    """
-    u = axis_vector(up)
-    pos = np.concatenate([starts, ends], axis=1)
-    size = float(np.max(np.median(pos.max(axis=1) - pos.min(axis=1), axis=0)))
-    h = pos @ u
-    floor = h.min(axis=1)
-    legs = []
-    for first, leaf in _leaf_chains(skeleton):
-        v = np.median(ends[:, leaf] - starts[:, first], axis=0)
-        nv = float(np.linalg.norm(v))
-        if nv <= 0 or float(-(v @ u)) / nv < LEG_DOWN_COS:
-            continue
-        if float(np.quantile(ends[:, leaf] @ u - floor, 0.25)) <= LEG_FLOOR_SHARE * size:
-            chain, i = {leaf}, leaf
-            while i != first:
-                i = skeleton.joints[i].parent
-                chain.add(i)
-            legs.append(chain)
-    return legs
-
-
-def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) -> tuple[str, dict]:
-    """The up axis of a motion, from the joint roles for a biped, from the legs otherwise.
-
-    *A biped* (a ``head`` and two feet, ``left_ankle``/``right_ankle`` or
-    ``left_toe``/``right_toe``, by joint role; at most :data:`MAX_BIPED_LEGS`
-    leg-like chains, :func:`leg_chains`, along any axis along which a foot's
-    chain is one of them): the signed axis nearest to the head minus the
-    mid-point of the feet (median over frames). It is ambiguous when
-    that vector's second largest component is more than
-    :data:`AMBIGUOUS_RATIO` of its largest (the body lies diagonally), when the
-    hips are not between head and feet along it, or when the body is clearly
-    tallest along another axis (a lying body).
-
-    *Not a biped* (no head or feet by role, or four or more leg-like chains:
-    a quadruped, a crab): a four-legged body is longer than it is tall, so the
-    extents do not tell up. The up axis is the signed axis with the most
-    leg-like chains (pointing down and ending on the floor). It is ambiguous
-    with fewer than three such chains or when another axis has more than
-    :data:`AMBIGUOUS_RATIO` of them; then the file's own axes are kept
-    (``+y``, BVH's convention), never a turn.
-
-    Parameters
-    ----------
-    skeleton : Skeleton
-    values : array (frames, n_dof)
-    overrides : dict, optional
-        ``{role: joint name}`` over the skeleton's own.
-
-    Returns
-    -------
-    axis : str
-        One of :data:`AXES`.
-    info : dict
-        ``extent`` (3,) median extents; ``ratio`` (second largest / largest
-        extent); ``biped`` (bool); ``legs`` (leg-like chains along ``axis``);
-        ``sign_from`` (``"roles"``: head above feet; ``"legs"``; ``"file"``:
-        kept, as nothing told); ``ambiguous`` (bool); ``why`` (str: what was
-        found, for the log).
-    """
-    starts = forward_kinematics(skeleton, values, ends=False)
-    ends = forward_kinematics(skeleton, values, ends=True)
-    pos = np.concatenate([starts, ends], axis=1)
-    ext = np.median(pos.max(axis=1) - pos.min(axis=1), axis=0)
-    tall = int(np.argmax(ext))
-    ratio = float(np.sort(ext)[-2] / max(ext[tall], 1e-300))
-    info = {"extent": ext, "ratio": ratio, "biped": False, "legs": 0, "ambiguous": False, "why": ""}
-    head = _role_index(skeleton, ("head",), overrides)
-    feet = (_role_index(skeleton, ("left_ankle", "right_ankle"), overrides)
-            or _role_index(skeleton, ("left_toe", "right_toe"), overrides))
-    chains = {ax: leg_chains(skeleton, starts, ends, ax) for ax in AXES}
-    counts = {ax: len(c) for ax, c in chains.items()}
-    # four or more legs where the feet (by role) stand: a four-legged animal on a biped template's names
-    most = max((n for ax, n in counts.items()
-                if feet is None or any(f in c for c in chains[ax] for f in feet)), default=0)
-    if head is not None and feet is not None and most <= MAX_BIPED_LEGS:
-        d = np.median(starts[:, head[0]] - 0.5 * (starts[:, feet[0]] + starts[:, feet[1]]), axis=0)
-        a = int(np.argmax(np.abs(d)))
-        axis = ("+" if d[a] >= 0 else "-") + "xyz"[a]
-        info.update(biped=True, legs=counts[axis], sign_from="roles")
-        why = []
-        second = float(np.sort(np.abs(d))[-2] / max(abs(d[a]), 1e-300))
-        if second > AMBIGUOUS_RATIO:
-            why.append(f"the head-to-feet vector {_fmt_vec(d)} lies between two axes")
-        hips = _role_index(skeleton, ("left_hip", "right_hip"), overrides)
-        if hips is not None:
-            u = axis_vector(axis)
-            hh = float(np.median(0.5 * (starts[:, hips[0]] + starts[:, hips[1]]) @ u))
-            hd = float(np.median(starts[:, head[0]] @ u))
-            hf = float(np.median(0.5 * (starts[:, feet[0]] + starts[:, feet[1]]) @ u))
-            if not hf <= hh <= hd:
-                why.append("the hips are not between the head and the feet")
-        if tall != a and ratio < AMBIGUOUS_RATIO:
-            why.append(f"the body is tallest along {'xyz'[tall]} (lying down?)")
-        info.update(ambiguous=bool(why), why="; ".join(why) or "head above feet")
-        return axis, info
-    if head is not None and feet is not None:
-        info["why"] = f"head and feet found by role, but {most} leg-like chains"
-    else:
-        info["why"] = "no head or feet by joint role"
-    best = max(AXES, key=lambda ax: (counts[ax], ax == CANONICAL_UP))
-    second = max(c for ax, c in counts.items() if ax != best)
-    info["legs"] = counts[best]
-    if counts[best] >= 3 and second <= AMBIGUOUS_RATIO * counts[best]:
-        info.update(sign_from="legs", why=info["why"] + f"; {counts[best]} legs stand on the floor along {best}")
-        return best, info
-    info.update(sign_from="file", ambiguous=True, legs=counts[CANONICAL_UP],
-                why=info["why"] + "; leg-like chains per up axis: "
-                + " ".join(f"{ax} {counts[ax]}" for ax in AXES))
-    return CANONICAL_UP, info
-
-
-def lying_down(skeleton: Skeleton, values, up, overrides: dict | None = None) -> str:
-    """Why the body would lie down or stand on its head with ``up`` as the up axis, or ``""``.
-
-    For a biped by joint role (head, ankles or toes): its head not above its
-    feet (median over frames), or its extent along ``up`` less than half its
-    largest extent across. For any body: :func:`detect_up_axis` finding
-    another axis without ambiguity.
-    """
-    u = axis_vector(up)
-    detected, info = detect_up_axis(skeleton, values, overrides)
-    why = []
-    head = _role_index(skeleton, ("head",), overrides)
-    feet = (_role_index(skeleton, ("left_ankle", "right_ankle"), overrides)
-            or _role_index(skeleton, ("left_toe", "right_toe"), overrides))
-    if info["biped"] and head is not None and feet is not None:
-        s = joint_starts(skeleton, values, [head[0], feet[0], feet[1]])
-        if float(np.median((s[:, 0] - 0.5 * (s[:, 1] + s[:, 2])) @ u)) <= 0:
-            why.append("its head is not above its feet")
-        ext = info["extent"]
-        k = int(np.argmax(np.abs(u)))
-        across = max(ext[i] for i in range(3) if i != k)
-        if ext[k] < 0.5 * across:
-            why.append(f"it is {ext[k]:.3g} units tall along {up} but {across:.3g} across")
-    if detected != parse_axis(up) and not info["ambiguous"] and not why:
-        why.append(f"its {'head is above its feet' if info['biped'] else 'legs stand'} along {detected}")
-    return "; ".join(why)
-
-
-def _fmt_vec(v) -> str:
-    return "(" + " ".join(f"{float(x):.3g}" for x in v) + ")"
-
-
-def detect_forward_axis(skeleton: Skeleton, values, up, overrides: dict | None = None) -> tuple[str, str]:
-    """The signed world axis, perpendicular to ``up``, the body faces most: from the hips, else the travel.
-
-    Returns ``(axis, source)`` with source ``"hips"`` (mean of the per-frame
-    unit :func:`hip_forward`) or ``"travel"`` (root displacement, first to last
-    frame) or ``"default"`` (neither gives a direction: the axis after ``up``
-    in ``x y z`` order).
-    """
-    u = axis_vector(up)
-    v, src = None, "default"
-    if _role_index(skeleton, ("left_hip", "right_hip"), overrides) is not None:
-        f = hip_forward(skeleton, values, up, overrides)
-        f = f - np.outer(f @ u, u)
-        n = np.linalg.norm(f, axis=1)
-        if np.any(n > 0):
-            v, src = (f[n > 0] / n[n > 0, None]).mean(axis=0), "hips"
-    if v is None or np.linalg.norm(v) < 1e-6:
-        t = root_translation(skeleton, values)
-        d = t[-1] - t[0]
-        d = d - (d @ u) * u
-        v, src = (d, "travel") if np.linalg.norm(d) > 0 else (None, "default")
-    ua = int(np.argmax(np.abs(u)))
-    cands = [s + "xyz"[k] for k in range(3) if k != ua for s in "+-"]
-    if v is None:
-        return cands[0], src
-    return max(cands, key=lambda c: float(axis_vector(c) @ v)), src
-
-
-def frame_rotation(up, forward) -> Rotation:
-    """The rotation taking the file's ``up`` to +y and ``forward`` to +z.
+def rest_forward(skeleton: Skeleton, overrides: dict | None = None) -> np.ndarray:
+    """The skeleton's forward direction in the zero pose, (3,) unit: :func:`hip_forward` of the zero pose
+    projected on the floor (independent of a file's forward axis).
 
     Raises
     ------
     ValueError
-        ``up`` and ``forward`` are not perpendicular.
+        The hips are vertically aligned in the zero pose.
     """
-    u, f = axis_vector(up), axis_vector(forward)
-    if abs(u @ f) > 0:
-        raise ValueError(f"up axis {up!r} and forward axis {forward!r} must be perpendicular")
-    return Rotation.from_matrix(np.stack([np.cross(u, f), u, f]))
+    rest = forward_kinematics(skeleton, np.zeros((1, skeleton.n_dof)), ends=False)
+    f = hip_forward(skeleton, None, CANONICAL_UP, overrides, starts=rest)[0]
+    f[UP] = 0.0
+    n = float(np.linalg.norm(f))
+    if n < 1e-9:
+        from .joints import resolve_roles
+
+        lh, rh = resolve_roles(skeleton, ("left_hip", "right_hip"), overrides)
+        raise ValueError(f"skeleton {skeleton.name!r}: the hips ({lh}, {rh}) are vertically aligned in the zero pose; "
+                         "no facing direction")
+    return f / n
 
 
-def default_forward(up) -> str:
-    """The forward axis that the smallest turn taking ``up`` to +y takes to +z (``+z`` up -> ``-y`` forward,
-    Blender's and 3ds Max's convention)."""
-    u = axis_vector(up)
-    e_y = np.array([0.0, 1.0, 0.0])
-    c = np.cross(u, e_y)
-    if np.linalg.norm(c) < 1e-12:
-        R = Rotation.identity() if u[1] > 0 else Rotation.from_euler("x", 180, degrees=True)
-    else:
-        R = Rotation.from_rotvec(c / np.linalg.norm(c) * np.arccos(np.clip(u @ e_y, -1.0, 1.0)))
-    back = R.inv().apply(np.array([0.0, 0.0, 1.0]))
-    k = int(np.argmax(np.abs(back)))
-    return ("+" if back[k] > 0 else "-") + "xyz"[k]
-
-
-def to_canonical_frame(skeleton: Skeleton, values, up, forward) -> tuple[Skeleton, np.ndarray]:
-    """Express a motion in the canonical frame (+y up, +z forward): turn the whole body by
-    :func:`frame_rotation`.
-
-    Only the root changes: its world rotation becomes ``R @ W_root`` and its
-    translation ``R @ t`` (the children's offsets are in the root's frame and
-    follow). A root without three rotation or three translation DOF gets the
-    missing ones (zero in the rest pose), so the turn is exact; every joint's
-    world position becomes ``R @ p``. Returns ``(skeleton, values)``, the
-    skeleton a copy when it changed.
-    """
-    values = _check_values(skeleton, values)
-    R = frame_rotation(up, forward)
-    if np.allclose(R.as_matrix(), np.eye(3)):
-        return skeleton, values
-    sk = copy.deepcopy(skeleton)
-    root = sk.joints[0]
-    old = skeleton.joints[0]
-    t = root_translation(skeleton, values)
-    W = root_rotation(skeleton, values)
-    trans = [d for d in old.dofs if d in TRANS_DOFS]
-    rots = [d for d in old.dofs if d in ROT_DOFS]
-    trans += [d for d in TRANS_DOFS if d not in trans]
-    rots += [d for d in ROT_DOFS if d not in rots]
-    root.dofs = trans + rots
-    root.limits = []
-    root.offset = R.apply(np.asarray(old.offset, float))
-    n = values.shape[0]
-    tn = R.apply(t)
-    C = root.axis_rotation()
-    ang = _continuous_euler((C.inv() * R * W * C).as_euler("".join(d[1] for d in rots), degrees=True))
-    block = np.concatenate([tn[:, [TRANS_DOFS.index(d) for d in trans]] - root.offset[[TRANS_DOFS.index(d)
-                                                                                       for d in trans]], ang], axis=1)
-    sl = skeleton.dof_slices()[old.name]
-    out = np.concatenate([block, values[:, sl.stop:]], axis=1).reshape(n, sk.n_dof)
-    sk.__post_init__()
-    return sk, out
-
-
-# ---------------------------------------------------------------------------------------------------------------
-# continuous angles (the one place Euler angles are unwrapped along time and put on one branch across clips)
-# ---------------------------------------------------------------------------------------------------------------
-#: A rotation DOF that changes by more than this many degrees between consecutive frames has wrapped (a file
-#: writes every angle in (-180, 180], so a joint turning past 180 jumps by about 360): :func:`unwrap_angles`
-#: adds the multiple of 360 degrees that removes the jump (``numpy.unwrap`` with period 360).
-WRAP_JUMP_DEG = 180.0
-
-
-def rotation_columns(skeleton: Skeleton, root: bool = True) -> np.ndarray:
-    """Indices of the rotational DOF columns of a motion on ``skeleton``, shape ``(k,)`` int.
-
-    ``root=False`` leaves out the root joint's.
-    """
-    cols, k = [], 0
-    for i, j in enumerate(skeleton.joints):
-        for d in j.dofs:
-            if d in ROT_DOFS and (root or i > 0):
-                cols.append(k)
-            k += 1
-    return np.array(cols, dtype=int)
-
-
-def wrap_count(skeleton: Skeleton, values) -> int:
-    """How many frame-to-frame changes above :data:`WRAP_JUMP_DEG` the rotational DOF of ``values``
-    (frames, n_dof) hold (all columns together)."""
-    v = np.asarray(values, float)
-    cols = rotation_columns(skeleton)
-    if v.shape[0] < 2 or not cols.size:
-        return 0
-    return int(np.count_nonzero(np.abs(np.diff(v[:, cols], axis=0)) > WRAP_JUMP_DEG))
-
-
-def unwrap_angles(motion, what: str | None = None):
-    """``motion`` with every rotational DOF made continuous along time.
-
-    Each rotation column (the root's too) is unwrapped on its own with ``numpy.unwrap(period=360)``: a change
-    between consecutive frames above :data:`WRAP_JUMP_DEG` degrees gets the multiple of 360 degrees that makes
-    it at most 180. Every frame keeps the same rotation (an Euler angle plus 360 degrees is the same turn), so
-    forward kinematics is unchanged up to rounding; translations (the root's, and those of other joints) are
-    untouched. A column without such a change keeps its values bit for bit (no arithmetic touches it), and a
-    motion without any is returned as it is.
-
-    Parameters
-    ----------
-    motion : Motion, ``values`` (frames, n_dof)
-    what : str, optional
-        Names the motion in the log line (default its name).
-
-    Returns
-    -------
-    Motion
-        The same object when nothing wrapped, else a new one (same skeleton, frame rate, name; ``meta`` copied
-        with ``"unwrapped"``: the number of changes removed). One info line gives the count and the columns.
-    """
-    from .motion import Motion
-
-    v = np.asarray(motion.values, float)
-    if v.shape[0] < 2:
-        return motion
-    cols = rotation_columns(motion.skeleton)
-    if not cols.size:
-        return motion
-    jumps = np.abs(np.diff(v[:, cols], axis=0)) > WRAP_JUMP_DEG
-    hit = np.flatnonzero(jumps.any(axis=0))
-    if not hit.size:
-        return motion
-    out = v.copy()
-    for c in cols[hit]:
-        out[:, c] = np.unwrap(v[:, c], period=360.0)
-    names = motion.skeleton.columns()
-    n = int(jumps.sum())
-    log.info("%s: %d frame-to-frame change(s) above %g degrees in %d rotation column(s) (%s) read as wraps of "
-             "the Euler angle and unwrapped (the same rotations, continuous along time)", what or motion.name, n,
-             WRAP_JUMP_DEG, hit.size, ", ".join(names[c] for c in cols[hit][:8]) + (" ..." if hit.size > 8 else ""))
-    return Motion(out, motion.skeleton, motion.fps, motion.name, dict(motion.meta, unwrapped=n))
-
-
-def align_angle_branches(motion, reference):
-    """``motion`` with each non-root rotation column shifted by the multiple of 360 degrees that brings its
-    median nearest the ``reference``'s median of that column.
-
-    The branch rule of a database of clips: after :func:`unwrap_angles` each clip is continuous on its own,
-    but a joint that sits near 180 degrees may sit near +180 in one clip and near -180 in another. Shifting
-    the clip by ``360 * round((median_ref - median_clip) / 360)`` per column gives the same pose the same
-    value across clips (the same rotation). The root's rotation is left as it is: it is the clip's heading,
-    not part of the pose, and differs between clips anyway.
-
-    Parameters
-    ----------
-    motion : Motion, ``(frames, n_dof)``
-    reference : Motion or ndarray ``(frames_r, n_dof)`` on a skeleton with the same columns
-
-    Returns
-    -------
-    Motion, the same object when no column moves, else a new one (``meta["branch_shift"]``: the columns moved).
-    """
-    from .motion import Motion
-
-    ref = np.asarray(getattr(reference, "values", reference), float)
-    v = np.asarray(motion.values, float)
-    if ref.shape[1] != v.shape[1]:
-        raise ValueError(f"{motion.name!r}: {v.shape[1]} DOF columns, the reference has {ref.shape[1]}")
-    cols = rotation_columns(motion.skeleton, root=False)
-    if not cols.size or not len(ref) or not len(v):
-        return motion
-    k = np.round((np.median(ref[:, cols], axis=0) - np.median(v[:, cols], axis=0)) / 360.0)
-    moved = np.flatnonzero(k != 0)
-    if not moved.size:
-        return motion
-    out = v.copy()
-    out[:, cols[moved]] += 360.0 * k[moved]
-    names = motion.skeleton.columns()
-    log.info("%s: %d rotation column(s) (%s) shifted by a multiple of 360 degrees to the branch of the "
-             "database's first clip", motion.name, moved.size, ", ".join(names[c] for c in cols[moved][:8]))
-    return Motion(out, motion.skeleton, motion.fps, motion.name,
-                  dict(motion.meta, branch_shift=[names[c] for c in cols[moved]]))
-
-
-def continuous_clips(motions, reference=None) -> list:
-    """Clips made ready to share one database: each :func:`unwrap_angles` on its own, then
-    :func:`align_angle_branches` to ``reference`` (default: the first clip, itself unwrapped).
-
-    Parameters
-    ----------
-    motions : list of Motion on skeletons with the same DOF columns
-    reference : Motion, optional
-
-    Returns
-    -------
-    list of Motion (an input that needs no change is returned as it is)
-    """
-    out = [unwrap_angles(m) for m in motions]
-    if not out:
-        return out
-    ref = out[0] if reference is None else unwrap_angles(reference)
-    return [align_angle_branches(m, ref) for m in out]
-
-
-def retarget(motion, reference: Skeleton, what: str = "", reference_name: str = "", tol_m: float = SAME_SKELETON_TOL_M):
-    """``motion`` on the ``reference`` skeleton, by joint name.
-
-    * The same skeleton (:func:`compare_skeletons` within ``tol_m``, no rest-frame turn) with the same DOF
-      columns: the values as they are, on ``reference`` (bit for bit).
-    * The same skeleton otherwise (other channels or channel orders, or its rest pose turned, as in a Z-up
-      re-export): the local rotations read onto ``reference``'s DOF (``L' = Q L Q^-1``, the root's world
-      rotation ``W Q^-1``): every joint's world position is unchanged. One info line.
-    * Other rest offsets (bone lengths, or directions within :data:`RETARGET_MAX_ANGLE_DEG`): retargeted, the
-      local rotations kept (after the rest-frame turn) and the root's world translation kept, on
-      ``reference``'s offsets. One warning names both and the largest offset difference.
-    * Refused (ValueError naming both and the largest difference): other joint names or parents, or a bone
-      whose rest direction differs by more than :data:`RETARGET_MAX_ANGLE_DEG` (another rest pose: keeping the
-      local rotations would not carry the motion over).
-
-    Translation DOF of non-root joints the reference lacks are dropped; rotation DOF the reference lacks must be
-    zero (:func:`animsynth.kinematics.dof_values_from_local`). The result's angles are made continuous
-    (:func:`animsynth.kinematics.unwrap_angles`).
-
-    Parameters
-    ----------
-    motion : Motion, ``(frames, n_dof)``
-    reference : Skeleton
-    what, reference_name : str, name the motion and the reference in messages
-    tol_m : float, metres
-
-    Returns
-    -------
-    Motion, ``(frames, reference.n_dof)`` on ``reference``
-    """
-    from .motion import Motion
-
-    what = what or motion.name or "motion"
-    ref_name = reference_name or reference.name
-    sk = motion.skeleton
-    diff = compare_skeletons(sk, reference, tol_m)
-    if not diff.joints_match:
-        raise ValueError(f"{what}: its joints differ from the reference's ({ref_name}): {diff.why}; "
-                         "give motions on the same skeleton")
-    values = np.asarray(motion.values, float)
-    same_cols = sk.columns() == reference.columns()
-    turned = diff.turn_deg > 0
-    if diff.same and same_cols and not turned:
-        return Motion(values, reference, motion.fps, motion.name, dict(motion.meta))
-    if diff.largest_angle_deg > RETARGET_MAX_ANGLE_DEG:
-        raise ValueError(f"{what} and {ref_name}: another rest pose (rest offsets differ by up to "
-                         f"{diff.largest_m * 1000:.1f} mm at joint {diff.joint!r}, a bone's rest direction by "
-                         f"{diff.largest_angle_deg:.0f} degrees > {RETARGET_MAX_ANGLE_DEG:g}); retargeting by joint "
-                         "name would not carry the motion over: give motions on one skeleton")
-    Q = diff.turn
-    L = local_rotations(sk, values)
-    T = joint_translations(sk, values)
-    n = values.shape[0]
-    rots, trans = [], np.empty((n, len(reference.joints), 3))
-    for i, j in enumerate(reference.joints):
-        k = sk.index(j.name)
-        rots.append(L[k] * Q.inv() if j.parent < 0 else Q * L[k] * Q.inv())
-        if j.parent >= 0:
-            moved = (T[:, k] - np.asarray(sk.joints[k].offset, float)) * (sk.length_to_m / reference.length_to_m)
-            trans[:, i] = np.asarray(j.offset, float) + Q.apply(moved)
-    root_t = root_translation(sk, values) * (sk.length_to_m / reference.length_to_m)
-    trans[:, 0] = root_t
-    out = Motion(dof_values_from_local(reference, rots, root_t, trans), reference, motion.fps, motion.name,
-                 dict(motion.meta))
-    if diff.same:
-        log.info("%s: the skeleton of %s%s (rest offsets within %g mm); its rotations are read onto %s's DOF "
-                 "(every joint's position unchanged)", what, ref_name,
-                 f" with its rest pose turned by {diff.turn_deg:.0f} degrees" if turned else "", tol_m * 1000,
-                 ref_name)
-    else:
-        log.warning("%s and %s: rest offsets differ by up to %.1f mm (joint %r; tolerance %g mm)%s; %s is "
-                    "retargeted onto %s's skeleton by joint name (local rotations kept, %s's offsets)", what,
-                    ref_name, diff.largest_m * 1000, diff.joint, tol_m * 1000,
-                    f" after turning the rest pose by {diff.turn_deg:.0f} degrees" if turned else "", what, ref_name,
-                    ref_name)
-    return unwrap_angles(out, what)
+def yaw_rotation(yaw) -> Rotation:
+    """Rotations about +y by ``yaw`` (radians, one per frame); ``yaw_rotation(a)`` turns +z to
+    ``(sin a, 0, cos a)``."""
+    return Rotation.from_euler("y", np.atleast_1d(np.asarray(yaw, float))[:, None])

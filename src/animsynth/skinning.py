@@ -27,7 +27,7 @@ import numpy as np
 from scipy import sparse
 from scipy.spatial.transform import Rotation
 
-from .kinematics import forward_kinematics
+from .kinematics import forward_kinematics, tree_forward, tree_local
 from .skeleton import Joint, Skeleton
 
 #: The 18 joints, parents before children.
@@ -146,7 +146,8 @@ def matrix_to_euler(R: np.ndarray) -> np.ndarray:
 
 
 def forward(rig: Rig, root_t: np.ndarray, angles: np.ndarray):
-    """World rotations and joint starts for every frame.
+    """World rotations and joint starts for every frame: :func:`animsynth.kinematics.tree_forward` on rotation
+    matrices (the rig's offsets the same in every frame).
 
     Parameters
     ----------
@@ -164,16 +165,9 @@ def forward(rig: Rig, root_t: np.ndarray, angles: np.ndarray):
         L = euler_to_matrix(L)
     F, J = L.shape[:2]
     off = rig.offsets
-    W = np.empty((F, J, 3, 3))
-    S = np.empty((F, J, 3))
-    for j, p in enumerate(rig.parents):
-        if p < 0:
-            W[:, j] = L[:, j]
-            S[:, j] = root_t
-        else:
-            W[:, j] = W[:, p] @ L[:, j]
-            S[:, j] = S[:, p] + W[:, p] @ off[j]
-    return W, S
+    T = [np.broadcast_to(root_t, (F, 3)) if p < 0 else off[j] for j, p in enumerate(rig.parents)]
+    W, S = tree_forward(rig.parents, [L[:, j] for j in range(J)], T)
+    return np.stack(W, axis=1), np.stack(S, axis=1)
 
 
 def joint_transforms(rig: Rig, W: np.ndarray, S: np.ndarray) -> np.ndarray:
@@ -286,10 +280,7 @@ def cmu_motion_to_rig(motion, rig: Rig | None = None):
     starts, Wc = forward_kinematics(sk, motion.values, ends=False, world_rotations=True)
     idx = [sk.index(CMU_MAP[n]) for n in JOINTS]
     Wm = np.stack([Wc[i].as_matrix() for i in idx], axis=1)  # (F, 18, 3, 3)
-    L = np.empty_like(Wm)
-    for j, p in enumerate(rig.parents):
-        L[:, j] = Wm[:, j] if p < 0 else np.swapaxes(Wm[:, p], -1, -2) @ Wm[:, j]
-    angles = np.unwrap(matrix_to_euler(L), axis=0)
+    angles = np.unwrap(matrix_to_euler(tree_local(rig.parents, Wm)), axis=0)
     root_t = starts[:, idx[0]] * sk.length_to_m
     return rig, root_t, angles
 
@@ -310,10 +301,7 @@ def rebase_pose(rig: Rig, root_t: np.ndarray, angles: np.ndarray, angles0: np.nd
     W, _ = forward(rig, root_t, angles)
     W0, _ = forward(rig, np.zeros((1, 3)), np.asarray(angles0)[None])
     Wn = W @ np.swapaxes(W0, -1, -2)  # new world rotations: W_j(t) W_j(0)^T
-    L = np.empty_like(Wn)
-    for j, p in enumerate(rig.parents):
-        L[:, j] = Wn[:, j] if p < 0 else np.swapaxes(Wn[:, p], -1, -2) @ Wn[:, j]
-    return np.unwrap(matrix_to_euler(L), axis=0)
+    return np.unwrap(matrix_to_euler(tree_local(rig.parents, Wn)), axis=0)
 
 
 # --------------------------------------------------------------------------- inside test

@@ -43,20 +43,10 @@ from scipy.ndimage import median_filter
 from scipy.spatial.transform import Rotation
 
 from ..joints import resolve_roles
-from ..kinematics import forward_kinematics, wrap_degrees
+from ..kinematics import UP, decay_spring, forward_kinematics, joint_euler, nearest_euler, wrap_degrees
 from ..skeleton import ROT_DOFS
 
 __all__ = ["leg_chains", "contact_points", "contact_labels", "lock_contacts", "two_bone_ik", "place_feet"]
-
-UP = 1
-
-
-def _decay(x, v, halflife: float, dt: float):
-    """The critically damped spring towards zero (as :func:`animsynth.compare.motionmatching.decay_spring`)."""
-    y = 2.0 * np.log(2.0) / float(halflife)
-    j = v + x * y
-    e = np.exp(-y * dt)
-    return e * (x + j * dt), e * (v - j * y * dt)
 
 
 def leg_chains(skeleton) -> np.ndarray:
@@ -136,7 +126,7 @@ def lock_contacts(points: np.ndarray, states: np.ndarray, fps: float, reset_poin
             v_in = (x_in - prev_in) / dt
             prev_in = x_in
             # the inertialized output follows the locked point (at rest) or the animation
-            off_x, off_v = _decay(off_x, off_v, halflife_s, dt)
+            off_x, off_v = decay_spring(off_x, off_v, halflife_s, dt)
             pos = (point if lock else x_in) + off_x
             targets[t, f] = pos
             locked[t, f] = lock
@@ -156,23 +146,6 @@ def lock_contacts(points: np.ndarray, states: np.ndarray, fps: float, reset_poin
     return targets, locked
 
 
-def _joint_euler(skeleton, j: int, L: Rotation, old: np.ndarray) -> np.ndarray:
-    """Euler DOF values (degrees, ``(T, 3)``) of joint ``j``'s local rotations ``L`` (three rotational DOF),
-    each frame on the branch and turn nearest its ``old`` values."""
-    joint = skeleton.joints[j]
-    C = joint.axis_rotation()
-    seq = "".join(d[1] for d in joint.dofs if d in ROT_DOFS)
-    ang = (C.inv() * L * C).as_euler(seq, degrees=True)
-    alt = ang + np.array([180.0, 0.0, 180.0])
-    alt[:, 1] = 180.0 - ang[:, 1]
-    best = None
-    for cand in (ang, alt):
-        c = old + wrap_degrees(cand - old)
-        d = np.abs(c - old).sum(axis=1)
-        best = (c, d) if best is None else (np.where((d < best[1])[:, None], c, best[0]), np.minimum(d, best[1]))
-    return best[0]
-
-
 def _unit(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v, axis=-1, keepdims=True)
     return v / np.where(n > 1e-12, n, 1.0)
@@ -186,14 +159,9 @@ def _write_rotation(skeleton, j: int, L: Rotation, values: np.ndarray) -> None:
     start = skeleton.dof_slices()[joint.name].start
     rd = [(i, d[1]) for i, d in enumerate(joint.dofs) if d in ROT_DOFS]
     cols = np.array([start + i for i, _ in rd])
-    if len(rd) == 3:
-        values[:, cols] = _joint_euler(skeleton, j, L, values[:, cols])
-        return
-    axes = [a for _, a in rd]
-    C = joint.axis_rotation()
-    ang = (C.inv() * L * C).as_euler("".join(axes + [a for a in "xyz" if a not in axes]), degrees=True)[:, :len(rd)]
+    ang = joint_euler(joint, L)
     old = values[:, cols]
-    values[:, cols] = old + wrap_degrees(ang - old)
+    values[:, cols] = nearest_euler(ang, old) if len(rd) == 3 else old + wrap_degrees(ang - old)
 
 
 def place_feet(skeleton, values, chain, targets, max_length_buffer_m: float = 0.015, fk=None) -> np.ndarray:
@@ -310,11 +278,11 @@ def _two_bone(skeleton, values, chain, targets, max_length_buffer_m, effector, s
     else:
         Wp = W[knee.parent]
         Lk = Wp.inv() * turn * W[k]
-        values[:, kcols] = _joint_euler(skeleton, k, Lk, values[:, kcols])
+        values[:, kcols] = nearest_euler(joint_euler(knee, Lk), values[:, kcols])
     # hip DOF: new world rotation R2 * W_h
     hip = skeleton.joints[h]
     hcols = np.array([sl[hip.name].start + i for i, d in enumerate(hip.dofs) if d in ROT_DOFS])
     Wp = W[hip.parent] if hip.parent >= 0 else Rotation.identity(T)
     Lh = Wp.inv() * R2 * W[h]
-    values[:, hcols] = _joint_euler(skeleton, h, Lh, values[:, hcols])
+    values[:, hcols] = nearest_euler(joint_euler(hip, Lh), values[:, hcols])
     return values, R2 * turn * W[k]

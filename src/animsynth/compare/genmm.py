@@ -57,10 +57,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import wrap_radians
+from ..kinematics import from_rot6d, rest_forward, root_rotation, rot6d, rotation_heading, wrap_radians, yaw_rotation
 from ..motion import Motion
 from ..generator import Database, Generator
-from .poses import decode, encode, rest_forward, from_rot6d, rot6d, rotation_yaw, yaw_rotation
+from .poses import decode, encode, rotating_joints
 
 __all__ = ["GenMM", "make_genmm", "extract_patches", "match_patches", "vote", "resample_rows", "level_scales"]
 
@@ -241,10 +241,8 @@ class GenMM(Generator):
         if self.root == "local":
             return decode(sk, q, root_q, height, r[:, 7:9] / (m * fps), r[:, 9] / fps, anchor, self.forward_)
         R = Rotation.from_quat(root_q)
-        from ..kinematics import root_rotation
-
-        yaw0 = rotation_yaw(sk, root_rotation(sk, anchor[None, :]), self.forward_)[0]
-        yaw = rotation_yaw(sk, R, self.forward_)
+        yaw0 = rotation_heading(root_rotation(sk, anchor[None, :]), self.forward_, hold_vertical=True)[0]
+        yaw = rotation_heading(R, self.forward_, hold_vertical=True)
         prev = np.concatenate([[yaw0], yaw[:-1]])
         turn = wrap_radians(yaw - prev)
         disp = r[:, 7:9] / (m * fps)
@@ -265,8 +263,6 @@ class GenMM(Generator):
         if not float(self.alpha) > 0.0:
             raise ValueError(f"genmm: alpha must be > 0 (inf: no normalisation), got {self.alpha}")
         self.db_ = db = Database(database)
-        from .poses import rotating_joints
-
         self.joints_ = rotating_joints(db.skeleton)
         self.forward_ = rest_forward(db.skeleton)
         self.frames_ = [self._rows(c) for c in db.clips]

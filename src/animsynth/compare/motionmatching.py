@@ -5,7 +5,7 @@ reference (github.com/orangeduck/Motion-Matching); no code copied. The estimator
 interface of :mod:`animsynth.compare.generators` (``fit(database)``, ``generate(start, length, seed)``).
 
 Features (every database frame, in the frame's own root frame: the root's ground point turned so that
-its facing, :func:`animsynth.compare.poses.facing_yaw`, is +Z; metres and m/s):
+its facing, :func:`animsynth.kinematics.rotation_heading` of :func:`animsynth.kinematics.rest_forward`, is +Z; metres and m/s):
 
 ==========================  ====  ======  ==========================================================
 group                       dims  weight  what
@@ -32,7 +32,7 @@ the character plays ``j + 1, j + 2, ...``.
 Inertialization (at every switch, the start's entry included): the offset between the pose shown
 and the matched frame (joint rotations, root tilt and height, root ground velocity and turning rate
 in the facing frame), and between their velocities, decays by the critically damped spring of the
-reference (:func:`decay_spring`, half-life ``inertialize_halflife_s`` = 0.1 s) and is added to every
+reference (:func:`animsynth.kinematics.decay_spring`, half-life ``inertialize_halflife_s`` = 0.1 s) and is added to every
 played frame. The root is integrated from the start's last frame with the played frames' own ground
 steps and turns (offsets included).
 
@@ -83,39 +83,18 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..joints import resolve_roles
-from ..kinematics import forward_kinematics, wrap_radians
+from ..kinematics import (decay_spring, forward_kinematics, halflife_to_damping, qexp, qinv, qlog, qmul, rest_forward,
+                          wrap_radians, yaw_rotation)
 from ..motion import Motion
 from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
 from ..generator import Database, Generator
-from .poses import Track, decode, encode, qexp, qinv, qlog, qmul, rest_forward, yaw_rotation
+from .poses import Track, decode, encode
 
-__all__ = ["MotionMatching", "make_motion_matching", "decay_spring", "spring_position", "spring_angle",
-           "halflife_to_damping", "pose_features", "trajectory_features"]
-
-LN2 = float(np.log(2.0))
+__all__ = ["MotionMatching", "make_motion_matching", "spring_position", "spring_angle", "pose_features",
+           "trajectory_features"]
 
 
-# ----------------------------------------------------------------------------- springs (the reference's, exact)
-
-
-def halflife_to_damping(halflife: float) -> float:
-    """Damping of a critically damped spring whose offset halves in ``halflife`` seconds (without velocity):
-    ``4 ln 2 / halflife``."""
-    return 4.0 * LN2 / float(halflife)
-
-
-def decay_spring(x, v, halflife: float, dt: float):
-    """A critically damped spring towards zero after ``dt`` seconds: ``(x, v)`` of offset and its velocity.
-
-    With ``y = damping / 2`` and ``j = v0 + y x0``: ``x(t) = e^(-y t) (x0 + j t)``, ``v(t) = e^(-y t) (v0 - j y t)``.
-    After one half-life from rest the offset is ``(1 + 2 ln 2) / 4 = 0.597`` of where it started.
-    """
-    y = halflife_to_damping(halflife) / 2.0
-    x = np.asarray(x, float)
-    v = np.asarray(v, float)
-    j = v + x * y
-    e = np.exp(-y * dt)
-    return e * (x + j * dt), e * (v - j * y * dt)
+# ----------------------------------------------------------------------------- the reference's trajectory springs
 
 
 def spring_position(x, v, a, goal_velocity, halflife: float, dt):
@@ -156,7 +135,7 @@ def _velocity(x: np.ndarray, fps: float) -> np.ndarray:
 def pose_features(motion: Motion, yaw: np.ndarray) -> np.ndarray:
     """The pose part of the features of every frame (>= 2 frames): ``(T, 15)`` = left and right foot
     positions, left and right foot velocities, hip velocity, each (x, y, z) in the frame's root frame
-    (metres, m/s); ``yaw (T,)`` the frames' facing yaw (:func:`animsynth.compare.poses.facing_yaw`)."""
+    (metres, m/s); ``yaw (T,)`` the frames' facing yaw (:func:`animsynth.compare.poses.encode`)."""
     sk, fps = motion.skeleton, float(motion.fps)
     pos = forward_kinematics(sk, motion.values, ends=False) * float(sk.length_to_m)
     turn = yaw_rotation(-yaw)

@@ -144,17 +144,17 @@ def prepare_clips(trials: dict, subsets: dict, resequencing: dict, cfg: dict) ->
         :func:`animsynth.compare.settings.native_rates`)
 
     Every trial's angles are made continuous at its own rate, before resampling
-    (:func:`animsynth.kinematics.unwrap_angles`: a fast joint may turn by more than 180 degrees between two
+    (:func:`animsynth.retarget.unwrap_angles`: a fast joint may turn by more than 180 degrees between two
     working frames without wrapping, so the working frames are not unwrapped again). A leave-one-out clip's
-    database trials are put on the held-out trial's skeleton (:func:`animsynth.kinematics.retarget`: the same
+    database trials are put on the held-out trial's skeleton (:func:`animsynth.retarget.retarget`: the same
     skeleton is kept as it is; other rest offsets are retargeted with a logged warning, or refused naming
     both trials) and every one of them, the held-out trial too, on the angle branch of the database's first
-    trial (:func:`animsynth.kinematics.align_angle_branches`). A temporal split's database and held-out part
+    trial (:func:`animsynth.retarget.align_angle_branches`). A temporal split's database and held-out part
     are one continuous trial and stay as they are. The clips at a native rate are made the same way from
     the unwrapped trials.
     """
-    from ..kinematics import align_angle_branches, unwrap_angles
-    from ..kinematics import retarget
+    from ..retarget import align_angle_branches, unwrap_angles
+    from ..retarget import retarget
 
     fps, context = float(cfg["fps"]), int(cfg["context"])
     length, min_length = int(cfg["length"]), int(cfg["min_length"])

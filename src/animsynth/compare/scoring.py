@@ -259,14 +259,14 @@ def on_skeleton(motion: Motion, skeleton, what: str, reference_name: str = "the 
     Every joint of ``skeleton`` must be in ``motion`` with the same parent joint (by name); joints of
     ``motion`` that the reference does not have (an extra end joint, a prop, a finger) are left out, logged.
     Otherwise (a joint missing, or one whose parent differs: an extra joint inside a chain would move its
-    children) a ``ValueError`` names the joints. The rest is :func:`animsynth.kinematics.retarget`: its values
+    children) a ``ValueError`` names the joints. The rest is :func:`animsynth.retarget.retarget`: its values
     as they are when it is the same skeleton (rest offsets within
     :data:`animsynth.skeleton.SAME_SKELETON_TOL_M`) with the same DOF columns; its rotations read onto the
     reference's DOF when only the channels or the rest frame differ (a Z-up re-export: every joint's position
     unchanged); retargeted by joint name with a logged warning when the rest offsets differ; refused (naming
     both and the largest offset difference) when the rest pose differs.
     """
-    from ..kinematics import retarget
+    from ..retarget import retarget
 
     msk = motion.skeleton
     missing = [n for n in skeleton.names if n not in msk.names]

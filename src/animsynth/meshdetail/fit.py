@@ -35,6 +35,7 @@ import numpy as np
 from scipy import sparse
 from threadpoolctl import threadpool_limits
 
+from ..kinematics import tree_local
 from ..skinning import Rig, inside_mesh, joint_transforms, lbs, matrix_to_euler, winding_number
 
 log = logging.getLogger("animsynth.meshdetail.fit")
@@ -89,13 +90,6 @@ def _skew(v):
     z = np.zeros(v.shape[:-1])
     return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1),
                      np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
-
-
-def world_to_local(rig: Rig, W: np.ndarray) -> np.ndarray:
-    L = np.empty_like(W)
-    for j, p in enumerate(rig.parents):
-        L[:, j] = W[:, j] if p < 0 else np.swapaxes(W[:, p], -1, -2) @ W[:, j]
-    return L
 
 
 class PoseFitter:
@@ -171,7 +165,7 @@ class PoseFitter:
             while j >= 0:
                 desc[k, j] = 1.0  # k is in the subtree of j
                 j = rig.parents[j]
-        L = world_to_local(rig, W)
+        L = tree_local(rig.parents, W)
         sub = np.unique(np.linspace(0, V - 1, min(V, self.max_vertices)).round().astype(int))
         chunk = max(1, int(4e6 // (len(sub) * J * 3)))
         for f0 in range(0, F, chunk):
@@ -182,7 +176,7 @@ class PoseFitter:
         S = _fk_from_world(rig, W, root_t)
         self.W_ = W
         self.root_t_ = root_t
-        self.angles_ = np.unwrap(matrix_to_euler(world_to_local(rig, W)), axis=0)
+        self.angles_ = np.unwrap(matrix_to_euler(tree_local(rig.parents, W)), axis=0)
         self.residual_ = np.linalg.norm(lbs(Wsp, rest, joint_transforms(rig, W, S)) - frames, axis=-1).mean(axis=1)
         return self
 

@@ -21,12 +21,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import quaternions, root_translation, translated_joints
+from ..kinematics import qinv, qmul, quaternions, root_translation, translated_joints
 
 log = logging.getLogger("animsynth.resequencing")
 
 __all__ = ["quat_log", "relative_log", "linearize_quaternions", "MotionFeatures", "motion_features",
-           "angular_velocity", "SIGN_MODES", "quat_multiply", "matrix_naive_quaternions", "naive_quat_log",
+           "angular_velocity", "SIGN_MODES", "matrix_naive_quaternions", "naive_quat_log",
            "sign_flips"]
 
 #: Quaternion sign handling of the linearisation (config key ``resequencing.linearisation.sign_mode``).
@@ -52,22 +52,6 @@ def relative_log(qa, qb) -> np.ndarray:
     ra = Rotation.from_quat(qa.reshape(-1, 4))
     rb = Rotation.from_quat(qb.reshape(-1, 4))
     return (0.5 * (ra.inv() * rb).as_rotvec()).reshape(shape + (3,))
-
-
-def quat_multiply(a, b) -> np.ndarray:
-    """Hamilton product of scalar-last quaternions ``(..., 4)``, *without* any sign normalisation.
-
-    Written out because :mod:`scipy.spatial.transform` composes rotations and is
-    free to return either sign; the ``matrix_naive`` reproduction needs the raw product.
-    """
-    a = np.asarray(a, float)
-    b = np.asarray(b, float)
-    x1, y1, z1, w1 = np.moveaxis(a, -1, 0)
-    x2, y2, z2, w2 = np.moveaxis(b, -1, 0)
-    return np.stack([w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-                     w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2], axis=-1)
 
 
 def matrix_naive_quaternions(q) -> np.ndarray:
@@ -158,7 +142,7 @@ def linearize_quaternions(q, sign_mode: str = "continuous") -> np.ndarray:
             inc = relative_log(q[:-1], q[1:])
         else:
             qn = matrix_naive_quaternions(q)
-            inc = naive_quat_log(quat_multiply(qn[:-1] * np.array([-1.0, -1.0, -1.0, 1.0]), qn[1:]))
+            inc = naive_quat_log(qmul(qinv(qn[:-1]), qn[1:]))
         v[1:] = np.cumsum(inc, axis=0)
     return v[:, 0, :] if squeeze else v
 

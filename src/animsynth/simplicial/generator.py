@@ -163,13 +163,13 @@ class FieldFollower(Generator):
     # ------------------------------------------------------------------ the generator interface
     def fit(self, database) -> "FieldFollower":
         """Fit on a database of motions (list of Motion): the joint angles of every clip, root removed, each clip
-        on the angle branch of the first clip's (:func:`animsynth.kinematics.align_angle_branches`; the
+        on the angle branch of the first clip's (:func:`animsynth.retarget.align_angle_branches`; the
         comparison's clips already are, and stay as they are). The clips are expected continuous along time
-        (:func:`animsynth.kinematics.unwrap_angles`, which :func:`animsynth.data.load_trial` and the
+        (:func:`animsynth.retarget.unwrap_angles`, which :func:`animsynth.data.load_trial` and the
         comparison's clips apply at the capture's own rate)."""
         from scipy.spatial import cKDTree
 
-        from ..kinematics import align_angle_branches
+        from ..retarget import align_angle_branches
 
         self.db_ = db = Database(database)
         clips = [align_angle_branches(c, db.clips[0]) for c in db.clips]
@@ -198,7 +198,7 @@ class FieldFollower(Generator):
         frame); ``meta``: ``seams`` (empty, int64), ``source_frames`` ``(length, 2)`` int64 of -1 (decoded poses
         have no source frame), ``fallback_share`` (float, the share of steps that fell back to k-NN)
         """
-        from ..kinematics import align_angle_branches
+        from ..retarget import align_angle_branches
 
         self._check_start(start, length)
         db, spf, length = self.db_, self.steps_per_frame_, int(length)

@@ -32,14 +32,14 @@ def load_trials(paths, ids) -> tuple[dict, dict]:
     """Parsed trials of one subset -> (id -> 56 joint-angle columns, id -> Motion), in the given order.
 
     The subset's trials share one database in every fold, so they are put on one skeleton and one angle branch
-    first: every trial on the first trial's skeleton (:func:`animsynth.kinematics.retarget`: the same skeleton,
+    first: every trial on the first trial's skeleton (:func:`animsynth.retarget.retarget`: the same skeleton,
     rest offsets within 1 mm, is kept as it is; other rest offsets are retargeted with a logged warning, or
     refused naming both trials), each trial's angles continuous along time and on the branch of the first
-    trial's (:func:`animsynth.kinematics.continuous_clips`). A trial that needs neither keeps its values bit
+    trial's (:func:`animsynth.retarget.continuous_clips`). A trial that needs neither keeps its values bit
     for bit.
     """
-    from ..kinematics import continuous_clips
-    from ..kinematics import retarget
+    from ..retarget import continuous_clips
+    from ..retarget import retarget
 
     if len(paths) != len(ids):
         raise ValueError(f"{len(paths)} trial files for {len(ids)} trial ids")

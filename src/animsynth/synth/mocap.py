@@ -29,8 +29,8 @@ from scipy.ndimage import gaussian_filter1d
 from scipy.spatial.transform import Rotation
 
 from ..motion import Motion
-from ..kinematics import forward_kinematics
-from ..skeleton import Joint, Skeleton
+from ..kinematics import forward_kinematics, joint_euler
+from ..skeleton import ROT_DOFS, Joint, Skeleton
 
 KINDS = ("walk_straight", "walk_turn", "run_straight", "run_turn", "dance")
 
@@ -162,11 +162,7 @@ class _Pose:
 
     def set_world_aligned(self, joint: str, rot: Rotation):
         """Give a 3-DOF joint the local rotation ``rot`` (axes of the rest pose)."""
-        j = self.sk[joint]
-        C = j.axis_rotation()
-        M = C.inv() * rot * C
-        ang = M.as_euler("".join(d[1] for d in j.dofs), degrees=True)
-        self.values[:, self.sl[joint]] = ang
+        self.values[:, self.sl[joint]] = joint_euler(self.sk[joint], rot)
 
 
 def _arm_rotation(side: str, swing_deg, abduct_deg, n):
@@ -270,10 +266,8 @@ def _locomotion(P: _Pose, rng, t, fps, kind):
 
 def _set_root_rotation(P: _Pose, rot: Rotation):
     j = P.sk.joints[0]
-    C = j.axis_rotation()
-    M = C.inv() * rot * C
-    rdofs = [d for d in j.dofs if d.startswith("r")]
-    ang = M.as_euler("".join(d[1] for d in rdofs), degrees=True)
+    rdofs = [d for d in j.dofs if d in ROT_DOFS]
+    ang = joint_euler(j, rot)
     for k, d in enumerate(rdofs):
         P.set_dof("root", d, ang[:, k])
 
