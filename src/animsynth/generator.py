@@ -15,10 +15,9 @@ comparison (:mod:`animsynth.compare`) all call; this module knows no family.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .kinematics import (heading, local_rotations, root_rotation, root_translation, rotation_heading, set_root,
-                         wrap_radians)
+                         wrap_radians, yaw_rotation)
 from .motion import Motion
 
 __all__ = ["Database", "Generator", "align_root", "check_generated", "play_path", "QUERY_START",
@@ -39,7 +38,7 @@ def align_root(skeleton, values, anchor, index: int = 0) -> np.ndarray:
     R = root_rotation(skeleton, values)
     p = root_translation(skeleton, values)
     turn = float(heading(skeleton, anchor)[0] - heading(skeleton, values[index:index + 1])[0])
-    Ry = Rotation.from_euler("y", turn)
+    Ry = yaw_rotation(turn)[0]
     pa = root_translation(skeleton, anchor)[0]
     q = Ry.apply(p - p[index])
     q[:, 0] += pa[0]
@@ -259,6 +258,6 @@ def play_path(motion: Motion, path, root: str = "integrate", name: str | None = 
             new_p[t, 1] = p[b, 1]
             new_yaw[t] = new_yaw[t - 1] + dyaw
         # new root rotation = R_y(new_yaw - yaw[b]) * R[b]
-        Ry = Rotation.from_euler("y", (new_yaw - yaw[path])[:, None])
+        Ry = yaw_rotation(new_yaw - yaw[path])
         out = set_root(sk, out, Ry * R0[path], new_p)
     return Motion(out, sk, motion.fps, name or f"{motion.name}_reseq", dict(motion.meta))

@@ -89,7 +89,7 @@ from ..io.bvh import write_bvh
 from ..kinematics import dof_values_from_local
 from ..motion import Motion
 from ..skeleton import Skeleton
-from ..kinematics import local_rotations, root_translation
+from ..kinematics import local_rotations, root_translation, yaw_rotation
 from .fairmotion_fixes import check_fixes, walk_patches
 from .motiongraph import budget_keep
 from .point_clouds import apply_floor_transform, pair_terms, positions_m, transform_from_terms, window_clouds
@@ -665,7 +665,7 @@ class FairmotionGraph(Generator):
         scale = self.skeleton_.length_to_m
         root = mats[:, idx[self.skeleton_.joints[0].name], :3, 3]  # metres (BVH written in metres)
         theta, x0, z0 = place
-        rots[0] = Rotation.from_euler("y", theta) * rots[0]
+        rots[0] = yaw_rotation(theta)[0] * rots[0]
         root = apply_floor_transform(root[:, None, :], theta, x0, z0)[:, 0] / scale
         values = dof_values_from_local(self.skeleton_, rots, root)
         seams = np.unique([-(-s // up) for s in seams]).astype(int)

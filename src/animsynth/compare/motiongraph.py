@@ -69,7 +69,7 @@ from scipy.sparse.csgraph import connected_components, dijkstra
 from scipy.spatial.transform import Rotation
 
 from ..generator import Database, Generator, check_generated
-from ..kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation
+from ..kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation, yaw_rotation
 from ..motion import Motion
 from .point_clouds import (apply_floor_transform, compose_floor_transforms, normalised_weights, pair_terms,
                            positions_m, transform_from_terms, window_clouds)
@@ -565,7 +565,7 @@ class MotionGraph(Generator):
         seams = blend_starts[blend_starts > 0]
 
         def placed(idx, tf):
-            rot = Rotation.from_euler("y", tf[:, :1]) * Rotation.from_quat(self._quat_[idx, 0])
+            rot = yaw_rotation(tf[:, 0]) * Rotation.from_quat(self._quat_[idx, 0])
             root = apply_floor_transform(self._root_[idx][:, None, :], tf[:, 0], tf[:, 1], tf[:, 2])[:, 0]
             return rot, root
 

@@ -13,7 +13,7 @@ from ..joints import FOOT_ROLES, resolve_roles
 from ..kinematics import HORIZONTAL as _KINHORIZONTAL
 from ..kinematics import UP as _KIN_UP
 from ..kinematics import facing as _hip_facing
-from ..kinematics import forward_kinematics
+from ..kinematics import continuous_sign, forward_kinematics
 
 __all__ = ["UP", "HORIZONTAL", "positions", "foot_indices", "facing", "body_frame", "pose_features",
            "align_quaternions", "global_quaternions", "rotate_to"]
@@ -158,11 +158,7 @@ def align_quaternions(q: np.ndarray, ref: np.ndarray | None = None) -> np.ndarra
         if ref.shape != q.shape:
             raise ValueError(f"quaternion arrays differ in shape: {q.shape} vs {ref.shape}")
         return np.where((np.sum(q * ref, axis=-1) < 0)[..., None], -q, q)
-    if q.shape[0] < 2:
-        return q.copy()
-    step = np.where(np.sum(q[1:] * q[:-1], axis=-1) < 0, -1.0, 1.0)
-    sign = np.concatenate([np.ones((1,) + step.shape[1:]), np.cumprod(step, axis=0)])
-    return q * sign[..., None]
+    return continuous_sign(q)
 
 
 def global_quaternions(motion) -> np.ndarray:
