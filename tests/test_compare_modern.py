@@ -45,6 +45,30 @@ def test_encode_then_decode_from_the_frame_before_gives_the_motion_back(walks):
     assert _angle_diff(back, m.values[c:]) < 1e-8
 
 
+def test_decode_holds_the_anchors_translation_on_joints_with_position_channels():
+    """A BVH with position channels on every joint (3ds Max Biped): the pose encoding keeps no translation of a
+    non-root joint, so decoding holds each at the anchor's, not at the root's position; the angles come back."""
+    from pathlib import Path
+
+    from animsynth.io.bvh import read_bvh
+    from animsynth.skeleton import TRANS_DOFS
+
+    m = read_bvh(Path(__file__).parent / "data" / "bvh" / "every6_bip.bvh")
+    sk = m.skeleton
+    sl = sk.dof_slices()
+    cols = np.concatenate([np.arange(sl[j.name].start, sl[j.name].stop)[[d in TRANS_DOFS for d in j.dofs]]
+                           for j in sk.joints[1:]])
+    assert cols.size  # the file has position channels below the root
+    fwd = np.array([0.0, 0.0, 1.0])  # the Biped's joint names need joint_roles: its forward given
+    tr = encode(m, fwd)
+    c = 5
+    back = decode(sk, tr.rotations[c:], tr.tilt[c:], tr.height[c:], tr.step[c:], tr.turn[c:], m.values[c - 1], fwd)
+    np.testing.assert_allclose(back[:, cols], np.broadcast_to(m.values[c - 1, cols], back[:, cols].shape), atol=1e-9)
+    root = np.arange(sl[sk.joints[0].name].start, sl[sk.joints[0].name].stop)
+    others = np.setdiff1d(np.arange(sk.n_dof), np.concatenate([cols, root]))
+    assert _angle_diff(back[:, others], m.values[c:, others]) < 1e-6  # the joints' angles come back
+
+
 # ----------------------------------------------------------------------------- motion matching
 
 

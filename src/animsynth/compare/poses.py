@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import (continuous_sign, dof_values_from_local, local_rotations, rest_forward, root_rotation,
-                          root_translation, rotation_heading, wrap_radians, yaw_rotation)
+from ..kinematics import (continuous_sign, dof_values_from_local, joint_translations, local_rotations, rest_forward,
+                          root_rotation, root_translation, rotation_heading, wrap_radians, yaw_rotation)
 from ..motion import Motion
 from ..skeleton import ROT_DOFS
 
@@ -122,7 +122,7 @@ def decode(skeleton, rotations: np.ndarray, tilt: np.ndarray, height: np.ndarray
     where = {int(i): k for k, i in enumerate(joints)}
     for i in range(1, len(skeleton.joints)):
         rots.append(Rotation.from_quat(rotations[:, where[i]]) if i in where else ident)
-    # the encoding keeps no translation of a non-root joint: every joint's translation DOF are read from the root's
-    # position, as the root's are
-    translations = np.broadcast_to(pos[:, None, :], (T, len(skeleton.joints), 3))
+    # the encoding keeps no translation of a non-root joint (BVH position channels on any joint): each holds the
+    # anchor's translation, the pose the frames continue
+    translations = np.broadcast_to(joint_translations(skeleton, anchor[None, :]), (T, len(skeleton.joints), 3))
     return dof_values_from_local(skeleton, rots, pos, translations, anchor)
