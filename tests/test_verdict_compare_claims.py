@@ -212,5 +212,17 @@ def test_the_declared_list_in_the_config_is_the_modules():
     from conftest import default_config
 
     declared = default_config()["compare"]["claims"]
-    filled = [dict({"skating": False, "paper_value": "", "note": ""}, **c) for c in CV.DEFAULT_CLAIMS]
+    filled = [dict({"paper_value": "", "note": ""}, **c) for c in CV.DEFAULT_CLAIMS]
     assert declared == filled
+
+
+def test_a_claim_is_a_skating_claim_by_its_metrics_record_unless_it_says():
+    """The skating flag is written once, in the metric table: a declared claim on skate_share is a skating claim
+    without a ``skating`` key, one on l2p is not, and an explicit key overrides the table."""
+    base = {"id": "x", "claim": "x", "a": "a", "b": "b", "direction": "lower", "min_effect": 0.0}
+    assert CV.skating_claim(dict(base, metric="skate_share"))
+    assert CV.skating_claim(dict(base, metric="transition_skate_share"))
+    assert not CV.skating_claim(dict(base, metric="l2p"))
+    assert not CV.skating_claim(dict(base, metric="skate_share", skating=False))
+    assert CV.skating_claim(dict(base, metric="l2p", skating=True))
+    assert not any("skating" in c for c in CV.DEFAULT_CLAIMS)

@@ -6,7 +6,7 @@ Declared claims
 The primary claims are a list fixed in advance (``compare.claims``; :data:`DEFAULT_CLAIMS` when none is given):
 each has an ``id``, the claim text, generators ``a`` and ``b`` (``b: "*"``: every generator of the run but the
 references, one intersection-union finding), a ``metric``, a ``direction`` (``lower`` / ``higher``: which value of
-``a`` the claim expects), a ``min_effect`` in the metric's units and, for skating metrics, ``skating: true``. Only
+``a`` the claim expects), a ``min_effect`` in the metric's units (``skating``: :func:`skating_claim`). Only
 these are findings (``verdicts.csv``, with their numbers in ``claims_stats.csv``) and Holm's correction runs over
 them alone. Every other pair of generators on the main metrics (:data:`EXPLORATORY_METRICS`), including a pair whose
 claim a user removed from the list, is **exploratory** (:func:`exploratory_table`, ``exploratory.csv``): numbers
@@ -93,7 +93,7 @@ from .claim_stats import floating_reason, group_outcomes, metric_median, pair_ou
     subject_tests, t_interval
 from .groups import GROUPINGS, clip_groups, independent_groups
 from .generators import REFERENCES
-from .metrics import METRICS
+from .metric_table import EXPLORATORY_METRICS, METRICS, SKATING_CLAIM_METRICS
 
 __all__ = ["independent_groups", "group_outcomes", "pair_outcomes", "per_clip", "sign_flip_p", "t_interval", "Stats",
            "decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks", "DEFAULT_CLAIMS",
@@ -123,12 +123,8 @@ def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> 
             f"{'; '.join(parts)}; {a} lower at {lower} of {len(parts)} budgets")
 
 
-#: the skating metrics: a claim on one of them compares generators whose feet touch the floor
-SKATING_METRICS = tuple(m.name for m in METRICS if m.skating_claim)
 #: ``b`` of the capture claim: every generator of the run but the references
 EVERY = "*"
-#: the metrics of the exploratory table (with every declared claim's metric)
-EXPLORATORY_METRICS = tuple(m.name for m in METRICS if m.exploratory)
 #: the largest number of groups whose 2^n sign flips are all enumerated
 EXACT_MAX = 16
 _DIRECTION = {m.name: m.better for m in METRICS}
@@ -137,18 +133,17 @@ _DIRECTION = {m.name: m.better for m in METRICS}
 #: keeps the two equal): used when a caller gives none.
 DEFAULT_CLAIMS = (
     {"id": "graph_vs_stisomap_skating", "claim": "the classic motion graph skates less than ST-Isomap re-sequencing",
-     "a": "motion_graph", "b": "stisomap", "metric": "skate_share", "direction": "lower", "min_effect": 0.02,
-     "skating": True},
+     "a": "motion_graph", "b": "stisomap", "metric": "skate_share", "direction": "lower", "min_effect": 0.02},
     {"id": "graph_vs_fairmotion_transitions",
      "claim": "our motion graph's transitions skate less than fairmotion 0.0.4's as released (at its native 60 fps)",
      "a": "motion_graph", "b": "fairmotion", "metric": "transition_skate_share", "direction": "lower",
-     "min_effect": 0.02, "skating": True,
+     "min_effect": 0.02,
      "note": "fairmotion as released: its walk blends from a held pose and turns an appended piece without its path "
              "(animsynth.compare.fairmotion_peer); both graphs keep the same transition budget"},
     {"id": "graph_vs_fairmotion_fixed_transitions",
      "claim": "our motion graph's transitions skate less than fairmotion's with upstream's walk fixes",
      "a": "motion_graph", "b": "fairmotion_fixed", "metric": "transition_skate_share", "direction": "lower",
-     "min_effect": 0.02, "skating": True,
+     "min_effect": 0.02,
      "note": "fairmotion with the fixes output_rate, blend_source, rigid_turn, cut_copy; both graphs keep the same "
              "transition budget"},
     {"id": "stisomap_vs_isomap_jumps",
@@ -162,13 +157,12 @@ DEFAULT_CLAIMS = (
      "paper_value": "Delaunay gives lower Error A/F than k-NN (Gauch & Peters Table II)"},
     {"id": "mm_vs_graph_skating", "claim": "motion matching skates less than the motion graph",
      "a": "motion_matching", "b": "motion_graph", "metric": "skate_share", "direction": "lower", "min_effect": 0.02,
-     "skating": True,
      "note": "motion matching with the reference's foot locking and leg IK, its query a steady gamepad from the "
              "start; deterministic, so inside a clip only the motion graph's seeds vary"},
     {"id": "mm_traj_vs_graph_skating",
      "claim": "motion matching (queried with the held-out future trajectory) skates less than the motion graph",
      "a": "motion_matching_traj", "b": "motion_graph", "metric": "skate_share", "direction": "lower",
-     "min_effect": 0.02, "skating": True,
+     "min_effect": 0.02,
      "note": "motion matching with the reference's foot locking and leg IK, its query the held-out future trajectory "
              "(information no other generator is given)"},
     {"id": "genmm_vs_graph_coverage", "claim": "GenMM covers more of the database than the motion graph",
@@ -177,7 +171,7 @@ DEFAULT_CLAIMS = (
              "compare.metrics.coverage_threshold_m of"},
     {"id": "capture_skates_least",
      "claim": "the held-out capture skates less than every generator (the realism upper bound holds for this metric)",
-     "a": "replay", "b": EVERY, "metric": "skate_share", "direction": "lower", "min_effect": 0.02, "skating": True},
+     "a": "replay", "b": EVERY, "metric": "skate_share", "direction": "lower", "min_effect": 0.02},
 )
 #: the columns of ``claims_stats.csv``
 STATS_COLUMNS = ("claim_id", "a", "b", "metric", "direction", "n_groups", "mean_effect", "ci_low", "ci_high", "p",
@@ -317,6 +311,13 @@ def decide(st: Stats, p_holm: float, min_effect: float, vc: dict) -> tuple[str, 
                          f"possible p is {V.fmt(floor, 3)})")
 
 
+def skating_claim(spec: dict) -> bool:
+    """Whether a declared claim is a skating claim (its contact shares shown beside it; a generator whose feet do not
+    touch the floor cannot win it): its ``skating`` key when given, else its metric's record in the metric table
+    (:data:`animsynth.compare.metric_table.SKATING_CLAIM_METRICS`)."""
+    return spec["metric"] in SKATING_CLAIM_METRICS if spec.get("skating") is None else bool(spec["skating"])
+
+
 class _Claim:
     """One declared claim: its statistics (or why it has none) and how to write its row once Holm has run."""
 
@@ -326,7 +327,7 @@ class _Claim:
         self.a, self.b, self.metric = spec["a"], spec["b"], spec["metric"]
         self.better = spec.get("direction", "lower")
         self.me = float(spec["min_effect"])
-        self.skating = bool(spec.get("skating", False))
+        self.skating = skating_claim(spec)
         self.missing, self.blocked, self.st, self.parts, self.left = "", "", None, [], []
         self.mode = "claim"
         self.metrics, self.sweep = metrics, sweep
@@ -557,7 +558,7 @@ def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | Non
     declared = set()
     for s in specs:
         bs = [g for g in gens if g not in REFERENCES and g != s["a"]] if s["b"] == EVERY else [s["b"]]
-        if s["b"] == EVERY and s.get("skating"):  # a floating generator is no part of the claim: exploratory
+        if s["b"] == EVERY and skating_claim(s):  # a floating generator is no part of the claim: exploratory
             bs = [g for g in bs if not floating_reason(metrics, g, vc)]
         declared |= {(frozenset((s["a"], b)), s["metric"]) for b in bs}
     mets = list(dict.fromkeys([*EXPLORATORY_METRICS, *(s["metric"] for s in specs)]))
