@@ -13,7 +13,8 @@ Selections
     section of docs/compare.md): tuples of names in the order of their table or figure, each name checked against
     :data:`METRICS` on import. :data:`EXPLORATORY_METRICS` (the exploratory table's metrics) and
     :data:`SKATING_CLAIM_METRICS` (a claim on one of them compares generators whose feet touch the floor), in the
-    table's order: flags of the records.
+    table's order: flags of the records. :data:`SENSITIVITY_METRICS`: the skating metrics whose
+    ``<name>_at_<speed>`` records (:func:`at_speed`) the table holds for every :data:`SENSITIVITY_SPEEDS`.
 """
 
 from __future__ import annotations
