@@ -67,11 +67,14 @@ def _run(tmp_path):
     comp = _verdicts(tmp_path, "compare", [
         {"claim": "our graph skates less than fairmotion", "verdict": "reproduced", "evidence": "30 pairs"},
         {"claim": "replay copies the capture", "verdict": "reproduced", "evidence": "by construction"}])
-    real = {"simplicial": True, "resequencing": True, "facegraph": False, "compare": True, "data": True}
-    data = {"simplicial": "CMU mocap", "resequencing": "CMU mocap", "facegraph": "synthetic CK+-layout database",
-            "compare": "CMU mocap"}
+    # the registry's families by their kind of data: the mocap ones on CMU, the faces synthetic, the mesh one skipped
+    ran = [f for f in report_order() if f.data != "mesh"]
+    skipped = [f for f in report_order() if f.data == "mesh"]
+    real = {**{f.name: f.data == "mocap" for f in ran}, "data": True}
+    data = {f.name: {"mocap": "CMU mocap", "faces": "synthetic CK+-layout database"}[f.data] for f in ran}
     prov = pd.DataFrame([{"family": f, "data": d, "status": "ran"} for f, d in data.items()]
-                        + [{"family": "meshdetail", "data": "mesh sequence samba", "status": "skipped: absent"}])
+                        + [{"family": f.name, "data": "mesh sequence samba", "status": "skipped: absent"}
+                           for f in skipped])
     return [simp, reseq, face, comp], real, data, prov
 
 

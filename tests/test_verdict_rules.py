@@ -2,7 +2,10 @@
 
 The facegraph trend and the meshdetail block comparison are decided by :func:`animsynth.verdicts.a_beats_b`; the
 reference functions below are those families' rules written out on their own, and the shared rule must give the
-same word on every constructed input, the edges included (p exactly alpha, a zero margin, one block, NaN)."""
+same word on every constructed input, the edges included (p exactly alpha, a zero margin, one block, NaN).
+
+The reference rules of facegraph and meshdetail here are frozen copies, kept apart from the package on purpose:
+they are what the equivalence tests compare the shared rule with, and are not to follow later edits of it."""
 
 import itertools
 
@@ -27,6 +30,12 @@ from animsynth.meshdetail.verdicts import block_margin, block_verdict
 ])
 def test_share_verdict_all_some_none(ok, none, want):
     assert v.share_verdict(ok, none=none) == want
+
+
+@pytest.mark.parametrize("ok, want", [([True, True], "all"), ([True, False], "some"), ([False, False], "none"),
+                                      ([], "all"), (np.array([False, True]), "some")])
+def test_share_outcome_all_some_none(ok, want):
+    assert v.share_outcome(ok) == want
 
 
 def test_share_verdict_refuses_a_word_outside_the_vocabulary():

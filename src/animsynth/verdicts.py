@@ -58,7 +58,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = ["COLUMNS", "VOCABULARY", "OUTCOMES", "VerdictError", "row", "table", "read", "check", "fmt",
-           "agreement_verdict", "share_verdict", "holm", "unit_votes", "sign_test", "a_beats_b"]
+           "agreement_verdict", "share_outcome", "share_verdict", "holm", "unit_votes", "sign_test", "a_beats_b"]
 
 COLUMNS = ("claim", "paper_value", "ours", "data", "verdict", "evidence", "source")
 VOCABULARY = ("reproduced", "partly", "not reproduced", "contradicted", "within noise", "undecided")
@@ -152,6 +152,18 @@ def agreement_verdict(share: float) -> str:
     return "within noise"
 
 
+def share_outcome(ok) -> str:
+    """Whether a claim checked case by case holds on ``"all"`` cases, ``"some"`` or ``"none"``.
+
+    Parameters
+    ----------
+    ok : array-like of bool (cases,)
+        Whether the claim holds on each case (no case: ``"all"``, as ``all`` of nothing).
+    """
+    ok = np.asarray(ok, bool)
+    return "all" if ok.all() else ("some" if ok.any() else "none")
+
+
 def share_verdict(ok, none: str = "not reproduced") -> str:
     """Verdict of a claim checked case by case: ``reproduced`` when it holds on every case, ``partly`` on some,
     ``none`` on none.
@@ -162,7 +174,8 @@ def share_verdict(ok, none: str = "not reproduced") -> str:
         Whether the claim holds on each case (no case: ``reproduced``, as ``all`` of nothing).
     none : str
         The word when it holds on no case: a word of :data:`VOCABULARY` (``not reproduced``, ``contradicted``,
-        or ``within noise`` when every case said so).
+        ``within noise`` when every case said so, or ``partly`` when a case short of the claim's margin does not
+        contradict it).
 
     Raises
     ------
@@ -171,8 +184,7 @@ def share_verdict(ok, none: str = "not reproduced") -> str:
     """
     if none not in VOCABULARY:
         raise VerdictError(f"verdict {none!r} is not one of {list(VOCABULARY)}")
-    ok = np.asarray(ok, bool)
-    return "reproduced" if ok.all() else ("partly" if ok.any() else none)
+    return {"all": "reproduced", "some": "partly", "none": none}[share_outcome(ok)]
 
 
 def holm(pvalues) -> np.ndarray:

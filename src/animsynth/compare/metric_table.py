@@ -13,14 +13,16 @@ Selections
     section of docs/compare.md): tuples of names in the order of their table or figure, each name checked against
     :data:`METRICS` on import. :data:`EXPLORATORY_METRICS` (the exploratory table's metrics) and
     :data:`SKATING_CLAIM_METRICS` (a claim on one of them compares generators whose feet touch the floor), in the
-    table's order: flags of the records.
+    table's order: flags of the records. :data:`SENSITIVITY_METRICS`: the skating metrics whose
+    ``<name>_at_<speed>`` records (:func:`at_speed`) the table holds for every :data:`SENSITIVITY_SPEEDS`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["Metric", "METRICS", "METRIC_NAMES", "KEY_COLUMNS", "SENSITIVITY_SPEEDS", "NEEDS", "PER_RUN", "metric",
+__all__ = ["Metric", "METRICS", "METRIC_NAMES", "KEY_COLUMNS", "SENSITIVITY_SPEEDS", "SENSITIVITY_METRICS",
+           "at_speed", "NEEDS", "PER_RUN", "metric", "metric_or_blank",
            "names_needing", "SWEEP_METRICS", "SWEEP_PANELS", "FIGURE_METRICS", "RESULT_METRICS", "EXPLORATORY_METRICS",
            "SKATING_CLAIM_METRICS"]
 
@@ -67,22 +69,33 @@ class Metric:
 
 #: the skating threshold sensitivity speeds (m/s) of the ``*_at_<speed>`` columns
 SENSITIVITY_SPEEDS = (0.15, 0.3, 0.5)
+_SKATE_SHARE = Metric("skate_share", "share of contact joint-frames", "lower", "floor", "skate share",
+                      "foot skating: share of contact frames", exploratory=True, skating_claim=True)
+_SKATING_RATIO_GMD = Metric("skating_ratio_gmd", "share of frame steps (GMD)", "lower", "floor", "GMD skating ratio",
+                            "skating ratio (GMD-style)")
+_SENSITIVITY = (_SKATE_SHARE, _SKATING_RATIO_GMD)
+#: the skating metrics measured again at each of :data:`SENSITIVITY_SPEEDS` (the ``<name>_at_<speed>`` columns,
+#: :func:`at_speed`: no direction, the unit of the metric at that speed)
+SENSITIVITY_METRICS = tuple(m.name for m in _SENSITIVITY)
+
+
+def at_speed(name: str, speed: float) -> str:
+    """The column of the sensitivity metric ``name`` (:data:`SENSITIVITY_METRICS`) at the speed threshold ``speed``
+    (m/s): ``<name>_at_<speed>``."""
+    return f"{name}_at_{speed:g}"
+
+
 #: the key columns of ``metrics.csv``, before :data:`METRIC_NAMES` and ``note``
 KEY_COLUMNS = ["clip", "group", "protocol", "generator", "seed"]
 #: every metric column of ``metrics.csv``, in its order
 METRICS = (
     Metric("contact_share", "share of foot joint-frames", "", "floor"),
-    Metric("skate_share", "share of contact joint-frames", "lower", "floor", "skate share",
-           "foot skating: share of contact frames", exploratory=True, skating_claim=True),
+    _SKATE_SHARE,
     Metric("skate_m_per_contact_frame", "m", "lower", "floor"),
     Metric("transition_skate_share", "share of contact joint-frames near seams", "lower", "seams",
            "skate share near seams", "skating near seams: share", exploratory=True, skating_claim=True),
-    Metric("skating_ratio_gmd", "share of frame steps (GMD)", "lower", "floor", "GMD skating ratio",
-           "skating ratio (GMD-style)"),
-    *(Metric(f"skate_share_at_{v:g}", f"share of contact joint-frames, {v:g} m/s", "", "floor")
-      for v in SENSITIVITY_SPEEDS),
-    *(Metric(f"skating_ratio_gmd_at_{v:g}", f"share of frame steps (GMD), {v:g} m/s", "", "floor")
-      for v in SENSITIVITY_SPEEDS),
+    _SKATING_RATIO_GMD,
+    *(Metric(at_speed(m.name, v), f"{m.unit}, {v:g} m/s", "", m.needs) for m in _SENSITIVITY for v in SENSITIVITY_SPEEDS),
     Metric("velocity_jump_p95", "m/s", "lower", "", "per-frame velocity jump p95 (m/s)",
            "per-frame velocity jump: 95th percentile (m/s)", exploratory=True),
     Metric("velocity_jump_max", "m/s", "lower", ""),
@@ -142,6 +155,12 @@ def metric(name: str) -> Metric:
         return _BY_NAME[name]
     except KeyError:
         raise KeyError(f"no metric {name!r} (one of {METRIC_NAMES})") from None
+
+
+def metric_or_blank(name: str) -> Metric:
+    """The record of the column ``name``, or for a name outside the table (a declared claim may name any column
+    with its own ``direction``) a record with no unit and no direction."""
+    return _BY_NAME.get(name) or Metric(name, "", "", "")
 
 
 def names_needing(*needs: str) -> tuple[str, ...]:

@@ -3,15 +3,13 @@
 Pure numpy functions (scipy where it helps). Every length is in metres, every speed in m/s, every acceleration
 in m/s^2; the vertical axis is y (:data:`UP`), as in CMU ASF/AMC and BVH. ``docs/compare.md`` (section
 "Metrics") defines each metric, names its source and says where ours differs from it. This module gathers them;
-each concern is a module of its own.
+each concern is a module of its own. The columns of ``metrics.csv`` (unit, direction, what each needs) are the
+metric table, :mod:`.metric_table`.
 
-The metric table (:mod:`.metric_table`)
-    :data:`METRICS` (one record per column of ``metrics.csv``: unit, which way is better, what it needs, its
-    label), :data:`METRIC_NAMES`, :data:`SENSITIVITY_SPEEDS`: read by the scoring, the tables, the verdicts and
-    the figures, which therefore never import the jobs (nor, through them, the generators)
 Positions and features (:mod:`.positions`)
-    :func:`positions` (forward kinematics in metres), :func:`foot_indices`, :func:`facing`,
-    :func:`body_frame`, :func:`pose_features`, :func:`global_quaternions`, :func:`align_quaternions`
+    :func:`positions` (forward kinematics in metres), :func:`positions_and_quaternions` (and the world rotations,
+    one pass), :func:`foot_indices`, :func:`facing`, :func:`body_frame`,
+    :func:`pose_features`, :func:`global_quaternions`, :func:`align_quaternions`
 Foot skating (:mod:`.skating`)
     :func:`floor_height`, :func:`foot_skating`, :func:`skating_ratio` (GMD's)
 Transitions and per-frame jumps (:mod:`.jumps`)
@@ -33,16 +31,14 @@ from __future__ import annotations
 
 from .ground_truth import l2p, l2q, npss, position_stats
 from .jumps import JumpReference, capture_max_jumps, frame_jumps, jump_reference, seam_jumps
-from .metric_table import METRIC_NAMES, METRICS, SENSITIVITY_SPEEDS, Metric
 from .positions import (HORIZONTAL, UP, align_quaternions, body_frame, facing, foot_indices, global_quaternions,
-                        pose_features, positions)
+                        pose_features, positions, positions_and_quaternions)
 from .skating import floor_height, foot_skating, skating_ratio
 from .smoothness import ldlj, sparc, speed_profile
 from .windows import coverage, local_diversity, novelty, seed_diversity, window_nearest, window_scores
 
 __all__ = [
-    "Metric", "METRICS", "METRIC_NAMES", "SENSITIVITY_SPEEDS",
-    "UP", "HORIZONTAL", "positions", "foot_indices", "facing", "body_frame", "pose_features",
+    "UP", "HORIZONTAL", "positions", "positions_and_quaternions", "foot_indices", "facing", "body_frame", "pose_features",
     "global_quaternions", "align_quaternions", "floor_height", "foot_skating", "skating_ratio", "JumpReference",
     "jump_reference", "seam_jumps", "frame_jumps", "capture_max_jumps", "speed_profile", "ldlj", "sparc",
     "position_stats", "l2p", "l2q", "npss", "window_nearest",

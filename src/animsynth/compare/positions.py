@@ -15,7 +15,7 @@ from ..kinematics import UP as _KIN_UP
 from ..kinematics import facing as _hip_facing
 from ..kinematics import continuous_sign, forward_kinematics
 
-__all__ = ["UP", "HORIZONTAL", "positions", "foot_indices", "facing", "body_frame", "pose_features",
+__all__ = ["UP", "HORIZONTAL", "positions", "positions_and_quaternions", "foot_indices", "facing", "body_frame", "pose_features",
            "align_quaternions", "global_quaternions", "rotate_to"]
 
 #: Index of the vertical axis (y up: the canonical frame of :mod:`animsynth.kinematics`).
@@ -40,6 +40,30 @@ def positions(motion) -> np.ndarray:
     """
     sk = motion.skeleton
     return forward_kinematics(sk, motion.values, ends=True) * float(sk.length_to_m)
+
+
+def positions_and_quaternions(skeleton, values, start: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """World joint positions in metres and world joint rotations, from one forward kinematics pass.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    values : ndarray, shape (T, n_dof)
+    start : int
+        The first frame of the rotations: their signs are made continuous from it on
+        (:func:`align_quaternions`).
+
+    Returns
+    -------
+    positions : ndarray, shape (T, J, 3)
+        As :func:`positions`: the end of every joint's segment, in metres.
+    quaternions : ndarray, shape (T - start, J, 4)
+        The world rotation of every joint of frames ``start:``, unit quaternions, scalar last, continuous over
+        time (:func:`global_quaternions`).
+    """
+    pos, W = forward_kinematics(skeleton, values, ends=True, world_rotations=True)
+    q = align_quaternions(np.stack([r.as_quat() for r in W], axis=1)[start:])
+    return pos * float(skeleton.length_to_m), q
 
 
 def foot_indices(skeleton, overrides: dict | None = None) -> np.ndarray:
@@ -172,5 +196,4 @@ def global_quaternions(motion) -> np.ndarray:
     -------
     ndarray, shape (T, J, 4)
     """
-    _, W = forward_kinematics(motion.skeleton, motion.values, world_rotations=True)
-    return align_quaternions(np.stack([r.as_quat() for r in W], axis=1))
+    return positions_and_quaternions(motion.skeleton, motion.values)[1]

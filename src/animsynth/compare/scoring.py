@@ -26,7 +26,8 @@ import numpy as np
 import pandas as pd
 
 from ..motion import Motion
-from .metric_table import KEY_COLUMNS, METRIC_NAMES, PER_RUN, SENSITIVITY_SPEEDS, names_needing
+from .metric_table import (KEY_COLUMNS, METRIC_NAMES, PER_RUN, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, at_speed,
+                           names_needing)
 from .protocol import Clip
 
 log = logging.getLogger("animsynth.compare.scoring")
@@ -73,8 +74,9 @@ class Reference:
 
 
 class DatabaseKinematics:
-    """Positions (m, :func:`animsynth.compare.metrics.positions`) and facing (:func:`~animsynth.compare.metrics.facing`)
-    of each database motion, computed once per job for every clip and metric that reads them.
+    """Positions (m, :func:`animsynth.compare.positions.positions`) and facing
+    (:func:`~animsynth.compare.positions.facing`) of each database motion, computed once per job for every clip and
+    metric that reads them.
 
     A database clip is shared by several held-out clips (leave one out) and read by the run's L2P statistics and
     by each clip's reference: calling an instance with a motion returns its ``(positions, facing)``, computed on
@@ -157,8 +159,6 @@ def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray
     (positions and the ground truth's world rotations from one pass)."""
     from . import metrics as M
 
-    from ..kinematics import forward_kinematics
-
     kin = kin or DatabaseKinematics(roles)
     sk = clip.held_out.skeleton
     fps = clip.held_out.fps
@@ -169,12 +169,10 @@ def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray
     if std is None:
         window = min(clip.context + clip.length, max(p.shape[0] for p in db_pos))
         std = M.position_stats(db_pos, db_fwd, window, int(mcfg["l2p_stride"]), min(clip.context, window))[1]
-    # one pass over the held-out clip: its positions (M.positions) and the ground truth's world rotations
-    # (M.global_quaternions of the frames after the start)
-    held_pos, W = forward_kinematics(sk, clip.held_out.values, ends=True, world_rotations=True)
-    held_pos = held_pos * float(sk.length_to_m)
+    # the held-out clip's positions and the world rotations of the frames after the start (the ground truth's)
+    held_pos, truth_q = M.positions_and_quaternions(sk, clip.held_out.values, start=clip.context)
     truth = slice(clip.context, clip.context + clip.length)
-    truth_q = M.align_quaternions(np.stack([r.as_quat() for r in W], axis=1)[truth])
+    truth_q = truth_q[:clip.length]
     held_fwd = M.facing(clip.held_out, roles)
     return Reference(foot, floor, M.jump_reference(db_pos, fps), std,
                      [M.pose_features(p, f) for p, f in zip(db_pos, db_fwd)],
@@ -195,16 +193,11 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     """
     from . import metrics as M
 
-    from ..kinematics import forward_kinematics
-
     fps = float(motion.fps)
     start = clip.start
     joined = Motion(np.vstack([start.values, motion.values]), motion.skeleton, fps, motion.name)
     c = clip.context
-    # one forward kinematics pass for positions (M.positions) and world rotations (M.global_quaternions)
-    pos, W = forward_kinematics(joined.skeleton, joined.values, ends=True, world_rotations=True)
-    pos = pos * float(joined.skeleton.length_to_m)
-    q = M.align_quaternions(np.stack([r.as_quat() for r in W], axis=1)[c:])
+    pos, q = M.positions_and_quaternions(joined.skeleton, joined.values, start=c)
     gen_pos = pos[c:]
     seams = np.asarray(motion.meta.get("seams", []), np.int64)
     if generator != "replay":
@@ -214,10 +207,11 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     row.update(M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, speed, ref.floor))
     gmd_feet = ref.foot_idx[[0, 2]]  # left_ankle, right_ankle: the balls of the feet
     row["skating_ratio_gmd"] = M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, speed, ref.floor)
+    at = {"skate_share": lambda v: M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, v, ref.floor)["skate_share"],
+          "skating_ratio_gmd": lambda v: M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, v, ref.floor)}
     for v in SENSITIVITY_SPEEDS:
-        row[f"skate_share_at_{v:g}"] = M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, v,
-                                                      ref.floor)["skate_share"]
-        row[f"skating_ratio_gmd_at_{v:g}"] = M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, v, ref.floor)
+        for k in SENSITIVITY_METRICS:
+            row[at_speed(k, v)] = at[k](v)
     # skating near seams: frames within transition_window of a seam, pooled over seams
     w = int(mcfg["transition_window"])
     n_contact = n_skate = 0.0

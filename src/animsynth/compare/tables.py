@@ -10,7 +10,8 @@ import numpy as np
 import pandas as pd
 
 from .generators import GENERATORS, REFERENCES
-from .metric_table import METRIC_NAMES, RESULT_METRICS, SENSITIVITY_SPEEDS, SWEEP_METRICS, metric
+from .metric_table import (METRIC_NAMES, RESULT_METRICS, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, SWEEP_METRICS,
+                           at_speed, metric)
 from .verdicts import pair_outcomes
 
 log = logging.getLogger("animsynth.compare.tables")
@@ -171,24 +172,26 @@ def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
 
 
 def sensitivity_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
-    """Skating against its speed threshold: per generator and speed (:data:`animsynth.compare.metrics.SENSITIVITY_SPEEDS`)
-    the median skate share (ours) and GMD-style skating ratio over clips x seeds, and each generator's rank
-    (1 = skates least, reference rows aside) by each, so a reader sees whether the order holds."""
+    """Skating against its speed threshold: per generator and speed
+    (:data:`animsynth.compare.metric_table.SENSITIVITY_SPEEDS`) the median of each
+    :data:`~animsynth.compare.metric_table.SENSITIVITY_METRICS` (the skate share, ours, and the GMD-style skating
+    ratio) over clips x seeds, and each generator's rank (1 = skates least, reference rows aside) by each, so a
+    reader sees whether the order holds."""
     rows = []
     gens = order_generators(metrics["generator"].unique(), order)
     for v in SENSITIVITY_SPEEDS:
         med = {}
         for g in gens:
             sub = metrics[metrics["generator"] == g]
-            med[g] = {k: float(np.nanmedian(pd.to_numeric(sub[f"{k}_at_{v:g}"], errors="coerce")))
-                      if sub[f"{k}_at_{v:g}"].notna().any() else np.nan for k in ("skate_share", "skating_ratio_gmd")}
+            med[g] = {k: float(np.nanmedian(pd.to_numeric(sub[at_speed(k, v)], errors="coerce")))
+                      if sub[at_speed(k, v)].notna().any() else np.nan for k in SENSITIVITY_METRICS}
         ranks = {k: pd.Series({g: med[g][k] for g in gens if g not in REFERENCES}).rank(method="min")
-                 for k in ("skate_share", "skating_ratio_gmd")}
+                 for k in SENSITIVITY_METRICS}
         for g in gens:
-            rows.append({"speed_m_s": v, "generator": g, "skate_share_median": med[g]["skate_share"],
-                         "skate_share_rank": ranks["skate_share"].get(g, np.nan),
-                         "skating_ratio_gmd_median": med[g]["skating_ratio_gmd"],
-                         "skating_ratio_gmd_rank": ranks["skating_ratio_gmd"].get(g, np.nan)})
+            row = {"speed_m_s": v, "generator": g}
+            for k in SENSITIVITY_METRICS:
+                row.update({f"{k}_median": med[g][k], f"{k}_rank": ranks[k].get(g, np.nan)})
+            rows.append(row)
     return pd.DataFrame(rows)
 
 

@@ -93,14 +93,11 @@ from .claim_stats import floating_reason, group_outcomes, metric_median, pair_ou
     subject_tests, t_interval
 from .groups import GROUPINGS, clip_groups, independent_groups
 from .generators import REFERENCES
-from .metric_table import EXPLORATORY_METRICS, METRICS, SKATING_CLAIM_METRICS
+from .metric_table import EXPLORATORY_METRICS, SKATING_CLAIM_METRICS, metric_or_blank
 
 __all__ = ["independent_groups", "group_outcomes", "pair_outcomes", "per_clip", "sign_flip_p", "t_interval", "Stats",
            "decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks", "DEFAULT_CLAIMS",
            "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
-
-_UNITS = {m.name: m.unit for m in METRICS}
-
 
 def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> str:
     """What the transition budget sweep (``compare/budget_sweep.csv``) says of ``a`` vs ``b`` on ``metric``
@@ -127,7 +124,6 @@ def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> 
 EVERY = "*"
 #: the largest number of groups whose 2^n sign flips are all enumerated
 EXACT_MAX = 16
-_DIRECTION = {m.name: m.better for m in METRICS}
 
 #: The declared primary claims of the comparison (``compare.claims`` of config/config.yaml repeats them; a test
 #: keeps the two equal): used when a caller gives none.
@@ -414,7 +410,7 @@ class _Claim:
 
     def _ours(self, word: str, p_holm: float) -> str:
         st, vc = self.st, self.vc
-        unit = _UNITS.get(self.metric, "")
+        unit = metric_or_blank(self.metric).unit
         head = f"{word} ({st.n} {_units(vc, st.n)})" if word == "undecided" else f"{st.n} {_units(vc, st.n)}"
         which = ("" if not self.parts else "weakest part " if self.mode == "claim" else
                  "the most significant opposite part ")
@@ -443,7 +439,7 @@ class _Claim:
             return V.row(spec["claim"], "not reproduced", f"no pair to compare ({self.missing})",
                          paper_value=spec.get("paper_value", ""), data=self.data, source="compare/metrics.csv")
         st = self.st
-        unit = _UNITS.get(self.metric, "")
+        unit = metric_or_blank(self.metric).unit
         grouping = GROUPINGS[vc.get("grouping", "subject")]
         lead = (f"tested: {self.a} {self.better} than "
                 f"{'every generator' if self.b == EVERY else self.b} on {self.metric}; ")
@@ -564,7 +560,7 @@ def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | Non
     mets = list(dict.fromkeys([*EXPLORATORY_METRICS, *(s["metric"] for s in specs)]))
     rows = []
     for metric in mets:
-        better = _DIRECTION.get(metric) or next((s["direction"] for s in specs if s["metric"] == metric), "")
+        better = metric_or_blank(metric).better or next((s["direction"] for s in specs if s["metric"] == metric), "")
         if metric not in metrics or better not in ("lower", "higher"):
             continue
         me = float(vc.get("min_effect", {}).get(metric, 0.0))
@@ -643,7 +639,7 @@ def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
             continue
         claim, ours, lead, me, metric = x
         word, why = decide(st, float(pa), me, vc)
-        unit = _UNITS.get(metric, "")
+        unit = metric_or_blank(metric).unit
         rows.append(V.row(claim, word, f"tested: {lead}; {word} because {why}. {st.n} independent "
                           f"{_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted over the {m} sanity checks p = "
                           f"{V.fmt(pa, 3)}; holds in {st.holding}, opposite in {st.opposite} (minimum effect "

@@ -165,7 +165,8 @@ def path_finding_claim(baseline: pd.DataFrame, data: str) -> dict:
     work_face = (face.edges + face.nodes * np.log2(face.nodes.clip(lower=2))).astype(float)
     return row(
         "Path finding on region graphs is faster than on the face graph",
-        "reproduced" if (work_face > 10 * work_region).all() else "partly",
+        # the margin is tenfold: a face graph short of it still needs more work, so no case contradicts the claim
+        share_verdict(work_face > 10 * work_region, none="partly"),
         "Compared on graph size (deterministic); measured path times are in facegraph/baseline_timing.csv.",
         paper_value="face graph ~1.9 s per path",
         ours=f"Dijkstra work (E + N log N) {fmt(work_region)} vs {fmt(work_face.min())}-{fmt(work_face.max())}",

@@ -138,7 +138,6 @@ def holds_on(verdicts_by_seq: dict) -> tuple[str, str]:
     verdict = common.share_verdict([n in held for n in names],
                                    none=kinds.pop() if len(kinds) == 1 and kinds <= {"contradicted", "within noise"}
                                    else "not reproduced")
-    n = len(names)
     if verdict == "reproduced":
         words = "holds on both" if n == 2 else ("holds on its one sequence" if n == 1 else f"holds on all {n}")
     elif verdict == "partly":

@@ -14,6 +14,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..verdicts import share_outcome
+
 
 def stability(share: float) -> str:
     """``stable`` when an ordering holds in every ensemble member (share 0 or 1), else the share."""
@@ -217,7 +219,7 @@ def claim_matches(claim: str, a_lower_a: bool, a_lower_f: bool) -> str:
         return "unknown"
     want = claim == "delaunay_better"
     hits = [a_lower_a == want, a_lower_f == want]
-    return "yes" if all(hits) else ("no" if not any(hits) else "partly")
+    return {"all": "yes", "some": "partly", "none": "no"}[share_outcome(hits)]
 
 
 __all__ = [
