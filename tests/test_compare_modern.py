@@ -11,7 +11,8 @@ from animsynth.compare import generators as G
 from animsynth.compare import protocol
 from animsynth.compare.footlock import contact_points, leg_chains, lock_contacts, place_feet, two_bone_ik
 from animsynth.compare.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
-from animsynth.compare.motionmatching import MotionMatching, make_motion_matching, spring_angle, spring_position
+from animsynth.compare.motionmatching import MotionMatching, make_motion_matching
+from animsynth.kinematics import spring_angle, spring_position
 from animsynth.compare.poses import decode, encode
 from animsynth.compare.references import Replay
 from animsynth.kinematics import bone_lengths, decay_spring, forward_kinematics, root_translation

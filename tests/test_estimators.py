@@ -183,10 +183,41 @@ def test_the_registry_holds_no_method_code():
     assert G.FieldFollower is FieldFollower and G.Resequencer is Resequencer
 
 
+def _imports_from(path: Path, root: Path, text: str):
+    """(module, names) of every ``from module import names`` in a file: relative imports of a module under src
+    resolved to their absolute name; a Python file parsed, any other file (Markdown code blocks, rules) read by
+    pattern."""
+    import re
+
+    if path.suffix != ".py":
+        for m in re.finditer(r"from\s+([\w.]+)\s+import\s+(?:\(([^)]*)\)|([\w ,]+))", text):
+            yield m.group(1), {n.split(" as ")[0].strip() for n in (m.group(2) or m.group(3)).split(",")}
+        return
+    parts = path.relative_to(root).with_suffix("").parts
+    package = list(parts[1:-1] if parts[0] == "src" else parts[:-1])  # a module's package, or an __init__'s own
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, ast.ImportFrom):
+            base = package[:len(package) - node.level + 1] if node.level else []
+            module = ".".join(base + ([node.module] if node.module else []))
+            yield module, {a.name for a in node.names}
+
+
+def _exported(tree: ast.AST) -> set[str]:
+    """The names a module's ``__all__`` lists, or a package's lazy ``_EXPORTS`` maps (its ``__all__``)."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id in ("__all__", "_EXPORTS")
+                                                for t in node.targets):
+            values = node.value.keys if isinstance(node.value, ast.Dict) else getattr(node.value, "elts", [])
+            names |= {v.value for v in values if isinstance(v, ast.Constant) and isinstance(v.value, str)}
+    return names
+
+
 def test_the_interface_has_one_import_path():
     """Generator, Database, align_root, check_generated, play_path and the queries are imported from
-    animsynth.generator alone: there is no compare.base, and nothing imports a name from the registry
-    (compare.generators) that the registry does not export; it exports none of the interface."""
+    animsynth.generator alone: there is no compare.base, nothing imports a name of animsynth.generator from
+    another module, and no other module exports one (in its ``__all__``); nothing imports a name from the
+    registry (compare.generators) that the registry does not export; it exports none of the interface."""
     import re
 
     import animsynth.generator as interface
@@ -206,6 +237,15 @@ def test_the_interface_has_one_import_path():
             names = {n.strip() for n in (m.group(1) or m.group(2)).split(",") if n.strip()}
             if names - set(G.__all__):
                 bad.append((str(p.relative_to(root)), sorted(names - set(G.__all__))))
+    interface_names = set(interface.__all__)
+    interface_file = root / "src" / "animsynth" / "generator.py"
+    for p in files + [Path(__file__).resolve()]:
+        text = p.read_text(errors="replace")
+        for module, names in _imports_from(p, root, text):
+            if names & interface_names and module != "animsynth.generator":
+                bad.append((str(p.relative_to(root)), module, sorted(names & interface_names)))
+        if p.suffix == ".py" and p != interface_file and _exported(ast.parse(text)) & interface_names:
+            bad.append((str(p.relative_to(root)), "exports", sorted(_exported(ast.parse(text)) & interface_names)))
     assert not bad
 
 

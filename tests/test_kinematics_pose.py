@@ -9,10 +9,12 @@ from scipy.spatial.transform import Rotation
 
 from animsynth import skinning
 from animsynth.kinematics import (continuous_euler, continuous_sign, decay_spring, dof_values_from_local,
-                                  forward_kinematics, from_rot6d, halflife_to_damping, heading, hip_forward,
-                                  joint_euler, joint_starts, local_rotations, nearest_euler, other_euler_branch, qexp,
-                                  qinv, qlog, qmul, rest_forward, root_rotation, root_translation, rot6d, set_root,
-                                  rotation_heading, tree_forward, tree_local, wrap_degrees, yaw_rotation)
+                                  forward_kinematics, from_rot6d, ground_heading, halflife_to_damping, heading,
+                                  hip_forward, joint_euler, joint_starts, local_rotations, matrix_to_xyz_euler,
+                                  nearest_euler, other_euler_branch, qexp, qinv, qlog, qmul, rest_forward,
+                                  root_rotation, root_translation, rot6d, set_root, rotation_heading, spring_angle,
+                                  tree_forward, tree_local, wrap_degrees, xyz_euler_rotation, xyz_euler_to_matrix,
+                                  yaw_rotation)
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 
@@ -186,7 +188,7 @@ def test_skinning_forward_is_kinematics_forward_kinematics_on_the_rig():
     assert np.allclose(S, pos, atol=1e-12)
     assert np.allclose(W, np.stack([w.as_matrix() for w in Wk], axis=1), atol=1e-12)
     # rotation matrices or Euler angles: the same transforms
-    W2, S2 = skinning.forward(rig, root_t, skinning.euler_to_matrix(angles))
+    W2, S2 = skinning.forward(rig, root_t, xyz_euler_to_matrix(angles))
     assert np.array_equal(W, W2) and np.array_equal(S, S2)
 
 
@@ -214,4 +216,30 @@ def test_tree_local_inverts_tree_forward_on_the_rig():
     rig = skinning.default_rig()
     angles = np.random.default_rng(2).uniform(-1.0, 1.0, (4, rig.n_joints, 3))
     W, _ = skinning.forward(rig, np.zeros((4, 3)), angles)
-    assert np.allclose(tree_local(rig.parents, W), skinning.euler_to_matrix(angles), atol=1e-12)
+    assert np.allclose(tree_local(rig.parents, W), xyz_euler_to_matrix(angles), atol=1e-12)
+
+
+def test_ground_heading_is_the_angle_from_plus_z_towards_plus_x():
+    assert ground_heading(np.array([1.0, 0.0])) == pytest.approx(np.pi / 2)
+    v = np.array([[0.0, 1.0], [0.0, -1.0], [-1.0, 0.0], [1.0, 1.0]])
+    assert np.allclose(ground_heading(v), [0.0, np.pi, -np.pi / 2, np.pi / 4])
+    a = np.linspace(-3.0, 3.0, 7)
+    assert np.allclose(ground_heading(yaw_rotation(a).apply([0.0, 0.0, 1.0])[:, [0, 2]]), a)
+
+
+def test_spring_angle_takes_the_short_way_round_across_pi():
+    a = spring_angle(3.0, 0.0, -3.0, 0.27, np.array([0.0, 0.1, 5.0]))
+    assert a[0] == 3.0 and 3.0 < a[1] < a[2]  # from 3 up through pi, not down through 0
+    assert np.cos(a[2] + 3.0) == pytest.approx(1.0, abs=1e-9)
+    assert spring_angle(-3.0, 0.0, 3.0, 0.27, 0.1) < -3.0
+
+
+def test_xyz_euler_is_the_extrinsic_rz_ry_rx_product_and_inverts():
+    a = np.random.default_rng(3).uniform(-1.2, 1.2, (2, 5, 3))
+    M = xyz_euler_to_matrix(a)
+    assert M.shape == (2, 5, 3, 3)
+    rx, ry, rz = (Rotation.from_rotvec(np.outer(a[..., k].ravel(), e)).as_matrix()
+                  for k, e in enumerate(np.eye(3)))
+    assert np.allclose(M.reshape(-1, 3, 3), rz @ ry @ rx, atol=1e-12)
+    assert np.allclose(matrix_to_xyz_euler(M), a, atol=1e-12)
+    assert np.array_equal(xyz_euler_rotation(a).as_matrix(), M.reshape(-1, 3, 3))

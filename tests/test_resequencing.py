@@ -23,7 +23,8 @@ from animsynth.resequencing.features import (angular_velocity, linearize_quatern
 from animsynth.resequencing.metrics import (Reference, TransitionReference, classify_path, foot_skate, pass_jumps,
                                             jerk_magnitude, pose_steps, root_reversals, smoothness,
                                             transition_measures, transitions)
-from animsynth.resequencing.paths import pad_path, play_path, resolve_frame, shortest_path_frames
+from animsynth.generator import play_path
+from animsynth.resequencing.paths import pad_path, resolve_frame, shortest_path_frames
 from animsynth.resequencing.jobs import analyse, explain, path_pairs, prepare_motion, resequence, splice, summarise_paths
 from animsynth.resequencing.tables import min_k_table, published_table2
 from animsynth.resequencing.verdicts import (explanation_verdicts, global_dof_verdict, lee_vs_l2_verdict,

@@ -384,6 +384,24 @@ def joint_euler(joint, rotations: Rotation) -> np.ndarray:
     return (C.inv() * rotations * C).as_euler("".join(full), degrees=True)[:, :len(axes)]
 
 
+def xyz_euler_rotation(angles) -> Rotation:
+    """Rotations of extrinsic-xyz Euler angles in radians (``Rz Ry Rx``, the Acclaim ``rx ry rz`` order; the
+    pose convention of :mod:`animsynth.skinning`): ``angles (..., 3)`` to one Rotation of ``prod(...)``."""
+    return Rotation.from_euler("xyz", np.asarray(angles, float).reshape(-1, 3))
+
+
+def xyz_euler_to_matrix(angles) -> np.ndarray:
+    """Extrinsic-xyz Euler angles ``(..., 3)`` radians to rotation matrices ``(..., 3, 3)`` ``Rz Ry Rx``."""
+    a = np.asarray(angles, float)
+    return xyz_euler_rotation(a).as_matrix().reshape(a.shape[:-1] + (3, 3))
+
+
+def matrix_to_xyz_euler(R) -> np.ndarray:
+    """Inverse of :func:`xyz_euler_to_matrix` (scipy's branch): ``(..., 3, 3)`` to ``(..., 3)`` radians."""
+    R = np.asarray(R, float)
+    return Rotation.from_matrix(R.reshape(-1, 3, 3)).as_euler("xyz").reshape(R.shape[:-2] + (3,))
+
+
 def dof_values_from_local(skeleton: Skeleton, rotations: list[Rotation], root_t: np.ndarray,
                           translations: np.ndarray | None = None, anchor=None) -> np.ndarray:
     """Inverse of :func:`local_rotations`: DOF values (degrees) from local rotations.
@@ -454,8 +472,7 @@ def set_root(skeleton: Skeleton, values, R: Rotation, pos: np.ndarray) -> np.nda
         if len(rd) < 3:
             raise ValueError(f"skeleton {skeleton.name!r}: setting the root rotation needs a root with three "
                              f"rotational DOF, {root.name!r} has {len(rd)}")
-        C = root.axis_rotation()
-        ang = (C.inv() * R * C).as_euler("".join(d[1] for d in rd), degrees=True)
+        ang = joint_euler(root, R)
         for k, d in enumerate(root.dofs):
             if d in ROT_DOFS:
                 out[:, sl.start + k] = ang[:, rd.index(d)]
@@ -492,6 +509,25 @@ def decay_spring(x, v, halflife: float, dt: float):
     j = v + x * y
     e = np.exp(-y * dt)
     return e * (x + j * dt), e * (v - j * y * dt)
+
+
+def spring_angle(x, v, goal, halflife: float, dt):
+    """Angle after ``dt`` seconds (any shape broadcasting) of a critically damped spring from ``x`` (radians,
+    rate ``v``) to ``goal`` the shortest way round: :func:`decay_spring` of the wrapped offset ``x - goal``."""
+    offset = wrap_radians(x - goal)
+    return decay_spring(offset, v, halflife, dt)[0] + x - offset
+
+
+def spring_position(x, v, a, goal_velocity, halflife: float, dt):
+    """Position after ``dt`` seconds (any shape broadcasting) of the reference's velocity spring: a point at
+    ``x`` with velocity ``v`` and acceleration ``a`` whose velocity is drawn to ``goal_velocity`` by a
+    critically damped spring of half-life ``halflife``."""
+    y = halflife_to_damping(halflife) / 2.0
+    dt = np.asarray(dt, float)
+    j0 = np.asarray(v, float) - goal_velocity
+    j1 = np.asarray(a, float) + j0 * y
+    e = np.exp(-y * dt)
+    return (e * (-j1 / y ** 2 + (-j0 - j1 * dt) / y) + j1 / y ** 2 + j0 / y + goal_velocity * dt + x)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -599,9 +635,15 @@ def heading(skeleton: Skeleton, values, overrides: dict | None = None) -> np.nda
     skeleton has no hip roles.
     """
     if role_indices(skeleton, ("left_hip", "right_hip"), overrides) is not None:
-        f = facing(skeleton, values, overrides)
-        return np.arctan2(f[:, 0], f[:, 1])
+        return ground_heading(facing(skeleton, values, overrides))
     return rotation_heading(root_rotation(skeleton, values))
+
+
+def ground_heading(v) -> np.ndarray:
+    """Heading (radians about +y, 0 = +z) of ground vectors ``v (..., 2)`` given as (x, z):
+    ``arctan2(x, z)``, shape ``(...)`` (``(1, 0)``, along +x, is ``pi / 2``)."""
+    v = np.asarray(v)
+    return np.arctan2(v[..., 0], v[..., 1])
 
 
 def rotation_heading(R: Rotation, forward: np.ndarray | None = None, hold_vertical: bool = False) -> np.ndarray:

@@ -9,7 +9,7 @@ Conventions (the same as :mod:`animsynth.skeleton`, with the ASF local frame
 * a pose is a root translation ``root_t`` (F, 3) (world position of the root
   start) and per-joint Euler angles ``angles`` (F, 18, 3) in **radians**, the
   local rotation being the *extrinsic* ``xyz`` rotation ``L = Rz Ry Rx`` (the
-  Acclaim ``rx ry rz`` convention);
+  Acclaim ``rx ry rz`` convention; :func:`animsynth.kinematics.xyz_euler_to_matrix`);
 * world rotation ``W_j = W_parent L_j``, world start ``s_j = s_parent + W_parent offset_j``;
 * LBS: ``p_i = sum_j w_ij (W_j (v_i - starts[j]) + s_j)``.
 
@@ -25,9 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
-from scipy.spatial.transform import Rotation
 
-from .kinematics import forward_kinematics, tree_forward, tree_local
+from .kinematics import forward_kinematics, matrix_to_xyz_euler, tree_forward, tree_local, xyz_euler_to_matrix
 from .skeleton import Joint, Skeleton
 
 #: The 18 joints, parents before children.
@@ -133,18 +132,6 @@ def default_rig(height: float = 1.72) -> Rig:
 
 
 # --------------------------------------------------------------------------- kinematics
-def euler_to_matrix(angles: np.ndarray) -> np.ndarray:
-    """Extrinsic-xyz Euler angles (..., 3) radians -> rotation matrices (..., 3, 3) ``Rz Ry Rx``."""
-    a = np.asarray(angles, float)
-    return Rotation.from_euler("xyz", a.reshape(-1, 3)).as_matrix().reshape(a.shape[:-1] + (3, 3))
-
-
-def matrix_to_euler(R: np.ndarray) -> np.ndarray:
-    """Inverse of :func:`euler_to_matrix` (principal branch)."""
-    R = np.asarray(R, float)
-    return Rotation.from_matrix(R.reshape(-1, 3, 3)).as_euler("xyz").reshape(R.shape[:-2] + (3,))
-
-
 def forward(rig: Rig, root_t: np.ndarray, angles: np.ndarray):
     """World rotations and joint starts for every frame: :func:`animsynth.kinematics.tree_forward` on rotation
     matrices (the rig's offsets the same in every frame).
@@ -162,7 +149,7 @@ def forward(rig: Rig, root_t: np.ndarray, angles: np.ndarray):
     root_t = np.atleast_2d(np.asarray(root_t, float))
     L = np.asarray(angles, float)
     if L.shape[-1] == 3 and L.ndim == 3:
-        L = euler_to_matrix(L)
+        L = xyz_euler_to_matrix(L)
     F, J = L.shape[:2]
     off = rig.offsets
     T = [np.broadcast_to(root_t, (F, 3)) if p < 0 else off[j] for j, p in enumerate(rig.parents)]
@@ -280,7 +267,7 @@ def cmu_motion_to_rig(motion, rig: Rig | None = None):
     starts, Wc = forward_kinematics(sk, motion.values, ends=False, world_rotations=True)
     idx = [sk.index(CMU_MAP[n]) for n in JOINTS]
     Wm = np.stack([Wc[i].as_matrix() for i in idx], axis=1)  # (F, 18, 3, 3)
-    angles = np.unwrap(matrix_to_euler(tree_local(rig.parents, Wm)), axis=0)
+    angles = np.unwrap(matrix_to_xyz_euler(tree_local(rig.parents, Wm)), axis=0)
     root_t = starts[:, idx[0]] * sk.length_to_m
     return rig, root_t, angles
 
@@ -301,7 +288,7 @@ def rebase_pose(rig: Rig, root_t: np.ndarray, angles: np.ndarray, angles0: np.nd
     W, _ = forward(rig, root_t, angles)
     W0, _ = forward(rig, np.zeros((1, 3)), np.asarray(angles0)[None])
     Wn = W @ np.swapaxes(W0, -1, -2)  # new world rotations: W_j(t) W_j(0)^T
-    return np.unwrap(matrix_to_euler(tree_local(rig.parents, Wn)), axis=0)
+    return np.unwrap(matrix_to_xyz_euler(tree_local(rig.parents, Wn)), axis=0)
 
 
 # --------------------------------------------------------------------------- inside test

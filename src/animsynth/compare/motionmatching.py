@@ -40,8 +40,8 @@ Query trajectory (the protocol: every generator sees only the start): a steady "
 start only. The desired ground velocity is the start's mean root velocity (its displacement over its
 duration, m/s), zero when slower than ``deadzone_m_s`` (0.2 m/s), held for the whole rollout; the
 desired facing is its direction (no velocity: the start's last facing). At each search the future
-positions and facings come from the reference's springs (:func:`spring_position`,
-:func:`spring_angle`, half-life ``trajectory_halflife_s`` = 0.27 s) started from the generated root's
+positions and facings come from the reference's springs (:func:`animsynth.kinematics.spring_position`,
+:func:`animsynth.kinematics.spring_angle`, half-life ``trajectory_halflife_s`` = 0.27 s) started from the generated root's
 position, velocity (backward difference; acceleration taken as zero) and facing and turning rate.
 ``generate(..., trajectory=motion)`` replaces the gamepad with a given future (the known-answer tests:
 a clip's own continuation), its root positions and facings read relative to the generated root.
@@ -83,40 +83,14 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..joints import resolve_roles
-from ..kinematics import (decay_spring, forward_kinematics, halflife_to_damping, qexp, qinv, qlog, qmul, rest_forward,
-                          wrap_radians, yaw_rotation)
+from ..kinematics import (decay_spring, forward_kinematics, ground_heading, qexp, qinv, qlog, qmul, rest_forward,
+                          spring_angle, spring_position, wrap_radians, yaw_rotation)
 from ..motion import Motion
 from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
 from ..generator import Database, Generator
 from .poses import Track, decode, encode
 
-__all__ = ["MotionMatching", "make_motion_matching", "spring_position", "spring_angle", "pose_features",
-           "trajectory_features"]
-
-
-# ----------------------------------------------------------------------------- the reference's trajectory springs
-
-
-def spring_position(x, v, a, goal_velocity, halflife: float, dt):
-    """Position after ``dt`` seconds (any shape broadcasting) of the reference's velocity spring: a point at
-    ``x`` with velocity ``v`` and acceleration ``a`` whose velocity is drawn to ``goal_velocity`` by a
-    critically damped spring of half-life ``halflife``."""
-    y = halflife_to_damping(halflife) / 2.0
-    dt = np.asarray(dt, float)
-    j0 = np.asarray(v, float) - goal_velocity
-    j1 = np.asarray(a, float) + j0 * y
-    e = np.exp(-y * dt)
-    return (e * (-j1 / y ** 2 + (-j0 - j1 * dt) / y) + j1 / y ** 2 + j0 / y + goal_velocity * dt + x)
-
-
-def spring_angle(x, v, goal, halflife: float, dt):
-    """Angle after ``dt`` seconds of a critically damped spring from ``x`` (radians, rate ``v``) to ``goal``
-    (the shortest way round)."""
-    y = halflife_to_damping(halflife) / 2.0
-    dt = np.asarray(dt, float)
-    j0 = wrap_radians(x - goal)
-    j1 = v + j0 * y
-    return np.exp(-y * dt) * (j0 + j1 * dt) + x - j0
+__all__ = ["MotionMatching", "make_motion_matching", "pose_features", "trajectory_features"]
 
 
 # ----------------------------------------------------------------------------- features
@@ -349,7 +323,7 @@ class MotionMatching(Generator):
         vel = (start_ground[-1] - start_ground[0]) / duration
         if float(np.linalg.norm(vel)) < float(self.deadzone_m_s):
             return np.zeros(2), float(start_yaw)
-        return vel, float(np.arctan2(vel[0], vel[1]))
+        return vel, float(ground_heading(vel))
 
     def _predict(self, ground: np.ndarray, yaw: np.ndarray, goal_v: np.ndarray, goal_yaw: float, fps: float):
         """Future ground positions (3, 2) and yaws (3,) from the last two generated root states."""

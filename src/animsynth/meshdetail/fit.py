@@ -35,8 +35,8 @@ import numpy as np
 from scipy import sparse
 from threadpoolctl import threadpool_limits
 
-from ..kinematics import tree_local
-from ..skinning import Rig, inside_mesh, joint_transforms, lbs, matrix_to_euler, winding_number
+from ..kinematics import matrix_to_xyz_euler, tree_local
+from ..skinning import Rig, inside_mesh, joint_transforms, lbs, winding_number
 
 log = logging.getLogger("animsynth.meshdetail.fit")
 
@@ -176,7 +176,7 @@ class PoseFitter:
         S = _fk_from_world(rig, W, root_t)
         self.W_ = W
         self.root_t_ = root_t
-        self.angles_ = np.unwrap(matrix_to_euler(tree_local(rig.parents, W)), axis=0)
+        self.angles_ = np.unwrap(matrix_to_xyz_euler(tree_local(rig.parents, W)), axis=0)
         self.residual_ = np.linalg.norm(lbs(Wsp, rest, joint_transforms(rig, W, S)) - frames, axis=-1).mean(axis=1)
         return self
 

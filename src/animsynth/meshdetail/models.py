@@ -33,13 +33,13 @@ import time
 
 import numpy as np
 from scipy import sparse
-from scipy.spatial.transform import Rotation
 
 from threadpoolctl import threadpool_limits
 
 from .detail import ControlMesh, LaplacianCoder, RBFUpsampler, farthest_point_order, to_local, to_world
 from .gp import GPRegression, SharedGPDM
-from ..skinning import Rig, euler_to_matrix, forward, joint_transforms, lbs
+from ..kinematics import xyz_euler_rotation
+from ..skinning import Rig, forward, joint_transforms, lbs
 
 log = logging.getLogger("animsynth.meshdetail.models")
 
@@ -53,7 +53,7 @@ def joint_features(angles: np.ndarray, param: str = "euler") -> np.ndarray:
     F = a.shape[0]
     if param == "euler":
         return a.reshape(F, -1)
-    R = Rotation.from_euler("xyz", a.reshape(-1, 3))
+    R = xyz_euler_rotation(a)
     if param == "expmap":
         return R.as_rotvec().reshape(F, -1)
     if param == "quaternion":
@@ -368,4 +368,4 @@ def reconstruction_seconds_per_frame(model: HybridModel, ctx: MeshContext, root_
 
 
 __all__ = ["HybridModel", "MeshContext", "pose_features", "joint_features", "mean_vertex_error",
-           "reconstruction_seconds_per_frame", "euler_to_matrix"]
+           "reconstruction_seconds_per_frame"]

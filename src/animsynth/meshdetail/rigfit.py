@@ -157,11 +157,11 @@ def rig_fit_table(frames, rig, weights, fitter, train, labels=None) -> pd.DataFr
 
 def joint_rotation_errors(fitter, true_angles) -> np.ndarray:
     """Per-joint mean angle (degrees) between fitted and true local rotations (root excluded: NaN)."""
-    from scipy.spatial.transform import Rotation
+    from ..kinematics import xyz_euler_rotation
 
     F, J = fitter.angles_.shape[:2]
-    a = Rotation.from_euler("xyz", fitter.angles_.reshape(-1, 3))
-    b = Rotation.from_euler("xyz", np.asarray(true_angles)[:F].reshape(-1, 3))
+    a = xyz_euler_rotation(fitter.angles_)
+    b = xyz_euler_rotation(np.asarray(true_angles)[:F])
     err = np.rad2deg((a.inv() * b).magnitude()).reshape(F, J).mean(axis=0)
     err[0] = np.nan
     return err

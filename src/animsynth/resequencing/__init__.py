@@ -7,7 +7,7 @@ features    quaternion linearisation (Lee & Shin), sign modes (continuous; matri
 distances   L2 between linearised frames, Lee et al. metric with the paper's weights
 embedding   k-NN graphs (optionally with always-present edges), exact minimum connected k,
             Isomap (no silent graph joining), ST-Isomap (Jenkins & Mataric 2004), residual variance
-paths       Dijkstra re-sequencing, padding, playing a path as a motion
+paths       Dijkstra re-sequencing, padding (a path plays as a motion by animsynth.generator.play_path)
 generator   the method as one estimator (Resequencer: the neighbourhood graph, sparse or dense, its Dijkstra
             paths, generate), called by the study's paths, the one-call route and the comparison
 metrics     transitions, path classes, per-transition and whole-path smoothness
@@ -43,7 +43,6 @@ _EXPORTS = {
     "motion_features": ".features",
     "pad_path": ".paths",
     "pass_jumps": ".metrics",
-    "play_path": ".paths",
     "quat_log": ".features",
     "residual_variance": ".embedding",
     "shortest_path_frames": ".paths",

@@ -39,6 +39,7 @@ import numpy as np
 import pandas as pd
 
 from ..limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
+from ..generator import play_path
 from ..motion import Motion
 from .embedding import (PrecomputedIsomap, graph_components, knn_graph, min_connected_k, neighbor_ranks,
                         residual_variance)
@@ -47,7 +48,7 @@ from .landmark import EMBED_METHODS, embed
 from .features import matrix_naive_quaternions, motion_features, sign_flips
 from .metrics import (Reference, TransitionReference, classify_path, jerk_magnitude, joint_quats, pass_jumps,
                       transition_measures)
-from .paths import pad_path, play_path, resolve_frame
+from .paths import pad_path, resolve_frame
 from .settings import METHODS, METRICS, MethodParams, gdof_name, method_params
 
 log = logging.getLogger("animsynth.resequencing")

@@ -1,6 +1,6 @@
 """Measured smoothness of a re-sequenced motion (what the paper judged by eye).
 
-All measures are computed on the *played* motion (:func:`~animsynth.resequencing.paths.play_path`)
+All measures are computed on the *played* motion (:func:`~animsynth.generator.play_path`)
 and, for reference, on the original trial:
 
 * **pose jumps**: per step, the pose distance ``sqrt(sum_j theta_j^2)`` where

@@ -1,15 +1,14 @@
-"""Re-sequencing: shortest-cost paths on the neighbourhood graph and the motion they play (:func:`play_path`,
-from :mod:`animsynth.generator`, where every generator plays its frame paths)."""
+"""Re-sequencing: shortest-cost paths on the neighbourhood graph (the motion a path plays is
+:func:`animsynth.generator.play_path`, where every generator plays its frame paths)."""
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.sparse.csgraph import dijkstra
 
-from ..generator import play_path  # noqa: F401  (the one player of a frame path, shared with every generator)
 from .embedding import DisconnectedGraphError
 
-__all__ = ["shortest_path_frames", "pad_path", "play_path", "resolve_frame"]
+__all__ = ["shortest_path_frames", "pad_path", "resolve_frame"]
 
 
 def resolve_frame(spec, n: int, what: str = "frame") -> int:

@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..generator import play_path
 from ..motion import Motion
 from .generator import Resequencer
-from .paths import pad_path, play_path, resolve_frame
+from .paths import pad_path, resolve_frame
 
 __all__ = ["resequence_motion"]
 
@@ -42,7 +43,7 @@ def resequence_motion(motion: Motion, start: int, end: int, method: str = "stiso
     st : dict, optional
         Keyword arguments of :func:`.embedding.spatio_temporal_distances` (in frames); its defaults otherwise.
     root_playback : {"integrate", "absolute"}
-        Root of the played motion (:func:`.paths.play_path`).
+        Root of the played motion (:func:`animsynth.generator.play_path`).
 
     Returns
     -------
