@@ -12,6 +12,8 @@ from animsynth.compare import generators as G
 from animsynth.compare import jobs, metric_table, protocol, runner, scoring
 from animsynth.compare import tables
 from animsynth.compare import settings
+from animsynth.compare import claim_stats as CS
+from animsynth.compare import groups as GR
 from animsynth.compare import verdicts as CV
 from animsynth.config import ConfigError
 from animsynth.generator import Database, align_root
@@ -266,11 +268,11 @@ def test_counting_clips_says_reproduced_where_counting_groups_cannot_decide():
     effects = [[0.05, 0.06, 0.05]] * 5 + [[0.05, -0.05]] * 2
     metrics, clips = _grouped(effects)
     claim = "the classic motion graph skates less than ST-Isomap re-sequencing"
-    j = CV.pair_outcomes(metrics, "motion_graph", "stisomap", "skate_share")
-    c = CV.per_clip(j)
+    j = CS.pair_outcomes(metrics, "motion_graph", "stisomap", "skate_share")
+    c = CS.per_clip(j)
     h, f = int((c["outcome"] > 0).sum()), int((c["outcome"] < 0).sum())
     assert (h, f) == (17, 2) and h / (h + f) >= 0.75 and binomtest(h, h + f).pvalue < 0.05  # by clips: reproduced
-    groups = CV.independent_groups(clips)
+    groups = GR.independent_groups(clips)
     assert len(set(groups.values())) == 7
     v = CV.build_verdicts(metrics, VC, "test data", {}, clips).set_index("claim")
     # by groups: 5 effects of 0.05 and 2 of 0: the sign-flip p is 8/128 = 0.0625, no group the opposite
@@ -356,18 +358,18 @@ def test_clips_sharing_a_trial_or_a_subject_in_a_subset_are_one_group():
         {"clip": "run/35_17", "group": "run", "held_out": "35_17[26:42]", "database": "35_17 frames 0-25"},
         {"clip": "dance/05_02", "group": "dance", "held_out": "05_02[197:281]", "database": "05_02 frames 0-196"},
     ])
-    g = CV.independent_groups(clips, "subset_subject")
+    g = GR.independent_groups(clips, "subset_subject")
     assert g["r1/35_17"] == g["r1/35_22"] == g["run/35_17"] == "r1 + run"
     assert g["w1/35_16"] == "w1" and g["dance/05_02"] == "dance"
     # by subject (the default): every clip of subject 35 is one group, whatever its subset
-    g = CV.independent_groups(clips)
+    g = GR.independent_groups(clips)
     assert g["r1/35_17"] == g["r1/35_22"] == g["run/35_17"] == g["w1/35_16"] == "subject 35 (r1, w1, run)"
     assert g["dance/05_02"] == "subject 05 (dance)"
     # a clip without a subject id keeps its subset as its group
     other = pd.concat([clips, pd.DataFrame([{"clip": "x/walkA", "group": "x", "held_out": "walkA", "database": "walkB"}])])
-    assert CV.independent_groups(other)["x/walkA"] == "x"
+    assert GR.independent_groups(other)["x/walkA"] == "x"
     with pytest.raises(ValueError, match="compare.verdicts.grouping"):
-        CV.independent_groups(clips, "trial")
+        GR.independent_groups(clips, "trial")
 
 
 def test_verdict_builder_on_known_outcomes():
@@ -502,10 +504,10 @@ def test_the_seeds_of_one_clip_count_once():
     # five seeds of one clip for the claim, one seed each of four clips against: 5 of 9 pairs, but 1 of 5 clips
     j = pd.DataFrame({"clip": ["x"] * 5 + ["y", "z", "u", "w"], "group": ["g"] * 9,
                       "outcome": [1, 1, 1, 1, 1, -1, -1, -1, -1]})
-    c = CV.per_clip(j).set_index("clip")
+    c = CS.per_clip(j).set_index("clip")
     assert c["outcome"].to_dict() == {"x": 1, "y": -1, "z": -1, "u": -1, "w": -1}
     assert c.loc["x", "seeds_for"] == 5 and c.loc["x", "seeds_against"] == 0
-    tie = CV.per_clip(pd.DataFrame({"clip": ["x", "x"], "group": ["g", "g"], "outcome": [1, -1]}))
+    tie = CS.per_clip(pd.DataFrame({"clip": ["x", "x"], "group": ["g", "g"], "outcome": [1, -1]}))
     assert tie["outcome"].tolist() == [0]
 
 
@@ -643,7 +645,7 @@ def test_the_paper_configs_clips_make_one_group_per_subject_twelve_in_all():
     settings.check(cfg)
     table = _clips_table_of(cfg)
     assert list(table["clip"]) == settings.clip_ids(cfg)
-    groups = CV.independent_groups(table)
+    groups = GR.independent_groups(table)
     subjects = {c.split("/")[1].split("_")[0] for c in table["clip"]}
     assert subjects == {"35", "16", "127", "05", "02", "09", "07", "12", "49", "17", "06", "10"}
     assert len(set(groups.values())) == 12
@@ -658,7 +660,7 @@ def test_the_paper_configs_clips_make_one_group_per_subject_twelve_in_all():
     assert len(table) == 19 + (3 + 4 + 3 + 3 + 3) + 3
     # a mirror that cannot be read: its subjects' groups are left out, the others stay
     many = [t["id"] for t in cfg["trials"] if t.get("mirror") == "many"]
-    left = CV.independent_groups(_clips_table_of(cfg, many))
+    left = GR.independent_groups(_clips_table_of(cfg, many))
     assert len(set(left.values())) == 6  # 35, 16, 127, 05, 02, 09
 
 

@@ -12,7 +12,7 @@ import pandas as pd
 from .generators import GENERATORS, REFERENCES
 from .metric_table import (METRIC_NAMES, RESULT_METRICS, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, SWEEP_METRICS,
                            at_speed, metric)
-from .verdicts import pair_outcomes
+from .claim_stats import pair_outcomes
 
 log = logging.getLogger("animsynth.compare.tables")
 
@@ -63,7 +63,8 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
 
     ``sweep``: ``{"default": transitions_per_s, "budgets": [...], "generators": [...]}`` describing
     ``inp["sweep"]`` (:func:`sweep_runs`); the claims against the peer quote the sweep as evidence."""
-    from .verdicts import decide_claims, exploratory_table, independent_groups, sanity_checks
+    from .groups import independent_groups
+    from .verdicts import decide_claims, exploratory_table, sanity_checks
 
     order = list(cfg["generators"])
     metrics = read_metrics(inp["metrics"])

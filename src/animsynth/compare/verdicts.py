@@ -16,7 +16,7 @@ Independent units
 -----------------
 Clips are not independent: the leave-one-out clips of a subset share most of their database trials and the
 subject, and a re-sequencing clip may be a trial that a subset's clips use. The unit of every test is the
-**group** (:func:`independent_groups`, ``compare.verdicts.grouping``):
+**group** (:func:`animsynth.compare.groups.independent_groups`, ``compare.verdicts.grouping``):
 
 * ``subject`` (default): every clip of one subject (the CMU subject id of its held-out trial), joined with every
   other group with which it shares a trial (held out or in a database): clips that share a subject or database
@@ -91,13 +91,12 @@ import pandas as pd
 from .. import verdicts as V
 from .claim_stats import floating_reason, group_outcomes, metric_median, pair_outcomes, per_clip, spread, \
     subject_tests, t_interval
-from .groups import GROUPINGS, clip_groups, independent_groups
+from .groups import GROUPINGS, clip_groups
 from .generators import REFERENCES
 from .metric_table import EXPLORATORY_METRICS, SKATING_CLAIM_METRICS, metric_or_blank
 
-__all__ = ["independent_groups", "group_outcomes", "pair_outcomes", "per_clip", "sign_flip_p", "t_interval", "Stats",
-           "decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks", "DEFAULT_CLAIMS",
-           "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
+__all__ = ["sign_flip_p", "Stats", "decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks",
+           "DEFAULT_CLAIMS", "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
 
 def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> str:
     """What the transition budget sweep (``compare/budget_sweep.csv``) says of ``a`` vs ``b`` on ``metric``
@@ -502,7 +501,7 @@ def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
         ``permutations``)
     data : what the numbers ran on (e.g. "CMU: 19 held-out clips x 5 seeds")
     left_out : {generator: why it did not run}
-    clips : DataFrame, ``compare/clips.csv`` (for :func:`independent_groups`; ``None``: each subset one group)
+    clips : DataFrame, ``compare/clips.csv`` (for :func:`animsynth.compare.groups.independent_groups`; ``None``: each subset one group)
     sweep : DataFrame or None, the budget sweep table (:func:`animsynth.compare.tables.sweep_table`): quoted as
         evidence in the claims against the peer (decided at the default budget)
     claims : the declared claims (``compare.claims``; ``None``: :data:`DEFAULT_CLAIMS`); every one gets a row
