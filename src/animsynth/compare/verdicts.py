@@ -501,7 +501,7 @@ def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
         ``permutations``)
     data : what the numbers ran on (e.g. "CMU: 19 held-out clips x 5 seeds")
     left_out : {generator: why it did not run}
-    clips : DataFrame, ``compare/clips.csv`` (for :func:`animsynth.compare.groups.independent_groups`; ``None``: each subset one group)
+    clips : DataFrame, ``compare/clips.csv`` (for :func:`.groups.independent_groups`; ``None``: each subset one group)
     sweep : DataFrame or None, the budget sweep table (:func:`animsynth.compare.tables.sweep_table`): quoted as
         evidence in the claims against the peer (decided at the default budget)
     claims : the declared claims (``compare.claims``; ``None``: :data:`DEFAULT_CLAIMS`); every one gets a row
