@@ -8,11 +8,11 @@ name says which), resampled to 30 fps (every 4th frame: 413 frames), the compare
 Rows (family ``compare``, unit ``s``, CPU seconds by ``time.process_time``; the wall-clock times and the
 load average are in the row's ``baseline`` text):
 
-* ``motion_graph_build_cpu_s_<data>_walk_run_dance``: :meth:`animsynth.compare.motiongraph.MotionGraph.fit`
+* ``motion_graph_build_cpu_s_<data>_walk_run_dance``: :meth:`animsynth.compare.generators.motiongraph.MotionGraph.fit`
   (forward kinematics, all-pairs window distances, local minima, threshold, largest strongly connected
   component, per-frame rotations for the output) at its defaults, best of three. Target: <= 10 s CPU on the
   2-core build machine. Baseline, measured once in the same run: fairmotion 0.0.4's build on the same clips
-  (:class:`animsynth.compare.fairmotion_peer.FairmotionGraph.fit`: BVH writing and fairmotion's BVH loading,
+  (:class:`animsynth.compare.generators.fairmotion_peer.FairmotionGraph.fit`: BVH writing and fairmotion's BVH loading,
   its velocities, ``construct`` and ``reduce("scc")``), CPU including its worker process (fairmotion compares
   node pairs in a ``multiprocessing`` pool, here of one process); ratio = fairmotion / ours (lower is better:
   above 1, ours is faster; :func:`animsynth.tables.benchmark_row`). When fairmotion
@@ -33,8 +33,8 @@ from pathlib import Path
 import yaml
 from threadpoolctl import threadpool_limits
 
-from animsynth.compare.fairmotion_peer import FairmotionGraph, FairmotionUnavailable
-from animsynth.compare.motiongraph import MotionGraph
+from animsynth.compare.generators.fairmotion_peer import FairmotionGraph, FairmotionUnavailable
+from animsynth.compare.generators.motiongraph import MotionGraph
 from animsynth.motion import Motion
 from animsynth.tables import benchmark_row
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion

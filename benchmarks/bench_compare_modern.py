@@ -9,15 +9,15 @@ frames (``compare.context``, ``compare.length`` of the paper run).
 Rows (family ``compare``, unit ``ms``, CPU by ``time.process_time`` with one BLAS thread, as the family's
 jobs; wall and the load average in the row's ``baseline`` text):
 
-* ``motion_matching_sample_cpu_ms_<data>_w1``: :meth:`animsynth.compare.motionmatching.MotionMatching.generate`
+* ``motion_matching_sample_cpu_ms_<data>_w1``: :meth:`animsynth.compare.generators.motionmatching.MotionMatching.generate`
   (gamepad query, searches every 0.1 s, inertialization, decoding, and the reference's default foot locking
   with two-bone leg IK), the first call from the start;
-* ``genmm_sample_cpu_ms_<data>_w1``: :meth:`animsynth.compare.genmm.GenMM.generate` (pyramid, 3 EM steps
+* ``genmm_sample_cpu_ms_<data>_w1``: :meth:`animsynth.compare.generators.genmm.GenMM.generate` (pyramid, 3 EM steps
   per level, decoding), the first seed.
 
 The text gives the mean over the paper's 5 seeds too: motion matching is deterministic and keeps its last
 rollout, so its other seeds cost almost nothing. Baseline, measured in the same run: the classic motion graph's
-first sample on the same clip (:class:`animsynth.compare.motiongraph.MotionGraph`), ratio = motion graph /
+first sample on the same clip (:class:`animsynth.compare.generators.motiongraph.MotionGraph`), ratio = motion graph /
 ours (lower is better: above 1, ours samples faster; :func:`animsynth.tables.benchmark_row`). The build
 (``fit``) CPU is in the text. Report only: the budget these rows serve (the compare family's paper-run job CPU may grow by at
 most 60 s for the two rows) is judged on the run's ``cost_timing.csv``, where scoring counts too.
@@ -36,9 +36,9 @@ import numpy as np
 import yaml
 from threadpoolctl import threadpool_limits
 
-from animsynth.compare.genmm import GenMM
-from animsynth.compare.motiongraph import MotionGraph
-from animsynth.compare.motionmatching import MotionMatching
+from animsynth.compare.generators.genmm import GenMM
+from animsynth.compare.generators.motiongraph import MotionGraph
+from animsynth.compare.generators.motionmatching import MotionMatching
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 from animsynth.tables import benchmark_row

@@ -10,7 +10,7 @@ last frame and the generated ones, the database's floor, contact below 0.05 m, s
 
 Rows: ``motion_matching`` (the reference's defaults: foot locking and leg IK on), ``motion_matching_no_lock``
 (``make_motion_matching(..., foot_lock=False)``), ``motion_graph`` and ``replay`` (the compare family's own,
-:func:`animsynth.compare.generators.make_generator`). Motion matching is deterministic, so one seed per clip;
+:func:`animsynth.compare.generators.registry.make_generator`). Motion matching is deterministic, so one seed per clip;
 the motion graph gets the run's 5 seeds. Per clip the seeds' mean; printed: the mean, median and pooled values
 over clips, how many clips motion matching skates less than the motion graph on, and the CPU per sample
 (``time.process_time``, one BLAS thread; motion matching's first call, before its rollout is kept), and for
@@ -33,8 +33,8 @@ import yaml
 from threadpoolctl import threadpool_limits
 
 from animsynth.compare import protocol, scoring
-from animsynth.compare.generators import make_generator
-from animsynth.compare.motionmatching import make_motion_matching
+from animsynth.compare.generators.registry import make_generator
+from animsynth.compare.generators.motionmatching import make_motion_matching
 from animsynth.io import read_amc, read_asf
 
 REPO = Path(__file__).resolve().parents[1]
@@ -73,7 +73,7 @@ def _by_lock(clip, ref, motion, mcfg) -> dict:
     (labelled out of contact, so never locked). Empty for a motion without foot locking."""
     if "contact_locked" not in motion.meta:
         return {}
-    from animsynth.compare import metrics as M
+    from animsynth.compare import measures as M
     from animsynth.motion import Motion
 
     joined = Motion(np.vstack([clip.start.values[-1:], motion.values]), motion.skeleton, motion.fps)
@@ -85,7 +85,7 @@ def _by_lock(clip, ref, motion, mcfg) -> dict:
     locked = motion.meta["contact_locked"][:, foot]
     label = motion.meta["contact_states"][:, foot] & ~locked
     moving = ~motion.meta["contact_states"][:, foot]
-    from animsynth.compare.footlock import contact_points, leg_chains
+    from animsynth.compare.generators.footlock import contact_points, leg_chains
 
     sk = motion.skeleton
     miss = np.linalg.norm(contact_points(sk, motion.values, leg_chains(sk)) - motion.meta["contact_targets"], axis=-1)

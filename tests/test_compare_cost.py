@@ -97,6 +97,6 @@ def test_below_the_warning_level_nothing_is_printed(tmp_path, clips_file, capsys
 
 def test_every_generator_of_the_family_has_a_cost_model():
     """A row added to the registry without a model would run unguarded (only user generators have none)."""
-    from animsynth.compare.generators import GENERATORS
+    from animsynth.compare.generators.names import GENERATORS
 
     assert set(GENERATORS) <= set(cost.COST_MODELS), sorted(set(GENERATORS) - set(cost.COST_MODELS))

@@ -8,8 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from animsynth.compare import generators as G
-from animsynth.compare import jobs, metric_table, protocol, runner, scoring
+from animsynth.compare.generators import names as N
+from animsynth.compare.generators import registry as G
+from animsynth.compare import jobs, protocol, runner, scoring
+from animsynth.compare.measures import metric_table
 from animsynth.compare import tables
 from animsynth.compare import settings
 from animsynth.compare import claim_stats as CS
@@ -63,7 +65,7 @@ def test_generator_returns_length_frames_on_the_skeleton_and_is_seeded(fitted, w
     b = gen.generate(start, length, 5)
     assert np.array_equal(a.values, b.values) and np.array_equal(seams, b.meta["seams"])
     c = gen.generate(start, length, 6)
-    if name in G.DETERMINISTIC:  # the capture itself, or motion matching: whatever the seed
+    if name in N.DETERMINISTIC:  # the capture itself, or motion matching: whatever the seed
         assert np.array_equal(a.values, c.values), f"{name}: the seed changes the motion"
     else:
         assert not np.array_equal(a.values, c.values), f"{name}: the seed changes nothing"
@@ -336,7 +338,7 @@ def test_the_modern_rows_from_the_config(cfg):
     assert gm.name == "genmm" and gm.alpha == 0.01 and gm.patch_size == 11 and gm.root == "local"
     no_norm = G.make_generator("genmm", dict(cfg, genmm=dict(cfg["genmm"], alpha=None)))
     assert no_norm.alpha == float("inf")  # null in the config: the ablation without completeness normalisation
-    assert set(G.DETERMINISTIC) <= set(G.GENERATORS) and "genmm" not in G.DETERMINISTIC
+    assert set(N.DETERMINISTIC) <= set(N.GENERATORS) and "genmm" not in N.DETERMINISTIC
 
 
 def test_motion_matching_rows_have_seed_diversity_zero_and_genmm_does_not(walks, cfg):
@@ -422,7 +424,7 @@ def test_summary_and_winners_tables():
     n = 8
     metrics = _metrics({"motion_graph": [0.1] * n, "stisomap": [0.2] * n, "isomap": [0.3] * n,
                         "replay": [0.0] * n, "concat": [0.5] * n})
-    order = list(G.GENERATORS)
+    order = list(N.GENERATORS)
     s = tables.summary_table(metrics, order)
     row = s[(s["generator"] == "stisomap") & (s["metric"] == "skate_share")].iloc[0]
     assert row["n"] == n and row["median"] == pytest.approx(0.2) and row["better"] == "lower"
@@ -556,7 +558,7 @@ def test_the_job_config_holds_the_generators_block_and_nothing_of_the_others():
 
 
 def test_the_jobs_shared_kinematics_give_the_references_of_separate_computations(walks, cfg):
-    from animsynth.compare import metrics as M
+    from animsynth.compare import measures as M
 
     trials = {f"t{i}": Motion(w.values, w.skeleton, 30.0, f"t{i}") for i, w in enumerate(walks)}
     cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
@@ -704,7 +706,7 @@ def test_a_subject_set_with_a_taken_name_or_an_unknown_trial_is_refused(sets, fr
 def test_the_runner_gives_the_held_out_future_to_a_generator_whose_query_is_it(walks, cfg, monkeypatch):
     """``motion_matching_traj`` (``query = "future_trajectory"``) is passed the clip's held-out frames after the
     start, by its query attribute, not its name; a generator of the default query gets nothing more."""
-    from animsynth.compare.motionmatching import MotionMatchingTrajectory
+    from animsynth.compare.generators.motionmatching import MotionMatchingTrajectory
     from animsynth.generator import Generator
 
     trials = {f"t{i}": w for i, w in enumerate(walks)}
@@ -737,8 +739,8 @@ def test_the_runner_gives_the_held_out_future_to_a_generator_whose_query_is_it(w
 def test_the_runner_records_transitions_kept_from_the_generators_run_notes(walks, cfg, monkeypatch):
     """The ``transitions_kept`` column is what :meth:`Generator.run_notes` gives (NaN where it gives none), for
     every generator: no generator's own attribute is read."""
-    from animsynth.compare.motiongraph import MotionGraph
-    from animsynth.compare.references import Concat
+    from animsynth.compare.generators.motiongraph import MotionGraph
+    from animsynth.compare.generators.references import Concat
     from animsynth.generator import Generator
 
     assert Generator().run_notes() == {}

@@ -1,4 +1,4 @@
-"""Known-answer tests of the compare family's metrics (animsynth.compare.metrics)."""
+"""Known-answer tests of the compare family's metrics (animsynth.compare.measures)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.spatial.transform import Rotation
 
-from animsynth.compare import metrics as M
+from animsynth.compare import measures as M
 from animsynth.joints import JointRoleError
 from animsynth.kinematics import forward_kinematics
 from animsynth.motion import Motion

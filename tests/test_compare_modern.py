@@ -7,14 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from animsynth.compare import generators as G
+from animsynth.compare.generators import registry as G
 from animsynth.compare import protocol
-from animsynth.compare.footlock import contact_points, leg_chains, lock_contacts, place_feet, two_bone_ik
-from animsynth.compare.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
-from animsynth.compare.motionmatching import MotionMatching, make_motion_matching
+from animsynth.compare.generators.footlock import contact_points, leg_chains, lock_contacts, place_feet, two_bone_ik
+from animsynth.compare.generators.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
+from animsynth.compare.generators.motionmatching import MotionMatching, make_motion_matching
 from animsynth.kinematics import spring_angle, spring_position
-from animsynth.compare.poses import decode, encode
-from animsynth.compare.references import Replay
+from animsynth.compare.generators.poses import decode, encode
+from animsynth.compare.generators.references import Replay
 from animsynth.kinematics import bone_lengths, decay_spring, forward_kinematics, root_translation
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
@@ -416,7 +416,7 @@ def test_genmm_keeps_a_pyramid_on_a_short_database(walks):
     """A 40-frame database is shorter than the 5-patch rule's coarsest level (55 frames): it still gets a pyramid
     of several levels, every level at least a patch long, each finer level by the pyramid factor; the rule alone
     (``min_levels=1``) gives one level, and a long database keeps the rule's levels."""
-    from animsynth.compare.genmm import level_scales
+    from animsynth.compare.generators.genmm import level_scales
 
     db = [_cut(w, 0, 40, f"short{i}") for i, w in enumerate(walks[1:])]
     g = make_genmm({}).fit(db)

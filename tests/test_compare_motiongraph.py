@@ -1,4 +1,4 @@
-"""Kovar et al.'s motion graph (animsynth.compare.motiongraph): known answers on small synthetic clips."""
+"""Kovar et al.'s motion graph (animsynth.compare.generators.motiongraph): known answers on small synthetic clips."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from animsynth.compare.fairmotion_fixes import FIXES
-from animsynth.compare.motiongraph import MotionGraph, kovar_alpha
-from animsynth.compare.point_clouds import apply_floor_transform, floor_alignment, pair_terms, window_clouds
+from animsynth.compare.generators.fairmotion_fixes import FIXES
+from animsynth.compare.generators.motiongraph import MotionGraph, kovar_alpha
+from animsynth.compare.generators.point_clouds import apply_floor_transform, floor_alignment, pair_terms, window_clouds
 from animsynth.generator import check_generated
 from animsynth.kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation
 from animsynth.motion import Motion
@@ -272,7 +272,7 @@ def test_the_motion_graph_is_a_generator_of_the_interface(sk):
 
 # ---------------------------------------------------------------- the fairmotion peer
 def _fairmotion_reason() -> str:
-    from animsynth.compare.fairmotion_peer import FairmotionUnavailable, _fairmotion
+    from animsynth.compare.generators.fairmotion_peer import FairmotionUnavailable, _fairmotion
 
     try:
         _fairmotion()
@@ -284,7 +284,7 @@ def _fairmotion_reason() -> str:
 def test_missing_fairmotion_is_reported_with_the_install_command(sk, monkeypatch):
     import importlib.metadata
 
-    from animsynth.compare.fairmotion_peer import INSTALL_COMMAND, FairmotionGraph, FairmotionUnavailable
+    from animsynth.compare.generators.fairmotion_peer import INSTALL_COMMAND, FairmotionGraph, FairmotionUnavailable
 
     def absent(name):
         raise importlib.metadata.PackageNotFoundError(name)
@@ -298,7 +298,7 @@ def test_missing_fairmotion_is_reported_with_the_install_command(sk, monkeypatch
 
 @pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
 def test_fairmotion_peer_walks_its_graph_on_our_clips(sk):
-    from animsynth.compare.fairmotion_peer import FairmotionGraph
+    from animsynth.compare.generators.fairmotion_peer import FairmotionGraph
 
     a = generate_motion("walk_straight", 60, 1, sk, fps=FPS)
     b = generate_motion("walk_straight", 60, 8, sk, fps=FPS)
@@ -326,7 +326,7 @@ _FM_GRAPHS = {}
 
 def _fm(sk, fixes=(), native_fps=None, turn=False):
     """A small fairmotion graph (built once per kind: the fixes change only the walk)."""
-    from animsynth.compare.fairmotion_peer import FairmotionGraph
+    from animsynth.compare.generators.fairmotion_peer import FairmotionGraph
 
     a = generate_motion("walk_straight", 48, 1, sk, fps=FPS)
     b = generate_motion("walk_straight", 48, 8, sk, fps=FPS)
@@ -401,7 +401,7 @@ def test_fairmotion_cut_copy_fix_keeps_the_walks_clips_in_place(sk, monkeypatch)
     """Released, ``cut`` hands out the clips' own poses and placing a piece moves them, so the next piece of the
     same clip starts displaced and jumps back after its blend; with ``cut_copy`` no pose of the walk's clips moves
     and no root step of the output is far beyond the database's largest."""
-    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare.generators import fairmotion_peer as fp
 
     seen = []
 
@@ -448,7 +448,7 @@ def test_fairmotion_runs_at_its_native_rate_and_answers_at_ours(sk):
 
 
 def test_upsample_keeps_every_frame_and_interpolates_between():
-    from animsynth.compare.fairmotion_peer import upsample
+    from animsynth.compare.generators.fairmotion_peer import upsample
 
     sk = cmu_like_skeleton("up", 2)
     m = generate_motion("walk_straight", 20, 3, sk, fps=FPS)
@@ -460,7 +460,7 @@ def test_upsample_keeps_every_frame_and_interpolates_between():
 
 
 def test_budget_gives_every_graph_generator_the_same_transition_count(sk):
-    from animsynth.compare.motiongraph import budget_count
+    from animsynth.compare.generators.motiongraph import budget_count
 
     a = generate_motion("walk_straight", 48, 1, sk, fps=FPS)
     b = generate_motion("walk_straight", 48, 8, sk, fps=FPS)
@@ -470,7 +470,7 @@ def test_budget_gives_every_graph_generator_the_same_transition_count(sk):
         ours = MotionGraph(window=6, transitions_per_s=budget).fit([a, b])
         counts[("ours", budget)] = ours.n_below_threshold_
         if not _fairmotion_reason():
-            from animsynth.compare.fairmotion_peer import FairmotionGraph
+            from animsynth.compare.generators.fairmotion_peer import FairmotionGraph
 
             fm = FairmotionGraph(base=8, blend=4, compare=4, transitions_per_s=budget, fixes=FIXES,
                                  native_fps=60.0).fit([a, b])  # both rows build this graph (fixes: the walk)
@@ -489,7 +489,7 @@ def test_budget_gives_every_graph_generator_the_same_transition_count(sk):
 def test_fairmotion_loads_a_shared_trial_once_and_builds_what_a_fresh_load_builds(sk):
     """Two leave-one-out databases share a trial: the second build reuses fairmotion's loading of it (after
     walks on the first graph, which move poses in place) and equals a build from a cold start."""
-    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare.generators import fairmotion_peer as fp
 
     a, b, c = (generate_motion("walk_straight", 48, s, sk, fps=FPS) for s in (1, 8, 5))
     start = Motion(c.values[:10], sk, FPS, "start")
@@ -515,7 +515,7 @@ def test_fairmotion_loads_a_shared_trial_once_and_builds_what_a_fresh_load_build
 def test_fairmotion_reuses_its_construction_across_rows_and_budgets(sk):
     """The as-released row, the fixed row and another budget on one database: the second and third fits reuse
     the first's construction and give what a cold build gives (transitions, threshold, walks)."""
-    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare.generators import fairmotion_peer as fp
 
     a, b = (generate_motion("walk_straight", 48, s, sk, fps=FPS) for s in (1, 8))
     start = Motion(a.values[:10], sk, FPS, "start")
@@ -553,7 +553,7 @@ def test_fairmotion_construct_in_process_equals_its_pool(sk):
     """``construct``'s node comparisons mapped in this process (default) give the graph fairmotion's own
     one-worker pool gives (``pool=True``, as released): the same nodes and every edge's weight to the bit,
     in the same order; and the walks on both are equal."""
-    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare.generators import fairmotion_peer as fp
 
     a, b, c = (generate_motion(kind, 48, s, sk, fps=FPS) for kind, s in
                (("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5)))
@@ -582,7 +582,7 @@ def test_fairmotion_construct_in_process_equals_its_pool(sk):
 def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
     """Each walk copies a clip the first time it reads it (``_CopyOnRead``, one memo: the clips' shared skeleton
     copied once) and walks exactly as on a deep copy of every clip; the loaded clips stay untouched."""
-    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare.generators import fairmotion_peer as fp
 
     clips = [generate_motion(kind, 48, s, sk, fps=FPS) for kind, s in
              (("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5), ("walk_turn", 3))]
@@ -692,7 +692,7 @@ def test_a_source_rate_that_is_no_multiple_of_the_native_rate_falls_back_with_a_
 def test_fairmotion_builds_on_the_sources_60_fps_frames_not_the_30_fps_clips_upsampled(sk, monkeypatch):
     """Given the clips' 60 fps database (the runner passes it), fairmotion's loaded frames are the source trial's
     every second frame, not an interpolation of the 30 fps clip; without it, the upsampled clip as before."""
-    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare.generators import fairmotion_peer as fp
     from animsynth.compare import protocol, runner
 
     trials = _trials_120(sk)
@@ -742,7 +742,7 @@ def test_the_fairmotion_peer_is_a_generator_of_the_interface_on_what_it_is_given
     """fit sets ``db_`` (the working clips) and ``native_db_`` (the 60 fps clips fairmotion is given); generate
     refuses an unfitted peer and a start of one frame, at the working and at the native rate, with the interface's
     errors; its output passes the interface's check; run_notes gives the node pairs kept."""
-    from animsynth.compare import fairmotion_peer as fp
+    from animsynth.compare.generators import fairmotion_peer as fp
     from animsynth.compare import protocol, runner
     from animsynth.generator import Database, Generator
 

@@ -7,7 +7,8 @@ import pandas as pd
 import pytest
 
 from animsynth import cli
-from animsynth.compare import jobs, metric_table, protocol, runner, settings
+from animsynth.compare import jobs, protocol, runner, settings
+from animsynth.compare.measures import metric_table
 from animsynth.compare.scoring import DATABASE_METRICS, SKATING_METRICS, UNSCORED
 from animsynth.io.bvh import read_bvh, write_bvh
 from animsynth.motion import Motion
@@ -27,7 +28,7 @@ def run(tmp_path_factory):
     """A comparison of one clip (a temporal split of one walk, so the run's database is the clip's) with the
     project's defaults: knn, replay and a user's generator run by the family's job, each writing its BVH."""
     d = tmp_path_factory.mktemp("score_run")
-    (d / "mine.py").write_text("from animsynth.compare.references import Concat\n\n\nclass Mine:\n"
+    (d / "mine.py").write_text("from animsynth.compare.generators.references import Concat\n\n\nclass Mine:\n"
                                "    def fit(self, database):\n        self.g = Concat().fit(database.clips)\n"
                                "        return self\n\n    def generate(self, start, length, seed):\n"
                                "        return self.g.generate(start, length, seed)\n")

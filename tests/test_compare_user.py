@@ -11,7 +11,9 @@ import pandas as pd
 import pytest
 import yaml
 
-from animsynth.compare import jobs, metric_table, protocol, runner, settings
+from animsynth.compare import jobs, protocol, runner, settings
+
+from animsynth.compare.measures import metric_table
 from animsynth.config import ConfigError, validate_config
 from animsynth.io.bvh import read_bvh
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
@@ -50,7 +52,7 @@ def _run(tmp_path, name, cfg, clips_file):
 
 #: a user's class that runs the family's own random concatenation through the public interface only
 CONCAT_WRAPPER = """
-from animsynth.compare.references import Concat
+from animsynth.compare.generators.references import Concat
 
 
 class Wrapped:

@@ -2,7 +2,7 @@
 import pandas as pd
 import pytest
 
-from animsynth.compare.metric_table import KEY_COLUMNS, METRIC_NAMES
+from animsynth.compare.measures.metric_table import KEY_COLUMNS, METRIC_NAMES
 from animsynth.verdicts import VOCABULARY
 
 

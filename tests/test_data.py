@@ -84,7 +84,7 @@ def test_cmu_yaml_bvh_trials_parse_with_their_records_settings(cmu_many_dir):
     and the compare family's foot roles resolve (ankles found by name, the toes named on the record)."""
     import yaml
 
-    from animsynth.compare.metrics import foot_indices, positions
+    from animsynth.compare.measures import foot_indices, positions
     from conftest import REPO
 
     cfg = yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from animsynth.compare import metric_table
+from animsynth.compare.measures import metric_table
 from animsynth.compare import verdicts as CV
 from animsynth.scoreboard import VERDICT_COLOURS, scoreboard_counts
 from animsynth.verdicts import VOCABULARY

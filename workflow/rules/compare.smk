@@ -7,7 +7,7 @@
 # compare_figures gather them. A generator that cannot run here (fairmotion without its package) is left
 # out at parse time with one line, and the tables and docs say why. Every job gets only the config keys it
 # uses. Resources: measured on CMU (the paper run) with headroom.
-from animsynth.compare.generators import FAIRMOTION_ROWS
+from animsynth.compare.generators.names import FAIRMOTION_ROWS
 from animsynth.compare.settings import (clips_cfg, generator_order, groups, job_cfg, run_generators, showcase,
                                         user_generators)
 
@@ -37,7 +37,7 @@ CMP_OUT = {
 }
 # fairmotion's rows and its budget sweep run in one job (compare_run_fairmotion): they build the same graphs, so
 # fairmotion's loading of every trial and its graph construction run once; each row and budget keeps its own
-# threshold and walks (animsynth.compare.fairmotion_peer)
+# threshold and walks (animsynth.compare.generators.fairmotion_peer)
 CMP_FM = [g for g in FAIRMOTION_ROWS if g in CMP_RUN]
 CMP_FM_SWEEP = [(g, b) for b in CMP_SWEEP for g in CMP_GRAPHS if g in CMP_FM]
 CMP_OWN_JOB = [g for g in CMP_RUN if g not in CMP_FM]

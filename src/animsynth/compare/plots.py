@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 
 from ..atomic import atomic_path
-from .generators import REFERENCES
-from .metric_table import FIGURE_METRICS, SWEEP_PANELS, metric
+from .generators.names import REFERENCES
+from .measures.metric_table import FIGURE_METRICS, SWEEP_PANELS, metric
 
 __all__ = ["metrics_figure", "strips_figure", "sweep_figure"]
 
@@ -25,7 +25,7 @@ def _save(fig, path, title: str) -> None:
 
 
 def metrics_figure(path, metrics: pd.DataFrame, order, title: str = "") -> None:
-    """One panel per metric of :data:`~animsynth.compare.metric_table.FIGURE_METRICS`, titled by its record's
+    """One panel per metric of :data:`~animsynth.compare.measures.metric_table.FIGURE_METRICS`, titled by its record's
     ``title``: every generator's values over clips x seeds as a box
     (median, IQR, whiskers at 5-95 %); the reference rows (replay, concat) in grey."""
     import matplotlib.pyplot as plt
@@ -77,7 +77,7 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
     """
     import matplotlib.pyplot as plt
 
-    from .metrics import positions
+    from .measures import positions
 
     names = list(shown)
     fig, axes = plt.subplots(len(names), 1, figsize=(1.5 * n_panels, 1.9 * len(names)), dpi=100, squeeze=False)
@@ -116,7 +116,7 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
 def sweep_figure(table: pd.DataFrame, path, default_budget: float) -> None:
     """The transition budget sweep (:func:`animsynth.compare.tables.sweep_table`): one panel per metric, one line
     per graph generator against the budget (transitions per second of database, log scale), one panel per metric of
-    :data:`~animsynth.compare.metric_table.SWEEP_PANELS` titled by its record's ``title``; the default
+    :data:`~animsynth.compare.measures.metric_table.SWEEP_PANELS` titled by its record's ``title``; the default
     budget, at which the claims are decided, dashed."""
     import matplotlib.pyplot as plt
 

@@ -19,8 +19,8 @@ import pandas as pd
 from ..atomic import atomic_path
 from ..motion import Motion
 from ..skeleton import Skeleton
-from .generators import make_generator
-from .metric_table import KEY_COLUMNS, METRIC_NAMES
+from .generators.registry import make_generator
+from .measures.metric_table import KEY_COLUMNS, METRIC_NAMES
 from .protocol import Clip, clip_seeds
 from .scoring import DatabaseKinematics, joint_count, reference, run_stats_by_skeleton, score
 
@@ -60,7 +60,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     Parameters
     ----------
     clips : list of Clip
-    generator : a name of :data:`animsynth.compare.generators.GENERATORS`
+    generator : a name of :data:`animsynth.compare.generators.names.GENERATORS`
     cfg : the ``compare`` block (with the re-sequencing study's ``stisomap`` block added)
     master_seed : the config's ``seed``
     roles : joint-role overrides (config ``joint_roles``)
@@ -80,7 +80,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     A user generator (``compare.user_generators``) that fails in any way (:class:`UserGeneratorError`) stops at
     its first failure: one error line, and every row of it empty (:func:`failed_run`).
     """
-    from .user import UserGeneratorError, close_processes
+    from .generators.user import UserGeneratorError, close_processes
 
     try:
         return _run_generator(clips, generator, cfg, master_seed, roles, showcase)
@@ -217,7 +217,7 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
                     seams = np.union1d(seams, [0])
                 shown = Motion(np.vstack([start.values, m.values]), m.skeleton, m.fps, f"{generator} {clip.clip}",
                                {"context": clip.context, "seams": seams + clip.context})
-        from .metrics import seed_diversity
+        from .measures import seed_diversity
 
         div = seed_diversity(feats)
         for r in rows[-len(seeds):]:

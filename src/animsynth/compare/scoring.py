@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 
 from ..motion import Motion
-from .metric_table import (KEY_COLUMNS, METRIC_NAMES, PER_RUN, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, at_speed,
+from .measures.metric_table import (KEY_COLUMNS, METRIC_NAMES, PER_RUN, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, at_speed,
                            names_needing)
 from .protocol import Clip
 
@@ -74,8 +74,8 @@ class Reference:
 
 
 class DatabaseKinematics:
-    """Positions (m, :func:`animsynth.compare.positions.positions`) and facing
-    (:func:`~animsynth.compare.positions.facing`) of each database motion, computed once per job for every clip and
+    """Positions (m, :func:`animsynth.compare.measures.positions.positions`) and facing
+    (:func:`~animsynth.compare.measures.positions.facing`) of each database motion, computed once per job for every clip and
     metric that reads them.
 
     A database clip is shared by several held-out clips (leave one out) and read by the run's L2P statistics and
@@ -89,7 +89,7 @@ class DatabaseKinematics:
         self._memo: dict[str, tuple] = {}
 
     def __call__(self, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
-        from . import metrics as M
+        from . import measures as M
 
         hit = self._memo.get(motion.name)
         if hit is not None and (hit[0] is motion.values or np.array_equal(hit[0], motion.values)):
@@ -109,7 +109,7 @@ def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None,
     ``context + length`` frames (the longest of the run's clips; shorter if a database clip is shorter),
     every ``compare.metrics.l2p_stride`` frames, aligned at the last context frame (``kin``: the job's
     :class:`DatabaseKinematics`, made here if not given)."""
-    from . import metrics as M
+    from . import measures as M
 
     kin = kin or DatabaseKinematics(roles)
 
@@ -157,7 +157,7 @@ def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray
 
     Forward kinematics runs once per database motion of the job (``kin``) and once for the held-out clip
     (positions and the ground truth's world rotations from one pass)."""
-    from . import metrics as M
+    from . import measures as M
 
     kin = kin or DatabaseKinematics(roles)
     sk = clip.held_out.skeleton
@@ -183,7 +183,7 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
           roles: dict | None = None) -> tuple[dict, np.ndarray]:
     """Every per-seed metric of one generated motion; returns the row and its pose features.
 
-    The row has one value per record of :data:`~animsynth.compare.metric_table.METRICS` but those a run gives
+    The row has one value per record of :data:`~animsynth.compare.measures.metric_table.METRICS` but those a run gives
     (``needs`` ``"generator"``, ``"seeds"``: the transitions kept and the diversity over seeds, which the runner
     adds).
 
@@ -191,7 +191,7 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     first generated one (foot speed at the first frame, the jump at the entry seam); the entry
     (generated frame 0) is a seam for every generator but ``replay``.
     """
-    from . import metrics as M
+    from . import measures as M
 
     fps = float(motion.fps)
     start = clip.start
@@ -327,8 +327,8 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
 
     Returns
     -------
-    DataFrame with the columns of ``compare/metrics.csv`` (:data:`~animsynth.compare.metric_table.KEY_COLUMNS`,
-    :data:`~animsynth.compare.metric_table.METRIC_NAMES`, ``note``): ``generator`` the name, ``protocol`` "scored file",
+    DataFrame with the columns of ``compare/metrics.csv`` (:data:`~animsynth.compare.measures.metric_table.KEY_COLUMNS`,
+    :data:`~animsynth.compare.measures.metric_table.METRIC_NAMES`, ``note``): ``generator`` the name, ``protocol`` "scored file",
     ``seed`` empty, ``note`` what was left empty for want of a database.
     """
     ref = reference_motion
@@ -387,7 +387,7 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
 
 def _check_start(m: Motion, ref: Motion, context: int, name: str, reference_name: str) -> None:
     """Warn when the first ``context`` frames of ``m`` are not the reference's start (the reference's are used)."""
-    from .metrics import positions
+    from .measures import positions
 
     a = positions(Motion(np.asarray(m.values[:context], float), m.skeleton, m.fps))
     b = positions(Motion(np.asarray(ref.values[:context], float), ref.skeleton, ref.fps))

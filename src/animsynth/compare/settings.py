@@ -77,19 +77,19 @@ def unavailable(name: str) -> str:
     Only fairmotion can be missing: its package is installed apart from the stack (``python3 run.py``
     installs it with ``--no-deps``; docs/compare.md). Checked without importing it (the workflow parses
     this in every job): a package that is installed but whose motion graph cannot be imported stops
-    the fairmotion job with :class:`animsynth.compare.fairmotion_peer.FairmotionUnavailable`.
+    the fairmotion job with :class:`animsynth.compare.generators.fairmotion_peer.FairmotionUnavailable`.
     """
     import importlib.util
 
     if name in ("fairmotion", "fairmotion_fixed") and importlib.util.find_spec("fairmotion") is None:
         return ("fairmotion is not installed (python3 run.py installs fairmotion 0.0.4 with --no-deps; "
-                "animsynth.compare.fairmotion_peer.INSTALL_COMMAND)")
+                "animsynth.compare.generators.fairmotion_peer.INSTALL_COMMAND)")
     return ""
 
 
 def user_generators(config: dict) -> dict:
     """``{row name: "path/to/file.py:ClassName"}`` of ``compare.user_generators`` (a researcher's own classes,
-    :mod:`animsynth.compare.user`), in config order."""
+    :mod:`animsynth.compare.generators.user`), in config order."""
     return dict(config["compare"].get("user_generators") or {})
 
 
@@ -114,9 +114,9 @@ def run_generators(config: dict) -> tuple[list[str], dict]:
 
 def user_job_cfg(config: dict, name: str) -> dict:
     """What a user generator's job adds to the shared keys: its spec, as the job's rerun trigger the SHA-256 of its
-    file (:func:`animsynth.compare.user.file_sha256`: a changed file reruns that job alone), and how the class runs
+    file (:func:`animsynth.compare.generators.user.file_sha256`: a changed file reruns that job alone), and how the class runs
     (``compare.user_timeout_s``, ``compare.user_process``)."""
-    from .user import file_sha256
+    from .generators.user import file_sha256
 
     spec = user_generators(config)[name]
     cmp = config["compare"]
@@ -139,7 +139,7 @@ GENERATOR_BLOCKS = {"delaunay": "field", "knn": "field", "isomap": "resequencing
 def native_rates(config: dict) -> list[float]:
     """The native rates the clips are also prepared at: ``compare.fairmotion.native_fps`` when a fairmotion row is
     among ``compare.generators`` and the rate is set and differs from ``compare.fps`` (else none)."""
-    from .generators import FAIRMOTION_ROWS
+    from .generators.names import FAIRMOTION_ROWS
 
     cmp = config["compare"]
     rate = (cmp.get("fairmotion") or {}).get("native_fps")
@@ -202,8 +202,8 @@ def check(config: dict) -> None:
         if d not in config["resequencing_trials"]:
             log.warning("config key 'compare.resequencing': %r is not a key of resequencing_trials (%s): left out "
                         "of the comparison", d, sorted(config["resequencing_trials"]))
-    from .generators import GENERATORS
-    from .user import parse_spec
+    from .generators.names import GENERATORS
+    from .generators.user import parse_spec
 
     for name, spec in user_generators(config).items():
         if name in GENERATORS:

@@ -9,8 +9,8 @@ import logging
 import numpy as np
 import pandas as pd
 
-from .generators import GENERATORS, REFERENCES
-from .metric_table import (METRIC_NAMES, RESULT_METRICS, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, SWEEP_METRICS,
+from .generators.names import GENERATORS, REFERENCES
+from .measures.metric_table import (METRIC_NAMES, RESULT_METRICS, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, SWEEP_METRICS,
                            at_speed, metric)
 from .claim_stats import pair_outcomes
 
@@ -174,8 +174,8 @@ def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
 
 def sensitivity_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
     """Skating against its speed threshold: per generator and speed
-    (:data:`animsynth.compare.metric_table.SENSITIVITY_SPEEDS`) the median of each
-    :data:`~animsynth.compare.metric_table.SENSITIVITY_METRICS` (the skate share, ours, and the GMD-style skating
+    (:data:`animsynth.compare.measures.metric_table.SENSITIVITY_SPEEDS`) the median of each
+    :data:`~animsynth.compare.measures.metric_table.SENSITIVITY_METRICS` (the skate share, ours, and the GMD-style skating
     ratio) over clips x seeds, and each generator's rank (1 = skates least, reference rows aside) by each, so a
     reader sees whether the order holds."""
     rows = []

@@ -92,8 +92,8 @@ from .. import verdicts as V
 from .claim_stats import floating_reason, group_outcomes, metric_median, pair_outcomes, per_clip, spread, \
     subject_tests, t_interval
 from .groups import GROUPINGS, clip_groups
-from .generators import REFERENCES
-from .metric_table import EXPLORATORY_METRICS, SKATING_CLAIM_METRICS, metric_or_blank
+from .generators.names import REFERENCES
+from .measures.metric_table import EXPLORATORY_METRICS, SKATING_CLAIM_METRICS, metric_or_blank
 
 __all__ = ["sign_flip_p", "Stats", "decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks",
            "DEFAULT_CLAIMS", "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
@@ -134,7 +134,7 @@ DEFAULT_CLAIMS = (
      "a": "motion_graph", "b": "fairmotion", "metric": "transition_skate_share", "direction": "lower",
      "min_effect": 0.02,
      "note": "fairmotion as released: its walk blends from a held pose and turns an appended piece without its path "
-             "(animsynth.compare.fairmotion_peer); both graphs keep the same transition budget"},
+             "(animsynth.compare.generators.fairmotion_peer); both graphs keep the same transition budget"},
     {"id": "graph_vs_fairmotion_fixed_transitions",
      "claim": "our motion graph's transitions skate less than fairmotion's with upstream's walk fixes",
      "a": "motion_graph", "b": "fairmotion_fixed", "metric": "transition_skate_share", "direction": "lower",
@@ -309,7 +309,7 @@ def decide(st: Stats, p_holm: float, min_effect: float, vc: dict) -> tuple[str, 
 def skating_claim(spec: dict) -> bool:
     """Whether a declared claim is a skating claim (its contact shares shown beside it; a generator whose feet do not
     touch the floor cannot win it): its ``skating`` key when given, else its metric's record in the metric table
-    (:data:`animsynth.compare.metric_table.SKATING_CLAIM_METRICS`)."""
+    (:data:`animsynth.compare.measures.metric_table.SKATING_CLAIM_METRICS`)."""
     return spec["metric"] in SKATING_CLAIM_METRICS if spec.get("skating") is None else bool(spec["skating"])
 
 

@@ -9,7 +9,7 @@ chains of such paths to seeded targets played as motion (:meth:`Resequencer.gene
   capture, a path between two frames;
 * the paper study's paths (:func:`.jobs.resequence`): the dense graph of a configuration (metric, global DOF,
   sign mode, the config's ST-Isomap block) at the configuration's k, the measured paths between frame pairs;
-* the side-by-side comparison's ``isomap`` and ``stisomap`` rows (:mod:`animsynth.compare.generators`): the sparse
+* the side-by-side comparison's ``isomap`` and ``stisomap`` rows (:mod:`animsynth.compare.generators.registry`): the sparse
   graph of a database of clips, :meth:`Resequencer.generate`.
 
 The frame distances of the dense graph (:func:`frame_distances`) and the method's adjustment of them

@@ -11,7 +11,7 @@ calls it:
   :func:`~.path.follow_batch`, the batched form of the same steps);
 * the one-call user route (:func:`.generate.generate_from_trials`, the CLI ``animsynth generate``) fits on
   joint-angle clips (:meth:`FieldFollower.fit_angles`), follows from the encoded start and decodes the path;
-* the side-by-side comparison's ``delaunay`` and ``knn`` rows (:mod:`animsynth.compare.generators`) fit on a
+* the side-by-side comparison's ``delaunay`` and ``knn`` rows (:mod:`animsynth.compare.generators.registry`) fit on a
   database of motions (:meth:`FieldFollower.fit`) and generate poses (:meth:`FieldFollower.generate`).
 """
 

@@ -32,33 +32,33 @@ Generators (``GENERATORS``):
     from the database frame nearest the start to seeded random targets, chained until ``length``
     frames, played with the root integrated.
 ``motion_graph``
-    the classic motion graph of Kovar, Gleicher & Pighin 2002 (:mod:`animsynth.compare.motiongraph`).
+    the classic motion graph of Kovar, Gleicher & Pighin 2002 (:mod:`animsynth.compare.generators.motiongraph`).
 ``fairmotion``
     fairmotion 0.0.4's motion graph as released, on the same clips fed at its native 60 fps
-    (:mod:`animsynth.compare.fairmotion_peer`), when its package is installed
+    (:mod:`animsynth.compare.generators.fairmotion_peer`), when its package is installed
     (:func:`animsynth.compare.settings.unavailable` gives the reason when not).
 ``fairmotion_fixed``
     the same with upstream's later fixes of its walk (output rate, blend source, rigid turn of the
-    appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.fairmotion_fixes.FIXES`).
+    appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.generators.fairmotion_fixes.FIXES`).
 
 The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare.transitions_per_s``
-(:func:`animsynth.compare.motiongraph.budget_count`).
+(:func:`animsynth.compare.generators.motiongraph.budget_count`).
 ``motion_matching``
     motion matching with inertialization and the reference's foot locking and leg IK (Clavet 2016; the
-    baseline of Holden et al. 2020; :mod:`animsynth.compare.motionmatching`), its query trajectory a
+    baseline of Holden et al. 2020; :mod:`animsynth.compare.generators.motionmatching`), its query trajectory a
     steady "gamepad" from the start; deterministic (every seed gives the same motion).
 ``motion_matching_pose``
     the same with the trajectory weights at 0: matching on the pose only.
 ``motion_matching_traj``
     the same with the held-out future as its query trajectory (``query = "future_trajectory"``,
-    :class:`animsynth.compare.motionmatching.MotionMatchingTrajectory`; the runner passes the held-out frames
+    :class:`animsynth.compare.generators.motionmatching.MotionMatchingTrajectory`; the runner passes the held-out frames
     after the start): it sees where the capture went next, information no other generator is given, so it
     is a different protocol (following a known path), not a better generator.
 
 Every generator's ``query`` (:class:`animsynth.generator.Generator`) says what it is given: ``"start"`` (the
 start alone; all but ``motion_matching_traj``) or ``"future_trajectory"``.
 ``genmm``
-    generative motion matching (Li et al. 2023; :mod:`animsynth.compare.genmm`) in keyframe mode from the
+    generative motion matching (Li et al. 2023; :mod:`animsynth.compare.generators.genmm`) in keyframe mode from the
     start; seeds differ by the initial noise.
 ``replay``
     the held-out capture itself (upper bound for realism; the same for every seed; :mod:`.references`).
@@ -71,28 +71,16 @@ from __future__ import annotations
 
 import logging
 
-from ..generator import Generator
-from ..motion import Motion
-from ..resequencing.generator import Resequencer
-from ..simplicial.generator import FieldFollower
+from ...generator import Generator
+from ...motion import Motion
+from ...resequencing.generator import Resequencer
+from ...simplicial.generator import FieldFollower
+from .names import FAIRMOTION_ROWS, GENERATORS
 from .references import Concat, Replay
 
-log = logging.getLogger("animsynth.compare.generators")
+log = logging.getLogger("animsynth.compare.generators.registry")
 
-__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINISTIC", "make_generator"]
-
-#: every generator name, in the order of the tables
-GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "fairmotion_fixed",
-              "motion_matching", "motion_matching_pose", "motion_matching_traj", "genmm", "replay", "concat")
-#: the motion-graph generators: one transition budget for all of them
-GRAPHS = ("motion_graph", "fairmotion", "fairmotion_fixed")
-#: the generators that run fairmotion's package
-FAIRMOTION_ROWS = ("fairmotion", "fairmotion_fixed")
-#: the two reference rows (bounds, not methods)
-REFERENCES = ("replay", "concat")
-#: the generators whose motion the seed does not change (seed diversity 0)
-DETERMINISTIC = ("motion_matching", "motion_matching_pose", "motion_matching_traj", "replay")
-
+__all__ = ["make_generator"]
 
 # ----------------------------------------------------------------------------- the factory
 
@@ -103,7 +91,7 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
     Parameters
     ----------
     name : one of :data:`GENERATORS`, or a key of ``cfg["user_generators"]`` (a user's class:
-        :class:`animsynth.compare.user.UserGenerator`, run in a child process unless ``cfg["user_process"]`` is
+        :class:`animsynth.compare.generators.user.UserGenerator`, run in a child process unless ``cfg["user_process"]`` is
         false, with the time limit ``cfg["user_timeout_s"]`` per call and the folders ``cfg["user_guard"]``
         guarded)
     cfg : dict, the ``compare`` block with ``stisomap`` (the re-sequencing study's block) added
@@ -141,7 +129,7 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
     if name == "concat":
         return Concat(**cfg["concat"])
     user = cfg.get("user_generators") or {}
-    if name in user:  # a researcher's own class (compare.user_generators; animsynth.compare.user)
+    if name in user:  # a researcher's own class (compare.user_generators; animsynth.compare.generators.user)
         from .user import UserGenerator
 
         return UserGenerator(name, user[name], timeout_s=cfg.get("user_timeout_s"),

@@ -33,13 +33,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..motion import Motion
-from ..generator import Database, Generator, check_generated
+from ...motion import Motion
+from ...generator import Database, Generator, check_generated
 
 __all__ = ["UserGeneratorError", "UserGenerator", "UserProcess", "user_process", "close_processes", "parse_spec",
            "resolve_path", "file_sha256", "load_class"]
 
-log = logging.getLogger("animsynth.compare.user")
+log = logging.getLogger("animsynth.compare.generators.user")
 
 
 class UserGeneratorError(RuntimeError):
@@ -332,7 +332,7 @@ class UserProcess:
         allow = [os.path.realpath(self.workdir)] + ([user_dir] if not any(_inside(g, user_dir) for g in guard)
                                                     else [])
         mine, theirs = socket.socketpair()
-        code = ("import sys; sys.path[:0] = {path!r}; from animsynth.compare.user import _child_main; "
+        code = ("import sys; sys.path[:0] = {path!r}; from animsynth.compare.generators.user import _child_main; "
                 "_child_main({fd}, {name!r}, {spec!r}, {base!r}, {guard!r}, {allow!r})").format(
             path=[p for p in sys.path if p], fd=theirs.fileno(), name=name, spec=spec, base=self.base, guard=guard,
             allow=allow)

@@ -1,5 +1,5 @@
 """The named fixes of fairmotion 0.0.4's walk (:data:`FIXES`) and the swaps of its functions they are applied
-through (:func:`walk_patches`), for :class:`animsynth.compare.fairmotion_peer.FairmotionGraph`.
+through (:func:`walk_patches`), for :class:`animsynth.compare.generators.fairmotion_peer.FairmotionGraph`.
 
 Four defects of 0.0.4's walk were changed upstream after the release (never released). The peer runs as
 released (``fixes=()``, the row ``fairmotion``) and with each fix applied as a small patch of the walk

@@ -1,6 +1,6 @@
 """Against the database: nearest windows (coverage, local diversity), novelty and the diversity across seeds.
 
-Frame distance: these compare :func:`~animsynth.compare.positions.pose_features` rows, scaled so that the Euclidean
+Frame distance: these compare :func:`~animsynth.compare.measures.positions.pose_features` rows, scaled so that the Euclidean
 distance of two rows is the root-mean-square distance of corresponding joints (metres) in the body frame."""
 
 from __future__ import annotations

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..joints import FOOT_ROLES, resolve_roles
-from ..kinematics import HORIZONTAL as _KINHORIZONTAL
-from ..kinematics import UP as _KIN_UP
-from ..kinematics import facing as _hip_facing
-from ..kinematics import continuous_sign, forward_kinematics
+from ...joints import FOOT_ROLES, resolve_roles
+from ...kinematics import HORIZONTAL as _KINHORIZONTAL
+from ...kinematics import UP as _KIN_UP
+from ...kinematics import facing as _hip_facing
+from ...kinematics import continuous_sign, forward_kinematics
 
 __all__ = ["UP", "HORIZONTAL", "positions", "positions_and_quaternions", "foot_indices", "facing", "body_frame", "pose_features",
            "align_quaternions", "global_quaternions", "rotate_to"]

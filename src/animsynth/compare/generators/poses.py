@@ -25,10 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import (continuous_sign, dof_values_from_local, joint_translations, local_rotations, rest_forward,
+from ...kinematics import (continuous_sign, dof_values_from_local, joint_translations, local_rotations, rest_forward,
                           root_rotation, root_translation, rotation_heading, wrap_radians, yaw_rotation)
-from ..motion import Motion
-from ..skeleton import ROT_DOFS
+from ...motion import Motion
+from ...skeleton import ROT_DOFS
 
 __all__ = ["Track", "encode", "decode", "rotating_joints"]
 

@@ -3,7 +3,7 @@
 Why it is written here
 ----------------------
 No maintained library implements Kovar et al.'s graph. The one public motion-graph module, fairmotion's
-``tasks/motion_graph`` (the peer row, :mod:`animsynth.compare.fairmotion_peer`), builds a different graph:
+``tasks/motion_graph`` (the peer row, :mod:`animsynth.compare.generators.fairmotion_peer`), builds a different graph:
 fixed-length segments as nodes, a joint-angle and end-effector similarity at the segment boundaries, every
 pair below a threshold an edge, no point-cloud alignment and no local-minimum selection. What comes from
 libraries here: forward kinematics (:mod:`animsynth.kinematics`), the all-pairs window terms as three matrix
@@ -19,7 +19,7 @@ Candidate transitions. Frame ``i`` of clip A and frame ``j`` of clip B are compa
     ``B_{j-k+1} .. B_j`` (the window that *ends* at B_j). The points are the joint positions of every frame
     of the window (forward kinematics, metres). ``D(A_i, B_j) = min_{theta, x0, z0} sum_n w_n
     |p_n - T(theta, x0, z0) p'_n|^2``, ``T`` a rotation by ``theta`` about the vertical (y) axis followed by
-    the floor translation ``(x0, 0, z0)``, solved in closed form (:func:`animsynth.compare.point_clouds.floor_alignment`). With
+    the floor translation ``(x0, 0, z0)``, solved in closed form (:func:`.point_clouds.floor_alignment`). With
     ``sum w_n = 1`` D is a weighted mean squared distance (m^2); we report and threshold ``sqrt(D)``, the
     RMS point distance in metres (monotone in D: the same minima).
 Transition points: the local minima of D over ``(i, j)`` below a threshold.
@@ -68,9 +68,9 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 from scipy.spatial.transform import Rotation
 
-from ..generator import Database, Generator, check_generated
-from ..kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation, yaw_rotation
-from ..motion import Motion
+from ...generator import Database, Generator, check_generated
+from ...kinematics import dof_values_from_local, forward_kinematics, local_rotations, root_translation, yaw_rotation
+from ...motion import Motion
 from .point_clouds import (apply_floor_transform, compose_floor_transforms, normalised_weights, pair_terms,
                            positions_m, transform_from_terms, window_clouds)
 

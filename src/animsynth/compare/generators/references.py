@@ -1,14 +1,14 @@
 """The two reference rows of the comparison, bounds rather than methods: :class:`Replay` (the held-out capture
 itself, the upper bound for realism) and :class:`Concat` (random database segments appended without blending,
-the lower bound). The registry (:mod:`animsynth.compare.generators`) names them ``replay`` and ``concat``."""
+the lower bound). The registry (:mod:`animsynth.compare.generators.registry`) names them ``replay`` and ``concat``."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..generator import Database, Generator
-from ..kinematics import root_rotation, root_translation, set_root
-from ..motion import Motion
+from ...generator import Database, Generator
+from ...kinematics import root_rotation, root_translation, set_root
+from ...motion import Motion
 
 __all__ = ["Concat", "Replay"]
 

@@ -42,9 +42,9 @@ import numpy as np
 from scipy.ndimage import median_filter
 from scipy.spatial.transform import Rotation
 
-from ..joints import resolve_roles
-from ..kinematics import UP, decay_spring, forward_kinematics, joint_euler, nearest_euler, wrap_degrees
-from ..skeleton import ROT_DOFS
+from ...joints import resolve_roles
+from ...kinematics import UP, decay_spring, forward_kinematics, joint_euler, nearest_euler, wrap_degrees
+from ...skeleton import ROT_DOFS
 
 __all__ = ["leg_chains", "contact_points", "contact_labels", "lock_contacts", "two_bone_ik", "place_feet"]
 

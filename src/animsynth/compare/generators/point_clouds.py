@@ -4,15 +4,15 @@ The distance between two poses or windows of poses is the weighted mean squared 
 positions after the best rotation about the vertical y axis and translation on the floor
 (:func:`floor_alignment`, the paper's closed form), for one pair of clouds or for every pair of two sets at once
 as matrix products (:func:`pair_terms`, :func:`transform_from_terms`). Both graph generators of the comparison
-(:mod:`animsynth.compare.motiongraph`, :mod:`animsynth.compare.fairmotion_peer`) compare and place motion with it.
+(:mod:`.motiongraph`, :mod:`.fairmotion_peer`) compare and place motion with it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import forward_kinematics
-from ..motion import Motion
+from ...kinematics import forward_kinematics
+from ...motion import Motion
 
 __all__ = ["apply_floor_transform", "compose_floor_transforms", "floor_alignment", "normalised_weights", "pair_terms",
            "positions_m", "transform_from_terms", "window_clouds"]

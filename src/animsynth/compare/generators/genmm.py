@@ -2,10 +2,10 @@
 
 A reimplementation in numpy and scipy, written from the paper and the documented defaults of the
 Apache-2.0 reference (github.com/wyysf-98/GenMM, torch); no code copied. The estimator follows the
-common interface of :mod:`animsynth.compare.generators` (``fit(database)``, ``generate(start, length,
+common interface of :mod:`animsynth.compare.generators.registry` (``fit(database)``, ``generate(start, length,
 seed)``).
 
-Representation (one row per frame, :mod:`animsynth.compare.poses`): the 6D rotation (Zhou et al. 2019)
+Representation (one row per frame, :mod:`animsynth.compare.generators.poses`): the 6D rotation (Zhou et al. 2019)
 of every joint with rotational DOF, then the root. ``root="local"`` (default, heading-invariant): the
 root rotation without its facing yaw (6D), the root height (m), the ground velocity in the previous
 frame's facing frame (x, z; m/s) and the turning rate (rad/s). ``root="world"`` (the paper's, an
@@ -44,7 +44,7 @@ Synthesis (the paper's, with the reference's defaults):
 * keyframe mode, so that every generator starts from the same context: the first ``start`` frames
   (resampled to the level) are written back after every step.
 
-The generated frames are decoded back to the skeleton's Euler DOF (:func:`animsynth.compare.poses.decode`;
+The generated frames are decoded back to the skeleton's Euler DOF (:func:`animsynth.compare.generators.poses.decode`;
 1- and 2-DOF joints keep their own axes), the root integrated from the start's last frame.
 
 Departures: the root's velocities are per second (the reference's per frame, in file units); no
@@ -57,9 +57,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import from_rot6d, rest_forward, root_rotation, rot6d, rotation_heading, wrap_radians, yaw_rotation
-from ..motion import Motion
-from ..generator import Database, Generator
+from ...kinematics import from_rot6d, rest_forward, root_rotation, rot6d, rotation_heading, wrap_radians, yaw_rotation
+from ...motion import Motion
+from ...generator import Database, Generator
 from .poses import decode, encode, rotating_joints
 
 __all__ = ["GenMM", "make_genmm", "extract_patches", "match_patches", "vote", "resample_rows", "level_scales"]

@@ -29,7 +29,7 @@ given to its ``MotionGraph`` (``construct``, ``reduce("scc")``, ``create_random_
   an edge with its difference), then the edges above the resolved threshold are removed, which is what
   ``construct(diff_threshold=threshold)`` would have kept. As for our graph, ``threshold=None`` resolves it
   as the ``threshold_quantile`` quantile of the differences (here of the node pairs that are not one clip
-  playing on). With a transition budget (``transitions_per_s``, :func:`animsynth.compare.motiongraph.budget_count`)
+  playing on). With a transition budget (``transitions_per_s``, :func:`animsynth.compare.generators.motiongraph.budget_count`)
   the threshold is the difference of the budget's last kept pair instead: the same rule as our motion graph's.
   Since that graph does not depend on the threshold, it is built once per database and process and reused
   (the nodes and weighted edges in ``construct``'s order): both rows and every budget of the sweep run in one
@@ -60,7 +60,7 @@ Defects of the release, and the fixes (``fixes``)
 -------------------------------------------------
 Four defects of 0.0.4's walk were changed upstream after the release (never released). The peer runs as
 released (``fixes=()``, the row ``fairmotion``) and with each fix applied as a small patch of the walk
-(``fixes=FIXES``, the row ``fairmotion_fixed``; :mod:`animsynth.compare.fairmotion_fixes` names and describes them).
+(``fixes=FIXES``, the row ``fairmotion_fixed``; :mod:`animsynth.compare.generators.fairmotion_fixes` names and describes them).
 
 Released (the row ``fairmotion``), ``cut`` shares the poses and a walk displaces poses that later pieces of the
 same walk reuse. Between walks we step in for both rows: every :meth:`FairmotionGraph.generate` walks a fresh
@@ -84,12 +84,12 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from ..generator import Database, Generator, check_generated
-from ..io.bvh import write_bvh
-from ..kinematics import dof_values_from_local
-from ..motion import Motion
-from ..skeleton import Skeleton
-from ..kinematics import local_rotations, root_translation, yaw_rotation
+from ...generator import Database, Generator, check_generated
+from ...io.bvh import write_bvh
+from ...kinematics import dof_values_from_local
+from ...motion import Motion
+from ...skeleton import Skeleton
+from ...kinematics import local_rotations, root_translation, yaw_rotation
 from .fairmotion_fixes import check_fixes, walk_patches
 from .motiongraph import budget_keep
 from .point_clouds import apply_floor_transform, pair_terms, positions_m, transform_from_terms, window_clouds
@@ -311,13 +311,13 @@ class FairmotionGraph(Generator):
         the differences between nodes that are not one clip playing on.
     threshold_quantile : float
     transitions_per_s : float or None
-        The transition budget (:func:`animsynth.compare.motiongraph.budget_count`): keep the node pairs of
+        The transition budget (:func:`animsynth.compare.generators.motiongraph.budget_count`): keep the node pairs of
         smallest difference, ``transitions_per_s`` per second of database; overrides both thresholds.
     native_fps : float or None
         The rate the walk runs at (fairmotion's native 60 fps; an integer multiple of the database's rate);
         ``None``: the database's rate.
     fixes : sequence of str
-        Which of :data:`animsynth.compare.fairmotion_fixes.FIXES` to apply to the walk (``()``: as released).
+        Which of :data:`animsynth.compare.generators.fairmotion_fixes.FIXES` to apply to the walk (``()``: as released).
         They change the walk, not the graph: read at every :meth:`generate`.
     w_joint_pos, w_joint_vel, w_root_pos, w_root_vel, w_ee_pos, w_ee_vel, w_trajectory : float
         fairmotion's similarity weights.

@@ -2,7 +2,7 @@
 
 A reimplementation written from the papers and the documented constants of Holden's MIT-licensed
 reference (github.com/orangeduck/Motion-Matching); no code copied. The estimator follows the common
-interface of :mod:`animsynth.compare.generators` (``fit(database)``, ``generate(start, length, seed)``).
+interface of :mod:`animsynth.compare.generators.registry` (``fit(database)``, ``generate(start, length, seed)``).
 
 Features (every database frame, in the frame's own root frame: the root's ground point turned so that
 its facing, :func:`animsynth.kinematics.rotation_heading` of :func:`animsynth.kinematics.rest_forward`, is +Z; metres and m/s):
@@ -54,7 +54,7 @@ future itself, which the runner passes as ``trajectory``. That row sees informat
 how a generator continues a start on its own.
 
 Foot locking and leg IK (``foot_lock=True``, the reference's default ``ik_enabled``;
-:mod:`animsynth.compare.footlock`): the database's frames are labelled in contact where the foot's contact
+:mod:`animsynth.compare.generators.footlock`): the database's frames are labelled in contact where the foot's contact
 point (the end of the ankle role's segment: the ball of the foot, the reference's toe bone) moves slower
 than ``contact_speed_m_s`` (0.15 m/s), median-filtered over ``contact_filter_s`` (0.1 s; the reference: 6
 frames at 60 fps). While playing, a foot whose played frame starts a contact is locked where it is (at its
@@ -65,7 +65,7 @@ reach the targets less the animation's heel-to-contact vectors, kept ``ik_max_le
 short of full extension, and the feet are turned back to the animation's world orientation.
 These constants are the reference's (``ik_unlock_radius``, ``ik_blending_halflife``,
 ``ik_max_length_buffer``, and its database script's contact speed and filter). What differs (details in
-:mod:`animsynth.compare.footlock`): the foot keeps the animation's world orientation instead of the heel
+:mod:`animsynth.compare.generators.footlock`): the foot keeps the animation's world orientation instead of the heel
 look-at, with no toe alignment with the floor (``ik_toe_length``); the knee turns about its own DOF axis and
 the result is written back to the skeleton's Euler DOF (an ankle with two DOF drops the rest); heights
 come from the database (lock height: the foot's median contact height; the floor clamp: its lowest
@@ -82,12 +82,12 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..joints import resolve_roles
-from ..kinematics import (decay_spring, forward_kinematics, ground_heading, qexp, qinv, qlog, qmul, rest_forward,
+from ...joints import resolve_roles
+from ...kinematics import (decay_spring, forward_kinematics, ground_heading, qexp, qinv, qlog, qmul, rest_forward,
                           spring_angle, spring_position, wrap_radians, yaw_rotation)
-from ..motion import Motion
+from ...motion import Motion
 from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
-from ..generator import Database, Generator
+from ...generator import Database, Generator
 from .poses import Track, decode, encode
 
 __all__ = ["MotionMatching", "make_motion_matching", "pose_features", "trajectory_features"]
@@ -109,7 +109,7 @@ def _velocity(x: np.ndarray, fps: float) -> np.ndarray:
 def pose_features(motion: Motion, yaw: np.ndarray) -> np.ndarray:
     """The pose part of the features of every frame (>= 2 frames): ``(T, 15)`` = left and right foot
     positions, left and right foot velocities, hip velocity, each (x, y, z) in the frame's root frame
-    (metres, m/s); ``yaw (T,)`` the frames' facing yaw (:func:`animsynth.compare.poses.encode`)."""
+    (metres, m/s); ``yaw (T,)`` the frames' facing yaw (:func:`animsynth.compare.generators.poses.encode`)."""
     sk, fps = motion.skeleton, float(motion.fps)
     pos = forward_kinematics(sk, motion.values, ends=False) * float(sk.length_to_m)
     turn = yaw_rotation(-yaw)
