@@ -55,6 +55,11 @@ class Metric:
     exploratory : bool, a metric of the exploratory table (:data:`EXPLORATORY_METRICS`)
     skating_claim : bool, a skating metric of the claims (:data:`SKATING_CLAIM_METRICS`): a claim on it compares
         generators whose feet touch the floor
+    margin : float or None, the smallest difference a user would care about, in the metric's units, declared before
+        any run (never tuned to results): a claim on the metric takes it unless the claim gives its own
+        (``compare.claims[i].min_effect``) or ``compare.verdicts.min_effect`` overrides it; ``None``: no margin
+        (the metric is descriptive, or no claim or vote uses it)
+    margin_why : str, one sentence of why that size matters to a user
     """
 
     name: str
@@ -65,14 +70,20 @@ class Metric:
     title: str = ""
     exploratory: bool = False
     skating_claim: bool = False
+    margin: float | None = None
+    margin_why: str = ""
 
 
 #: the skating threshold sensitivity speeds (m/s) of the ``*_at_<speed>`` columns
 SENSITIVITY_SPEEDS = (0.15, 0.3, 0.5)
 _SKATE_SHARE = Metric("skate_share", "share of contact joint-frames", "lower", "floor", "skate share",
-                      "foot skating: share of contact frames", exploratory=True, skating_claim=True)
+                      "foot skating: share of contact frames", exploratory=True, skating_claim=True,
+                      margin=0.05, margin_why="5 percentage points of contact joint-frames: in a 2-s walk (about four "
+                      "stances of 15 frames) some 3 more sliding frames per foot joint, about the smallest slide an "
+                      "animator would go in to fix")
 _SKATING_RATIO_GMD = Metric("skating_ratio_gmd", "share of frame steps (GMD)", "lower", "floor", "GMD skating ratio",
-                            "skating ratio (GMD-style)")
+                            "skating ratio (GMD-style)", margin=0.05,
+                            margin_why="5 percentage points of frame steps, as for the skate share")
 _SENSITIVITY = (_SKATE_SHARE, _SKATING_RATIO_GMD)
 #: the skating metrics measured again at each of :data:`SENSITIVITY_SPEEDS` (the ``<name>_at_<speed>`` columns,
 #: :func:`at_speed`: no direction, the unit of the metric at that speed)
@@ -93,11 +104,14 @@ METRICS = (
     _SKATE_SHARE,
     Metric("skate_m_per_contact_frame", "m", "lower", "floor"),
     Metric("transition_skate_share", "share of contact joint-frames near seams", "lower", "seams",
-           "skate share near seams", "skating near seams: share", exploratory=True, skating_claim=True),
+           "skate share near seams", "skating near seams: share", exploratory=True, skating_claim=True, margin=0.05,
+           margin_why="5 percentage points of the contact joint-frames near seams, as for the skate share"),
     _SKATING_RATIO_GMD,
     *(Metric(at_speed(m.name, v), f"{m.unit}, {v:g} m/s", "", m.needs) for m in _SENSITIVITY for v in SENSITIVITY_SPEEDS),
     Metric("velocity_jump_p95", "m/s", "lower", "", "per-frame velocity jump p95 (m/s)",
-           "per-frame velocity jump: 95th percentile (m/s)", exploratory=True),
+           "per-frame velocity jump: 95th percentile (m/s)", exploratory=True, margin=0.2,
+           margin_why="a change of joint velocity of 0.2 m/s within one frame (7 mm of position at 30 fps), about half "
+                      "of a capture's own 95th percentile: smaller pops hide in the capture's own noise"),
     Metric("velocity_jump_max", "m/s", "lower", ""),
     Metric("velocity_jump_over_capture", "share of frames", "lower", "reference",
            "frames above the capture's largest jump", "share of frames jumping more than the capture's largest"),
@@ -118,15 +132,20 @@ METRICS = (
            "smoothness: log dimensionless jerk (higher smoother)"),
     Metric("sparc", "spectral arc length", "higher", ""),
     Metric("l2p", "LAFAN1 L2P (run statistics)", "lower", "database", "L2P", "L2P vs held-out continuation",
-           exploratory=True),
+           exploratory=True, margin=0.25,
+           margin_why="a quarter of the database's own per-joint position standard deviation (the unit L2P is "
+                      "normalised by): a smaller gap to the capture is not a different continuation"),
     Metric("l2p_m", "m", "lower", "reference", "L2P (m)"),
     Metric("l2q", "LAFAN1 L2Q", "lower", "reference"),
     Metric("npss", "NPSS", "lower", "reference", title="NPSS vs held-out continuation"),
     Metric("coverage", "share of database windows", "higher", "database", "coverage", "coverage of database windows",
-           exploratory=True),
+           exploratory=True, margin=0.05,
+           margin_why="5 % of the database's windows: about one second of a 20-s database reached or missed"),
     Metric("local_diversity_m", "m", "", "database"),
     Metric("seed_diversity_m", "m", "higher", "seeds", title="diversity across seeds (m)"),
-    Metric("novelty_median_m", "m", "", "database", "novelty (m)", "novelty: distance to nearest database frame (m)"),
+    Metric("novelty_median_m", "m", "", "database", "novelty (m)", "novelty: distance to nearest database frame (m)",
+           margin=0.01, margin_why="1 cm median distance to the nearest database pose: closer, a pose is a copy with "
+                                   "capture noise"),
     Metric("copy_share", "share of frames", "", "database"),
 )
 METRIC_NAMES = [m.name for m in METRICS]
@@ -176,6 +195,8 @@ def _check() -> None:
     for m in METRICS:
         if m.better not in ("lower", "higher", "") or m.needs not in NEEDS:
             raise ValueError(f"metric {m.name!r}: better {m.better!r}, needs {m.needs!r}")
+        if m.margin is not None and not (m.margin > 0 and m.margin_why):
+            raise ValueError(f"metric {m.name!r}: a margin must be positive and say why (margin_why)")
     for what, names, text in (("SWEEP_METRICS", SWEEP_METRICS, None), ("SWEEP_PANELS", SWEEP_PANELS, "title"),
                               ("FIGURE_METRICS", FIGURE_METRICS, "title"), ("RESULT_METRICS", RESULT_METRICS, "label")):
         for n in names:
