@@ -184,7 +184,7 @@ def _settling(trial, motion, speed, arms, s, first_frame) -> CaptureFlag | None:
         i += 1
     if i == 0:
         return None
-    last = i if i - 1 < n - 1 and fast[i - 1] and i < n else i - 1
+    last = i if i < n and fast[i - 1] else i - 1  # the frame the last too-fast step lands on
     seen = []
     if up[0]:
         seen.append(f"both upper arms raised at least {float(arms[0]):.0f} degrees from hanging at frame 0, limit "
