@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -377,16 +378,22 @@ def a_beats_b(wins: int, losses: int, undecided: int = 0, *, share: float, alpha
     return "noise"
 
 
+@lru_cache(maxsize=512)
+def _t_quantile(q: float, df: int) -> float:
+    """scipy's t quantile, cached: the tables ask for the same few (level, units) pairs hundreds of times."""
+    from scipy.stats import t
+
+    return float(t.ppf(q, df))
+
+
 def t_interval(effects, level: float = 0.95) -> tuple[float, float]:
     """The ``level`` t interval of the mean of ``effects`` (mean +- t(1 - (1 - level) / 2, n - 1) x sd / sqrt(n));
     NaN for fewer than 2 finite values."""
-    from scipy.stats import t
-
     e = np.asarray(effects, float)
     e = e[np.isfinite(e)]
     if e.size < 2:
         return float("nan"), float("nan")
-    half = float(t.ppf(1 - (1 - level) / 2, e.size - 1)) * float(e.std(ddof=1)) / np.sqrt(e.size)
+    half = _t_quantile(1 - (1 - level) / 2, int(e.size - 1)) * float(e.std(ddof=1)) / np.sqrt(e.size)
     return float(e.mean() - half), float(e.mean() + half)
 
 

@@ -68,10 +68,14 @@ def declared_claims(cmp: dict) -> list[dict]:
 def check_claims(config: dict) -> None:
     """Refuse at config time what the schema cannot see in ``compare.claims``, one line naming the key.
 
-    An unknown metric, a text column (clip, seed, group, note, ...), a generator that is neither in
-    ``compare.generators`` nor ``compare.user_generators``, ``a == b``, ``'*'`` anywhere but ``b``, a duplicate id,
-    a metric with neither a margin nor ``min_effect``, and a descriptive metric (no direction in the metric table)
-    without ``direction``.
+    An unknown metric, a text column (clip, seed, group, note, ...), an unknown generator (neither one of the
+    family's rows, :data:`animsynth.compare.generators.names.GENERATORS`, nor in ``compare.user_generators``: a typo),
+    ``a == b``, ``'*'`` anywhere but ``b``, a duplicate id, a metric with neither a margin nor ``min_effect``, and a
+    descriptive metric (no direction in the metric table) without ``direction``.
+
+    A family row that this run leaves out of ``compare.generators`` is no error: a run may compare fewer generators
+    than the shipped claims name, and such a claim is "did not run" (not in this run), as for a row left out because
+    its package is not installed.
 
     Raises
     ------
@@ -79,8 +83,10 @@ def check_claims(config: dict) -> None:
     """
     from .measures.metric_table import METRIC_NAMES
 
+    from .generators.names import GENERATORS
+
     cmp = config["compare"]
-    known = set(cmp["generators"]) | set(cmp.get("user_generators") or {})
+    known = set(GENERATORS) | set(cmp["generators"]) | set(cmp.get("user_generators") or {})
     seen: dict = {}
     for i, c in enumerate(cmp.get("claims") or []):
         key = f"config key 'compare.claims[{i}]"
@@ -94,8 +100,8 @@ def check_claims(config: dict) -> None:
             if g == EVERY and side == "a":
                 raise ConfigError(f"{key}.a': '*' (every generator) may only be b")
             if g != EVERY and g not in known:
-                raise ConfigError(f"{key}.{side}': {g!r} is not a generator of this run (compare.generators or "
-                                  "compare.user_generators)")
+                raise ConfigError(f"{key}.{side}': {g!r} is not a generator (one of the family's rows, "
+                                  "animsynth.compare.generators.names.GENERATORS, or of compare.user_generators)")
         if c["a"] == c["b"]:
             raise ConfigError(f"{key}.b': {c['b']!r} is also a; a claim compares two generators")
         if c["id"] in seen:
