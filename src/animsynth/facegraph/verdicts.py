@@ -151,7 +151,8 @@ def memory_claim(baseline: pd.DataFrame, data: str) -> dict:
     region, face = _region_and_face(baseline)
     smaller = face.memory_mb > region.memory_mb
     return row(
-        "Region graphs need less memory than the face graph (Zhang et al. 2004)", share_verdict(smaller),
+        "Region graphs need less memory than the face graph (Zhang et al. 2004)",
+        share_verdict(smaller, none="opposite"),
         "float32 storage of what synthesis needs; complete face graphs hold N^2 weights"
         + ("" if face.built.all() else " (graphs too large to build: memory computed from their size)") + ".",
         ours=f"{fmt(region.memory_mb)} MB vs {fmt(face.memory_mb.min())}-{fmt(face.memory_mb.max())} MB",
@@ -196,7 +197,8 @@ def interpolation_claim(t: pd.DataFrame, data: str) -> dict:
     lm = t["landmark_diff_px"].astype(float)
     lin = t["linear_landmark_diff_px"].astype(float)
     return row(
-        "The graph adds over straight neutral-to-peak interpolation (landmark difference)", share_verdict(lm < lin),
+        "The graph adds over straight neutral-to-peak interpolation (landmark difference)",
+        share_verdict(lm < lin, none="opposite"),
         f"Graph counterpart below the linear baseline in {int((lm < lin).sum())}/{len(t)} configurations; "
         f"velocity angle {fmt(t.velocity_angle_diff_pct.median())} % vs {fmt(t.linear_velocity_angle_diff_pct.median())} %. "
         "The reference is the pre-processed sequence, whose eq.-1 fit (one timing for x and y) moves every landmark "
