@@ -143,6 +143,13 @@ def test_no_evidence_is_never_reproduced_nor_not_reproduced():
     assert "no clip x seed with a skate_share value for both" in v["evidence"].iloc[0]
 
 
+def test_a_claim_without_a_margin_is_refused_by_the_library_too():
+    metrics, clips = build([0.08] * 4)
+    bare = dict(SKATE, metric="velocity_jump_max")  # no margin in the metric table, no min_effect
+    with pytest.raises(ValueError, match="'t_skate': metric 'velocity_jump_max' needs a margin"):
+        CV.decide_claims(metrics, VC, "d", {}, clips, claims=[bare])
+
+
 def test_three_equal_effects_do_not_give_p_zero():
     assert CS.sign_flip_p([0.033] * 3) == pytest.approx(2 / 8)
     assert CS.sign_flip_p([0.0] * 3) == 1.0

@@ -149,6 +149,9 @@ class _Claim:
                  seed: int, sweep=None, generic=frozenset()):
         self.spec, self.data, self.vc, self.groups, self.seed = spec, data, vc, groups, seed
         self.a, self.b, self.metric = spec["a"], spec["b"], spec["metric"]
+        if spec["margin"] is None or not spec["direction"]:
+            raise ValueError(f"claim {spec['id']!r}: metric {self.metric!r} needs a margin (min_effect) and a direction "
+                             "(animsynth.compare.claims.check_claims refuses such a claim at config time)")
         self.better, self.me = spec["direction"], float(spec["margin"])
         self.skating = skating_claim(spec)
         self.missing, self.empty, self.st, self.all_st = "", "", None, None
