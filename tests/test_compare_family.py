@@ -227,9 +227,18 @@ def _metrics(values: dict) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-VC = {"share": 0.75, "alpha": 0.05, "min_groups": 3, "novelty_copy_m": 0.01,
+#: the rule's settings with smaller margins than the metric table's (compare.verdicts.min_effect overrides them), so
+#: the constructed effects of a few hundredths count
+VC = {"alpha": 0.05, "min_groups": 3, "novelty_copy_m": 0.01,
       "min_effect": {"skate_share": 0.02, "transition_skate_share": 0.02, "velocity_jump_p95": 0.1, "l2p": 0.25,
                      "novelty_median_m": 0.005, "coverage": 0.02}}
+#: the declared claims of the shipped config
+CLAIMS = _config()["compare"]["claims"]
+
+
+def _claim(a: str, b: str, metric: str) -> str:
+    """The text of the declared claim of ``a`` against ``b`` on ``metric`` (from the config)."""
+    return next(c["claim"] for c in CLAIMS if (c["a"], c["b"], c["metric"]) == (a, b, metric))
 
 
 def test_holm_adjusts_a_family_of_p_values():
@@ -269,62 +278,74 @@ def test_counting_clips_says_reproduced_where_counting_groups_cannot_decide():
     # holds and one the opposite (the group votes neither way)
     effects = [[0.05, 0.06, 0.05]] * 5 + [[0.05, -0.05]] * 2
     metrics, clips = _grouped(effects)
-    claim = "the classic motion graph skates less than ST-Isomap re-sequencing"
+    claim = _claim("motion_graph", "stisomap", "skate_share")
     j = CS.pair_outcomes(metrics, "motion_graph", "stisomap", "skate_share")
     c = CS.per_clip(j)
     h, f = int((c["outcome"] > 0).sum()), int((c["outcome"] < 0).sum())
     assert (h, f) == (17, 2) and h / (h + f) >= 0.75 and binomtest(h, h + f).pvalue < 0.05  # by clips: reproduced
     groups = GR.independent_groups(clips)
     assert len(set(groups.values())) == 7
-    v = CV.build_verdicts(metrics, VC, "test data", {}, clips).set_index("claim")
+    v = CV.build_verdicts(metrics, VC, "test data", {}, clips, claims=CLAIMS).set_index("claim")
     # by groups: 5 effects of 0.05 and 2 of 0: the sign-flip p is 8/128 = 0.0625, no group the opposite
     assert v.loc[claim, "verdict"] == "undecided" and v.loc[claim, "ours"].startswith("undecided (7 subjects)")
     ev = v.loc[claim, "evidence"]
     assert "7 independent subjects" in ev and "holds in 5, opposite in 0, neither in 2" in ev
-    assert "Holm-adjusted" in ev and "minimum effect 0.02" in ev and "17 of 19 untied clips" in ev
+    assert "Holm-adjusted" in ev and "margin 0.02" in ev and "17 of 19 untied clips" in ev
     assert ev.startswith("tested: motion_graph lower than stisomap on skate_share; ")  # the hypothesis
     # every group holding: reproduced (p = 2/2^7); two groups holding the opposite without a significant split
-    # between subjects (2 or 3 clips x 2 seeds per subject): within noise, not partly
+    # between subjects (2 or 3 clips x 2 seeds per subject): undecided, not partly
     def verdict(effects):
         m, c = _grouped(effects)
-        return CV.build_verdicts(m, VC, "test data", {}, c).set_index("claim").loc[claim, "verdict"]
+        return CV.build_verdicts(m, VC, "test data", {}, c, claims=CLAIMS).set_index("claim").loc[claim, "verdict"]
 
     assert verdict([[0.05, 0.06, 0.05]] * 7) == "reproduced"
-    assert verdict([[0.05, 0.06, 0.05]] * 5 + [[-0.05, -0.04]] * 2) == "within noise"
-    # effects below the metric's minimum effect, however consistent: significant, no material effect
-    assert verdict([[0.01, 0.012, 0.011]] * 7) == "not reproduced"
+    assert verdict([[0.05, 0.06, 0.05]] * 5 + [[-0.05, -0.04]] * 2) == "undecided"
+    # effects below the margin, however consistent, with a tight interval: equivalent within the margin
+    assert verdict([[0.01, 0.012, 0.011]] * 7) == "no material difference"
 
 
-@pytest.mark.parametrize("claim, pair, metric, sign", [
-    ("motion matching skates less than the motion graph", ("motion_matching", "motion_graph"), "skate_share", 1),
-    ("GenMM covers more of the database than the motion graph", ("genmm", "motion_graph"), "coverage", -1),
+@pytest.mark.parametrize("pair, metric, sign", [
+    (("motion_matching", "motion_graph"), "skate_share", 1),
+    (("genmm", "motion_graph"), "coverage", -1),
 ])
-def test_the_modern_rows_claims_are_decided_over_groups(claim, pair, metric, sign):
+def test_the_modern_rows_claims_are_decided_over_groups(pair, metric, sign):
     # effect = second minus first: motion matching skating less is a positive effect, GenMM covering more a
     # negative one (coverage: higher is better)
+    claim = _claim(*pair, metric)
+
     def verdict(effects, left_out=None, **kw):
         m, c = _grouped([[sign * e for e in g] for g in effects], pair=pair, metric=metric)
         if left_out:
             m = m[m["generator"] != left_out]
-        v = CV.build_verdicts(m, dict(VC, **kw), "test data", {left_out: "not in this run"} if left_out else {}, c)
+        v = CV.build_verdicts(m, dict(VC, **kw), "test data", {left_out: "not in this run"} if left_out else {}, c,
+                              claims=CLAIMS)
         return v.set_index("claim").loc[claim]
 
     row = verdict([[0.05, 0.06, 0.05]] * 7)
     assert row["verdict"] == "reproduced" and "7 independent subjects" in row["evidence"]
     assert "Holm-adjusted" in row["evidence"] and f"{metric} (" in row["ours"]
     assert verdict([[-0.05, -0.06, -0.05]] * 7)["verdict"] == "contradicted"
-    # groups both ways, no subject significant on its own 4-6 clip x seed effects: within noise, not partly
-    assert verdict([[0.05, 0.06, 0.05]] * 4 + [[-0.05, -0.04]] * 3)["verdict"] == "within noise"
-    assert verdict([[0.01, 0.012, 0.011]] * 7)["verdict"] == "not reproduced"  # below the minimum effect
+    # groups both ways, no subject significant on its own 4-6 clip x seed effects: undecided, not partly
+    assert verdict([[0.05, 0.06, 0.05]] * 4 + [[-0.05, -0.04]] * 3)["verdict"] == "undecided"
+    assert verdict([[0.01, 0.012, 0.011]] * 7)["verdict"] == "no material difference"  # within the margin
     missing = verdict([[0.05, 0.06, 0.05]] * 7, left_out=pair[0])
-    assert missing["verdict"] == "not reproduced" and "not in this run" in missing["evidence"]
+    assert missing["verdict"] == "did not run" and "not in this run" in missing["evidence"]
 
 
-def test_the_default_minimum_effects_cover_every_metric_a_claim_uses():
-    vc = _config()["compare"]["verdicts"]
-    for metric in ("skate_share", "transition_skate_share", "velocity_jump_p95", "l2p", "coverage",
-                   "novelty_median_m"):
-        assert vc["min_effect"].get(metric, 0) > 0, metric
+def test_every_declared_claim_and_sanity_check_has_a_margin_by_default():
+    """The shipped config names no margin: every declared claim takes its metric's margin from the metric table, and
+    so do the sanity checks' metrics (compare.verdicts.min_effect is an empty override)."""
+    from animsynth.compare.claims import declared_claims, margin
+
+    cmp = _config()["compare"]
+    assert cmp["verdicts"]["min_effect"] == {} and not any("min_effect" in c for c in cmp["claims"])
+    for c in declared_claims(cmp):
+        assert c["margin"] == metric_table.metric(c["metric"]).margin > 0, c["claim"]
+    for m in ("velocity_jump_p95", "novelty_median_m", *metric_table.EXPLORATORY_METRICS):
+        assert margin(m, cmp["verdicts"]) == metric_table.metric(m).margin > 0, m
+    # the override and a claim's own min_effect come first, in that order
+    assert margin("skate_share", {"min_effect": {"skate_share": 0.1}}) == 0.1
+    assert margin("skate_share", {"min_effect": {"skate_share": 0.1}}, {"min_effect": 0.2}) == 0.2
 
 
 def test_the_modern_rows_from_the_config(cfg):
@@ -380,19 +401,19 @@ def test_verdict_builder_on_known_outcomes():
     metrics = _metrics({"motion_graph": lo, "stisomap": hi, "isomap": [0.0] * n, "delaunay": hi, "knn": hi,
                         "concat": hi, "replay": [0.05] * n})
     vc = dict(VC, min_groups=2)
-    v = CV.build_verdicts(metrics, vc, "test data", {"fairmotion": "not installed here"}).set_index("claim")
+    v = CV.build_verdicts(metrics, vc, "test data", {"fairmotion": "not installed here"},
+                          claims=CLAIMS).set_index("claim")
     assert set(v["verdict"]) <= set(VOCABULARY)
-    claim = "the classic motion graph skates less than ST-Isomap re-sequencing"
+    claim = _claim("motion_graph", "stisomap", "skate_share")
     # two groups hold clearly, but two groups cannot decide: the smallest sign-flip p is 2 / 2^2 = 0.5
     assert v.loc[claim, "verdict"] == "undecided" and v.loc[claim, "ours"].startswith("undecided (2 subjects)")
     ev = v.loc[claim, "evidence"]
     assert "2 independent subjects" in ev and "holds in 2, opposite in 0" in ev and "p = 0.5" in ev
-    fm = v.loc["our motion graph's transitions skate less than fairmotion 0.0.4's as released (at its native 60 fps)"]
-    assert fm["verdict"] == "not reproduced" and "not installed here" in fm["evidence"]
-    assert v.loc["ST-Isomap re-sequencing jumps less than Isomap re-sequencing (95th percentile of the per-frame "
-                 "velocity jump)", "verdict"] == "not reproduced"  # no value in this table
-    capture = v.loc["the held-out capture skates less than every generator (the realism upper bound holds for "
-                    "this metric)"]
+    fm = v.loc[_claim("motion_graph", "fairmotion", "transition_skate_share")]
+    assert fm["verdict"] == "did not run" and "not installed here" in fm["evidence"]
+    jumps = v.loc[_claim("stisomap", "isomap", "velocity_jump_p95")]
+    assert jumps["verdict"] == "did not run" and "no values of velocity_jump_p95" in jumps["evidence"]
+    capture = v.loc[_claim("replay", "*", "skate_share")]
     # isomap skates less than the capture: its part holds the opposite in both groups; the parts carry numbers only
     import re
 
@@ -603,13 +624,13 @@ def test_the_claims_against_the_peer_quote_the_budget_sweep():
                           for b, g, v in ((2.0, "motion_graph", 0.2), (2.0, "fairmotion_fixed", 0.3),
                                           (4.0, "motion_graph", 0.25), (4.0, "fairmotion_fixed", 0.2),
                                           (8.0, "motion_graph", 0.3), (8.0, "fairmotion_fixed", 0.5))])
-    fixed = "our motion graph's transitions skate less than fairmotion's with upstream's walk fixes"
-    released = "our motion graph's transitions skate less than fairmotion 0.0.4's as released (at its native 60 fps)"
-    v = CV.build_verdicts(metrics, dict(VC, min_groups=2), "test data", {}, sweep=sweep).set_index("claim")
+    fixed = _claim("motion_graph", "fairmotion_fixed", "transition_skate_share")
+    released = _claim("motion_graph", "fairmotion", "transition_skate_share")
+    v = CV.build_verdicts(metrics, dict(VC, min_groups=2), "test data", {}, sweep=sweep, claims=CLAIMS).set_index("claim")
     ev = v.loc[fixed, "evidence"]
     assert "0.2 vs 0.3 at 2/s; 0.25 vs 0.2 at 4/s; 0.3 vs 0.5 at 8/s; motion_graph lower at 2 of 3 budgets" in ev
     assert "the budget sweep runs the fixed row" in v.loc[released, "evidence"]
-    without = CV.build_verdicts(metrics, dict(VC, min_groups=2), "test data", {}).set_index("claim")
+    without = CV.build_verdicts(metrics, dict(VC, min_groups=2), "test data", {}, claims=CLAIMS).set_index("claim")
     assert "budget sweep" not in without.loc[fixed, "evidence"]
     assert (v["verdict"] == without["verdict"]).all()  # evidence, not a vote: decided at the default budget
 

@@ -237,7 +237,7 @@ def test_tables_show_a_user_row_and_leave_the_claims_unchanged(tmp_path, clips_f
     jobs_clips = protocol.clips_table(clips)
     jobs_clips.to_csv(tmp_path / "clips.csv", index=False)
     tcfg = {"generators": list(_config()["compare"]["generators"]), "seeds": 2, "fps": 30, "context": 8, "length": 12,
-            "verdicts": _config()["compare"]["verdicts"]}
+            "verdicts": _config()["compare"]["verdicts"], "claims": _config()["compare"]["claims"]}
 
     def tables_for(gens, folder):
         folder.mkdir()

@@ -703,7 +703,8 @@ def test_table1_row_uniqueness_and_connectivity(db):
     common.check(v)
     assert set(v.verdict) <= set(common.VOCABULARY)
     assert v.data.eq("synthetic CK+-layout, 1 configurations").all()
-    assert (v.loc[v.claim == "Landmark error rises with compression", "verdict"] == "not reproduced").all()
+    # one configuration: no rank correlation to test, so the trend is undecided (no evidence is never "not reproduced")
+    assert (v.loc[v.claim == "Landmark error rises with compression", "verdict"] == "undecided").all()
 
 
 # -- the published Table 1 (animsynth.published.read_table, mapped to configuration names) ---------------

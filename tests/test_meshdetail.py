@@ -247,7 +247,7 @@ def test_single_frame_prediction_matches_batch(skirt_data):
     np.testing.assert_allclose(one[0], batch[11], atol=1e-10)
 
 
-def test_verdict_is_within_noise_when_blocks_disagree():
+def test_verdict_is_undecided_when_blocks_disagree():
     import pandas as pd
 
     from animsynth.meshdetail.verdicts import block_margin, block_verdict
@@ -258,6 +258,6 @@ def test_verdict_is_within_noise_when_blocks_disagree():
     assert k == 5 and share == 1.0 and block_verdict(m, sd, share, k) == "reproduced"
     mixed = pd.DataFrame({"block": block, "a": 1.0, "b": np.where(block == 2, 0.5, 1.1)})
     m, sd, share, k = block_margin(mixed, "a", "b")
-    assert m < 0.1 and share == 0.8 and block_verdict(m, sd, share, k) == "within noise"
+    assert m < 0.1 and share == 0.8 and block_verdict(m, sd, share, k) == "undecided"   # margin within its spread
     worse = pd.DataFrame({"block": block, "a": 3.0, "b": 1.0})
     assert block_verdict(*block_margin(worse, "a", "b")) == "contradicted"

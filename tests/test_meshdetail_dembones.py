@@ -70,6 +70,8 @@ def test_dembones_floor_reaches_near_zero_on_exact_lbs_data_and_beats_a_wrong_sk
     ({"samba": "reproduced", "crane": "within noise"}, "holds on one (samba)", "partly"),
     ({"samba": "within noise", "crane": "contradicted"}, "holds on neither", "not reproduced"),
     ({"samba": "within noise", "crane": "within noise"}, "holds on neither", "within noise"),
+    ({"samba": "undecided", "crane": "undecided"}, "holds on neither", "undecided"),
+    ({"samba": "did not run", "crane": "did not run"}, "holds on neither", "did not run"),
     ({"samba": "partly", "crane": "reproduced"}, "holds on one (crane)", "partly"),
 ])
 def test_holds_on_both_one_or_neither(verdicts, words, verdict):

@@ -572,14 +572,15 @@ def test_smoothness_verdicts_use_only_pairs_where_both_resequence():
     for p in range(10):
         vals[("walk", "stisomap", "l2", False, p)] = ("replays_backwards", np.nan)
     v = st_smoother_verdict(_paths(vals))
-    assert v["verdict"] == "within noise" and "both 2" in v["evidence"]
+    assert v["verdict"] == "undecided" and "both 2" in v["evidence"]
+    # no pair where both re-sequence: nothing to compare, so undecided (never "not reproduced")
     for p in range(12):
         vals[("walk", "stisomap", "l2", False, p)] = ("replays", np.nan)
-    assert st_smoother_verdict(_paths(vals))["verdict"] == "not reproduced"
-    # half and half: within noise
+    assert st_smoother_verdict(_paths(vals))["verdict"] == "undecided"
+    # half and half: the sign test decides nothing
     for p in range(12):
         vals[("walk", "stisomap", "l2", False, p)] = ("resequences", 2.0 if p % 2 else 4.0)
-    assert st_smoother_verdict(_paths(vals))["verdict"] == "within noise"
+    assert st_smoother_verdict(_paths(vals))["verdict"] == "undecided"
 
 
 def test_global_dof_verdict_per_dataset():
@@ -808,7 +809,7 @@ def test_explanation_claim_is_named_the_same_without_the_published_table():
 
     rows = explanation_verdicts(pd.DataFrame(), None, 1)
     assert len(rows) == 1 and rows[0]["claim"].startswith("which candidate explanation matches")
-    assert rows[0]["verdict"] == "not reproduced" and "not available" in rows[0]["evidence"]
+    assert rows[0]["verdict"] == "undecided" and "not available" in rows[0]["evidence"]  # no evidence
 
 
 def test_the_papers_min_k_stands_only_beside_the_trials_it_measured(tmp_path):

@@ -13,6 +13,7 @@ from animsynth.resequencing.jobs import base_distances, method_distances, prepar
 from animsynth.resequencing.settings import method_params
 from animsynth.resequencing.embedding import min_connected_k
 from animsynth.resequencing.features import motion_features
+from animsynth.verdicts import VOCABULARY
 from conftest import config_block
 
 
@@ -47,7 +48,7 @@ def test_tiny_workflow_resequencing_outputs(tiny_workflow):
     assert len(tr) == paths["transitions"].sum()
     v = pd.read_csv(out / "verdicts.csv")
     assert list(v.columns) == ["claim", "paper_value", "ours", "data", "verdict", "evidence", "source"]
-    assert set(v["verdict"]) <= {"reproduced", "partly", "not reproduced", "contradicted", "within noise"}
+    assert set(v["verdict"]) <= set(VOCABULARY)
     claims = " ".join(v["claim"])
     for text in ("ST-Isomap re-sequences more smoothly", "global DOF", "Lee metric needs far fewer",
                  "which candidate explanation"):

@@ -36,7 +36,7 @@ def test_read_names_file_and_line_of_a_bad_verdict(tmp_path):
 
 
 @pytest.mark.parametrize("share, word", [(1.0, "reproduced"), (0.0, "contradicted"), (0.5, "within noise"),
-                                         (float("nan"), "not reproduced"), (None, "not reproduced")])
+                                         (float("nan"), "undecided"), (None, "undecided")])
 def test_agreement_verdict(share, word):
     assert v.agreement_verdict(share) == word
 

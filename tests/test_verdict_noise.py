@@ -204,10 +204,10 @@ def test_compare_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow
     clips = pd.read_csv(out / "clips.csv")
     data = data_label("synthetic", clips, cmp["seeds"])
     left_out = {g: "left out" for g in cmp["generators"] if g not in set(metrics["generator"])}
-    want = build_verdicts(metrics, cmp["verdicts"], data, left_out)
+    want = build_verdicts(metrics, cmp["verdicts"], data, left_out, clips, claims=cmp["claims"])
     written = pd.read_csv(out / "verdicts.csv")
     assert want[["claim", "verdict"]].equals(written[["claim", "verdict"]])  # the rule's inputs, rebuilt
-    got = build_verdicts(perturbed(metrics, seed), cmp["verdicts"], data, left_out)
+    got = build_verdicts(perturbed(metrics, seed), cmp["verdicts"], data, left_out, clips, claims=cmp["claims"])
     assert len(want) >= 5
     assert got["verdict"].tolist() == want["verdict"].tolist(), pd.concat(
         [want[["claim", "verdict"]], got["verdict"].rename("noisy")], axis=1).to_string()

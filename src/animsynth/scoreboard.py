@@ -36,10 +36,14 @@ VERDICT_COLOURS = {
     "contradicted": "#d7191c",
     # not on the scale: too few independent units to decide (a neutral grey-blue, apart from "within noise")
     "undecided": "#9fb4c7",
+    # decided, but neither way: equivalence within the margin (a blue, apart from the green-to-red scale)
+    "no material difference": "#2b83ba",
+    # no evidence at all: the thing did not run (near white)
+    "did not run": "#f7f7f7",
 }
 #: a verdict word outside the vocabulary (a family's newer word): drawn grey, named in the legend
 OTHER_COLOUR = "#bdbdbd"
-_DARK = {"reproduced", "contradicted"}  # white id text on these
+_DARK = {"reproduced", "contradicted", "no material difference"}  # white id text on these
 HATCH = "///"  # the cells of claims on synthetic data
 #: the order of the rows: the four papers as the project lists them, then the generators side by side (the family
 #: registry's report order, :func:`animsynth.families.report_order`); a family not named here follows in the order

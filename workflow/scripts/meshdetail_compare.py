@@ -18,7 +18,8 @@ write_table(table, o.table, title="Hybrid mesh animation: sequences side by side
                  "blocks when the bone transforms are solved from the held-out meshes), not a skeleton-driven model.")
 verdicts = combine_verdicts({n: common.read(f) for n, f in zip(names, i.verdicts)})
 write_table(verdicts, o.verdicts, title="Meshdetail verdicts (every sequence, and across sequences)",
-            note="Per sequence: model comparisons on held-out frames of the blocked cross-validation; 'within noise' "
-                 "where the margin does not exceed the per-block spread or the blocks disagree. [all sequences]: a "
+            note="Per sequence: model comparisons on held-out frames of the blocked cross-validation; 'undecided' "
+                 "where the margin does not exceed the per-block spread, 'partly' where it does but not every block "
+                 "agrees. [all sequences]: a "
                  "claim holds on a sequence when its verdict there is 'reproduced'.")
 log.info("\n%s\n%s", table.to_string(), verdicts.to_string())

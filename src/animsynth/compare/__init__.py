@@ -19,7 +19,8 @@ scoring         one generated motion's metrics against its clip (``score``), als
 runner, cost    one generator over every clip and seed, scored, with its cost; the cost guard
 jobs            one function per workflow step (clips, one generator's run, the tables, the budget sweep, figures)
 tables, plots   the family's tables and figures
-verdicts        the declared claims, decided over independent groups (groups, claim_stats)
+verdicts        the declared claims (claims: read from config, margins, checks), decided over independent
+                groups (groups, claim_stats)
 settings        config checks and what the workflow reads of the ``compare`` block
 """
 

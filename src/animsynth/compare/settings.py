@@ -283,6 +283,9 @@ def check(config: dict) -> None:
     if cmp["metrics"]["window"] > cmp["min_length"]:
         raise ConfigError(f"config key 'compare.metrics.window': {cmp['metrics']['window']} frames exceed "
                           f"compare.min_length ({cmp['min_length']}): a short clip would have no window")
+    from .claims import check_claims
+
+    check_claims(config)  # the declared claims against the metric table and the configured rows
 
 
 def _flow(values) -> str:

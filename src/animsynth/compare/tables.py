@@ -63,6 +63,7 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
 
     ``sweep``: ``{"default": transitions_per_s, "budgets": [...], "generators": [...]}`` describing
     ``inp["sweep"]`` (:func:`sweep_runs`); the claims against the peer quote the sweep as evidence."""
+    from .claim_stats import no_values
     from .groups import independent_groups
     from .verdicts import decide_claims, exploratory_table, sanity_checks
 
@@ -85,12 +86,15 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
         sweep_tab = sweep_table(sweep_runs(metrics, inp["sweep"], sweep["default"], sweep["budgets"],
                                            sweep["generators"]), order)
     seed = int(cfg.get("seed", 0))
-    declared = cfg.get("claims")
+    declared = cfg.get("claims") or []
     verdicts, claims_stats = decide_claims(own, cfg["verdicts"], data, left_out, clips_full, sweep=sweep_tab,
                                            claims=declared, seed=seed)
-    exploratory = exploratory_table(own, cfg["verdicts"], clips_full, claims=declared, order=order, seed=seed)
+    exploratory = exploratory_table(own, cfg["verdicts"], clips_full, claims=declared, order=order, seed=seed,
+                                    left_out=left_out)
     sanity = sanity_checks(own, cfg["verdicts"], data, left_out, clips_full, seed=seed)
     not_built = metrics.loc[metrics["note"] != "", ["generator", "clip", "note"]].drop_duplicates()
+    failed = set(not_built.loc[not_built["note"].str.startswith("failed: "), "generator"])  # said on their own line
+    empty = {g: no_values(metrics, g) for g in order_generators(metrics["generator"].unique(), order) if g not in failed}
     log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
              metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
              len(verdicts), ", ".join(verdicts["verdict"]))
@@ -98,7 +102,7 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
             "cost": cost_table(timing, order), "verdicts": verdicts, "claims_stats": claims_stats,
             "exploratory": exploratory, "sanity": sanity, "sensitivity": sensitivity_table(metrics, order),
             "summary_md": summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg, not_built,
-                                           sanity)}
+                                           sanity, {g: w for g, w in empty.items() if w})}
 
 
 def order_generators(names, order) -> list[str]:
@@ -229,9 +233,10 @@ def data_label(source: str, clips: pd.DataFrame, seeds: int) -> str:
 
 def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.DataFrame, generators, left_out: dict,
                      data: str, cfg: dict, not_built: pd.DataFrame | None = None,
-                     sanity: pd.DataFrame | None = None) -> str:
+                     sanity: pd.DataFrame | None = None, did_not_run: dict | None = None) -> str:
     """``compare/summary.md``: the protocol in numbers, which generator wins which metric, the verdicts.
-    Generated from the tables (no timing: cost is in ``cost_timing.csv``)."""
+    Generated from the tables (no timing: cost is in ``cost_timing.csv``). ``did_not_run``: {generator: why} of the
+    generators with no value on any clip (not ranked; their claims "did not run")."""
     from ..tables import to_markdown
 
     out = ["# The generators side by side", "",
@@ -245,6 +250,9 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
                 "(where the capture went next), information no other generator sees; its scores against the ground "
                 "truth are not comparable with those of the rows that see the start alone (docs/compare.md, "
                 "Motion matching).", ""]
+    if did_not_run:
+        out += ["Did not run (no value on any clip, so in no ranking; their claims read \"did not run\"): "
+                + "; ".join(f"**{g}**: {why.split(': ', 1)[-1]}" for g, why in did_not_run.items()) + ".", ""]
     if not_built is not None and len(not_built):
         failed = not_built[not_built["note"].str.startswith("failed: ")].drop_duplicates("generator")
         not_built = not_built[~not_built["note"].str.startswith("failed: ")]
@@ -271,10 +279,9 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
                 "best_wins_share", "replay_median", "concat_median"]
         out += [to_markdown(winners[[c for c in cols if c in winners]]), ""]
     out += ["## Verdicts", "", "The claims declared in advance (compare.claims), each decided over independent "
-            "groups of clips (subjects) by an exact sign-flip test of the mean group effect, its 95 % interval and "
-            "the claim's minimum effect, with a Holm correction over the declared claims only (docs/compare.md, "
-            "Verdicts; numbers: `claims_stats.csv`; every other pair of generators, without a verdict: "
-            "`exploratory.csv`).", "",
+            "groups of clips (subjects) by an exact sign-flip test of the mean group effect (Holm over the declared "
+            "claims only), its margin and its 90 % interval for equivalence (docs/compare/verdicts.md; numbers: "
+            "`claims_stats.csv`; every other pair of generators, without a verdict: `exploratory.csv`).", "",
             to_markdown(verdicts[["claim", "ours", "verdict", "evidence"]]), ""]
     if sanity is not None and len(sanity):
         out += ["## Sanity checks", "", "Claims true by construction, decided the same way; not findings.", "",

@@ -1,86 +1,36 @@
-"""The side-by-side claims, declared in advance and decided over independent groups of clips, in the common
-verdict format (:mod:`animsynth.verdicts`).
+"""The side-by-side claims, declared in advance and decided over independent subjects, in the common verdict format
+(:mod:`animsynth.verdicts`); the full rule, with its reasons, is docs/compare/verdicts.md.
 
 Declared claims
 ---------------
-The primary claims are a list fixed in advance (``compare.claims``; :data:`DEFAULT_CLAIMS` when none is given):
-each has an ``id``, the claim text, generators ``a`` and ``b`` (``b: "*"``: every generator of the run but the
-references, one intersection-union finding), a ``metric``, a ``direction`` (``lower`` / ``higher``: which value of
-``a`` the claim expects), a ``min_effect`` in the metric's units (``skating``: :func:`skating_claim`). Only
-these are findings (``verdicts.csv``, with their numbers in ``claims_stats.csv``) and Holm's correction runs over
-them alone. Every other pair of generators on the main metrics (:data:`EXPLORATORY_METRICS`), including a pair whose
-claim a user removed from the list, is **exploratory** (:func:`exploratory_table`, ``exploratory.csv``): numbers
-only, no verdict word, a Holm correction of its own, never a finding.
+The findings are the claims of ``compare.claims`` (config/config.yaml alone; read by
+:func:`animsynth.compare.claims.declared_claims`, checked at config time by
+:func:`animsynth.compare.claims.check_claims`): generators ``a`` and ``b`` (``b: "*"``: every generator of the run
+but the references, one intersection-union finding), a ``metric``, a ``direction`` and a margin (the claim's
+``min_effect``, else the metric's margin: :func:`animsynth.compare.claims.margin`). Holm's correction runs over them
+alone. Every other pair on the main metrics is **exploratory** (:func:`exploratory_table`): numbers, no verdict.
+Claims true by construction are **sanity checks** (:func:`sanity_checks`): the same rule, Holm among themselves.
 
-Independent units
------------------
-Clips are not independent: the leave-one-out clips of a subset share most of their database trials and the
-subject, and a re-sequencing clip may be a trial that a subset's clips use. The unit of every test is the
-**group** (:func:`animsynth.compare.groups.independent_groups`, ``compare.verdicts.grouping``):
+Units, effects, tests (:mod:`animsynth.compare.claim_stats`)
+-------------------------------------------------------------
+The unit is the independent group of clips, by default the subject (:mod:`animsynth.compare.groups`). A group's
+effect is the median over its clips of each clip's median over seeds of ``a - b``, signed so that positive favours
+the claim. Over the groups: the mean effect, its 95 % and 90 % t intervals, an exact sign-flip permutation p (Holm
+over the declared claims) and the subjects 80 % power would need at the observed effect; per subject, a sign test
+of its clips (Holm over the subjects) for a significant split. Subjects on a generic figure (``figure: generic`` in
+``compare/clips.csv``) leave every test; each claim's evidence gives its numbers with them included. A skating claim
+compares only the clips on which both generators' feet touch the floor (their median ``contact_share`` over the
+clip's seeds at least ``compare.verdicts.min_contact_share``); the clips left out are counted in its evidence.
 
-* ``subject`` (default): every clip of one subject (the CMU subject id of its held-out trial), joined with every
-  other group with which it shares a trial (held out or in a database): clips that share a subject or database
-  trials are one group. On the paper run's CMU protocol: subject 35 (w1, r1, run, walk), 16 (w2), 127 (r2),
-  05 (dance) and the eight sets of ``compare.subjects`` (02, 09, 07, 12, 49, 17, 06, 10): 12 groups for 38 clips.
-* ``subset_subject``: the clips of one subset (or re-sequencing dataset) and one subject, joined where they
-  share a trial. It counts the subsets of one subject as independent, which they are not for a claim about
-  people's motion; kept as an option.
-
-A clip without a subject id (not a CMU trial name) is grouped by its subset. The grouping lives in
-:mod:`animsynth.compare.groups`; the per-clip and per-group effects, the t interval and the per-subject tests in
-:mod:`animsynth.compare.claim_stats`.
-
-A group's **effect** is the median over its clips of each clip's median over seeds of ``a - b`` (signed so that
-positive favours the claim), in the metric's units. A group **holds** when more of its clips hold than not and its
-effect is at least the claim's minimum effect, holds the **opposite** for the reverse, and votes neither way
-otherwise (:func:`group_outcomes`).
-
-The test
---------
-Over the ``n`` group effects: the claim's effect is their **mean**, with a **95 % t interval** over the groups
-(mean +- t(0.975, n - 1) x standard deviation / sqrt(n); none for one group). Its p is an **exact sign-flip
-permutation test** of that mean (:func:`sign_flip_p`): under "no effect" each group's effect is as likely
-negative as positive, so the p is the share of the 2^n sign flips whose mean is at least as far from 0 as the
-observed one (two-sided; ``n > 16``: ``compare.verdicts.permutations`` seeded random flips, the seed
-``compare.seed``). Equal non-zero effects give p = 2 / 2^n, never 0; effects that are all 0 give 1. With 4 groups
-the smallest possible p is 2 / 2^4 = 0.125: four subjects cannot decide any claim, whatever its effect. Holm's
-step-down correction (Holm 1979) runs over the declared claims with a test.
-
-Per subject (for "partly" only): a two-sided exact sign test of the subject's clip outcomes (one vote per clip,
-the majority of its seeds: seeds share the clip's database and start, so they are not independent), Holm over
-the subjects of the claim; a subject is **significantly for** when its adjusted p is below ``alpha``, more of its
-clips favour the claim and its effect is at least the minimum effect (**against** the reverse).
-
-The verdict of a claim
-----------------------
-In this order (:func:`decide`):
-
-* ``not reproduced`` -- a generator did not run (the evidence says why), or on a skating claim a generator's feet
-  do not touch the floor (its median ``contact_share`` below ``compare.verdicts.min_contact_share``): a generator
-  that never touches cannot win (or lose) a skating comparison;
-* significant (Holm-adjusted p < ``alpha``, at least ``min_groups`` groups): ``reproduced`` when the mean effect
-  is at least the minimum effect, ``contradicted`` when it is at most minus it, ``not reproduced`` (no material
-  effect) when it lies between;
-* ``partly`` -- a significant split between subjects: some subjects significantly for and some significantly
-  against by the per-subject test;
-* ``not reproduced`` (no material effect) -- the 95 % interval lies inside (-minimum effect, +minimum effect);
-* ``within noise`` -- the groups vote both ways (some hold, some hold the opposite, by the minimum effect)
-  without a significant split; the evidence gives the share;
-* ``undecided`` -- anything else: too few groups or too wide an interval to decide; the text reads
-  "undecided (n subjects)" with the mean effect, its interval, p and the Holm-adjusted p.
-
-The capture claim ("the held-out capture skates less than every generator") holds only if it holds against each
-generator: one finding whose p is the largest of its parts' (an intersection-union test needs no correction among
-its parts), decided by the rules above with the effect and interval of its weakest part (the generator against
-which the mean effect is smallest). One significant part the other way refutes it: when some parts lean the other
-way by the minimum effect, the claim is tested for a contradiction instead, its p the smallest p of those parts
-times the number of parts (Bonferroni), with that part's effect and interval. Its parts show numbers (groups
-holding / opposite / neither, mean effect, interval, p), never a verdict word of their own. A generator whose
-feet do not touch is left out of it, named.
-
-Claims true by construction (re-sequencers copy database frames, so their novelty is 0; random concatenation
-is unblended, so a blended transition jumps less) are **sanity checks** (:func:`sanity_checks`): decided by the
-same rules with the metric's ``compare.verdicts.min_effect``, Holm among themselves, in their own table.
+The verdict
+-----------
+:func:`animsynth.verdicts.effect_verdict`, in this order: ``did not run`` (a generator of the claim has no value on
+any clip), ``reproduced``, ``contradicted``, ``no material difference`` (the 90 % interval inside plus or minus the
+margin), ``partly`` (a significant split), otherwise ``undecided (n subjects)``. The capture claim holds only if it
+holds against each generator: its p is the largest of its parts' (intersection-union), its effect the weakest part's;
+when some parts lean the other way by the margin it is tested for a contradiction instead (the smallest p of those
+parts times the number of parts, Bonferroni). It is equivalent only when every part's 90 % interval lies inside the
+margins.
 """
 
 from __future__ import annotations
@@ -89,14 +39,24 @@ import numpy as np
 import pandas as pd
 
 from .. import verdicts as V
-from .claim_stats import floating_reason, group_outcomes, metric_median, pair_outcomes, per_clip, spread, \
-    subject_tests, t_interval
+from .claim_stats import EXACT_MAX, Stats, generic_clips, metric_median, metric_wide, no_values, pair_from_wide, \
+    pair_outcomes, per_clip, spread, touching
+from .claims import EVERY, declared_claims, margin
 from .groups import GROUPINGS, clip_groups
 from .generators.names import REFERENCES
 from .measures.metric_table import EXPLORATORY_METRICS, SKATING_CLAIM_METRICS, metric_or_blank
 
-__all__ = ["sign_flip_p", "Stats", "decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks",
-           "DEFAULT_CLAIMS", "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
+__all__ = ["decide", "decide_claims", "build_verdicts", "exploratory_table", "sanity_checks", "skating_claim",
+           "STATS_COLUMNS", "EXPLORATORY_COLUMNS"]
+
+#: the columns of ``claims_stats.csv``
+STATS_COLUMNS = ("claim_id", "a", "b", "metric", "direction", "n_groups", "mean_effect", "ci_low", "ci_high",
+                 "ci90_low", "ci90_high", "p", "p_holm", "margin", "subjects_for_80_power", "verdict",
+                 "a_contact_share", "b_contact_share")
+#: the columns of ``exploratory.csv``
+EXPLORATORY_COLUMNS = ("label", "a", "b", "metric", "direction", "n_groups", "groups_holding", "groups_opposite",
+                       "mean_effect", "ci_low", "ci_high", "p", "p_holm", "margin")
+
 
 def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> str:
     """What the transition budget sweep (``compare/budget_sweep.csv``) says of ``a`` vs ``b`` on ``metric``
@@ -119,149 +79,6 @@ def _sweep_evidence(sweep: pd.DataFrame | None, a: str, b: str, metric: str) -> 
             f"{'; '.join(parts)}; {a} lower at {lower} of {len(parts)} budgets")
 
 
-#: ``b`` of the capture claim: every generator of the run but the references
-EVERY = "*"
-#: the largest number of groups whose 2^n sign flips are all enumerated
-EXACT_MAX = 16
-
-#: The declared primary claims of the comparison (``compare.claims`` of config/config.yaml repeats them; a test
-#: keeps the two equal): used when a caller gives none.
-DEFAULT_CLAIMS = (
-    {"id": "graph_vs_stisomap_skating", "claim": "the classic motion graph skates less than ST-Isomap re-sequencing",
-     "a": "motion_graph", "b": "stisomap", "metric": "skate_share", "direction": "lower", "min_effect": 0.02},
-    {"id": "graph_vs_fairmotion_transitions",
-     "claim": "our motion graph's transitions skate less than fairmotion 0.0.4's as released (at its native 60 fps)",
-     "a": "motion_graph", "b": "fairmotion", "metric": "transition_skate_share", "direction": "lower",
-     "min_effect": 0.02,
-     "note": "fairmotion as released: its walk blends from a held pose and turns an appended piece without its path "
-             "(animsynth.compare.generators.fairmotion_peer); both graphs keep the same transition budget"},
-    {"id": "graph_vs_fairmotion_fixed_transitions",
-     "claim": "our motion graph's transitions skate less than fairmotion's with upstream's walk fixes",
-     "a": "motion_graph", "b": "fairmotion_fixed", "metric": "transition_skate_share", "direction": "lower",
-     "min_effect": 0.02,
-     "note": "fairmotion with the fixes output_rate, blend_source, rigid_turn, cut_copy; both graphs keep the same "
-             "transition budget"},
-    {"id": "stisomap_vs_isomap_jumps",
-     "claim": "ST-Isomap re-sequencing jumps less than Isomap re-sequencing (95th percentile of the per-frame "
-              "velocity jump)",
-     "a": "stisomap", "b": "isomap", "metric": "velocity_jump_p95", "direction": "lower", "min_effect": 0.1,
-     "paper_value": "ST-Isomap re-sequences more smoothly than Isomap (the re-sequencing paper)"},
-    {"id": "delaunay_vs_knn_l2p",
-     "claim": "Delaunay field following stays closer to the held-out continuation than k-NN field following (L2P)",
-     "a": "delaunay", "b": "knn", "metric": "l2p", "direction": "lower", "min_effect": 0.25,
-     "paper_value": "Delaunay gives lower Error A/F than k-NN (Gauch & Peters Table II)"},
-    {"id": "mm_vs_graph_skating", "claim": "motion matching skates less than the motion graph",
-     "a": "motion_matching", "b": "motion_graph", "metric": "skate_share", "direction": "lower", "min_effect": 0.02,
-     "note": "motion matching with the reference's foot locking and leg IK, its query a steady gamepad from the "
-             "start; deterministic, so inside a clip only the motion graph's seeds vary"},
-    {"id": "mm_traj_vs_graph_skating",
-     "claim": "motion matching (queried with the held-out future trajectory) skates less than the motion graph",
-     "a": "motion_matching_traj", "b": "motion_graph", "metric": "skate_share", "direction": "lower",
-     "min_effect": 0.02,
-     "note": "motion matching with the reference's foot locking and leg IK, its query the held-out future trajectory "
-             "(information no other generator is given)"},
-    {"id": "genmm_vs_graph_coverage", "claim": "GenMM covers more of the database than the motion graph",
-     "a": "genmm", "b": "motion_graph", "metric": "coverage", "direction": "higher", "min_effect": 0.02,
-     "note": "coverage: the share of the database's windows that a generated window comes within "
-             "compare.metrics.coverage_threshold_m of"},
-    {"id": "capture_skates_least",
-     "claim": "the held-out capture skates less than every generator (the realism upper bound holds for this metric)",
-     "a": "replay", "b": EVERY, "metric": "skate_share", "direction": "lower", "min_effect": 0.02},
-)
-#: the columns of ``claims_stats.csv``
-STATS_COLUMNS = ("claim_id", "a", "b", "metric", "direction", "n_groups", "mean_effect", "ci_low", "ci_high", "p",
-                 "p_holm", "min_effect", "verdict", "a_contact_share", "b_contact_share")
-#: the columns of ``exploratory.csv``
-EXPLORATORY_COLUMNS = ("label", "a", "b", "metric", "direction", "n_groups", "groups_holding", "groups_opposite",
-                       "mean_effect", "ci_low", "ci_high", "p", "p_holm", "min_effect")
-_SIGNS: dict = {}
-
-
-def _signs(n: int) -> np.ndarray:
-    """Every one of the 2^n sign vectors of length ``n`` (rows, +1 / -1), cached."""
-    if n not in _SIGNS:
-        bits = (np.arange(2 ** n)[:, None] >> np.arange(n)) & 1
-        _SIGNS[n] = (1 - 2 * bits).astype(float)
-    return _SIGNS[n]
-
-
-def sign_flip_p(effects, *, seed: int = 0, draws: int = 100000, exact_max: int = EXACT_MAX) -> float:
-    """Two-sided sign-flip permutation test of the mean of independent effects against 0.
-
-    Parameters
-    ----------
-    effects : array (n,)
-        One effect per independent unit (NaN dropped).
-    seed : int
-        Seed of the random flips when ``n > exact_max``.
-    draws : int
-        Random flips when ``n > exact_max``.
-    exact_max : int
-        Up to this many units every one of the 2^n flips is enumerated (the exact test).
-
-    Returns
-    -------
-    float
-        The share of flips whose mean is at least as far from 0 as the observed mean (exact: the observed sign
-        vector and its negation count, so the smallest p is 2 / 2^n; random flips: (1 + hits) / (1 + draws));
-        1 when every effect is 0; NaN without a unit.
-    """
-    e = np.asarray(effects, float)
-    e = e[np.isfinite(e)]
-    n = e.size
-    if n == 0:
-        return float("nan")
-    obs = abs(float(e.mean()))
-    if obs == 0.0:
-        return 1.0
-    tol = 1e-9 * obs  # flips that reach the observed mean up to rounding count as reaching it
-    if n <= exact_max:
-        return float(np.mean(np.abs(_signs(n) @ e) / n >= obs - tol))
-    rng = np.random.default_rng(int(seed))
-    hits, left = 0, int(draws)
-    while left > 0:
-        k = min(left, 20000)
-        s = rng.integers(0, 2, size=(k, n)) * 2 - 1
-        hits += int(np.sum(np.abs(s @ e) / n >= obs - tol))
-        left -= k
-    return (1 + hits) / (1 + int(draws))
-
-
-class Stats:
-    """The subject-level statistics of one comparison ``a`` vs ``b`` on one metric.
-
-    Attributes
-    ----------
-    per : DataFrame, :func:`group_outcomes` (one row per group: clips, clip counts, ``effect``, ``vote``)
-    j : DataFrame, :func:`pair_outcomes` (clip x seed effects)
-    n, mean, lo, hi, p : the groups, their mean effect, its 95 % t interval, the sign-flip p
-    subjects : DataFrame per group: ``for``, ``against`` (clips each way, by the majority of their seeds), ``p`` (sign test),
-        ``p_holm`` (Holm over the groups), ``side`` (+1 significantly for, -1 against, 0 neither); None when built
-        with ``subjects=False`` (the exploratory table, which decides nothing)
-    """
-
-    def __init__(self, j: pd.DataFrame, groups: dict, min_effect: float, vc: dict, seed: int, subjects: bool = True):
-        self.j, self.min_effect = j, float(min_effect)
-        self.per = group_outcomes(j, groups, min_effect)
-        eff = self.per["effect"].to_numpy(float)
-        self.n = int(np.isfinite(eff).sum())
-        self.mean = float(np.nanmean(eff)) if self.n else float("nan")
-        self.lo, self.hi = t_interval(eff)
-        self.p = sign_flip_p(eff, seed=seed, draws=int(vc.get("permutations", 100000)))
-        self.subjects = subject_tests(j, groups, self.per, min_effect, float(vc["alpha"])) if subjects else None
-
-    @property
-    def holding(self) -> int:
-        return int((self.per["vote"] > 0).sum())
-
-    @property
-    def opposite(self) -> int:
-        return int((self.per["vote"] < 0).sum())
-
-    def numbers(self, unit: str = "") -> str:
-        """'mean effect 0.05 [95 % t interval 0.03, 0.07], p = 0.125' (the sign-flip p)."""
-        return (f"mean effect {V.fmt(self.mean)}{' ' + unit if unit else ''} [95 % t interval {V.fmt(self.lo)}, "
-                f"{V.fmt(self.hi)}], p = {V.fmt(self.p, 3)}")
 
 
 def _units(vc: dict, n: int | None = None) -> str:
@@ -269,112 +86,120 @@ def _units(vc: dict, n: int | None = None) -> str:
     return word + ("s" if n is None or n != 1 else "")
 
 
-def decide(st: Stats, p_holm: float, min_effect: float, vc: dict) -> tuple[str, str]:
-    """The verdict of a tested claim and its reason, by the rules of the module's docstring (in their order).
+def decide(st: Stats, p_holm: float, margin: float, vc: dict, ci90: tuple | None = None) -> tuple[str, str]:
+    """The verdict of a tested comparison and its reason: :func:`animsynth.verdicts.effect_verdict` on its
+    statistics.
 
     Parameters
     ----------
-    st : the claim's statistics (for the capture claim: its weakest part's)
+    st : the comparison's statistics (for the capture claim: its deciding part's)
     p_holm : its Holm-adjusted p
-    min_effect : its minimum effect (metric units)
-    vc : ``compare.verdicts`` (``alpha``, ``min_groups``)
+    margin : its margin (metric units)
+    vc : ``compare.verdicts`` (``alpha``, ``min_groups``, ``permutations``, ``grouping``)
+    ci90 : the 90 % interval that decides equivalence (default ``st``'s; the capture claim: the envelope of its
+        parts')
 
     Returns
     -------
     (verdict, reason): a word of :data:`animsynth.verdicts.VOCABULARY` and why, in words.
     """
-    alpha, me = float(vc["alpha"]), float(min_effect)
-    if st.n >= int(vc.get("min_groups", 2)) and np.isfinite(p_holm) and p_holm < alpha:
-        if st.mean >= me:
-            return "reproduced", "significant and the mean effect at least the minimum effect"
-        if st.mean <= -me:
-            return "contradicted", "significant, the mean effect at least the minimum effect the other way"
-        return "not reproduced", "significant but the mean effect below the minimum effect (no material effect)"
-    n_for, n_against = int((st.subjects["side"] > 0).sum()), int((st.subjects["side"] < 0).sum())
-    if n_for and n_against:
-        return "partly", (f"a significant split: {n_for} {_units(vc, n_for)} significantly for and {n_against} "
-                          "significantly against (per-subject sign tests over clips, Holm over the subjects)")
-    if np.isfinite(st.lo) and -me < st.lo and st.hi < me:
-        return "not reproduced", "the 95 % interval lies inside plus or minus the minimum effect (no material effect)"
-    if st.holding and st.opposite:
-        return "within noise", (f"not significant; the groups vote both ways: {st.holding} of {st.n} hold, "
-                                f"{st.opposite} of {st.n} the opposite (share holding {V.fmt(st.holding / st.n, 2)}), "
-                                "without a significant split")
-    floor = (2.0 / 2 ** st.n if st.n <= EXACT_MAX else 1.0 / (1 + int(vc.get("permutations", 100000)))) if st.n \
-        else float("nan")
-    return "undecided", (f"too few {_units(vc)} or too wide an interval to decide (with {st.n} the smallest "
-                         f"possible p is {V.fmt(floor, 3)})")
+    word, why = V.effect_verdict(n=st.n, mean=st.mean, p_holm=p_holm, ci90=ci90 or (st.lo90, st.hi90),
+                                 margin=float(margin), alpha=float(vc["alpha"]), min_units=int(vc.get("min_groups", 3)),
+                                 split=st.split, units=_units(vc))
+    n_for, n_against = st.split
+    if word == "partly":
+        why += " (per-subject sign tests over clips, Holm over the subjects)"
+    elif word == "no material difference" and n_for and n_against:  # the mean is equivalent, the subjects are not
+        why += (f"; but the {_units(vc)} split: {n_for} significantly for and {n_against} significantly against "
+                "(per-subject sign tests over clips, Holm over the subjects)")
+    if word == "undecided" and st.n:
+        floor = 2.0 / 2 ** st.n if st.n <= EXACT_MAX else 1.0 / (1 + int(vc.get("permutations", 100000)))
+        why += (f" (with {st.n} {_units(vc, st.n)} the smallest possible p is {V.fmt(floor, 3)}; 80 % power at the "
+                f"observed effect would need {st.power or 'an estimate from at least 2'} {_units(vc)})")
+    return word, why
 
 
 def skating_claim(spec: dict) -> bool:
-    """Whether a declared claim is a skating claim (its contact shares shown beside it; a generator whose feet do not
-    touch the floor cannot win it): its ``skating`` key when given, else its metric's record in the metric table
-    (:data:`animsynth.compare.measures.metric_table.SKATING_CLAIM_METRICS`)."""
+    """Whether a declared claim is a skating claim (its contact shares shown beside it; it compares only clips on
+    which both generators' feet touch the floor): its ``skating`` key when given, else its metric's record in the
+    metric table (:data:`animsynth.compare.measures.metric_table.SKATING_CLAIM_METRICS`)."""
     return spec["metric"] in SKATING_CLAIM_METRICS if spec.get("skating") is None else bool(spec["skating"])
+
+
+def _stats(metrics, groups, a, b, metric, better, margin, vc, seed, skating) -> tuple:
+    """(Stats or None, {generator: clips left out because its feet do not touch}, why there is no Stats)."""
+    j = pair_outcomes(metrics, a, b, metric, better)
+    dropped: dict = {}
+    if skating and len(j):
+        kept, dropped = touching(metrics, (a, b), float(vc.get("min_contact_share", 0.05)))
+        j = j[j["clip"].isin(kept)]
+        if not len(j):
+            return None, dropped, (f"no clip on which both {a}'s and {b}'s feet touch the floor (median contact_share "
+                                   f"over the clip's seeds at least compare.verdicts.min_contact_share "
+                                   f"{V.fmt(vc.get('min_contact_share', 0.05))})")
+    if not len(j):
+        return None, dropped, f"no clip x seed with a {metric} value for both {a} and {b}"
+    return Stats(j, groups, margin, vc, seed), dropped, ""
 
 
 class _Claim:
     """One declared claim: its statistics (or why it has none) and how to write its row once Holm has run."""
 
     def __init__(self, spec: dict, metrics: pd.DataFrame, groups: dict, vc: dict, data: str, left_out: dict,
-                 seed: int, sweep=None):
-        self.spec, self.data, self.vc = spec, data, vc
+                 seed: int, sweep=None, generic=frozenset()):
+        self.spec, self.data, self.vc, self.groups, self.seed = spec, data, vc, groups, seed
         self.a, self.b, self.metric = spec["a"], spec["b"], spec["metric"]
-        self.better = spec.get("direction", "lower")
-        self.me = float(spec["min_effect"])
+        if spec["margin"] is None or not spec["direction"]:
+            raise ValueError(f"claim {spec['id']!r}: metric {self.metric!r} needs a margin (min_effect) and a direction "
+                             "(animsynth.compare.claims.check_claims refuses such a claim at config time)")
+        self.better, self.me = spec["direction"], float(spec["margin"])
         self.skating = skating_claim(spec)
-        self.missing, self.blocked, self.st, self.parts, self.left = "", "", None, [], []
-        self.mode = "claim"
-        self.metrics, self.sweep = metrics, sweep
-        present = set(metrics["generator"])
-        gone = [g for g in (self.a, self.b) if g != EVERY and g not in present]
+        self.missing, self.empty, self.st, self.all_st = "", "", None, None
+        self.parts, self.left, self.dropped, self.mode = [], [], {}, "claim"
+        self.metrics, self.sweep, self.generic = metrics, sweep, set(generic)
+        self.main = metrics[~metrics["clip"].isin(self.generic)] if self.generic else metrics
+        gone = [w for w in (no_values(metrics, g, left_out, self.metric) for g in (self.a, self.b) if g != EVERY) if w]
         if gone:
-            self.missing = "; ".join(f"{g} did not run: {(left_out or {}).get(g, 'not in this run')}" for g in gone)
-            return
-        if self.b == EVERY:
-            self._every(metrics, groups, seed)
+            self.missing = "; ".join(gone)
+        elif self.b == EVERY:
+            self._every(left_out)
         else:
-            j = pair_outcomes(metrics, self.a, self.b, self.metric, self.better)
-            if not len(j):
-                self.missing = f"no clip x seed with a {self.metric} value for both {self.a} and {self.b}"
-                return
-            self.st = Stats(j, groups, self.me, vc, seed)
-            if self.skating:
-                self.blocked = "; ".join(w for w in (floating_reason(metrics, g, vc) for g in (self.a, self.b)) if w)
+            self.st, self.dropped[self.b], self.empty = self._stats(self.main, self.b)
+            self.all_st = self._stats(metrics, self.b)[0] if self.generic else None
 
-    def _every(self, metrics, groups, seed):
-        """The capture claim: one part per generator (its feet touching), the weakest part deciding."""
-        if self.skating and (w := floating_reason(metrics, self.a, self.vc)):
-            self.blocked = w
-        for g in dict.fromkeys(metrics["generator"]):
+    def _stats(self, metrics, b):
+        return _stats(metrics, self.groups, self.a, b, self.metric, self.better, self.me, self.vc, self.seed,
+                      self.skating)
+
+    def _every(self, left_out):
+        """The capture claim: one part per generator that ran (and, on skating, touches the floor somewhere)."""
+        for g in dict.fromkeys([*self.metrics["generator"], *(left_out or {})]):
             if g in REFERENCES or g == self.a:
                 continue
-            why = floating_reason(metrics, g, self.vc) if self.skating else ""
-            j = pair_outcomes(metrics, self.a, g, self.metric, self.better)
-            if why or not len(j):
-                self.left.append(f"{g} left out: {why or 'no value shared with ' + self.a}")
+            why = no_values(self.metrics, g, left_out, self.metric)
+            st, dropped, empty = (None, {}, "") if why else self._stats(self.main, g)
+            if st is None:
+                self.left.append(why or f"{g} left out: {empty}")
                 continue
-            self.parts.append((g, Stats(j, groups, self.me, self.vc, seed)))
+            self.parts.append((g, st))
+            self.dropped[g] = dropped
         if not self.parts:
-            self.missing = "no generator to compare with" + (f" ({'; '.join(self.left)})" if self.left else "")
+            self.empty = "no generator to compare with" + (f" ({'; '.join(self.left)})" if self.left else "")
             return
         # One significant opposite part refutes "less than every generator": when some parts lean the other way
-        # by the minimum effect, the claim is tested for a contradiction (union-intersection: the smallest p of
-        # those parts times the number of parts, Bonferroni); otherwise for the claim (intersection-union: the
-        # largest p), the weakest part (smallest mean effect) carrying the claim's effect.
-        opposite = [s for _g, s in self.parts if s.mean <= -self.me]
-        if opposite:
-            self.mode = "contradiction"
-            self.st = min(opposite, key=lambda s: (s.p, s.mean))
-        else:
-            self.mode = "claim"
-            self.st = min((s for _g, s in self.parts), key=lambda s: (s.mean, -s.p))
+        # by the margin, the claim is tested for a contradiction (union-intersection: the smallest p of those
+        # parts times the number of parts, Bonferroni); otherwise for the claim (intersection-union: the largest
+        # p), the weakest part (smallest mean effect) carrying the claim's effect.
+        opposite = [(g, s) for g, s in self.parts if s.mean <= -self.me]
+        self.mode = "contradiction" if opposite else "claim"
+        g, self.st = (min(opposite, key=lambda x: (x[1].p, x[1].mean)) if opposite else
+                      min(self.parts, key=lambda x: (x[1].mean, -x[1].p)))
+        self.all_st = self._stats(self.metrics, g)[0] if self.generic else None
 
     @property
     def p(self) -> float:
-        """The claim's p for Holm: NaN when it has no test or is blocked (a blocked claim is not a finding, so it
-        does not tighten the others' correction); the capture claim's by its mode (see :meth:`_every`)."""
-        if self.st is None or self.blocked:
+        """The claim's p for Holm: NaN when it has no test; the capture claim's by its mode (see :meth:`_every`)."""
+        if self.st is None:
             return float("nan")
         if self.parts:
             if self.mode == "contradiction":
@@ -383,24 +208,32 @@ class _Claim:
             return float(ps.max()) if np.all(np.isfinite(ps)) else float("nan")
         return self.st.p
 
-    def contact(self, g: str) -> float:
-        return metric_median(self.metrics, g, "contact_share")
+    def ci90(self) -> tuple[float, float]:
+        """The 90 % interval that decides equivalence: the claim's; the capture claim's parts' envelope."""
+        if self.parts:
+            return (min(s.lo90 for _g, s in self.parts), max(s.hi90 for _g, s in self.parts))
+        return self.st.lo90, self.st.hi90
 
     def verdict(self, p_holm: float) -> tuple[str, str]:
         if self.missing:
-            return "not reproduced", self.missing
-        if self.blocked:
-            return "not reproduced", self.blocked
-        return decide(self.st, p_holm, self.me, self.vc)
+            return V.word("did_not_run"), self.missing
+        if self.st is None:
+            return V.word("none"), self.empty
+        return decide(self.st, p_holm, self.me, self.vc, self.ci90())
+
+    def contact(self, g: str) -> float:
+        return metric_median(self.metrics, g, "contact_share")
 
     def stats_row(self, p_holm: float) -> dict:
         word, _why = self.verdict(p_holm)
         st = self.st
+        lo90, hi90 = self.ci90() if st is not None else (np.nan, np.nan)
         row = {"claim_id": self.spec["id"], "a": self.a, "b": "every generator" if self.b == EVERY else self.b,
                "metric": self.metric, "direction": self.better, "n_groups": st.n if st else 0,
                "mean_effect": st.mean if st else np.nan, "ci_low": st.lo if st else np.nan,
-               "ci_high": st.hi if st else np.nan, "p": self.p, "p_holm": p_holm, "min_effect": self.me,
-               "verdict": word, "a_contact_share": np.nan, "b_contact_share": np.nan}
+               "ci_high": st.hi if st else np.nan, "ci90_low": lo90, "ci90_high": hi90, "p": self.p, "p_holm": p_holm,
+               "margin": self.me, "subjects_for_80_power": st.power if st else "", "verdict": word,
+               "a_contact_share": np.nan, "b_contact_share": np.nan}
         if self.skating and not self.missing:
             row["a_contact_share"] = self.contact(self.a)
             bs = [self.contact(g) for g, _s in self.parts] if self.b == EVERY else [self.contact(self.b)]
@@ -416,6 +249,8 @@ class _Claim:
         text = (f"{head}: {which}mean {_units(vc, 1)}-level effect "
                 f"{V.fmt(st.mean)} {unit} (95 % t interval over {_units(vc)} {V.fmt(st.lo)} to {V.fmt(st.hi)}), "
                 f"sign-flip p = {V.fmt(self.p, 3)}, Holm p = {V.fmt(p_holm, 3)}")
+        if word == "undecided":
+            text += f", {_units(vc)} for 80 % power at this effect: {st.power or 'no estimate'}"
         if self.b == EVERY:
             med = {g: metric_median(self.metrics, g, self.metric) for g, _s in self.parts}
             text += f"; {self.metric} median {self.a} {spread(self.metrics, self.a, self.metric)}"
@@ -431,29 +266,56 @@ class _Claim:
                 f"{g} {V.fmt(self.contact(g))}" for g in gens)
         return text
 
+    def _guard_text(self) -> str:
+        """The clips a skating claim left out because a generator's feet do not touch (and the subjects gone)."""
+        if not self.skating:
+            return ""
+        floor = V.fmt(self.vc.get("min_contact_share", 0.05))
+        parts = [f"{len(cs)} clip{'s' if len(cs) != 1 else ''} of {g}" for d in self.dropped.values()
+                 for g, cs in d.items()]
+        clips = {c for d in self.dropped.values() for cs in d.values() for c in cs}
+        return (f"; skating compared only on clips where both generators' feet touch the floor (median contact_share "
+                f"over the clip's seeds at least compare.verdicts.min_contact_share {floor}): "
+                + (f"{len(clips)} clip{'s' if len(clips) != 1 else ''} left out ({', '.join(parts)}: "
+                   f"{', '.join(sorted(clips))})" if clips else "no clip left out"))
+
+    def _generic_text(self, unit: str) -> str:
+        """The sensitivity line: the claim's numbers with the generic-figure subjects included."""
+        if not self.generic:
+            return ""
+        n = self.metrics.loc[self.metrics["clip"].isin(self.generic), "clip"].nunique()
+        head = f"; sensitivity, with the {n} clips of subjects on a generic figure included (left out above)"
+        if self.all_st is None:
+            return head + ": no comparison"
+        s = self.all_st
+        return (f"{head}: {s.n} {_units(self.vc, s.n)}, {s.numbers(unit)} (not Holm-adjusted), 90 % t interval "
+                f"{V.fmt(s.lo90)} to {V.fmt(s.hi90)}")
+
     def row(self, p_holm: float, m: int) -> dict:
         spec, vc = self.spec, self.vc
         word, why = self.verdict(p_holm)
-        if self.missing:
-            return V.row(spec["claim"], "not reproduced", f"no pair to compare ({self.missing})",
-                         paper_value=spec.get("paper_value", ""), data=self.data, source="compare/metrics.csv")
+        lead = (f"tested: {self.a} {self.better} than "
+                f"{'every generator' if self.b == EVERY else self.b} on {self.metric}; ")
+        if self.st is None:
+            return V.row(spec["claim"], word, f"{lead}{word} because {why}", paper_value=spec.get("paper_value", ""),
+                         ours=f"{word} (0 {_units(vc)})" if word == "undecided" else word, data=self.data,
+                         source="compare/metrics.csv")
         st = self.st
         unit = metric_or_blank(self.metric).unit
         grouping = GROUPINGS[vc.get("grouping", "subject")]
-        lead = (f"tested: {self.a} {self.better} than "
-                f"{'every generator' if self.b == EVERY else self.b} on {self.metric}; ")
+        src = "the claim's min_effect" if spec.get("min_effect") is not None else "the metric's margin"
         text = f"{lead}{word} because {why}. "
         test = (f"exact sign-flip permutation test of the mean of the {_units(vc)}' effects (all 2^n flips up to "
                 f"n = {EXACT_MAX}, else {int(vc.get('permutations', 100000))} seeded random flips; two-sided), Holm "
-                f"over the {m} declared claims with a test; 95 % t interval over the {_units(vc)} (shown for the size of the "
-                f"effect; the verdict rests on the sign-flip p, so with skewed effects the two can disagree); minimum effect "
-                f"{V.fmt(self.me)} {unit}; independent {_units(vc)}: {grouping}")
+                f"over the {m} declared claims with a test; 95 % t interval over the {_units(vc)} (the size of the "
+                f"effect); equivalence: the 90 % t interval inside plus or minus the margin (two one-sided tests at "
+                f"5 %); margin {V.fmt(self.me)} {unit} ({src}); independent {_units(vc)}: {grouping}")
         if self.b == EVERY:
             parts = "; ".join(f"{g}: {s.holding}/{s.opposite}/{s.n - s.holding - s.opposite}, {s.numbers()}"
                               for g, s in self.parts)
             if self.mode == "contradiction":
                 text += (f"Tested for a contradiction: {sum(s.mean <= -self.me for _g, s in self.parts)} of the "
-                         f"{len(self.parts)} generators compared lean the other way by the minimum effect, and one "
+                         f"{len(self.parts)} generators compared lean the other way by the margin, and one "
                          f"significant such part refutes the claim (union-intersection test: the smallest p of those "
                          f"parts times the {len(self.parts)} parts, Bonferroni, p = {V.fmt(self.p, 3)}; one finding of "
                          f"the Holm correction: adjusted p = {V.fmt(p_holm, 3)}); {test}; per generator (groups "
@@ -464,6 +326,7 @@ class _Claim:
                          f"{V.fmt(self.p, 3)}, and it is one finding of the Holm correction: adjusted p = "
                          f"{V.fmt(p_holm, 3)}); {test}; per generator (groups holding / opposite / neither, mean "
                          f"effect, interval, p): {parts}")
+            text += f"; 90 % t intervals' envelope {V.fmt(self.ci90()[0])} to {V.fmt(self.ci90()[1])}"
             if self.left:
                 text += "; " + "; ".join(self.left)
         else:
@@ -474,10 +337,12 @@ class _Claim:
             subj = ", ".join(f"{g} {int(r['for'])}/{int(r['for'] + r['against'])} (Holm p {V.fmt(r.p_holm, 2)})"
                              for g, r in st.subjects.iterrows())
             text += (f"{st.n} independent {_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted p = "
-                     f"{V.fmt(p_holm, 3)}; {test}; holds in {st.holding}, opposite in {st.opposite}, neither in "
-                     f"{st.n - st.holding - st.opposite}; per group (clips holding / untied clips, median effect): "
-                     f"{groups}; per-subject sign tests (clips for / untied clips): {subj}; counted by clips "
-                     f"instead: {ch} of {ch + cf} untied clips")
+                     f"{V.fmt(p_holm, 3)}, 90 % t interval {V.fmt(st.lo90)} to {V.fmt(st.hi90)}, {_units(vc)} for "
+                     f"80 % power at this effect: {st.power or 'no estimate'}; {test}; holds in {st.holding}, "
+                     f"opposite in {st.opposite}, neither in {st.n - st.holding - st.opposite}; per group (clips "
+                     f"holding / untied clips, median effect): {groups}; per-subject sign tests (clips for / untied "
+                     f"clips): {subj}; counted by clips instead: {ch} of {ch + cf} untied clips")
+        text += self._guard_text() + self._generic_text(unit)
         if spec.get("note"):
             text += "; " + spec["note"]
         if self.sweep is not None and len(self.sweep) and self.a == "motion_graph":
@@ -490,7 +355,7 @@ class _Claim:
 
 
 def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
-                  clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None, claims=None,
+                  clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None, *, claims,
                   seed: int = 0) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The declared claims decided: the verdict table and ``claims_stats.csv`` (:data:`STATS_COLUMNS`).
 
@@ -498,19 +363,20 @@ def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
     ----------
     metrics : DataFrame, ``compare/metrics.csv``
     vc : the ``compare.verdicts`` block (``alpha``, ``min_groups``, ``grouping``, ``min_contact_share``,
-        ``permutations``)
+        ``permutations``, ``min_effect``)
     data : what the numbers ran on (e.g. "CMU: 19 held-out clips x 5 seeds")
     left_out : {generator: why it did not run}
-    clips : DataFrame, ``compare/clips.csv`` (for :func:`.groups.independent_groups`; ``None``: each subset one group)
+    clips : DataFrame, ``compare/clips.csv`` (the groups, :func:`.groups.independent_groups`, and the ``figure``
+        column; ``None``: each subset one group, every subject on its own skeleton)
     sweep : DataFrame or None, the budget sweep table (:func:`animsynth.compare.tables.sweep_table`): quoted as
         evidence in the claims against the peer (decided at the default budget)
-    claims : the declared claims (``compare.claims``; ``None``: :data:`DEFAULT_CLAIMS`); every one gets a row
-        (a claim on a generator that did not run: "not reproduced", saying why)
+    claims : the declared claims (``compare.claims`` of the config); every one gets a row
     seed : the seed of the random sign flips (more than :data:`EXACT_MAX` groups; ``compare.seed``)
     """
     groups = clip_groups(metrics, clips, vc)
-    specs = list(DEFAULT_CLAIMS if claims is None else claims)
-    cs = [_Claim(dict(s), metrics, groups, vc, data, left_out or {}, seed, sweep) for s in specs]
+    specs = declared_claims({"claims": claims, "verdicts": vc})
+    generic = generic_clips(clips)
+    cs = [_Claim(s, metrics, groups, vc, data, left_out or {}, seed, sweep, generic) for s in specs]
     ps = [c.p for c in cs]
     adj = V.holm(ps)
     m = int(np.sum(np.isfinite(ps)))
@@ -520,41 +386,54 @@ def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
 
 
 def build_verdicts(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
-                   clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None, claims=None,
+                   clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None, *, claims,
                    seed: int = 0) -> pd.DataFrame:
     """The findings of the comparison: the verdict table of :func:`decide_claims` (same parameters)."""
-    return decide_claims(metrics, vc, data, left_out, clips, sweep, claims, seed)[0]
+    return decide_claims(metrics, vc, data, left_out, clips, sweep, claims=claims, seed=seed)[0]
 
 
-def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | None = None, claims=None,
-                      order=None, seed: int = 0) -> pd.DataFrame:
+def _did_not_run(metrics: pd.DataFrame, gens, left_out: dict | None) -> dict:
+    """``{generator: why}`` of the generators of ``gens`` (and ``left_out``) with no value of any metric."""
+    out = {g: no_values(metrics, g, left_out) for g in dict.fromkeys([*gens, *(left_out or {})])}
+    return {g: w for g, w in out.items() if w}
+
+
+def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | None = None, *, claims, order=None,
+                      seed: int = 0, left_out: dict | None = None) -> pd.DataFrame:
     """Every pair of generators on the main metrics that no declared claim tests: numbers, no verdict.
 
     Parameters
     ----------
     metrics : DataFrame, ``compare/metrics.csv``
-    vc : ``compare.verdicts`` (``min_effect`` per metric: the groups' votes; ``permutations``)
-    clips : ``compare/clips.csv`` (the groups)
-    claims : the declared claims (``None``: :data:`DEFAULT_CLAIMS`): their pairs and metrics are left out (and their
-        metrics join :data:`EXPLORATORY_METRICS`)
+    vc : ``compare.verdicts`` (the margins' overrides ``min_effect``: the groups' votes; ``permutations``)
+    clips : ``compare/clips.csv`` (the groups; subjects on a generic figure left out)
+    claims : the declared claims (``compare.claims``): their pairs and metrics are left out (and their metrics join
+        :data:`EXPLORATORY_METRICS`)
     order : the generators' order (``a`` is the earlier of a pair; default the table's order)
     seed : the random flips' seed
+    left_out : {generator: why it did not run}
 
     Returns
     -------
     DataFrame with :data:`EXPLORATORY_COLUMNS`: ``label`` "exploratory", the pair (effect positive favours ``a``
-    in the metric's direction), the groups, the groups holding / opposite by the metric's minimum effect, the mean
-    effect with its 95 % t interval, the sign-flip p and a Holm p over this table alone. Never a verdict.
+    in the metric's direction), the groups, the groups holding / opposite by the metric's margin
+    (:func:`animsynth.compare.claims.margin`), the mean effect with its 95 % t interval, the sign-flip p and a Holm p
+    over this table alone; then one row labelled "did not run" per generator without any value (``a``). Never a
+    verdict.
     """
     groups = clip_groups(metrics, clips, vc)
-    specs = list(DEFAULT_CLAIMS if claims is None else claims)
+    main = metrics[~metrics["clip"].isin(generic_clips(clips))]
+    specs = declared_claims({"claims": claims, "verdicts": vc})
     present = list(dict.fromkeys(metrics["generator"]))
-    gens = [g for g in (order or present) if g in set(present)]
+    ran = [g for g in (order or present) if g in set(present)]
+    gone = _did_not_run(metrics, ran, left_out)
+    gens = [g for g in ran if g not in gone]
     declared = set()
+    floor = float(vc.get("min_contact_share", 0.05))
     for s in specs:
         bs = [g for g in gens if g not in REFERENCES and g != s["a"]] if s["b"] == EVERY else [s["b"]]
-        if s["b"] == EVERY and skating_claim(s):  # a floating generator is no part of the claim: exploratory
-            bs = [g for g in bs if not floating_reason(metrics, g, vc)]
+        if s["b"] == EVERY and skating_claim(s):  # a generator whose feet touch on no clip is no part of it
+            bs = [g for g in bs if touching(main, (s["a"], g), floor)[0]]
         declared |= {(frozenset((s["a"], b)), s["metric"]) for b in bs}
     mets = list(dict.fromkeys([*EXPLORATORY_METRICS, *(s["metric"] for s in specs)]))
     rows = []
@@ -562,85 +441,107 @@ def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | Non
         better = metric_or_blank(metric).better or next((s["direction"] for s in specs if s["metric"] == metric), "")
         if metric not in metrics or better not in ("lower", "higher"):
             continue
-        me = float(vc.get("min_effect", {}).get(metric, 0.0))
+        me = margin(metric, vc) or 0.0
+        wide = metric_wide(main, metric)
         for i, a in enumerate(gens):
             for b in gens[i + 1:]:
                 if (frozenset((a, b)), metric) in declared:
                     continue
-                j = pair_outcomes(metrics, a, b, metric, better)
+                j = pair_from_wide(wide, a, b, better)
                 if not len(j):
                     continue
                 st = Stats(j, groups, me, vc, seed, subjects=False)
                 rows.append({"label": "exploratory", "a": a, "b": b, "metric": metric, "direction": better,
                              "n_groups": st.n, "groups_holding": st.holding, "groups_opposite": st.opposite,
-                             "mean_effect": st.mean, "ci_low": st.lo, "ci_high": st.hi, "p": st.p, "min_effect": me})
-    out = pd.DataFrame(rows, columns=[c for c in EXPLORATORY_COLUMNS if c != "p_holm"])
+                             "mean_effect": st.mean, "ci_low": st.lo, "ci_high": st.hi, "p": st.p, "margin": me})
+    cols = [c for c in EXPLORATORY_COLUMNS if c != "p_holm"]
+    out = pd.DataFrame(rows, columns=cols)
     out.insert(out.columns.get_loc("p") + 1, "p_holm", V.holm(out["p"]) if len(out) else [])
+    if gone:
+        dnr = pd.DataFrame([{"label": "did not run", "a": g, "b": "", "metric": "", "direction": "", "n_groups": 0}
+                            for g in gone], columns=list(EXPLORATORY_COLUMNS))
+        out = pd.concat([out, dnr], ignore_index=True) if len(out) else dnr
     return out
 
 
-def _copy_claim(metrics, groups, vc, data, seed):
-    claim = "re-sequencers copy database frames (novelty ~ 0) while field followers synthesise new poses"
-    copiers = [g for g in ("isomap", "stisomap") if g in set(metrics["generator"])]
-    makers = [g for g in ("delaunay", "knn") if g in set(metrics["generator"])]
-    tol = float(vc["novelty_copy_m"])
+def _copy_test(metrics, groups, vc, seed, left_out):
+    """The copy claim's statistics: (Stats, ours, lead, margin, metric), or (None, why) when it cannot be tested."""
+    metric = "novelty_median_m"
+    why = {g: no_values(metrics, g, left_out, metric) for g in ("isomap", "stisomap", "delaunay", "knn")}
+    copiers = [g for g in ("isomap", "stisomap") if g in set(metrics["generator"]) and not why[g]]
+    makers = [g for g in ("delaunay", "knn") if g in set(metrics["generator"]) and not why[g]]
     if not copiers or not makers:
-        return None, V.row(claim, "not reproduced", "no pair to compare (a re-sequencer or a field follower did not "
-                           "run)", data=data, source="compare/metrics.csv")
+        side = "re-sequencer" if not copiers else "field follower"
+        reasons = "; ".join(w for w in why.values() if w) or "not in this run"
+        return None, ("did_not_run", f"no {side} ran ({reasons})")
+    tol = float(vc["novelty_copy_m"])
     wide = metrics[metrics["generator"].isin(copiers + makers)].pivot_table(
-        index=["clip", "seed"], columns="generator", values="novelty_median_m", aggfunc="first").dropna()
+        index=["clip", "seed"], columns="generator", values=metric, aggfunc="first").reindex(
+        columns=copiers + makers).dropna()
+    if not len(wide):
+        return None, ("none", "no clip x seed with a novelty value for every re-sequencer and field follower")
     # effect: how far the nearest field follower lies beyond the farthest re-sequencer (m)
     eff = wide[makers].min(axis=1) - wide[copiers].max(axis=1)
     ok = (wide[copiers].max(axis=1) <= tol) & (wide[makers].min(axis=1) > tol)
     j = pd.DataFrame({"clip": [c for c, _s in wide.index], "effect": np.where(ok, np.abs(eff), -np.abs(eff)),
                       "outcome": np.where(ok.to_numpy(), 1, -1)})
-    me = float(vc["min_effect"].get("novelty_median_m", 0.0))
-    ours = "; ".join(f"{g} novelty median {spread(metrics, g, 'novelty_median_m')} m" for g in copiers + makers)
+    me = margin(metric, vc) or 0.0
+    ours = "; ".join(f"{g} novelty median {spread(metrics, g, metric)} m" for g in copiers + makers)
     lead = f"every re-sequencer at most {V.fmt(tol)} m from the database and every field follower farther"
+    return Stats(j, groups, me, vc, seed), (ours, lead, me, metric)
+
+
+def _blend_test(metrics, groups, vc, seed, left_out):
+    """The motion graph's blended transitions against random concatenation's seams (velocity_jump_p95)."""
+    metric = "velocity_jump_p95"
+    gone = [w for w in (no_values(metrics, g, left_out, metric) for g in ("motion_graph", "concat")) if w]
+    if gone:
+        return None, ("did_not_run", "; ".join(gone))
+    j = pair_outcomes(metrics, "motion_graph", "concat", metric)
     if not len(j):
-        return None, V.row(claim, "not reproduced", "no pair to compare (no clip with every novelty value)", data=data,
-                           source="compare/metrics.csv")
-    return Stats(j, groups, me, vc, seed), (claim, ours, lead, me, "novelty_median_m")
+        return None, ("none", "no clip x seed with a value for both")
+    me = margin(metric, vc) or 0.0
+    ours = (f"{metric} (m/s) median motion_graph {spread(metrics, 'motion_graph', metric)} vs concat "
+            f"{spread(metrics, 'concat', metric)}")
+    return Stats(j, groups, me, vc, seed), (ours, "motion_graph lower than concat on velocity_jump_p95", me, metric)
+
+
+#: the sanity checks: (claim, which generators make it testable, its test)
+_SANITY = (
+    ("re-sequencers copy database frames (novelty ~ 0) while field followers synthesise new poses",
+     {"isomap", "stisomap", "delaunay", "knn"}, False, _copy_test),
+    ("the motion graph's blended transitions jump less than random concatenation's unblended seams (95th percentile "
+     "of the per-frame velocity jump)", {"motion_graph", "concat"}, True, _blend_test),
+)
 
 
 def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
                   clips: pd.DataFrame | None = None, seed: int = 0) -> pd.DataFrame:
-    """Claims true by construction, decided by the same rules (:func:`decide`; the metric's
-    ``compare.verdicts.min_effect``; Holm over the sanity checks alone): not findings."""
+    """Claims true by construction, decided by the same rule (:func:`decide`; the metric's margin,
+    :func:`animsynth.compare.claims.margin`; Holm over the sanity checks alone; subjects on a generic figure left
+    out): not findings. A check whose generators are not configured has no row; one whose generators did not run
+    is ``did not run``."""
     groups = clip_groups(metrics, clips, vc)
+    main = metrics[~metrics["clip"].isin(generic_clips(clips))]
     configured = set(metrics["generator"]) | set(left_out or {})
-    present = set(metrics["generator"])
-    tests = []  # (stats or None, (claim, ours, lead, min effect, metric) or a finished row)
-    if {"isomap", "stisomap", "delaunay", "knn"} & configured:
-        tests.append(_copy_claim(metrics, groups, vc, data, seed))
-    if {"motion_graph", "concat"} <= configured:
-        claim = ("the motion graph's blended transitions jump less than random concatenation's unblended seams "
-                 "(95th percentile of the per-frame velocity jump)")
-        gone = [g for g in ("motion_graph", "concat") if g not in present]
-        j = pd.DataFrame() if gone else pair_outcomes(metrics, "motion_graph", "concat", "velocity_jump_p95")
-        me = float(vc["min_effect"].get("velocity_jump_p95", 0.0))
-        if gone or not len(j):
-            why = "; ".join(f"{g}: {(left_out or {}).get(g, 'not in this run')}" for g in gone) or "no shared value"
-            tests.append((None, V.row(claim, "not reproduced", f"no pair to compare ({why})", data=data,
-                                      source="compare/metrics.csv")))
-        else:
-            ours = (f"velocity_jump_p95 (m/s) median motion_graph {spread(metrics, 'motion_graph', 'velocity_jump_p95')}"
-                    f" vs concat {spread(metrics, 'concat', 'velocity_jump_p95')}")
-            tests.append((Stats(j, groups, me, vc, seed),
-                          (claim, ours, "motion_graph lower than concat on velocity_jump_p95", me, "velocity_jump_p95")))
-    ps = [st.p if st is not None else np.nan for st, _x in tests]
+    tests = []
+    for claim, gens, need_all, test in _SANITY:
+        if (gens <= configured) if need_all else (gens & configured):
+            tests.append((claim, *test(main, groups, vc, seed, left_out)))
+    ps = [st.p if st is not None else np.nan for _c, st, _x in tests]
     adj = V.holm(ps)
     m = int(np.sum(np.isfinite(ps)))
     rows = []
-    for (st, x), pa in zip(tests, adj):
+    for (claim, st, x), pa in zip(tests, adj):
         if st is None:
-            rows.append(x)
+            w = V.word(x[0])
+            rows.append(V.row(claim, w, f"{w}: {x[1]}", data=data, source="compare/metrics.csv"))
             continue
-        claim, ours, lead, me, metric = x
+        ours, lead, me, metric = x
         word, why = decide(st, float(pa), me, vc)
         unit = metric_or_blank(metric).unit
         rows.append(V.row(claim, word, f"tested: {lead}; {word} because {why}. {st.n} independent "
                           f"{_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted over the {m} sanity checks p = "
-                          f"{V.fmt(pa, 3)}; holds in {st.holding}, opposite in {st.opposite} (minimum effect "
+                          f"{V.fmt(pa, 3)}; holds in {st.holding}, opposite in {st.opposite} (margin "
                           f"{V.fmt(me)} {unit})", ours=ours, data=data, source="compare/metrics.csv"))
     return V.table(rows)

@@ -3,7 +3,9 @@
 One function per claim returns its row, built with :func:`animsynth.verdicts.row` (which refuses a word outside
 the common vocabulary); :func:`build_verdicts` lists them and returns the common verdict table
 (:func:`animsynth.verdicts.table`). A claim checked per configuration is decided by
-:func:`animsynth.verdicts.share_verdict`, the trend by :func:`animsynth.verdicts.a_beats_b` (:func:`trend_verdict`).
+:func:`animsynth.verdicts.share_verdict`, the trend by :func:`animsynth.verdicts.a_beats_b` (:func:`trend_verdict`),
+the uniqueness claim by :func:`animsynth.verdicts.ladder`: each names an outcome and
+:func:`animsynth.verdicts.word` gives its word, the same in every family.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import spearmanr
 
-from ..verdicts import a_beats_b, fmt, row, share_verdict, table
+from ..verdicts import a_beats_b, fmt, ladder, row, share_verdict, table, word
 
 
 def _rank_trend(x, y, samples: dict | None, order: list[str], n_boot: int = 200, seed: int = 0):
@@ -39,14 +41,12 @@ def trend_verdict(rho: float, p: float, share: float, alpha: float = 0.05, stabl
     The correlation is one unit of :func:`animsynth.verdicts.a_beats_b` (for the claim when ``rho > 0``, against
     otherwise, none when ``rho`` is NaN), its test Spearman's ``p < alpha``; the rise must also be stable: rho > 0
     in at least ``stable_share`` of the bootstrap resamples (``share``; NaN: no resampling). ``reproduced`` when
-    it holds, ``contradicted`` for a significant fall, ``within noise`` for any other rise, else ``not
-    reproduced``.
+    it holds, ``contradicted`` for a significant fall, ``within noise`` for a significant rise that flips over the
+    resamples, ``undecided`` when Spearman's test decides nothing (or there is no correlation).
     """
     rises = bool(rho > 0)
-    outcome = a_beats_b(int(rises), int(rho <= 0), share=1.0, alpha=alpha, p=p,
-                        stable=bool(np.isnan(share) or share >= stable_share))
-    return {"holds": "reproduced", "opposite": "contradicted"}.get(
-        outcome, "within noise" if rises else "not reproduced")
+    return word(a_beats_b(int(rises), int(rho <= 0), share=1.0, alpha=alpha, p=p,
+                          stable=bool(np.isnan(share) or share >= stable_share)))
 
 
 def _data_text(t: pd.DataFrame, source: str) -> str:
@@ -151,7 +151,8 @@ def memory_claim(baseline: pd.DataFrame, data: str) -> dict:
     region, face = _region_and_face(baseline)
     smaller = face.memory_mb > region.memory_mb
     return row(
-        "Region graphs need less memory than the face graph (Zhang et al. 2004)", share_verdict(smaller),
+        "Region graphs need less memory than the face graph (Zhang et al. 2004)",
+        share_verdict(smaller, none="opposite"),
         "float32 storage of what synthesis needs; complete face graphs hold N^2 weights"
         + ("" if face.built.all() else " (graphs too large to build: memory computed from their size)") + ".",
         ours=f"{fmt(region.memory_mb)} MB vs {fmt(face.memory_mb.min())}-{fmt(face.memory_mb.max())} MB",
@@ -166,7 +167,7 @@ def path_finding_claim(baseline: pd.DataFrame, data: str) -> dict:
     return row(
         "Path finding on region graphs is faster than on the face graph",
         # the margin is tenfold: a face graph short of it still needs more work, so no case contradicts the claim
-        share_verdict(work_face > 10 * work_region, none="partly"),
+        share_verdict(work_face > 10 * work_region, none="split"),
         "Compared on graph size (deterministic); measured path times are in facegraph/baseline_timing.csv.",
         paper_value="face graph ~1.9 s per path",
         ours=f"Dijkstra work (E + N log N) {fmt(work_region)} vs {fmt(work_face.min())}-{fmt(work_face.max())}",
@@ -183,7 +184,7 @@ def accuracy_claim(baseline: pd.DataFrame, data: str) -> dict | None:
     better = built.landmark_diff_px > region.landmark_diff_px
     return row(
         "Region graphs reproduce database sequences more accurately than the face graph",
-        share_verdict(better, none="contradicted"),
+        share_verdict(better, none="opposite"),
         "Same queries (neutral to own peak); the face graph's shortest path on the database poses can follow "
         "the sample itself, so it is a strong baseline for re-synthesis.",
         ours=f"region graphs {fmt(region.landmark_diff_px)} px vs face graph {fmt(built.landmark_diff_px.min())}-"
@@ -196,7 +197,8 @@ def interpolation_claim(t: pd.DataFrame, data: str) -> dict:
     lm = t["landmark_diff_px"].astype(float)
     lin = t["linear_landmark_diff_px"].astype(float)
     return row(
-        "The graph adds over straight neutral-to-peak interpolation (landmark difference)", share_verdict(lm < lin),
+        "The graph adds over straight neutral-to-peak interpolation (landmark difference)",
+        share_verdict(lm < lin, none="opposite"),
         f"Graph counterpart below the linear baseline in {int((lm < lin).sum())}/{len(t)} configurations; "
         f"velocity angle {fmt(t.velocity_angle_diff_pct.median())} % vs {fmt(t.linear_velocity_angle_diff_pct.median())} %. "
         "The reference is the pre-processed sequence, whose eq.-1 fit (one timing for x and y) moves every landmark "
@@ -212,8 +214,8 @@ def uniqueness_claim(uniqueness: pd.DataFrame, data: str) -> dict:
     plain, noisy, full = u.iloc[0], u.iloc[2], u.iloc[3]
     return row(
         "Coherent (node and duration) noise makes repeated runs of one label sequence distinct",
-        "reproduced" if noisy.distinct == noisy.runs and noisy.distinct > plain.distinct else
-        ("partly" if noisy.distinct > plain.distinct else "not reproduced"),
+        ladder([(noisy.distinct == noisy.runs and noisy.distinct > plain.distinct, "holds"),
+                (noisy.distinct > plain.distinct, "split")], "short"),
         f"{plain.labels}, same peak nodes: {int(plain.distinct)}/{int(plain.runs)} distinct without noise, "
         f"{int(noisy.distinct)}/{int(noisy.runs)} with node + duration noise (mean pairwise distance "
         f"{fmt(noisy.distance_mean_px)} px); random peaks too: {int(full.distinct)}/{int(full.runs)}.",

@@ -1,14 +1,14 @@
 """Claims of the hybrid mesh animation paper checked against the meshdetail tables.
 
 Common verdict format (:mod:`animsynth.verdicts`; every row built with :func:`animsynth.verdicts.row`):
-``claim, paper_value, ours, data, verdict, evidence, source`` with ``verdict`` one of ``reproduced``,
-``partly``, ``not reproduced``, ``contradicted``, ``within noise``. Model comparisons are keyed on held-out
-frames of the blocked cross-validation and decided by the common "A beats B" rule
-(:func:`animsynth.verdicts.a_beats_b`, :func:`block_verdict`): the margin is the mean over blocks of
-the per-block difference, and it counts only when every block agrees and the
-margin exceeds the spread (SD) of the per-block differences; otherwise the
-verdict is ``within noise`` with the share of blocks that agree. Claims checked case by case (edits,
-sequences) are decided by :func:`animsynth.verdicts.share_verdict`.
+``claim, paper_value, ours, data, verdict, evidence, source`` with ``verdict`` a word of
+:data:`animsynth.verdicts.VOCABULARY`. Model comparisons are keyed on held-out frames of the blocked
+cross-validation and decided by the common "A beats B" rule (:func:`animsynth.verdicts.a_beats_b`,
+:func:`block_verdict`): the margin is the mean over blocks of the per-block difference, and it counts only when it
+exceeds the spread (SD) of the per-block differences; every block agreeing is ``reproduced`` (``contradicted`` the
+other way), some blocks ``partly``, a margin within its spread ``undecided`` (the blocks cannot decide). Claims
+checked case by case (edits, sequences) are decided by :func:`animsynth.verdicts.share_verdict`, the coarse-mesh
+ratio by :func:`animsynth.verdicts.ladder`; :func:`animsynth.verdicts.word` gives every word.
 """
 
 from __future__ import annotations
@@ -41,12 +41,12 @@ def block_verdict(margin: float, sd: float, share: float, blocks: int) -> str:
 
     Returns
     -------
-    ``reproduced`` (holds), ``contradicted`` (the opposite) or ``within noise``.
+    ``reproduced`` (holds on every block), ``contradicted`` (the opposite), ``partly`` (a significant margin that
+    not every block shares) or ``undecided`` (the margin within its spread, or no block).
     """
     wins = int(round(share * blocks)) if blocks else 0
     significant = bool(np.isfinite(margin) and margin != 0 and (np.isnan(sd) or abs(margin) > sd))
-    outcome = common.a_beats_b(wins, int(blocks) - wins, share=1.0, significant=significant)
-    return {"holds": "reproduced", "opposite": "contradicted"}.get(outcome, "within noise")
+    return common.word(common.a_beats_b(wins, int(blocks) - wins, share=1.0, significant=significant))
 
 
 SKIN_NOTE = {
@@ -87,13 +87,13 @@ def build_verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame
     compare("The paper's SGPLVM+GPDM detail model beats a linear detail model (ridge, penalty tuned by blocked CV)",
             "hybrid_mm", "ridge_cv_mm", "not compared in the paper")
     compare("The GPDM dynamics term helps (dynamics weight 1 vs 0)", "hybrid_mm", "hybrid_no_dynamics_mm",
-            "not reported separately", note="; 'within noise' means the term changes nothing measurable")
+            "not reported separately", note="; 'undecided' means the term changes nothing measurable here")
     a_tr, a_te = fig5a[fig5a.split == "train"], fig5a[fig5a.split == "test"]
     ok_tr = a_tr.detail_only_mm.mean() < a_tr.full_deformation_mm.mean()
     ok_te = a_te.detail_only_mm.mean() < a_te.full_deformation_mm.mean() if len(a_te) else ok_tr
     rows.append(common.row(
         "Learning only the fine detail is more accurate than learning the full deformation (Fig. 5a)",
-        common.share_verdict([ok_tr, ok_te], none="contradicted"),
+        common.share_verdict([ok_tr, ok_te], none="opposite"),
         f"training {f(a_tr.detail_only_mm.mean())} vs {f(a_tr.full_deformation_mm.mean())} mm; "
         f"held-out {f(a_te.detail_only_mm.mean())} vs {f(a_te.full_deformation_mm.mean())} mm",
         paper_value="plotted only (Fig. 5a)",
@@ -104,7 +104,7 @@ def build_verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame
         better = int(np.sum(ed.hybrid_mm < ed.lbs_mm))
         rows.append(common.row(
             "The learned detail transfers to edited motions (beats LBS against re-simulated truth)",
-            common.share_verdict(ed.hybrid_mm < ed.lbs_mm),
+            common.share_verdict(ed.hybrid_mm < ed.lbs_mm, none="opposite"),  # LBS at least as good on every edit
             "; ".join(f"{c.split(': ')[-1]}: {f(h)} ± {f(hs)} vs {f(lb)} mm (mean ± SD over folds)"
                       for c, h, hs, lb in zip(ed.case, ed.hybrid_mm, ed.hybrid_fold_sd_mm, ed.lbs_mm)),
             paper_value="shown qualitatively", ours=f"hybrid better on {better} of {len(ed)} edits", data=data,
@@ -116,7 +116,7 @@ def build_verdicts(fig5a: pd.DataFrame, fig5b: pd.DataFrame, fig5c: pd.DataFrame
         rows.append(common.row(
             "A coarse control mesh suffices: held-out error changes little from the full mesh down to "
             "the smallest level while the stored size shrinks (Fig. 5b)",
-            "reproduced" if ratio <= 1.5 else ("partly" if ratio <= 3 else "not reproduced"),
+            common.ladder([(ratio <= 1.5, "holds"), (ratio <= 3, "split")], "short", evidence=bool(np.isfinite(ratio))),
             f"held-out {f(hi.test_mm)} mm at {hi.level_pct:g}% vs {f(lo.test_mm)} mm at "
             f"{lo.level_pct:g}%; size {f(hi.size_pct_of_original)}% -> {f(lo.size_pct_of_original)}% of the original",
             paper_value="plotted only (Fig. 5b)", ours=f"x{f(ratio)} error at {lo.level_pct:g}% vs {hi.level_pct:g}%",
@@ -128,16 +128,17 @@ def holds_on(verdicts_by_seq: dict) -> tuple[str, str]:
     """(words, verdict) for one claim across sequences: ``verdicts_by_seq`` maps sequence -> verdict.
 
     The claim holds on a sequence when its verdict there is ``reproduced``. Holds on all:
-    ``reproduced``; on some: ``partly``; on none: ``contradicted`` / ``within noise`` when
-    every sequence says so, else ``not reproduced``.
+    ``reproduced``; on some: ``partly``; on none: the sequences' one word when they all say the same
+    (``contradicted``, ``within noise``, ``undecided``, ``did not run``), else ``not reproduced``; no sequence:
+    ``undecided``.
     """
     names = list(verdicts_by_seq)
     held = [n for n in names if verdicts_by_seq[n] == "reproduced"]
     n = len(names)
     kinds = set(verdicts_by_seq.values())
+    same = {"contradicted": "opposite", "within noise": "flips", "undecided": "none", "did not run": "did_not_run"}
     verdict = common.share_verdict([n in held for n in names],
-                                   none=kinds.pop() if len(kinds) == 1 and kinds <= {"contradicted", "within noise"}
-                                   else "not reproduced")
+                                   none=same.get(kinds.pop(), "short") if len(kinds) == 1 else "short")
     if verdict == "reproduced":
         words = "holds on both" if n == 2 else ("holds on its one sequence" if n == 1 else f"holds on all {n}")
     elif verdict == "partly":

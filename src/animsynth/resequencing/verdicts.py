@@ -23,8 +23,13 @@ verdict, evidence, source``; ``verdict`` a word of :data:`animsynth.verdicts.VOC
   rule for "A beats B over units" (:func:`animsynth.verdicts.a_beats_b`, the
   pairs the units, tied pairs dropped): a claim holds when the share is at
   least ``share`` and the sign test gives p < ``alpha``; the opposite when the
-  other arm's share is at least ``share`` with p < ``alpha``; otherwise
-  "within noise".
+  other arm's share is at least ``share`` with p < ``alpha``; a significant lead
+  short of the share is "partly"; otherwise "undecided".
+
+Every word comes from an outcome through :func:`animsynth.verdicts.word` (the
+ladders of the min-k claims through :func:`animsynth.verdicts.ladder`), so the
+same outcome reads the same in every family; a claim with nothing to compare
+is "undecided", never "not reproduced".
 """
 
 from __future__ import annotations
@@ -66,7 +71,7 @@ def explanation_verdicts(grid: pd.DataFrame, published: pd.DataFrame | None, fra
     claim0 = "the paper's Isomap-L2 min k (tens to about a hundred) is explained by"
     which = "which candidate explanation matches the paper's Table 2 (Isomap-L2 min k, with Lee staying small)"
     if published is None or published.empty:
-        return [_row(which, "", "", data, "not reproduced",
+        return [_row(which, "", "", data, V.word("none"),
                      "the published Table 2 file was not available, so no candidate can be checked",
                      source)]
     pub = published[(published["method"] == "isomap")]
@@ -109,8 +114,8 @@ def explanation_verdicts(grid: pd.DataFrame, published: pd.DataFrame | None, fra
             n_all += ok_l2 and ok_lee
             parts.append(f"{d} ({'global in' if g else 'global out'}): L2 {l2} vs paper {p} "
                          f"({'within' if ok_l2 else 'outside'} x{factor:g}), Lee {lee}")
-        verdict = ("reproduced" if datasets and n_all == len(datasets) else
-                   "partly" if n_l2 > 0 else "not reproduced")
+        verdict = V.ladder([(n_all == len(datasets), "holds"), (n_l2 > 0, "split")], "short",
+                           evidence=bool(datasets))
         ours = "; ".join(parts)
         scored.append((n_all, n_l2, label, verdict, ours))
         rows.append(_row(f"{claim0} {label}", paper_txt, ours, data, verdict,
@@ -142,11 +147,11 @@ def lee_vs_l2_verdict(table2: pd.DataFrame, factor: float = 3.16, data: str = ""
             rows.append((d, bool(g), mode, int(k["l2"]), int(k["lee"])))
     cont = [r for r in rows if r[2] == "continuous"]
     if not cont:
-        return _row(claim, paper_txt, "", data, "not reproduced", "no configuration has both metrics", source)
+        return _row(claim, paper_txt, "", data, V.word("none"), "no configuration has both metrics", source)
     far = sum(l2 >= factor * lee for *_, l2, lee in cont)
     worse = sum(lee > l2 for *_, l2, lee in cont)
-    verdict = ("reproduced" if far == len(cont) else "contradicted" if worse > len(cont) / 2
-               else "partly" if far > 0 else "not reproduced")
+    verdict = V.ladder([(far == len(cont), "holds"), (worse > len(cont) / 2, "opposite"), (far > 0, "split")],
+                       "short")
     ours = "; ".join(f"{d} {'global' if g else 'noglobal'} L2 {l2} / Lee {lee}" for d, g, _, l2, lee in cont)
     naive = [r for r in rows if r[2] == "matrix_naive"]
     nfar = sum(l2 >= factor * lee for *_, l2, lee in naive)
@@ -191,12 +196,10 @@ def st_smoother_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: floa
               f"(transitions per 100 frames played: Isomap {iso.loc[common, 'transitions_per_100_frames'].mean():.2f}, "
               f"ST-Isomap {st.loc[common, 'transitions_per_100_frames'].mean():.2f})")
     if not both:
-        return _row(claim, paper_value, counts, data, "not reproduced",
+        return _row(claim, paper_value, counts, data, V.word("none"),
                     "no pair where both methods re-sequence, so smoothness cannot be compared; " + counts, source)
     lo, hi, ties, p = paired_share(iso.loc[both, PRIMARY], st.loc[both, PRIMARY])
-    dec = _decide(lo, hi, p, share, alpha)
-    verdict = {"holds": "reproduced", "opposite": "contradicted", "lean": "partly", "lean_opposite": "not reproduced",
-               "noise": "within noise", "none": "within noise"}[dec]
+    verdict = V.word(_decide(lo, hi, p, share, alpha))
     others = []
     for c in SECONDARY:
         l2, h2, _, p2 = paired_share(iso.loc[both, c], st.loc[both, c])
@@ -233,7 +236,7 @@ def global_dof_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: float
     inn = per_path[per_path["global_dof"].astype(bool)].set_index(keys)
     common = out.index.intersection(inn.index)
     if len(common) == 0:
-        return _row(claim, paper_value, "", data, "not reproduced",
+        return _row(claim, paper_value, "", data, V.word("none"),
                     "not measured: needs both global-DOF flags for the same configurations", source)
     roots = sorted(set(per_path["root_playback"]))
     want = {"walk": "hurt", "run": "hurt", "dance": "help"}
@@ -265,14 +268,9 @@ def global_dof_verdict(per_path: pd.DataFrame, share: float = 0.75, alpha: float
     missing = [d for d in want if d not in datasets]
     if missing:  # resequencing_trials without them: that half of the claim is not measured
         parts.append(f"{', '.join(missing)}: not in this run (no trial in resequencing_trials), not measured")
-    if n and agree == n and not missing:
-        verdict = "reproduced"
-    elif agree > 0:
-        verdict = "partly"
-    elif against > 0:
-        verdict = "contradicted"
-    else:
-        verdict = "within noise"
+    # a dataset whose comparisons decide nothing (no clear effect) leaves the claim undecided there
+    verdict = V.ladder([(n and agree == n and not missing, "holds"), (agree > 0, "split"), (against > 0, "opposite")],
+                       "noise")
     ours = "; ".join(parts)
     ev = (f"{ours}. Smoothness measure: mean per-transition velocity discontinuity; root playback "
           f"{', '.join(roots)} in both arms; an effect needs >= {100 * share:.0f} % of the deciding pairs to agree "

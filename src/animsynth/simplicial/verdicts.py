@@ -8,7 +8,9 @@ An ordering (method a has the lower error than b) is judged over the ensemble
 of starts (:mod:`animsynth.simplicial.folds`): it is *stable* only when it
 holds in every member; it is ``reproduced`` (or ``contradicted``) only when
 stable, and otherwise ``within noise`` with the share of members that agree
-(:func:`animsynth.verdicts.agreement_verdict`).
+(:func:`animsynth.verdicts.agreement_verdict`). Every other ladder names its
+outcomes through :func:`animsynth.verdicts.ladder`; a claim with nothing to
+compare is ``undecided``.
 
 One function per claim returns its row (or ``None`` when the tables cannot test it); :func:`build_verdicts`
 lists them.
@@ -21,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..verdicts import agreement_verdict, row, share_verdict, table
+from ..verdicts import agreement_verdict, ladder, ladder_why, row, share_verdict, table, word
 from ..verdicts import fmt as _fmt
 from .stats import member_share, paired_comparison, stability
 
@@ -119,14 +121,10 @@ def subset_cells_claim(T: Tables, members: pd.DataFrame) -> dict | None:
     same_cells = (np.array([[lower[j, i] == bool(paper_lower.get(c)) for i, c in enumerate(cells)]
                             for j in range(n_mem)]).all(axis=1) if T.has_paper and n_mem else np.zeros(0, bool))
     target = paper_count if paper_count is not None else 5
-    if same_cells.size and same_cells.all():
-        v = "reproduced"
-    elif n_mem and (counts == target).all():
-        v = "partly"
-    elif n_mem and counts.min() <= target <= counts.max():
-        v = "within noise"
-    else:
-        v = "not reproduced"
+    # the paper's cells in every member; its count in every member on other cells; its count in some members only;
+    # never its count
+    v = ladder([(same_cells.size and same_cells.all(), "holds"), ((counts == target).all(), "split"),
+                (bool(n_mem) and counts.min() <= target <= counts.max(), "flips")], "short", evidence=bool(n_mem))
     per_cell = "; ".join(
         f"{LABEL[met]} {d}: {a} lower in {100 * lower[:, i].mean():.0f} %"
         + (f" (paper: {'yes' if paper_lower.get((met, d)) else 'no'})" if T.has_paper else "")
@@ -153,8 +151,7 @@ def magnitude_claim(T: Tables, magnitude_factor: float) -> dict | None:
     ours, pap = np.array(ours), np.array(pap)
     ratio = ours / pap
     within = np.mean((ratio <= magnitude_factor) & (ratio >= 1.0 / magnitude_factor)) if ratio.size else np.nan
-    v = ("reproduced" if within >= 0.75 else "partly" if within >= 0.25 else "not reproduced") if ratio.size else \
-        "not reproduced"
+    v = ladder([(within >= 0.75, "holds"), (within >= 0.25, "split")], "short", evidence=bool(ratio.size))
     return row("Our error magnitudes are in the paper's range", v,
                f"{100 * within:.0f} % of the {ratio.size} published cells are within a factor {magnitude_factor:g} "
                f"of ours (ours/paper median {_fmt(np.median(ratio))}, range {_fmt(ratio.min())}-{_fmt(ratio.max())}); "
@@ -168,18 +165,13 @@ def magnitude_claim(T: Tables, magnitude_factor: float) -> dict | None:
 def derivative_verdict(T: Tables, r: pd.Series) -> str:
     """Whether training-vector variant ``r`` (a row of the derivative summary) gives the paper's ordering on A
     and F in every member (``reproduced``), the opposite on both (``contradicted``), a stable ordering that
-    agrees on one metric only (``partly``), or flips (``within noise``)."""
+    agrees on one metric only (``partly``), or flips (``within noise``); ``undecided`` without the paper's
+    ordering or the shares."""
     sa, sf = float(r[f"{T.a}_lower_share_a"]), float(r[f"{T.a}_lower_share_f"])
-    if T.want_a_lower is None or not (np.isfinite(sa) and np.isfinite(sf)):
-        return "not reproduced"
+    known = T.want_a_lower is not None and bool(np.isfinite(sa) and np.isfinite(sf))
     ga, gf = (sa, sf) if T.want_a_lower else (1 - sa, 1 - sf)
-    if ga == 1 and gf == 1:
-        return "reproduced"
-    if ga == 0 and gf == 0:
-        return "contradicted"
-    if ga in (0.0, 1.0) and gf in (0.0, 1.0):
-        return "partly"
-    return "within noise"
+    return ladder([(ga == 1 and gf == 1, "holds"), (ga == 0 and gf == 0, "opposite"),
+                   (ga in (0.0, 1.0) and gf in (0.0, 1.0), "split")], "flips", evidence=known)
 
 
 def derivative_claim(T: Tables, r: pd.Series) -> dict:
@@ -206,14 +198,11 @@ def some_variant_claim(T: Tables, deriv: pd.DataFrame) -> dict | None:
     verdicts = [(r["derivative"], derivative_verdict(T, r)) for _, r in deriv.iterrows()]
     rep = [d for d, v in verdicts if v == "reproduced"]
     opp = [d for d, v in verdicts if v == "contradicted"]
-    if rep:
-        v, txt = "reproduced", f"{', '.join(rep)} reproduce(s) it stably"
-    elif opp:
-        v, txt = "contradicted", (f"no variant reproduces it; {', '.join(opp)} give(s) the opposite ordering "
-                                  "on A and F in every ensemble member")
-    else:
-        v, txt = "within noise", ("no variant gives a stable ordering on both metrics; the orderings flip "
-                                  "between nearby starts")
+    v, txt = ladder_why([
+        (rep, "holds", f"{', '.join(rep)} reproduce(s) it stably"),
+        (opp, "opposite", f"no variant reproduces it; {', '.join(opp)} give(s) the opposite ordering on A and F in "
+                          "every ensemble member")],
+        ("flips", "no variant gives a stable ordering on both metrics; the orderings flip between nearby starts"))
     return row("Some training-vector variant (half / forward / central) reproduces the paper's conclusion", v,
                "per-variant shares in the rows above; a variant counts only when its ordering holds in every member",
                paper_value=T.claim.replace("_", " "), ours=txt, data=T.data, source="simplicial/derivative.csv")
@@ -242,7 +231,7 @@ def nearby_starts_claim(T: Tables, d: str, r: pd.Series) -> dict:
     fa, fb = r[f"{a}_sep_final_rel"], r[f"{b}_sep_final_rel"]
     stable_paths = all(np.isfinite(x) and x < 1e-3 for x in (fa, fb))
     return row(f"Paths from nearby starts stay together (training vectors '{d}')",
-               "reproduced" if stable_paths else "not reproduced",
+               ladder([(stable_paths, "holds")], "short"),
                f"starts moved by the configured jitter; median log10 growth of the separation over the path "
                f"{_fmt(r[f'{a}_sep_growth_log10'])} ({a}), {_fmt(r[f'{b}_sep_growth_log10'])} ({b}); "
                "a final separation above 1e-3 of the diagonal means the paths are chaotic at the scale of the data",
@@ -253,8 +242,8 @@ def nearby_starts_claim(T: Tables, d: str, r: pd.Series) -> dict:
 def connected_claim(m: str, s: pd.DataFrame, data: str) -> dict:
     """G' (method ``m``) is strongly connected in every fold (``s``: its fold rows)."""
     one = int((s["components"] == 1).sum())
-    return row(f"G' ({m}) is strongly connected in every fold", "reproduced" if one == len(s) else "not reproduced",
-               f"{one}/{len(s)} folds with one strongly connected component (max {int(s['components'].max())}); "
+    return row(f"G' ({m}) is strongly connected in every fold", ladder([(one == len(s), "holds")], "short", evidence=len(s) > 0),
+               f"{one}/{len(s)} folds with one strongly connected component (max {int(s['components'].max()) if len(s) else 0}); "
                f"undirected connected in {int(s['undirected_connected'].sum())}/{len(s)}; "
                f"H connected in {int(s['h_connected'].sum())}/{len(s)}",
                ours=f"{one}/{len(s)} folds", data=data, source="simplicial/folds.csv")
@@ -361,7 +350,7 @@ def beyond_dimension_claim(beyond: pd.DataFrame, beyond_members, data: str) -> d
     if best_d != dims[0]:
         sh = member_share(beyond_members, name_best, f"delaunay_idw_d{dims[0]}", metric)
     return row("Beyond the paper: a higher latent dimension lowers pose-space Error A (Delaunay 1/D^2)",
-               agreement_verdict(sh) if best_d != dims[0] else "not reproduced",
+               agreement_verdict(sh) if best_d != dims[0] else word("short"),
                (f"d={int(best_d)} lower than d={dims[0]} in {100 * sh:.0f} % of the members ({stability(sh)}); "
                 if np.isfinite(sh) else "")
                + "the floor is the error of a perfect latent path (PCA reconstruction loss), so part of a gain from a "
