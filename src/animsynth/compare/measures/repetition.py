@@ -9,8 +9,8 @@ count). A window closer than ``repetition_tolerance_m`` to an earlier one repeat
 repeating window counts. A clip played three times in a row gives 2/3: its second and third playing repeat the
 first.
 
-The tolerance comes from the captures, not from any generator: over 66 CMU walk trials (every walk of
-/work/shared/data/cmu_mocap and of cmu_mocap_many, 10,319 frames at 30 fps) a capture's 1-s window never comes
+The tolerance comes from the captures, not from any generator: over 66 CMU walk trials (every ASF/AMC walk of the
+two CMU mirrors, 10,319 frames at 30 fps; ``benchmarks/capture_long_measures.py``) a capture's 1-s window never comes
 closer than 1.27 cm to an earlier window of the same capture (5th percentile over the trials of each one's
 closest pair 1.35 cm, median 2.1 cm): successive steps of a real walk are alike but not that alike. With 1 cm the
 captures' own repetition share is 0 on every one of the 66 trials, and a replayed loop (distance 0) counts in
