@@ -185,3 +185,21 @@ def test_the_long_track_records_declare_a_margin_and_why():
     with pytest.raises(ValueError, match="unknown track"):
         metric_table.on_track("medium")
 
+
+
+def test_run_values_are_the_generator_count_and_the_spread_over_seeds_on_either_track():
+    class Counted:
+        def run_notes(self):
+            return {"transitions_kept": 3}
+
+    f = np.zeros((10, 6))
+    g = f + np.array([0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
+    for track in ("short", "long"):
+        assert scoring.run_values(Counted(), [f, g], track) == {"transitions_kept": 3.0,
+                                                                 "seed_diversity_m": pytest.approx(0.3)}
+
+    class Silent:
+        def run_notes(self):
+            return {}
+
+    assert np.isnan(scoring.run_values(Silent(), [f])["transitions_kept"])

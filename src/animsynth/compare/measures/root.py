@@ -142,9 +142,8 @@ def score_freezing(s) -> dict:
 def _capture_ranges(s) -> tuple:
     """The (min, max) root height and root tilt over the clip's database and held-out trial (memoised per clip)."""
     def compute(_ref):
-        sk = s.clip.held_out.skeleton
         heights = [p[:, 0, UP] for p in (*s.ref.db_pos, s.ref.held_pos)]
-        tilts = [root_tilt_deg(sk, m.values) for m in (*s.clip.database, s.clip.held_out)]
+        tilts = [root_tilt_deg(m.skeleton, m.values) for m in (*s.clip.database, s.clip.held_out)]
         h, a = np.concatenate(heights), np.concatenate(tilts)
         return (float(h.min()), float(h.max())), (float(a.min()), float(a.max()))
 
