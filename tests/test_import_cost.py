@@ -29,3 +29,11 @@ def test_a_name_loads_its_module_on_first_use():
     # the lazy export really imports the module behind the name (and with it what that module needs)
     assert "sklearn" in _loaded_after("from animsynth.simplicial import run_fold")
     assert "sklearn" in _loaded_after("from animsynth.resequencing import STIsomap")
+
+
+def test_the_metric_table_imports_no_computation():
+    # the tables, verdicts and figures read the records for names, units and directions: no numpy, no measure
+    loaded = _loaded_after("import animsynth.compare.measures.metric_table, sys\n"
+                           "print(' '.join(m for m in ('numpy', 'scipy', 'animsynth.compare.measures.pose') "
+                           "if m in sys.modules))")
+    assert loaded == set()

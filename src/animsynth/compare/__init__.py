@@ -12,7 +12,8 @@ Layout
 ------
 generators/     the rows it runs (registry, names, motion graph, fairmotion peer and its fixes, motion matching and
                 foot locking, GenMM, the references, user generators)
-measures/       the metric table and each measure (positions, skating, jumps, smoothness, ground truth, windows)
+measures/       the metric table and each measure (pose, skating, jumps, transitions, smoothness, ground truth, windows;
+                the long track's repetition, root, over time)
 protocol        the protocol: held-out clips, their databases, starts and seeds; the clips file
 scoring         one generated motion's metrics against its clip (``score``), also for motion files from any tool
                 (``animsynth score``)

@@ -22,7 +22,7 @@ from ..skeleton import Skeleton
 from .generators.registry import make_generator
 from .measures.metric_table import KEY_COLUMNS, METRIC_NAMES
 from .protocol import Clip, clip_seeds
-from .scoring import DatabaseKinematics, joint_count, reference, run_stats_by_skeleton, score
+from .scoring import DatabaseKinematics, joint_count, reference, run_stats_by_skeleton, run_values, score
 
 __all__ = ["TIMING_COLUMNS", "cpu_seconds", "peak_rss_mb", "run_generator", "run_isolated", "failed_run",
            "generation_query", "native_inputs", "save_shown", "load_shown"]
@@ -208,7 +208,6 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
             gen_cpu += cpu_seconds() - c0 + float(getattr(gen, "child_cpu_s_", 0.0))
             gen_wall += time.perf_counter() - w0
             row, f = score(clip, ref, m, generator, mcfg, roles)
-            row["transitions_kept"] = float(gen.run_notes().get("transitions_kept", np.nan))
             feats.append(f)
             rows.append({**key, "seed": i, **row, "note": ""})
             if showcase is not None and (clip.clip, i) == tuple(showcase):
@@ -217,11 +216,9 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
                     seams = np.union1d(seams, [0])
                 shown = Motion(np.vstack([start.values, m.values]), m.skeleton, m.fps, f"{generator} {clip.clip}",
                                {"context": clip.context, "seams": seams + clip.context})
-        from .measures import seed_diversity
-
-        div = seed_diversity(feats)
+        per_run = run_values(gen, feats)  # the generator's own count, the spread over seeds: one value per clip
         for r in rows[-len(seeds):]:
-            r["seed_diversity_m"] = div
+            r.update(per_run)
         trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
                       "build_cpu_s": build_cpu, "build_wall_s": build_wall, "generate_cpu_s": gen_cpu,
                       "generate_wall_s": gen_wall, "frames_generated": clip.length * len(seeds),

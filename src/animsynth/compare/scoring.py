@@ -8,6 +8,12 @@ frames are the start (the frames the generator was given, as in the protocol: th
 reference's first ``context``), the frames after them are the generated ones, compared with the reference's
 frames after its start.
 
+:func:`score` loops over the records of the metric table (:mod:`.measures.metric_table`) computed on a track, grouped
+by what they need, and calls the computation each record names once per motion (one computation may fill several
+records); the intermediates they share (positions, world rotations, seams, pose features, the floor) are computed
+once per motion (:class:`~.measures.scored.ScoredMotion`). The records a run gives, not one motion (the generator's
+transitions, the spread over seeds), are computed once per clip and generator by :func:`run_values`.
+
 What a scored file cannot give is left empty, by what each metric needs (:attr:`~.metric_table.Metric.needs`):
 :data:`UNSCORED`, the generator's seams (and so every metric at seams), its transition count and the spread over
 seeds. The metrics that read the database (:data:`DATABASE_METRICS`: L2P's normalisation, coverage, novelty) and
@@ -20,20 +26,20 @@ run's database is this clip's, as in a run of one clip; the comparison normalise
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from ..motion import Motion
-from .measures.metric_table import (KEY_COLUMNS, METRIC_NAMES, PER_RUN, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, at_speed,
-                           names_needing)
+from .measures.metric_table import (KEY_COLUMNS, METRIC_NAMES, MOTION_NEEDS, PER_RUN, RUN_NEEDS, by_computation,
+                                    computation, names_needing, on_track)
 from .protocol import Clip
 
 log = logging.getLogger("animsynth.compare.scoring")
 
 __all__ = ["Reference", "DatabaseKinematics", "run_stats", "run_stats_by_skeleton", "joint_count", "reference",
-           "score", "SKATING_METRICS", "DATABASE_METRICS", "UNSCORED", "score_motions", "on_skeleton"]
+           "score", "run_values", "SKATING_METRICS", "DATABASE_METRICS", "UNSCORED", "score_motions", "on_skeleton"]
 
 #: foot skating: needs the floor (the database's foot heights, or compare.metrics.floor_m)
 SKATING_METRICS = names_needing("floor")
@@ -60,6 +66,8 @@ class Reference:
     features : list of ndarray, the database clips' pose features
     truth_pos, truth_q : the ground truth's positions (m) and global quaternions
     truth_forward : ndarray (2,), the ground truth's facing at the last start frame
+    db_pos : list of ndarray (T_i, J, 3), the database clips' positions (read-only: shared by the job's clips)
+    held_pos, held_facing : ndarray (T, J, 3) and (T, 2), the whole held-out clip's positions and facing
     """
 
     foot_idx: np.ndarray
@@ -71,11 +79,22 @@ class Reference:
     truth_q: np.ndarray
     truth_forward: np.ndarray
     capture_max: tuple = (np.nan, np.nan)
+    db_pos: list = field(default_factory=list)
+    held_pos: np.ndarray | None = None
+    held_facing: np.ndarray | None = None
+    _shared: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def shared(self, key: str, compute):
+        """``compute(self)``, computed once per clip for every motion scored against it (a measure's own reading
+        of the database or the held-out capture, such as the capture's still share)."""
+        if key not in self._shared:
+            self._shared[key] = compute(self)
+        return self._shared[key]
 
 
 class DatabaseKinematics:
-    """Positions (m, :func:`animsynth.compare.measures.positions.positions`) and facing
-    (:func:`~animsynth.compare.measures.positions.facing`) of each database motion, computed once per job for every clip and
+    """Positions (m, :func:`animsynth.compare.measures.pose.positions`) and facing
+    (:func:`~animsynth.compare.measures.pose.facing`) of each database motion, computed once per job for every clip and
     metric that reads them.
 
     A database clip is shared by several held-out clips (leave one out) and read by the run's L2P statistics and
@@ -176,72 +195,81 @@ def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray
     held_fwd = M.facing(clip.held_out, roles)
     return Reference(foot, floor, M.jump_reference(db_pos, fps), std,
                      [M.pose_features(p, f) for p, f in zip(db_pos, db_fwd)],
-                     held_pos[truth], truth_q, held_fwd[clip.context - 1], M.capture_max_jumps(held_pos, fps))
+                     held_pos[truth], truth_q, held_fwd[clip.context - 1], M.capture_max_jumps(held_pos, fps),
+                     db_pos=db_pos, held_pos=held_pos, held_facing=held_fwd)
 
 
-def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict,
-          roles: dict | None = None) -> tuple[dict, np.ndarray]:
-    """Every per-seed metric of one generated motion; returns the row and its pose features.
+def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict, roles: dict | None = None,
+          track: str = "short", needs=None) -> tuple[dict, np.ndarray]:
+    """Every metric of ``track`` that one generated motion gives; returns the row and its pose features.
 
-    The row has one value per record of :data:`~animsynth.compare.measures.metric_table.METRICS` but those a run gives
-    (``needs`` ``"generator"``, ``"seeds"``: the transitions kept and the diversity over seeds, which the runner
-    adds).
+    Parameters
+    ----------
+    clip : Clip, the held-out clip the motion continues
+    ref : Reference, the clip's database side (:func:`reference`)
+    motion : Motion, the generated frames (without the start)
+    generator : str, its name (the entry, generated frame 0, is a seam for every generator but ``replay``)
+    mcfg : the ``compare.metrics`` block
+    roles : joint-role overrides
+    track : ``"short"`` (the columns of ``metrics.csv``) or ``"long"``: the records computed on it
+        (:func:`~animsynth.compare.measures.metric_table.on_track`)
+    needs : the needs available (keys of :data:`~animsynth.compare.measures.metric_table.NEEDS`; ``None``: every
+        need of one motion, :data:`~animsynth.compare.measures.metric_table.MOTION_NEEDS`): a record whose need is
+        not among them is NaN, its computation not called
 
-    The start and the generated frames are scored together where a measure needs frames before the
-    first generated one (foot speed at the first frame, the jump at the entry seam); the entry
-    (generated frame 0) is a seam for every generator but ``replay``.
+    Returns
+    -------
+    row : dict, one value per record of the track but those a run gives (``needs`` ``"generator"``, ``"seeds"``:
+        :func:`run_values`)
+    features : ndarray (T, 3 J), the generated frames' pose features (the runner's spread over seeds reads them)
+
+    The records are computed grouped by what they need; a computation that fills several records is called once,
+    and the intermediates are computed once per motion (:class:`~.measures.scored.ScoredMotion`). The start and
+    the generated frames are scored together where a measure needs frames before the first generated one (foot
+    speed at the first frame, the jump at the entry seam).
     """
-    from . import measures as M
+    from .measures.scored import ScoredMotion
 
-    fps = float(motion.fps)
-    start = clip.start
-    joined = Motion(np.vstack([start.values, motion.values]), motion.skeleton, fps, motion.name)
-    c = clip.context
-    pos, q = M.positions_and_quaternions(joined.skeleton, joined.values, start=c)
-    gen_pos = pos[c:]
-    seams = np.asarray(motion.meta.get("seams", []), np.int64)
-    if generator != "replay":
-        seams = np.union1d(seams, [0])
-    row = {}
-    height, speed = float(mcfg["contact_height_m"]), float(mcfg["skate_speed_m_s"])
-    row.update(M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, speed, ref.floor))
-    gmd_feet = ref.foot_idx[[0, 2]]  # left_ankle, right_ankle: the balls of the feet
-    row["skating_ratio_gmd"] = M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, speed, ref.floor)
-    at = {"skate_share": lambda v: M.foot_skating(pos[c - 1:], fps, ref.foot_idx, height, v, ref.floor)["skate_share"],
-          "skating_ratio_gmd": lambda v: M.skating_ratio(pos[c - 1:], fps, gmd_feet, height, v, ref.floor)}
-    for v in SENSITIVITY_SPEEDS:
-        for k in SENSITIVITY_METRICS:
-            row[at_speed(k, v)] = at[k](v)
-    # skating near seams: frames within transition_window of a seam, pooled over seams
-    w = int(mcfg["transition_window"])
-    n_contact = n_skate = 0.0
-    for s in seams:
-        lo, hi = c + max(int(s) - w, 0), c + min(int(s) + w, motion.n_frames - 1)
-        part = M.foot_skating(pos[lo - 1:hi + 1], fps, ref.foot_idx, height, speed, ref.floor)
-        nc = part["contact_share"] * (hi - lo + 1) * len(ref.foot_idx)
-        n_contact += nc
-        n_skate += (part["skate_share"] * nc) if nc else 0.0
-    row["transition_skate_share"] = n_skate / n_contact if n_contact else np.nan
-    jumps = M.seam_jumps(pos, fps, seams + c, ref.jumps)
-    row.update(M.frame_jumps(pos, fps, c, ref.capture_max))
-    row["n_seams"] = int(seams.size)
-    row["seams_per_s"] = seams.size / (motion.n_frames / fps)
-    for k in ("velocity_jump", "velocity_jump_ratio", "velocity_jump_pct", "accel_jump", "accel_jump_ratio",
-              "accel_jump_pct"):
-        row[k] = jumps[k]
-    row["ldlj"] = M.ldlj(gen_pos, fps)
-    row["sparc"] = M.sparc(gen_pos, fps)
-    row["l2p"] = M.l2p(gen_pos, ref.truth_pos, ref.std, forward=ref.truth_forward)
-    row["l2p_m"] = M.l2p(gen_pos, ref.truth_pos, None)
-    row["l2q"] = M.l2q(q, ref.truth_q)
-    row["npss"] = M.npss(q, ref.truth_q, spectrum=mcfg["npss_spectrum"], quaternions=True)
-    feats = M.pose_features(gen_pos, M.facing(joined, roles)[c:])
-    win = M.window_scores(feats, ref.features, min(int(mcfg["window"]), motion.n_frames),
-                          float(mcfg["coverage_threshold_m"]))
-    row["coverage"] = win["coverage"]
-    row["local_diversity_m"] = win["local_diversity"]
-    row.update(M.novelty(feats, ref.features, float(mcfg["copy_tolerance_m"])))
-    return row, feats
+    s = ScoredMotion(clip, ref, motion, generator, mcfg, roles)
+    have = MOTION_NEEDS if needs is None else tuple(needs)
+    row: dict = {}
+    for need in MOTION_NEEDS:
+        records = [m for m in on_track(track) if m.needs == need]
+        row.update(_values(records, s) if need in have else dict.fromkeys((m.name for m in records), np.nan))
+    return row, s.features
+
+
+def run_values(generator, features, track: str = "short") -> dict:
+    """The values of the records a run gives, not one motion (``needs`` ``"generator"`` and ``"seeds"``): the same
+    for every seed's row of one clip and generator.
+
+    Parameters
+    ----------
+    generator : the fitted generator (its :meth:`~animsynth.generator.Generator.run_notes`)
+    features : list of ndarray, each seed's pose features (the second value :func:`score` returns), in seed order
+    track : the track whose records are computed
+
+    Returns
+    -------
+    dict, one value per record of ``track`` whose need is in
+    :data:`~animsynth.compare.measures.metric_table.RUN_NEEDS` (``transitions_kept``, ``seed_diversity_m``)
+    """
+    from .measures.scored import RunOutputs
+
+    return _values([m for m in on_track(track) if m.needs in RUN_NEEDS], RunOutputs(generator, list(features)))
+
+
+def _values(records, subject) -> dict:
+    """The values of ``records``: each computation they name called once with ``subject`` (a ScoredMotion or
+    RunOutputs), its value for every record that names it taken."""
+    out = {}
+    for path, names in by_computation(records).items():
+        got = computation(path)(subject)
+        missing = [n for n in names if n not in got]
+        if missing:
+            raise KeyError(f"the computation {path} gives no value for the metric(s) {missing} that name it")
+        out.update((n, got[n]) for n in names)
+    return out
 
 
 # ----------------------------------------------------------------------------- motion files
@@ -343,17 +371,17 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
         if not np.isclose(float(d.fps), fps):
             raise ValueError(f"database {name}: {float(d.fps):g} fps, the reference runs at {fps:g} fps")
         db.append(Motion(on_skeleton(d, sk, f"database {name}", reference_name).values, sk, fps, name))
-    blank = set(UNSCORED)
+    have = [n for n in MOTION_NEEDS if n not in PER_RUN]  # a file reports no seams
     note = ""
     if not db:
-        blank |= set(DATABASE_METRICS)
+        have.remove("database")
         if mcfg.get("floor_m") is None:
-            blank |= set(SKATING_METRICS)
+            have.remove("floor")
             note = "no database: foot skating (no floor height), L2P, coverage and novelty empty"
         else:
             note = "no database: L2P, coverage and novelty empty"
     roles = None
-    if SKATING_METRICS[0] in blank:  # no foot metric: the feet need no joint (the columns are left empty)
+    if "floor" not in have:  # no foot metric: the feet need no joint (the columns are left empty)
         from ..joints import FOOT_ROLES, JointRoleError, resolve_roles
 
         try:
@@ -378,8 +406,8 @@ def score_motions(generated: dict, reference_motion: Motion, database: dict | No
         clip = Clip(reference_name, "", "scored file", reference_name, ref, db or [ref], context, length)
         std = run_stats([clip], mcfg) if db else np.ones((len(sk.joints), 3))
         row, _f = score(clip, reference(clip, mcfg, roles, std),
-                        Motion(np.asarray(m.values[context:], float), sk, fps, name), name, mcfg, roles)
-        row.update({k: np.nan for k in blank})
+                        Motion(np.asarray(m.values[context:], float), sk, fps, name), name, mcfg, roles, needs=have)
+        row.update(dict.fromkeys(names_needing(*RUN_NEEDS), np.nan))
         rows.append({"clip": reference_name, "group": "", "protocol": "scored file", "generator": name, "seed": "",
                      **row, "note": note})
     return pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"])

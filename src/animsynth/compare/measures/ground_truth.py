@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .positions import HORIZONTAL, align_quaternions, rotate_to
+from .pose import HORIZONTAL, align_quaternions, rotate_to
 
-__all__ = ["position_stats", "l2p", "l2q", "npss"]
+__all__ = ["position_stats", "l2p", "l2q", "npss", "score_l2p", "score_l2p_m", "score_l2q", "score_npss"]
 
 _NAN = float("nan")
 
@@ -151,3 +151,28 @@ def npss(gen, gt, spectrum: str = "real", quaternions: bool = False) -> float:
     ct = np.cumsum(pt[:, keep] / tt[keep], axis=0)
     emd = np.sum(np.abs(cg[:, keep] - ct), axis=0)
     return float(np.average(emd, weights=tt[keep]))
+
+
+# ----------------------------------------------------------------------------- the records' computations
+# Each takes a :class:`~.scored.ScoredMotion` ``s`` and compares its generated frames with the held-out ground
+# truth of the same frames (``s.ref``: ``truth_pos``, ``truth_q``, ``truth_forward``, the run's ``std``).
+
+
+def score_l2p(s) -> dict:
+    """``l2p``: LAFAN1's L2P, normalised by the run's database statistics, errors in the truth's facing."""
+    return {"l2p": l2p(s.generated_pos, s.ref.truth_pos, s.ref.std, forward=s.ref.truth_forward)}
+
+
+def score_l2p_m(s) -> dict:
+    """``l2p_m``: L2P in metres (no normalisation)."""
+    return {"l2p_m": l2p(s.generated_pos, s.ref.truth_pos, None)}
+
+
+def score_l2q(s) -> dict:
+    """``l2q``: LAFAN1's L2Q on the world rotations."""
+    return {"l2q": l2q(s.quaternions, s.ref.truth_q)}
+
+
+def score_npss(s) -> dict:
+    """``npss`` of the world rotations (``compare.metrics.npss_spectrum``)."""
+    return {"npss": npss(s.quaternions, s.ref.truth_q, spectrum=s.mcfg["npss_spectrum"], quaternions=True)}

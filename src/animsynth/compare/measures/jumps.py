@@ -7,7 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["JumpReference", "jump_reference", "seam_jumps", "frame_jumps", "capture_max_jumps"]
+__all__ = ["JumpReference", "jump_reference", "seam_jumps", "frame_jumps", "capture_max_jumps", "score_frame_jumps",
+           "score_jumps_over_capture"]
 
 _NAN = float("nan")
 
@@ -152,3 +153,21 @@ def capture_max_jumps(pos, fps: float) -> tuple[float, float]:
     if jv.size == 0 or ja.size == 0:
         raise ValueError("the capture needs at least 4 frames for its largest jumps")
     return float(jv.max()), float(ja.max())
+
+
+# ----------------------------------------------------------------------------- the records' computations
+
+
+def _frame_jumps(s) -> dict:
+    """:func:`frame_jumps` of every generated frame of ``s`` (a :class:`~.scored.ScoredMotion`), once per motion."""
+    return s.shared("frame_jumps", lambda s: frame_jumps(s.pos, s.fps, s.context, s.ref.capture_max))
+
+
+def score_frame_jumps(s) -> dict:
+    """The 95th percentile and the largest velocity and acceleration jump of the generated frames of ``s``."""
+    return _frame_jumps(s)
+
+
+def score_jumps_over_capture(s) -> dict:
+    """The share of the generated frames of ``s`` jumping more than the held-out capture's largest jump."""
+    return _frame_jumps(s)

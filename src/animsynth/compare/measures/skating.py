@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .positions import HORIZONTAL, UP
+from .metric_table import SENSITIVITY_SPEEDS, at_speed
+from .pose import HORIZONTAL, UP
 
-__all__ = ["floor_height", "foot_skating", "skating_ratio"]
+__all__ = ["floor_height", "foot_skating", "skating_ratio", "score_foot_skating", "score_skating_ratio_gmd",
+           "score_skating_sensitivity", "score_transition_skating"]
 
 _NAN = float("nan")
 
@@ -52,7 +54,7 @@ def skating_ratio(pos, fps: float, foot_idx, height_m: float = 0.05, speed_m_s: 
     frame steps over **all** ``T - 1`` frame steps (not over contact steps as :func:`foot_skating`'s share, and
     not over joint-steps: one foot skating on every step gives 1, not 1/2).
 
-    Where ours still differs from GMD's (unavoidable; ``docs/compare.md``, "Foot skating"): the steps are at
+    Where ours still differs from GMD's (unavoidable; ``docs/compare/metrics.md``, "Foot skating"): the steps are at
     the motion's own rate (the compare family's working rate, 30 fps on CMU) where GMD's are at HumanML3D's
     20 fps, so a step's speed is over 1/30 s and the 5-step mean spans 1/6 s instead of 1/4 s (the thresholds
     are m/s, so they carry over); the floor is the caller's (the compare family: the database's, as for
@@ -136,3 +138,53 @@ def foot_skating(pos, fps: float, foot_idx, height_m: float, speed_m_s: float, f
         "skate_share": float(skate.sum()) / n if n else _NAN,
         "skate_m_per_contact_frame": float(step[skate].sum()) / n if n else _NAN,
     }
+
+
+# ----------------------------------------------------------------------------- the records' computations
+# Each takes a :class:`~.scored.ScoredMotion` ``s``: every generated frame is scored with the step into it from the
+# frame before (the start's last frame for the first), against the clip's floor (``s.ref.floor``).
+
+
+def _contact_speed(s) -> tuple[float, float]:
+    return s.setting("contact_height_m"), s.setting("skate_speed_m_s")
+
+
+def _gmd_feet(s) -> np.ndarray:
+    return s.ref.foot_idx[[0, 2]]  # left_ankle, right_ankle: the balls of the feet
+
+
+def score_foot_skating(s) -> dict:
+    """``contact_share``, ``skate_share``, ``skate_m_per_contact_frame`` (:func:`foot_skating`) of ``s``."""
+    height, speed = _contact_speed(s)
+    return foot_skating(s.pos[s.context - 1:], s.fps, s.ref.foot_idx, height, speed, s.ref.floor)
+
+
+def score_skating_ratio_gmd(s) -> dict:
+    """``skating_ratio_gmd`` (:func:`skating_ratio`, the balls of the feet) of ``s``."""
+    height, speed = _contact_speed(s)
+    return {"skating_ratio_gmd": skating_ratio(s.pos[s.context - 1:], s.fps, _gmd_feet(s), height, speed, s.ref.floor)}
+
+
+def score_skating_sensitivity(s) -> dict:
+    """The skate share and the GMD-style ratio of ``s`` at every speed threshold of
+    :data:`~.metric_table.SENSITIVITY_SPEEDS` (``<name>_at_<speed>``)."""
+    height, pos, out = s.setting("contact_height_m"), s.pos[s.context - 1:], {}
+    for v in SENSITIVITY_SPEEDS:
+        out[at_speed("skate_share", v)] = foot_skating(pos, s.fps, s.ref.foot_idx, height, v, s.ref.floor)["skate_share"]
+        out[at_speed("skating_ratio_gmd", v)] = skating_ratio(pos, s.fps, _gmd_feet(s), height, v, s.ref.floor)
+    return out
+
+
+def score_transition_skating(s) -> dict:
+    """``transition_skate_share``: the skate share of the frames within ``compare.metrics.transition_window`` of a
+    seam of ``s``, pooled over its seams (contact joint-frames near seams; NaN without any)."""
+    height, speed = _contact_speed(s)
+    w, c = int(s.mcfg["transition_window"]), s.context
+    n_contact = n_skate = 0.0
+    for seam in s.seams:
+        lo, hi = c + max(int(seam) - w, 0), c + min(int(seam) + w, s.n_frames - 1)
+        part = foot_skating(s.pos[lo - 1:hi + 1], s.fps, s.ref.foot_idx, height, speed, s.ref.floor)
+        nc = part["contact_share"] * (hi - lo + 1) * len(s.ref.foot_idx)
+        n_contact += nc
+        n_skate += (part["skate_share"] * nc) if nc else 0.0
+    return {"transition_skate_share": n_skate / n_contact if n_contact else _NAN}

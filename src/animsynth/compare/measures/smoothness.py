@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["speed_profile", "ldlj", "sparc"]
+__all__ = ["speed_profile", "ldlj", "sparc", "score_ldlj", "score_sparc"]
 
 _NAN = float("nan")
 
@@ -109,3 +109,13 @@ def sparc(x, fps: float, pad_level: int = 4, cutoff_hz: float = 10.0, amplitude_
         return _NAN
     f, m = freq[: last + 1], mag[: last + 1]
     return float(-np.sum(np.sqrt((np.diff(f) / (f[-1] - f[0])) ** 2 + np.diff(m) ** 2)))
+
+
+def score_ldlj(s) -> dict:
+    """``ldlj`` of the generated frames of ``s`` (a :class:`~.scored.ScoredMotion`)."""
+    return {"ldlj": ldlj(s.generated_pos, s.fps)}
+
+
+def score_sparc(s) -> dict:
+    """``sparc`` of the generated frames of ``s``."""
+    return {"sparc": sparc(s.generated_pos, s.fps)}

@@ -1,13 +1,14 @@
 """Against the database: nearest windows (coverage, local diversity), novelty and the diversity across seeds.
 
-Frame distance: these compare :func:`~animsynth.compare.measures.positions.pose_features` rows, scaled so that the Euclidean
+Frame distance: these compare :func:`~animsynth.compare.measures.pose.pose_features` rows, scaled so that the Euclidean
 distance of two rows is the root-mean-square distance of corresponding joints (metres) in the body frame."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["window_nearest", "window_scores", "coverage", "local_diversity", "seed_diversity", "novelty"]
+__all__ = ["window_nearest", "window_scores", "coverage", "local_diversity", "seed_diversity", "novelty", "score_windows",
+           "score_novelty", "run_seed_diversity"]
 
 _NAN = float("nan")
 
@@ -181,3 +182,25 @@ def novelty(gen, db, tolerance_m: float) -> dict:
         raise ValueError(f"generated features have {g.shape[1]} columns, the database's {d.shape[1]}")
     dist, _ = cKDTree(d).query(g, k=1)
     return {"novelty_median_m": float(np.median(dist)), "copy_share": float(np.mean(dist <= tolerance_m))}
+
+
+# ----------------------------------------------------------------------------- the records' computations
+
+
+def score_windows(s) -> dict:
+    """``coverage`` and ``local_diversity_m`` of the generated frames of ``s`` (a :class:`~.scored.ScoredMotion`)
+    against the clip's database: windows of ``compare.metrics.window`` frames (at most the motion's),
+    threshold ``coverage_threshold_m``."""
+    win = window_scores(s.features, s.ref.features, min(int(s.mcfg["window"]), s.n_frames),
+                        s.setting("coverage_threshold_m"))
+    return {"coverage": win["coverage"], "local_diversity_m": win["local_diversity"]}
+
+
+def score_novelty(s) -> dict:
+    """``novelty_median_m`` and ``copy_share`` of the generated frames of ``s`` (``compare.metrics.copy_tolerance_m``)."""
+    return novelty(s.features, s.ref.features, s.setting("copy_tolerance_m"))
+
+
+def run_seed_diversity(run) -> dict:
+    """``seed_diversity_m`` over every seed of one generator's run on a clip (a :class:`~.scored.RunOutputs`)."""
+    return {"seed_diversity_m": seed_diversity(run.features)}
