@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import signal
 import subprocess
 import sys
 import tomllib
@@ -157,12 +158,51 @@ def prescan(args: list[str]) -> int:
     files = configfiles(args)
     if not files:
         return 0
-    return subprocess.call([str(PY), str(Path(__file__).resolve()), "_check-configfiles", *files], cwd=ROOT)
+    return call([str(PY), str(Path(__file__).resolve()), "_check-configfiles", *files], "the config check", cwd=ROOT)
+
+
+#: The exit code of a command stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
+INTERRUPTED = 130
+
+
+def call(cmd: list[str], what: str = "", **kwargs) -> int:
+    """Run ``cmd`` and return its exit code; :data:`INTERRUPTED` (and one line) when Ctrl-C stopped it.
+
+    ``subprocess.call`` kills its child 0.25 s after a Ctrl-C, which leaves Snakemake's lock (every rerun is
+    then refused) and half-written outputs behind. Here a Ctrl-C (SIGINT, which the terminal sends to run.py
+    and Snakemake together, as one process group) only marks the run as interrupted: Snakemake cancels its
+    jobs, removes their incomplete outputs and its lock, and exits in its own time; run.py waits for it. A
+    SIGTERM sent to run.py alone (a scheduler stopping the run) is passed on to Snakemake, which then lets
+    its running jobs finish and stops. The same command afterwards resumes where the run stopped.
+
+    ``what``: how the one line names the command ("snakemake": it also says how to resume).
+    """
+    stopped, procs = [], []
+
+    def on_signal(signum, _frame):
+        stopped.append(signum)
+        if signum == signal.SIGTERM and procs and procs[0].poll() is None:
+            procs[0].send_signal(signal.SIGTERM)
+
+    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        procs.append(subprocess.Popen(cmd, **kwargs))
+        rc = procs[0].wait()
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+    if stopped or rc in (-signal.SIGINT, INTERRUPTED):
+        what = what or Path(cmd[0]).name
+        tail = (" after removing its lock and incomplete outputs; the same command resumes the run"
+                if what == "snakemake" else "")
+        print(f"[run.py] interrupted: {what} stopped{tail}", file=sys.stderr, flush=True)
+        return INTERRUPTED
+    return rc
 
 
 def sh(*args: str) -> int:
     print("[run.py] " + " ".join(args), flush=True)
-    return subprocess.call(list(args), cwd=ROOT)
+    return call(list(args), "snakemake" if Path(args[0]).name == "snakemake" else "", cwd=ROOT)
 
 
 # ----------------------------------------------------------------------------- the run's CPU breakdown
@@ -203,7 +243,7 @@ class RunCost:
         """Run ``snakemake ARGS`` (as :func:`sh` does) and record its CPU under ``label``."""
         print("[run.py] " + " ".join([str(BIN / "snakemake"), *args]), flush=True)
         env = dict(os.environ, ANIMSYNTH_RUN_COST=self.path, ANIMSYNTH_RUN_COST_LABEL=label)
-        return subprocess.call([str(PY), "-c", MEASURED_SNAKEMAKE, *args], cwd=ROOT, env=env)
+        return call([str(PY), "-c", MEASURED_SNAKEMAKE, *args], "snakemake", cwd=ROOT, env=env)
 
     def write(self, results_dir: str) -> None:
         """``results_dir``/run_cost.csv: where the CPU time of this run.py call went."""
@@ -289,9 +329,10 @@ def main(argv: list[str]) -> int:
             cost.write("results")
             print(DEMO_NOTE, flush=True)
         return rc
-    if argv[0] in ("paper", "bench", "snakemake") and prescan([*PAPER_CONFIG, *argv[1:]] if argv[0] == "paper"
-                                                             else argv[1:]):
-        return 2
+    if argv[0] in ("paper", "bench", "snakemake"):
+        rc = prescan([*PAPER_CONFIG, *argv[1:]] if argv[0] == "paper" else argv[1:])
+        if rc:  # 2: a config file refused (one line printed); 130: interrupted
+            return rc
     if argv[0] == "paper":
         # Extra arguments (e.g. --config cmu_mirror=DIR mesh_dir=DIR) go to both calls.
         cost = RunCost()
@@ -316,4 +357,9 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    try:
+        sys.exit(main(sys.argv[1:]))
+    except KeyboardInterrupt:  # Ctrl-C outside a Snakemake call (the venv set-up, the config prescan)
+        if sys.argv[1:2] != ["_check-configfiles"]:  # the prescan's parent says it
+            print("[run.py] interrupted", file=sys.stderr, flush=True)
+        sys.exit(INTERRUPTED)
