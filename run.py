@@ -128,6 +128,33 @@ def with_targets_first(args: list[str]) -> list[str]:
     return args
 
 
+def one_configfile_option(args: list[str]) -> list[str]:
+    """``args`` with every ``--configfile`` / ``--configfiles`` option joined into one, at the place of the first,
+    its files in the order given.
+
+    Snakemake keeps only the last ``--configfile`` option, so ``python3 run.py paper --configfile mine.yaml``
+    would otherwise run on ``mine.yaml`` alone, without config/cmu.yaml, samba.yaml and paper.yaml that run.py
+    passes first: a user's config over the paper run is meant (its trials mapping adds to cmu.yaml's).
+    """
+    names = ("--configfile", "--configfiles")
+    rest, files = split_option(args, names)
+    if not files:
+        return list(args)
+    first = next(i for i, a in enumerate(args) if a.partition("=")[0] in names)
+    before = split_option(args[:first], names)[0]
+    return [*before, "--configfile", *files, *rest[len(before):]]
+
+
+def snakemake_args(command: str, argv: list[str]) -> list[str]:
+    """The Snakemake arguments of ``python3 run.py COMMAND ARGV...`` (paper, bench, snakemake): targets first
+    (:func:`with_targets_first`), for ``paper`` the paper run's config files before the user's, and every config
+    file in one ``--configfile`` option (:func:`one_configfile_option`)."""
+    args = with_targets_first(argv)
+    if command == "paper":
+        args = sort_targets([*PAPER_CONFIG, *args])[0]
+    return one_configfile_option(args)
+
+
 def bench_args(argv: list[str]) -> tuple[list[str], list[str]]:
     """Split snakemake arguments into (the others, the KEY=VALUE pairs of a --config option)."""
     return split_option(argv, ("--config",))
@@ -318,8 +345,6 @@ def main(argv: list[str]) -> int:
         return 0
     ensure_venv()
     snakemake = str(BIN / "snakemake")
-    if argv and argv[0] in ("paper", "bench", "snakemake"):
-        argv = [argv[0], *with_targets_first(argv[1:])]
     if not argv:
         cost = RunCost()
         rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2))
@@ -330,28 +355,29 @@ def main(argv: list[str]) -> int:
             print(DEMO_NOTE, flush=True)
         return rc
     if argv[0] in ("paper", "bench", "snakemake"):
-        rc = prescan([*PAPER_CONFIG, *argv[1:]] if argv[0] == "paper" else argv[1:])
+        args = snakemake_args(argv[0], argv[1:])
+        rc = prescan(args)
         if rc:  # 2: a config file refused (one line printed); 130: interrupted
             return rc
     if argv[0] == "paper":
         # Extra arguments (e.g. --config cmu_mirror=DIR mesh_dir=DIR) go to both calls.
         cost = RunCost()
-        rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2), *PAPER_CONFIG, *argv[1:])
+        rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2), *args)
         if rc == 0:
-            rc = cost.snakemake("report", *PAPER_CONFIG, *argv[1:], "--report", "results/paper/report.html")
+            rc = cost.snakemake("report", *args, "--report", "results/paper/report.html")
         if rc == 0:
-            cost.write(results_dir_of(argv[1:], "results/paper"))
+            cost.write(results_dir_of(args, "results/paper"))
         return rc
     if argv[0] == "bench":
         # Extra arguments go to snakemake; KEY=VALUE pairs after --config join the bench run's own (snakemake
         # keeps only the last --config option).
-        args, extra = bench_args(argv[1:])
+        args, extra = bench_args(args)
         return sh(snakemake, "--cores", str(os.cpu_count() or 2), f"{BENCH_DIR}/benchmarks.csv", *args,
                   "--config", *extra, f"results_dir={BENCH_DIR}", "benchmark_size=full")
     if argv[0] == "test":
         return sh(str(PY), "-m", "pytest", *argv[1:])
     if argv[0] == "snakemake":
-        return sh(snakemake, *argv[1:])
+        return sh(snakemake, *args)
     print(__doc__)
     return 2
 

@@ -265,7 +265,11 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
 
 
 def _warn_shared_roles(skeleton, overrides: dict, where: str, setting: str) -> None:
-    """Log a warning for every joint that plays two roles or more (given or found by name)."""
+    """Log a warning for every joint that plays two roles or more (given or found by name).
+
+    One case is the documented setting, not a mistake, and is an info line: a toe role given to the joint that is
+    the same side's ankle when that joint ends its chain (a skeleton without toe joints, e.g. cgspeed's CMU BVH
+    files: the foot's End Site is the toe tip), so the foot's contacts are measured at the ankle joint."""
     from .joints import ROLES, JointRoleError, resolve_role
 
     played: dict[str, list[str]] = {}
@@ -275,10 +279,17 @@ def _warn_shared_roles(skeleton, overrides: dict, where: str, setting: str) -> N
         except JointRoleError:
             continue
     for joint, rs in played.items():
-        if len(rs) > 1:
-            given = [r for r in rs if r in (overrides or {})]
-            log.warning("%s: joint %r plays %d roles (%s%s); each role should be its own joint: check %s", where,
-                        joint, len(rs), ", ".join(rs), f"; given: {', '.join(given)}" if given else "", setting)
+        if len(rs) <= 1:
+            continue
+        given = [r for r in rs if r in (overrides or {})]
+        side = rs[0].split("_")[0]
+        if sorted(rs) == [f"{side}_ankle", f"{side}_toe"] and given == [f"{side}_toe"] and \
+                not skeleton.children(skeleton.names.index(joint)):
+            log.info("%s: joint %r is %s and, as given, %s (the skeleton has no toe joint below it)", where, joint,
+                     rs[0], rs[1])
+            continue
+        log.warning("%s: joint %r plays %d roles (%s%s); each role should be its own joint: check %s", where,
+                    joint, len(rs), ", ".join(rs), f"; given: {', '.join(given)}" if given else "", setting)
 
 
 def _fmt(a) -> str:

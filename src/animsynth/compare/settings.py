@@ -14,12 +14,14 @@ log = logging.getLogger("animsynth.compare")
 
 __all__ = ["check", "groups", "clip_ids", "subject_sets", "showcase", "run_generators", "clips_cfg", "native_rates",
            "job_cfg", "unavailable", "user_generators", "generator_order", "user_job_cfg", "left_out", "trial_rate",
-           "check_trial_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
+           "check_subject_sets", "check_trial_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
 def subject_sets(config: dict) -> dict:
-    """``{name: [trial ids]}`` of ``compare.subjects`` (the comparison's own per-subject sets), in config order."""
-    return {k: list(v) for k, v in (config["compare"].get("subjects") or {}).items()}
+    """``{name: [trial ids]}`` of ``compare.subjects`` (the comparison's own per-subject sets), in config order.
+
+    A later config drops one set with ``name: null`` and every set with ``subjects: null`` (configs merge)."""
+    return {k: list(v) for k, v in (config["compare"].get("subjects") or {}).items() if v is not None}
 
 
 def groups(config: dict, missing=()) -> tuple[dict, dict]:
@@ -216,16 +218,7 @@ def check(config: dict) -> None:
             parse_spec(spec)
         except ValueError as exc:
             raise ConfigError(f"config key 'compare.user_generators.{name}': {exc}") from None
-    known = {t["id"] for t in config["trials"]}
-    taken = set(config["subsets"]) | set(config["resequencing_trials"])
-    for name, ids in subject_sets(config).items():
-        if name in taken:
-            raise ConfigError(f"config key 'compare.subjects.{name}': {name!r} is the name of a subset or "
-                              "re-sequencing clip; give the set another name")
-        bad = [t for t in ids if t not in known]
-        if bad:
-            raise ConfigError(f"config key 'compare.subjects.{name}': unknown trial id(s) {bad} (every trial of "
-                              "the comparison is a record of 'trials', so it is fetched and parsed)")
+    check_subject_sets(config)
     subsets, reseq = groups(config)
     if not subsets and not reseq:
         raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': no clip to compare")
@@ -283,6 +276,38 @@ def check(config: dict) -> None:
     if cmp["metrics"]["window"] > cmp["min_length"]:
         raise ConfigError(f"config key 'compare.metrics.window': {cmp['metrics']['window']} frames exceed "
                           f"compare.min_length ({cmp['min_length']}): a short clip would have no window")
+
+
+def check_subject_sets(config: dict) -> None:
+    """Refuse a ``compare.subjects`` set that is not one subject's trials with records: a name taken by a subset or
+    re-sequencing clip, a trial without a record in ``trials``, or trials of two subjects (their records'
+    ``subject``) in one set, which would count two independent units as one.
+
+    Raises
+    ------
+    ConfigError
+        naming ``compare.subjects.<set>``
+    """
+    from ..config import ADD_TRIAL
+
+    records = {t["id"]: t for t in config["trials"]}
+    taken = set(config["subsets"]) | set(config["resequencing_trials"])
+    for name, ids in subject_sets(config).items():
+        key = f"config key 'compare.subjects.{name}'"
+        if name in taken:
+            raise ConfigError(f"{key}: {name!r} is the name of a subset or re-sequencing clip; give the set another "
+                              "name")
+        bad = [t for t in ids if t not in records]
+        if bad:
+            raise ConfigError(f"{key}: trial(s) {', '.join(map(repr, bad))} have no record in 'trials' (every trial "
+                              f"of the comparison is fetched and parsed); {ADD_TRIAL}")
+        subjects = {}
+        for t in ids:
+            subjects.setdefault(str(records[t]["subject"]), []).append(t)
+        if len(subjects) > 1:
+            parts = "; ".join(f"subject {s}: {', '.join(ts)}" for s, ts in subjects.items())
+            raise ConfigError(f"{key}: mixes trials of {len(subjects)} subjects ({parts}); a set is one subject "
+                              "(one independent unit of the verdicts): give each subject a set of its own")
 
 
 def _flow(values) -> str:
