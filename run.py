@@ -188,6 +188,9 @@ def prescan(args: list[str]) -> int:
     return call([str(PY), str(Path(__file__).resolve()), "_check-configfiles", *files], "the config check", cwd=ROOT)
 
 
+#: Snakemake's dry-run options.
+DRY_RUN = {"-n", "--dry-run", "--dryrun"}
+
 #: The exit code of a command stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
 INTERRUPTED = 130
 
@@ -360,13 +363,17 @@ def main(argv: list[str]) -> int:
         if rc:  # 2: a config file refused (one line printed); 130: interrupted
             return rc
     if argv[0] == "paper":
-        # Extra arguments (e.g. --config cmu_mirror=DIR mesh_dir=DIR) go to both calls.
+        # Extra arguments (e.g. --config cmu_mirror=DIR mesh_dir=DIR) go to both calls; a dry run (-n) or a run of
+        # named targets makes no report and no CPU breakdown (they describe the whole run).
         cost = RunCost()
         rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2), *args)
-        if rc == 0:
+        whole = not (DRY_RUN & set(args) or args[:1] and not args[0].startswith("-"))
+        if rc == 0 and whole:
             rc = cost.snakemake("report", *args, "--report", "results/paper/report.html")
-        if rc == 0:
+        if rc == 0 and whole:
             cost.write(results_dir_of(args, "results/paper"))
+        else:
+            os.unlink(cost.path)
         return rc
     if argv[0] == "bench":
         # Extra arguments go to snakemake; KEY=VALUE pairs after --config join the bench run's own (snakemake
