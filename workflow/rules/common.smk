@@ -12,6 +12,7 @@ from animsynth.config import (TRIAL_FILE_KEYS, check_config, derive_seed, normal
 from animsynth.families import FAMILIES, report_order
 from animsynth.meshdetail.settings import mesh_sequences
 from animsynth.sources import is_archive, is_url, mesh_source_name, missing_below, probe_source
+from animsynth.workflow_utils import config_errors_stop_the_run
 
 
 # Config checks beyond the schema, in one place: the shared ones, then the settings.check(config) of each family
@@ -20,11 +21,12 @@ from animsynth.sources import is_archive, is_url, mesh_source_name, missing_belo
 # this config are left out with a note (the default's trial ids are not a user's).
 import yaml as _yaml
 
-with open(Path(workflow.basedir) / "config" / "config.yaml") as _f:
-    normalise_resequencing_trials(config, (_yaml.safe_load(_f) or {}).get("resequencing_trials") or {})
-check_config(config)
-for _family in FAMILIES:
-    importlib.import_module(f"animsynth.{_family.name}.settings").check(config)
+with config_errors_stop_the_run():
+    with open(Path(workflow.basedir) / "config" / "config.yaml") as _f:
+        normalise_resequencing_trials(config, (_yaml.safe_load(_f) or {}).get("resequencing_trials") or {})
+    check_config(config)
+    for _family in FAMILIES:
+        importlib.import_module(f"animsynth.{_family.name}.settings").check(config)
 # On a user's data, every trial, subset or clip that a family's selection key leaves out is one line on stderr naming
 # the key (a family's settings.left_out(config); the demo's own selections, e.g. compare.subsets: [r1], would
 # otherwise leave a user's groups out silently).
