@@ -37,7 +37,7 @@ LAYERS = {
     3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "workflow_utils"],
     4: list(FAMILIES),
     5: [f.name for f in registry.FAMILIES if f.layer == 5],
-    6: ["report", "scale", "cli"],
+    6: ["report", "scale", "cli", "cli_inputs"],
 }
 TOP = {name: layer for layer, names in LAYERS.items() for name in names}
 
