@@ -32,7 +32,7 @@ PKG = "animsynth"
 FAMILIES = registry.paper_families()
 LAYERS = {
     0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton", "families"],
-    1: ["config", "tables", "motion", "kinematics", "axes", "retarget", "generator"],
+    1: ["config", "tables", "motion", "kinematics", "axes", "retarget", "generator", "pace"],
     2: ["io"],
     3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "workflow_utils"],
     4: list(FAMILIES),

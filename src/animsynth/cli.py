@@ -40,6 +40,7 @@ from .cli_inputs import (UsageError, _check_per_file_options, _existing_dir, _ex
                          _load, _load_any, _load_bvh, _out_with, _split_motion_args, fps_float, index_int,
                          positive_float, positive_int, seed_int)
 from .limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
+from .pace import pace, pace_warning
 
 MOTION_OUTPUTS = (".bvh", ".amc", ".gif")
 #: GIF frames of ``animsynth preview``: 20 s in real time at 30 GIF frames per second; a longer clip plays
@@ -127,21 +128,57 @@ def cmd_generate(a) -> None:
     n_start = train[a.start_trial].n_frames
     if a.start_frame >= n_start:
         raise UsageError("--start-frame", f"{a.start_frame} is outside {a.train[a.start_trial]} ({n_start} frames, 0-based)")
+    n_root = len(sk.joints[0].dofs)
+    first = train[a.start_trial].values[a.start_frame]  # a frame of the file, whatever --rate
+    train = _at_rate(train, a.rate, a.train)
     n_train = sum(m.n_frames for m in train)
     if a.k > n_train:
         raise UsageError("--k", f"{a.k} neighbours but the training files hold only {n_train} frames")
     if a.latent_dim > train[0].without_root().shape[1]:
         raise UsageError("--latent-dim", f"{a.latent_dim} exceeds the {train[0].without_root().shape[1]} joint angles")
-    start = train[a.start_trial].without_root()[a.start_frame] if a.start_pose is None else None
+    start = first[n_root:] if a.start_pose is None else None
     angles, info = generate_from_trials(
         [m.without_root() for m in train], method=a.method, k=a.k, latent_dim=a.latent_dim,
         steps=a.steps, start=start, seed=a.seed)
     values = np.zeros((angles.shape[0], sk.n_dof))
-    n_root = len(sk.joints[0].dofs)
     values[:, n_root:] = angles
-    values[:, :n_root] = train[a.start_trial].values[a.start_frame, :n_root]  # root held at the start pose
-    _write_motion(a.out, Motion(values, sk, train[0].fps if all(bvh) else a.fps, "generated"))
-    print(f"wrote {a.out}: {angles.shape[0]} frames ({info})")
+    values[:, :n_root] = first[:n_root]  # root held at the start pose
+    out = Motion(values, sk, train[0].fps, "generated")
+    moved = pace(out, train)
+    line = pace_warning(moved, _pace_helps(a, train[0].fps, float(train[0].meta.get("file_fps", train[0].fps))))
+    if line:
+        print(f"animsynth generate: warning: {line}", file=sys.stderr)
+    _write_motion(a.out, out)
+    print(f"wrote {a.out}: {angles.shape[0]} frames at {out.fps:g} fps ({info}; {moved.ratio:.2g} of the "
+          "capture's pace)")
+
+
+def _at_rate(clips: list, rate: float | None, names: list[str]) -> list:
+    """``clips`` at ``rate`` fps (``--rate``): every n-th frame, n = the files' rate / ``rate`` (a whole number);
+    unchanged without ``--rate``. ``meta["file_fps"]`` keeps the files' own rate."""
+    from .motion import Motion
+
+    fps = float(clips[0].fps)
+    if rate is None or abs(rate - fps) < 1e-9:
+        return [Motion(c.values, c.skeleton, c.fps, c.name, dict(c.meta, file_fps=fps)) for c in clips]
+    n = fps / rate
+    if abs(n - round(n)) > 1e-6 or round(n) < 1:
+        fits = [f"{fps / k:g}" for k in range(1, 9) if abs(fps / k - round(fps / k)) < 1e-9][:5]
+        raise UsageError("--rate", f"{rate:g} fps is not the rate of {names[0]} ({fps:g} fps) divided by a whole "
+                                   f"number; use one of {', '.join(fits)}")
+    return [Motion(c.values[::int(round(n))], c.skeleton, rate, c.name, dict(c.meta, file_fps=fps)) for c in clips]
+
+
+def _pace_helps(a, fps: float, file_fps: float) -> list[str]:
+    """What helps a field follower that stops or slows: a larger latent space, a lower rate, another method."""
+    helps = [f"--latent-dim {a.latent_dim + 1} or more (in a low-dimensional latent space the interpolated "
+             "vectors often cancel)"]
+    if fps > 30 and abs(file_fps / 30 - round(file_fps / 30)) < 1e-9:
+        helps.append(f"--rate 30 (every {round(file_fps / 30)}th frame of the {file_fps:g} fps files: each step "
+                     "then covers more motion; Gauch & Peters fitted every 120 fps frame, docs/cli.md)")
+    helps.append(f"--method {'knn' if a.method == 'delaunay' else 'delaunay'}, or a method that plays captured "
+                 "frames (animsynth resequence; the comparison's motion graph and motion matching)")
+    return helps
 
 
 def cmd_resequence(a) -> None:
@@ -296,6 +333,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--start-pose", default=None, help=argparse.SUPPRESS)
     s.add_argument("--seed", type=seed_int, default=0)
     s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
+    s.add_argument("--rate", type=fps_float, default=None,
+                   help="fit and generate at this rate: every n-th frame of the files, n = their rate / RATE (a "
+                        "whole number; default: every frame, as Gauch & Peters fitted CMU's 120 fps frames)")
     s.add_argument("--out", default=None, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_generate)
 
