@@ -124,3 +124,30 @@ def test_cli_names_the_up_axis_option(tmp_path, capsys, caplog):
                      "--out", str(tmp_path / "r.bvh")]) == 0
     w = [r.getMessage() for r in caplog.records if "given up axis" in r.getMessage()]
     assert w and "--up-axis" in w[0] and "z_up.bvh" in w[0]
+
+
+#: a two-legged bird whose joint names the role map does not know: two leg-like chains are too few to tell its up
+#: axis (the file's own axes are kept), yet a given up axis along which no leg stands is wrong
+BIRD = [("Body", None, (0.0, 0.6, 0.0), (0.0, 0.05, 0.3)),
+        ("NeckB", "Body", (0.0, 0.05, 0.3), (0.0, 0.25, 0.1)), ("Beak", "NeckB", (0.0, 0.25, 0.1), (0.0, 0.0, 0.12)),
+        ("TailB", "Body", (0.0, 0.0, -0.1), (0.0, 0.05, -0.3))]
+for _side, _x in (("A", 0.12), ("B", -0.12)):
+    BIRD += [(f"Thigh{_side}", "Body", (_x, -0.05, 0.05), (0.0, -0.3, 0.05)),
+             (f"Shank{_side}", f"Thigh{_side}", (0.0, -0.3, 0.05), (0.0, -0.25, -0.03)),
+             (f"Wing{_side}", "Body", (_x, 0.05, 0.1), (_x * 2, 0.0, -0.1))]
+
+
+@pytest.mark.parametrize("given, says", [("+x", "0 leg-like chains end on the floor along +x, 2 along +y"),
+                                         ("-y", "1 leg-like chains end on the floor along -y, 2 along +y"),  # the neck points up
+                                         ("+y", None)])
+def test_a_wrong_given_up_axis_on_an_animal_whose_axis_is_ambiguous_is_warned(tmp_path, caplog, given, says):
+    from bvh_classes import creature
+
+    path = tmp_path / "bird.bvh"
+    write_bvh(path, creature(BIRD, swing=6.0))
+    raw = read_bvh(path)
+    axis, info = detect_up_axis(raw.skeleton, raw.values)
+    assert axis == "+y" and not info["biped"] and info["ambiguous"] and info["leg_counts"]["+y"] == 2
+    _m, _msgs, warns = _load(path, caplog, up_axis=given)
+    w = [s for s in warns if "with the given up axis" in s]
+    assert (w == []) if says is None else (len(w) == 1 and says in w[0] and str(path) in w[0]), warns

@@ -143,6 +143,7 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     info : dict
         ``extent`` (3,) median extents; ``ratio`` (second largest / largest
         extent); ``biped`` (bool); ``legs`` (leg-like chains along ``axis``);
+        ``leg_counts`` (``{signed axis: leg-like chains along it}``);
         ``sign_from`` (``"roles"``: head above feet; ``"legs"``; ``"file"``:
         kept, as nothing told); ``ambiguous`` (bool); ``why`` (str: what was
         found, for the log).
@@ -153,12 +154,14 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     ext = np.median(pos.max(axis=1) - pos.min(axis=1), axis=0)
     tall = int(np.argmax(ext))
     ratio = float(np.sort(ext)[-2] / max(ext[tall], 1e-300))
-    info = {"extent": ext, "ratio": ratio, "biped": False, "legs": 0, "ambiguous": False, "why": ""}
+    info = {"extent": ext, "ratio": ratio, "biped": False, "legs": 0, "ambiguous": False, "why": "",
+            "leg_counts": {}}
     head = role_indices(skeleton, ("head",), overrides)
     feet = (role_indices(skeleton, ("left_ankle", "right_ankle"), overrides)
             or role_indices(skeleton, ("left_toe", "right_toe"), overrides))
     chains = {ax: leg_chains(skeleton, starts, ends, ax) for ax in AXES}
     counts = {ax: len(c) for ax, c in chains.items()}
+    info["leg_counts"] = counts
     # four or more legs where the feet (by role) stand: a four-legged animal on a biped template's names
     most = max((n for ax, n in counts.items()
                 if feet is None or any(f in c for c in chains[ax] for f in feet)), default=0)
@@ -205,7 +208,10 @@ def lying_down(skeleton: Skeleton, values, up, overrides: dict | None = None) ->
     For a biped by joint role (head, ankles or toes): its head not above its
     feet (median over frames), or its extent along ``up`` less than half its
     largest extent across. For any body: :func:`detect_up_axis` finding
-    another axis without ambiguity.
+    another axis without ambiguity. For a body that is not a biped, also when
+    that detection is ambiguous: more leg-like chains (two at least) ending on
+    the floor along another axis than along ``up`` (a bird, an animal whose
+    legs do not all touch the floor).
     """
     u = axis_vector(up)
     detected, info = detect_up_axis(skeleton, values, overrides)
@@ -224,6 +230,12 @@ def lying_down(skeleton: Skeleton, values, up, overrides: dict | None = None) ->
             why.append(f"it is {ext[k]:.3g} units tall along {up} but {across:.3g} across")
     if detected != parse_axis(up) and not info["ambiguous"] and not why:
         why.append(f"its {'head is above its feet' if info['biped'] else 'legs stand'} along {detected}")
+    counts = info["leg_counts"]
+    best = max(AXES, key=lambda ax: (counts.get(ax, 0), ax == parse_axis(up)))
+    if not info["biped"] and not why and counts.get(best, 0) >= 2 and counts[best] > counts.get(parse_axis(up), 0):
+        # not a biped, its up axis not told by the legs (ambiguous): still, more legs stand on another axis
+        why.append(f"{counts.get(parse_axis(up), 0)} leg-like chains end on the floor along {up}, {counts[best]} "
+                   f"along {best}")
     return "; ".join(why)
 
 
