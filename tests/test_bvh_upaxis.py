@@ -76,14 +76,22 @@ def test_crab_is_kept_as_it_is_warned_and_not_tipped_over(caplog):
     assert standing_height(m.skeleton, m.values) == pytest.approx(_true_height(path), rel=1e-3)
 
 
-def test_ambiguous_body_that_is_not_a_biped_keeps_the_files_axes(caplog):
-    """No head or feet by role (Bip01 names without joint_roles) and no clear legs: +y kept, warned."""
-    path = DATA / "every6_bip.bvh"
+def test_ambiguous_body_that_is_not_a_biped_keeps_the_files_axes(tmp_path, caplog):
+    """No head or feet by role (joint names the role map does not know, no joint_roles) and no clear legs: +y
+    kept, warned."""
+    from bvh_classes import renamed
+
+    bip = read_bvh(DATA / "every6_bip.bvh")
+    path = tmp_path / "unnamed.bvh"
+    write_bvh(path, renamed(bip, {j.name: f"part{k}" for k, j in enumerate(bip.skeleton.joints)}))
     raw = read_bvh(path)
     axis, info = detect_up_axis(raw.skeleton, raw.values)
     assert axis == "+y" and not info["biped"] and info["ambiguous"] and info["sign_from"] == "file"
     m, msgs, warns = _load(path, caplog, bvh_length_to_m=0.01)
     assert any("ambiguous: the file's own axes are kept" in s and str(path) in s and "up_axis" in s for s in warns)
+    # the 3ds Max Biped names themselves are known (Bip01_L_Thigh ...): a biped, up from its roles
+    axis, info = detect_up_axis(bip.skeleton, bip.values)
+    assert axis == "+y" and info["biped"] and info["sign_from"] == "roles"
     # the same file on its side is kept as it is too (nothing tells which way is up without roles or legs)
     from scipy.spatial.transform import Rotation
 

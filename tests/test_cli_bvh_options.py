@@ -144,3 +144,16 @@ def test_the_documented_toe_roles_of_a_skeleton_without_toes_are_not_warned(tmp_
         load_trial(bvh=tmp_path / "toeless.bvh", bvh_length_to_m=0.05644, joint_roles={"left_toe": "rfoot"})
     w = [r.getMessage() for r in caplog.records if "plays 2 roles" in r.getMessage()]
     assert len(w) == 3 and "'rfoot' plays 2 roles (right_ankle, left_toe" in w[2], w
+
+
+def test_3ds_max_biped_names_need_no_role_option(tmp_path, capsys):
+    """``Bip01_L_Thigh``, ``Bip01 L Calf`` ...: the role map drops Biped's prefix, so ``score`` (which needs the
+    feet, the hips and the head) runs on a Biped file without one --role."""
+    out = tmp_path / "s.csv"
+    f = str(DATA / "every6_bip.bvh")
+    assert main(["score", f, "--reference", f, "--database", f, "--length-to-m", "0.01", "--out", str(out)]) == 0, \
+        capsys.readouterr().err
+    import pandas as pd
+
+    row = pd.read_csv(out).iloc[0]
+    assert np.isfinite(row["skate_share"])
