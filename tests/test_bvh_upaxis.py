@@ -159,3 +159,36 @@ def test_a_wrong_given_up_axis_on_an_animal_whose_axis_is_ambiguous_is_warned(tm
     _m, _msgs, warns = _load(path, caplog, up_axis=given)
     w = [s for s in warns if "with the given up axis" in s]
     assert (w == []) if says is None else (len(w) == 1 and says in w[0] and str(path) in w[0]), warns
+
+
+def _leaning_take(tmp_path, lean_deg: float):
+    """A LAFAN1-like file (rest pose along +X, Hips names) of a walk leaning ``lean_deg`` forward throughout."""
+    from scipy.spatial.transform import Rotation
+
+    from animsynth.kinematics import root_rotation, root_translation, set_root
+    from animsynth.motion import Motion
+    from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+    from bvh_classes import convert
+
+    m = convert(generate_motion("walk_straight", 120, 0, cmu_like_skeleton("lafan", 1)), "rest_x")
+    sk = m.skeleton
+    values = set_root(sk, m.values, Rotation.from_euler("x", lean_deg, degrees=True) * root_rotation(sk, m.values),
+                      root_translation(sk, m.values))
+    path = tmp_path / f"lean{lean_deg:g}.bvh"
+    write_bvh(path, Motion(values, sk, m.fps, "take"))
+    return path
+
+
+def test_the_roles_decide_a_leaning_bipeds_up_axis_without_an_ambiguity_warning(tmp_path, caplog):
+    """A crouched walk leaning 38 degrees: the head-to-feet vector's forward part is over 0.7 of its upward part
+    (once "ambiguous"), but the head is above the feet along +y in every frame and the legs stand along +y: the
+    roles decide, no warning. Leaning 50 degrees, the head-to-feet vector points forward: still ambiguous."""
+    path = _leaning_take(tmp_path, 38.0)
+    raw = read_bvh(path)
+    axis, info = detect_up_axis(raw.skeleton, raw.values)
+    assert axis == "+y" and info["biped"] and not info["ambiguous"]
+    _m, _msgs, warns = _load(path, caplog, bvh_length_to_m=0.05644)
+    assert not [w for w in warns if "ambiguous" in w], warns
+    raw = read_bvh(_leaning_take(tmp_path, 50.0))
+    axis, info = detect_up_axis(raw.skeleton, raw.values)
+    assert info["ambiguous"] and "lies between two axes" in info["why"]

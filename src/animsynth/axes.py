@@ -108,6 +108,24 @@ def leg_chains(skeleton: Skeleton, starts: np.ndarray, ends: np.ndarray, up) -> 
     return legs
 
 
+#: The roles decide a biped's up axis, whatever its lean or extents, when its head is above its feet along that
+#: axis (the largest component of the head-to-feet vector) in at least this share of the frames ...
+ROLES_DECIDE_SHARE = 0.9
+
+
+def _roles_decide(head_to_feet: np.ndarray, axis: str, counts: dict) -> bool:
+    """Whether a biped's head-to-feet vectors ``(frames, 3)`` point along ``axis`` in :data:`ROLES_DECIDE_SHARE`
+    of the frames, and its legs do not say otherwise (two leg-like chains stand along ``axis``, or none stands
+    along any axis): a person leaning 40 degrees forward (a crouched walk), or taller across than along up in part
+    of a take, is still upright; a file turned 45 degrees is not decided."""
+    k = np.argmax(np.abs(head_to_feet), axis=1)
+    signs = np.sign(head_to_feet[np.arange(len(k)), k])
+    want = "xyz".index(axis[1]), (1.0 if axis[0] == "+" else -1.0)
+    share = float(np.mean((k == want[0]) & (signs == want[1]))) if len(k) else 0.0
+    legs_agree = counts.get(axis, 0) >= 2 or max(counts.values(), default=0) < 2
+    return share >= ROLES_DECIDE_SHARE and legs_agree
+
+
 def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) -> tuple[str, dict]:
     """The up axis of a motion, from the joint roles for a biped, from the legs otherwise.
 
@@ -119,7 +137,9 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     that vector's second largest component is more than
     :data:`AMBIGUOUS_RATIO` of its largest (the body lies diagonally), when the
     hips are not between head and feet along it, or when the body is clearly
-    tallest along another axis (a lying body).
+    tallest along another axis (a lying body); the first and the last do not
+    count when the roles decide (:func:`_roles_decide`: the head above the feet
+    along that axis in nearly every frame, the legs agreeing).
 
     *Not a biped* (no head or feet by role, or four or more leg-like chains:
     a quadruped, a crab): a four-legged body is longer than it is tall, so the
@@ -166,13 +186,15 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     most = max((n for ax, n in counts.items()
                 if feet is None or any(f in c for c in chains[ax] for f in feet)), default=0)
     if head is not None and feet is not None and most <= MAX_BIPED_LEGS:
-        d = np.median(starts[:, head[0]] - 0.5 * (starts[:, feet[0]] + starts[:, feet[1]]), axis=0)
+        per_frame = starts[:, head[0]] - 0.5 * (starts[:, feet[0]] + starts[:, feet[1]])
+        d = np.median(per_frame, axis=0)
         a = int(np.argmax(np.abs(d)))
         axis = ("+" if d[a] >= 0 else "-") + "xyz"[a]
         info.update(biped=True, legs=counts[axis], sign_from="roles")
         why = []
         second = float(np.sort(np.abs(d))[-2] / max(abs(d[a]), 1e-300))
-        if second > AMBIGUOUS_RATIO:
+        decided = _roles_decide(per_frame, axis, counts)
+        if second > AMBIGUOUS_RATIO and not decided:
             why.append(f"the head-to-feet vector {_fmt_vec(d)} lies between two axes")
         hips = role_indices(skeleton, ("left_hip", "right_hip"), overrides)
         if hips is not None:
@@ -182,7 +204,7 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
             hf = float(np.median(0.5 * (starts[:, feet[0]] + starts[:, feet[1]]) @ u))
             if not hf <= hh <= hd:
                 why.append("the hips are not between the head and the feet")
-        if tall != a and ratio < AMBIGUOUS_RATIO:
+        if tall != a and ratio < AMBIGUOUS_RATIO and not decided:
             why.append(f"the body is tallest along {'xyz'[tall]} (lying down?)")
         info.update(ambiguous=bool(why), why="; ".join(why) or "head above feet")
         return axis, info
