@@ -14,7 +14,7 @@ log = logging.getLogger("animsynth.compare")
 
 __all__ = ["check", "groups", "clip_ids", "subject_sets", "showcase", "run_generators", "clips_cfg", "native_rates",
            "job_cfg", "unavailable", "user_generators", "generator_order", "user_job_cfg", "left_out", "trial_rate",
-           "check_subject_sets", "check_trial_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
+           "check_subject_sets", "check_trial_rates", "common_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
 def subject_sets(config: dict) -> dict:
@@ -374,7 +374,8 @@ def check_trial_rates(config: dict) -> None:
     Raises
     ------
     ConfigError
-        naming ``compare.fps``, the trial and its rate
+        naming ``compare.fps``, the first trial it does not fit and its rate, and the rates that fit every trial
+        the comparison uses (:func:`common_rates`)
     """
     if config["mocap_source"] != "user":
         return
@@ -382,16 +383,43 @@ def check_trial_rates(config: dict) -> None:
     subsets, reseq = groups(config)
     used = list(dict.fromkeys([t for ids in subsets.values() for t in ids] + list(reseq.values())))
     records = {t["id"]: t for t in config["trials"]}
+    rates = {}
     for tid in used:
-        if tid not in records:
-            continue  # an unknown id: animsynth.config.check_config names it
-        fps, where = trial_rate(config, records[tid])
-        if fps is None:
-            continue
-        ratio = fps / want
-        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
-            divisors = [f"{fps / n:g}" for n in range(1, 7) if abs(fps / n - round(fps / n)) < 1e-9][:4] or [f"{fps:g}"]
-            raise ConfigError(f"config key 'compare.fps': {config['compare']['fps']} fps is not the rate of trial "
-                              f"{tid!r} ({fps:g} fps, {where}) divided by a whole number (the comparison keeps every "
-                              f"n-th frame); set compare.fps to one of {', '.join(divisors)}, or leave the trial out "
-                              "of compare.subsets / compare.resequencing")
+        if tid in records:  # an unknown id: animsynth.config.check_config names it
+            fps, where = trial_rate(config, records[tid])
+            if fps is not None:
+                rates[tid] = (fps, where)
+    bad = [(tid, fps, where) for tid, (fps, where) in rates.items() if not _divides(fps, want)]
+    if bad:
+        tid, fps, where = bad[0]
+        fits = common_rates([f for f, _w in rates.values()])
+        hint = (f"set compare.fps to one that fits every trial the comparison uses: {', '.join(fits)}" if fits
+                else "no rate fits every trial the comparison uses (" + ", ".join(
+                    sorted({f"{f:g}" for f, _w in rates.values()})) + " fps): leave the trials of another rate out "
+                "of compare.subsets / compare.resequencing")
+        more = f" (and {len(bad) - 1} more trial(s))" if len(bad) > 1 else ""
+        raise ConfigError(f"config key 'compare.fps': {config['compare']['fps']} fps is not the rate of trial "
+                          f"{tid!r} ({fps:g} fps, {where}){more} divided by a whole number (the comparison keeps "
+                          f"every n-th frame); {hint}")
+
+
+def _divides(fps: float, rate: float) -> bool:
+    ratio = fps / rate
+    return abs(ratio - round(ratio)) <= 1e-6 and round(ratio) >= 1
+
+
+def common_rates(rates, most: int = 4) -> list[str]:
+    """The working rates (whole frames per second, highest first, at most ``most``) that every rate of ``rates``
+    divides by a whole number: e.g. 6 for files at 24, 30 and 120 fps."""
+    rates = [float(r) for r in rates]
+    if not rates:
+        return []
+    low = min(rates)
+    out = []
+    for n in range(1, int(low) + 1):
+        r = low / n
+        if abs(r - round(r)) < 1e-9 and all(_divides(f, r) for f in rates):
+            out.append(f"{r:g}")
+        if len(out) == most:
+            break
+    return out
