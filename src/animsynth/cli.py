@@ -389,9 +389,14 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("--role", action="append", metavar="[FILE:]ROLE=JOINT",
                        help="joint role of BVH input (e.g. left_hip=Bip01_L_Thigh); repeatable")
         s.add_argument("--up-axis", action="append", metavar="[FILE=]AXIS",
-                       help="up axis of BVH input (+x -x +y -y +z -z; default: detected)")
+                       help="up axis of BVH input (+x -x +y -y +z -z; default: detected); a negative axis works "
+                            "either way: --up-axis -z or --up-axis=-z")
         s.add_argument("--forward-axis", action="append", metavar="[FILE=]AXIS",
-                       help="forward axis of BVH input (default: the smallest turn taking up to +y)")
+                       help="forward axis of BVH input (default: the smallest turn taking up to +y); a negative "
+                            "axis works either way: --forward-axis -y or --forward-axis=-y")
+        s.add_argument("--root", action="append", metavar="[FILE=]NAME",
+                       help="the skeleton to read from a BVH file that holds several (two characters, a "
+                            "character and a prop): the name of its root joint")
     for s in sub.choices.values():
         s.add_argument("--memory-budget-gib", type=positive_float, default=DEFAULT_MEMORY_BUDGET_GIB,
                        help=f"refuse requests whose arrays exceed this many GiB (default {DEFAULT_MEMORY_BUDGET_GIB:g})")
@@ -424,9 +429,28 @@ def _out_of_memory(a) -> str:
             "to be told which input is too large")
 
 
+#: The options whose value may be a negative axis (``-y``), which argparse would take for an option.
+AXIS_OPTIONS = ("--up-axis", "--forward-axis")
+
+
+def _negative_axes_joined(argv: list[str]) -> list[str]:
+    """``argv`` with ``--forward-axis -y`` written ``--forward-axis=-y`` (argparse reads a value starting with
+    ``-`` as an option, and ``-y`` is not a number)."""
+    out, i = [], 0
+    while i < len(argv):
+        if argv[i] in AXIS_OPTIONS and i + 1 < len(argv) and argv[i + 1].lower() in ("-x", "-y", "-z"):
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(argv[i])
+            i += 1
+    return out
+
+
 def main(argv=None) -> int:
     """Run one command; return the exit status (0 ok, 2 bad argument or input)."""
     parser = build_parser()
+    argv = _negative_axes_joined(list(sys.argv[1:] if argv is None else argv))
     try:
         # files may come after options too (resequence walk.bvh --start 10 --end 300 out.bvh): argparse leaves
         # the ones after an option over; they join the command's file list

@@ -153,7 +153,8 @@ def _load_bvh(a, path: str):
             raise UsageError(opt, f"expected auto or one of {', '.join(AXES)}, got {v!r}")
         axes[key] = v
     return load_trial(bvh=path, joint_roles=_roles_for(a.role, path), bvh_length_to_m=unit,
-                      name=os.path.splitext(os.path.basename(path))[0], setting_names=CLI_SETTING_NAMES, **axes)
+                      name=os.path.splitext(os.path.basename(path))[0], setting_names=CLI_SETTING_NAMES,
+                      bvh_root=_per_file(getattr(a, "root", None), path, "--root"), **axes)
 
 
 #: How :func:`animsynth.data.load_trial` names its settings in errors and warnings from the command line.
@@ -161,7 +162,7 @@ CLI_SETTING_NAMES = {"joint_roles": "argument --role", "up_axis": "--up-axis (e.
                      "bvh_length_to_m": "--length-to-m"}
 #: The per-file options (``FILE=VALUE``; ``--role FILE.bvh:ROLE=JOINT``) of the commands that read BVH files.
 PER_FILE_OPTIONS = (("--length-to-m", "length_to_m"), ("--up-axis", "up_axis"), ("--forward-axis", "forward_axis"),
-                    ("--role", "role"))
+                    ("--role", "role"), ("--root", "root"))
 
 
 def _check_per_file_options(a) -> None:

@@ -121,7 +121,7 @@ def _rename_path(exc: Exception, files: dict, shown: dict):
 def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
                bvh_length_to_m: float = 1.0, up_axis: str | None = "auto", forward_axis: str | None = "auto",
                source_files: dict | None = None, first_frame: int = 0,
-               setting_names: dict | None = None) -> Motion:
+               setting_names: dict | None = None, bvh_root: str | None = None) -> Motion:
     """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion` in the canonical frame (+y up, +z forward).
 
     Parameters
@@ -137,6 +137,10 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     bvh_length_to_m : float
         A BVH file's metres per length unit (0.01 centimetres, 0.05644
         cgspeed's CMU conversions, which keep the ASF unit).
+    bvh_root : str, optional
+        The skeleton to read from a BVH file that holds several (two
+        characters): the name of its root joint (:func:`animsynth.io.bvh.read_bvh`,
+        ``root``; config ``bvh_root`` on the trial, command line ``--root``).
     up_axis, forward_axis : str or None
         The file's world axes (``"+z"``, ...), or ``"auto"``/None. For BVH,
         ``auto`` detects the up axis from the motion
@@ -189,7 +193,7 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         if bvh is not None:
             from .io.bvh import read_bvh
 
-            m = read_bvh(bvh)
+            m = read_bvh(bvh, root=bvh_root)
             m.skeleton.length_to_m = float(bvh_length_to_m)
         else:
             m = read_amc(amc, read_asf(asf), fps=fps)

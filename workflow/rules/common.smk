@@ -565,6 +565,7 @@ def trial_settings(wildcards):
         "source_files": {k: (f"{root.rstrip('/')}/{v}" if root else v) for k, v in own.items()},
         # only when the record sets it, so the settings (a rerun trigger) of every other trial stay as they were
         **({"first_frame": rec["first_frame"]} if rec.get("first_frame") else {}),
+        **({"bvh_root": rec["bvh_root"]} if rec.get("bvh_root") else {}),
     }
 
 
