@@ -40,7 +40,8 @@ NEW = {"subject": "143", "kind": "walk_straight", "amc": "subjects/143/143_01.am
 
 def test_a_trials_mapping_adds_replaces_and_drops_records_by_id():
     shipped = trial_records(yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())["trials"])
-    cfg = _merged({"trials": {"143_01": NEW, "35_01": dict(shipped[16], note="mine"), "05_02": None}})
+    walk = next(t for t in shipped if t["id"] == "35_01")
+    cfg = _merged({"trials": {"143_01": NEW, "35_01": dict(walk, note="mine"), "05_02": None}})
     validate_config(cfg, SCHEMA)
     ids = [t["id"] for t in cfg["trials"]]
     assert isinstance(cfg["trials"], list) and len(ids) == len(shipped)  # one added, one dropped
