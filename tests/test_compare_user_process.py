@@ -81,6 +81,14 @@ class Starts:
 
 class Spins(Starts):
     spin = True
+
+
+class Sleeps(Starts):
+    def fit(self, database):
+        import time
+
+        super().fit(database)
+        time.sleep(600)
 """
 
 
@@ -112,11 +120,11 @@ def test_a_background_process_ends_also_when_the_class_ended_first(tmp_path):
     _wait_gone([background], "after the class's process ended")
 
 
-def test_a_spinning_class_and_its_background_process_end_at_the_time_limit(tmp_path):
+def test_a_hung_class_and_its_background_process_end_at_the_time_limit(tmp_path):
     pids = _write_class(tmp_path)
-    proc = UserProcess("mine", f"{tmp_path / 'mine.py'}:Spins")
-    with pytest.raises(UserGeneratorError, match="passed the time limit of 30 s"):
-        proc.call(("fit", _clips()), 30, "fit(database)")  # it spins: always past the limit
+    proc = UserProcess("mine", f"{tmp_path / 'mine.py'}:Sleeps")
+    with pytest.raises(UserGeneratorError, match="passed the time limit of 10 s"):
+        proc.call(("fit", _clips()), 10, "fit(database)")  # it sleeps 600 s: always past the limit
     assert pids.exists(), "the class did not start within the time limit"
     child, background = _wait_file(pids)
     _wait_gone([child, background], "after the time limit")
