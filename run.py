@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import signal
 import subprocess
 import sys
 import tomllib
@@ -127,6 +128,33 @@ def with_targets_first(args: list[str]) -> list[str]:
     return args
 
 
+def one_configfile_option(args: list[str]) -> list[str]:
+    """``args`` with every ``--configfile`` / ``--configfiles`` option joined into one, at the place of the first,
+    its files in the order given.
+
+    Snakemake keeps only the last ``--configfile`` option, so ``python3 run.py paper --configfile mine.yaml``
+    would otherwise run on ``mine.yaml`` alone, without config/cmu.yaml, samba.yaml and paper.yaml that run.py
+    passes first: a user's config over the paper run is meant (its trials mapping adds to cmu.yaml's).
+    """
+    names = ("--configfile", "--configfiles")
+    rest, files = split_option(args, names)
+    if not files:
+        return list(args)
+    first = next(i for i, a in enumerate(args) if a.partition("=")[0] in names)
+    before = split_option(args[:first], names)[0]
+    return [*before, "--configfile", *files, *rest[len(before):]]
+
+
+def snakemake_args(command: str, argv: list[str]) -> list[str]:
+    """The Snakemake arguments of ``python3 run.py COMMAND ARGV...`` (paper, bench, snakemake): targets first
+    (:func:`with_targets_first`), for ``paper`` the paper run's config files before the user's, and every config
+    file in one ``--configfile`` option (:func:`one_configfile_option`)."""
+    args = with_targets_first(argv)
+    if command == "paper":
+        args = sort_targets([*PAPER_CONFIG, *args])[0]
+    return one_configfile_option(args)
+
+
 def bench_args(argv: list[str]) -> tuple[list[str], list[str]]:
     """Split snakemake arguments into (the others, the KEY=VALUE pairs of a --config option)."""
     return split_option(argv, ("--config",))
@@ -157,12 +185,54 @@ def prescan(args: list[str]) -> int:
     files = configfiles(args)
     if not files:
         return 0
-    return subprocess.call([str(PY), str(Path(__file__).resolve()), "_check-configfiles", *files], cwd=ROOT)
+    return call([str(PY), str(Path(__file__).resolve()), "_check-configfiles", *files], "the config check", cwd=ROOT)
+
+
+#: Snakemake's dry-run options.
+DRY_RUN = {"-n", "--dry-run", "--dryrun"}
+
+#: The exit code of a command stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
+INTERRUPTED = 130
+
+
+def call(cmd: list[str], what: str = "", **kwargs) -> int:
+    """Run ``cmd`` and return its exit code; :data:`INTERRUPTED` (and one line) when Ctrl-C stopped it.
+
+    ``subprocess.call`` kills its child 0.25 s after a Ctrl-C, which leaves Snakemake's lock (every rerun is
+    then refused) and half-written outputs behind. Here a Ctrl-C (SIGINT, which the terminal sends to run.py
+    and Snakemake together, as one process group) only marks the run as interrupted: Snakemake cancels its
+    jobs, removes their incomplete outputs and its lock, and exits in its own time; run.py waits for it. A
+    SIGTERM sent to run.py alone (a scheduler stopping the run) is passed on to Snakemake, which then lets
+    its running jobs finish and stops. The same command afterwards resumes where the run stopped.
+
+    ``what``: how the one line names the command ("snakemake": it also says how to resume).
+    """
+    stopped, procs = [], []
+
+    def on_signal(signum, _frame):
+        stopped.append(signum)
+        if signum == signal.SIGTERM and procs and procs[0].poll() is None:
+            procs[0].send_signal(signal.SIGTERM)
+
+    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        procs.append(subprocess.Popen(cmd, **kwargs))
+        rc = procs[0].wait()
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+    if stopped or rc in (-signal.SIGINT, INTERRUPTED):
+        what = what or Path(cmd[0]).name
+        tail = (" after removing its lock and incomplete outputs; the same command resumes the run"
+                if what == "snakemake" else "")
+        print(f"[run.py] interrupted: {what} stopped{tail}", file=sys.stderr, flush=True)
+        return INTERRUPTED
+    return rc
 
 
 def sh(*args: str) -> int:
     print("[run.py] " + " ".join(args), flush=True)
-    return subprocess.call(list(args), cwd=ROOT)
+    return call(list(args), "snakemake" if Path(args[0]).name == "snakemake" else "", cwd=ROOT)
 
 
 # ----------------------------------------------------------------------------- the run's CPU breakdown
@@ -203,7 +273,7 @@ class RunCost:
         """Run ``snakemake ARGS`` (as :func:`sh` does) and record its CPU under ``label``."""
         print("[run.py] " + " ".join([str(BIN / "snakemake"), *args]), flush=True)
         env = dict(os.environ, ANIMSYNTH_RUN_COST=self.path, ANIMSYNTH_RUN_COST_LABEL=label)
-        return subprocess.call([str(PY), "-c", MEASURED_SNAKEMAKE, *args], cwd=ROOT, env=env)
+        return call([str(PY), "-c", MEASURED_SNAKEMAKE, *args], "snakemake", cwd=ROOT, env=env)
 
     def write(self, results_dir: str) -> None:
         """``results_dir``/run_cost.csv: where the CPU time of this run.py call went."""
@@ -278,8 +348,6 @@ def main(argv: list[str]) -> int:
         return 0
     ensure_venv()
     snakemake = str(BIN / "snakemake")
-    if argv and argv[0] in ("paper", "bench", "snakemake"):
-        argv = [argv[0], *with_targets_first(argv[1:])]
     if not argv:
         cost = RunCost()
         rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2))
@@ -289,31 +357,42 @@ def main(argv: list[str]) -> int:
             cost.write("results")
             print(DEMO_NOTE, flush=True)
         return rc
-    if argv[0] in ("paper", "bench", "snakemake") and prescan([*PAPER_CONFIG, *argv[1:]] if argv[0] == "paper"
-                                                             else argv[1:]):
-        return 2
+    if argv[0] in ("paper", "bench", "snakemake"):
+        args = snakemake_args(argv[0], argv[1:])
+        rc = prescan(args)
+        if rc:  # 2: a config file refused (one line printed); 130: interrupted
+            return rc
     if argv[0] == "paper":
-        # Extra arguments (e.g. --config cmu_mirror=DIR mesh_dir=DIR) go to both calls.
+        # Extra arguments (e.g. --config cmu_mirror=DIR mesh_dir=DIR) go to both calls; a dry run (-n) or a run of
+        # named targets makes no report and no CPU breakdown (they describe the whole run).
         cost = RunCost()
-        rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2), *PAPER_CONFIG, *argv[1:])
-        if rc == 0:
-            rc = cost.snakemake("report", *PAPER_CONFIG, *argv[1:], "--report", "results/paper/report.html")
-        if rc == 0:
-            cost.write(results_dir_of(argv[1:], "results/paper"))
+        rc = cost.snakemake("run", "--cores", str(os.cpu_count() or 2), *args)
+        whole = not (DRY_RUN & set(args) or args[:1] and not args[0].startswith("-"))
+        if rc == 0 and whole:
+            rc = cost.snakemake("report", *args, "--report", "results/paper/report.html")
+        if rc == 0 and whole:
+            cost.write(results_dir_of(args, "results/paper"))
+        else:
+            os.unlink(cost.path)
         return rc
     if argv[0] == "bench":
         # Extra arguments go to snakemake; KEY=VALUE pairs after --config join the bench run's own (snakemake
         # keeps only the last --config option).
-        args, extra = bench_args(argv[1:])
+        args, extra = bench_args(args)
         return sh(snakemake, "--cores", str(os.cpu_count() or 2), f"{BENCH_DIR}/benchmarks.csv", *args,
                   "--config", *extra, f"results_dir={BENCH_DIR}", "benchmark_size=full")
     if argv[0] == "test":
         return sh(str(PY), "-m", "pytest", *argv[1:])
     if argv[0] == "snakemake":
-        return sh(snakemake, *argv[1:])
+        return sh(snakemake, *args)
     print(__doc__)
     return 2
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    try:
+        sys.exit(main(sys.argv[1:]))
+    except KeyboardInterrupt:  # Ctrl-C outside a Snakemake call (the venv set-up, the config prescan)
+        if sys.argv[1:2] != ["_check-configfiles"]:  # the prescan's parent says it
+            print("[run.py] interrupted", file=sys.stderr, flush=True)
+        sys.exit(INTERRUPTED)

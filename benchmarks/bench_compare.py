@@ -33,6 +33,7 @@ from pathlib import Path
 import yaml
 from threadpoolctl import threadpool_limits
 
+from animsynth.config import trial_records
 from animsynth.compare.generators.fairmotion_peer import FairmotionGraph, FairmotionUnavailable
 from animsynth.compare.generators.motiongraph import MotionGraph
 from animsynth.motion import Motion
@@ -53,7 +54,7 @@ SYNTHETIC = {"walk": ("walk_straight", 358, "bench35"), "run": ("run_straight", 
 def _clips(cmu: bool, step: int, crop: int | None) -> tuple[list[Motion], str]:
     """The walk, run and dance clips at ``120 / step`` fps: CMU when present (and ``cmu``), else synthetic."""
     cfg = yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())
-    trials = {t["id"]: t for t in cfg["trials"]}
+    trials = {t["id"]: t for t in trial_records(cfg["trials"])}
     ids = [cfg["resequencing_trials"][k] for k in ("walk", "run", "dance")]
     if cmu and all((CMU / trials[i]["amc"]).is_file() and (CMU / trials[i]["asf"]).is_file() for i in ids):
         from animsynth.io import read_amc, read_asf

@@ -36,6 +36,7 @@ import numpy as np
 import yaml
 from threadpoolctl import threadpool_limits
 
+from animsynth.config import trial_records
 from animsynth.compare.generators.genmm import GenMM
 from animsynth.compare.generators.motiongraph import MotionGraph
 from animsynth.compare.generators.motionmatching import MotionMatching
@@ -56,7 +57,7 @@ W1 = {"35_16": 443, "35_07": 360, "35_08": 455, "35_13": 454}
 def _clips(cmu: bool, crop: int | None) -> tuple[list[Motion], str]:
     """w1's four walks at 30 fps (the held-out one first): CMU when present (and ``cmu``), else synthetic."""
     cfg = yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())
-    trials = {t["id"]: t for t in cfg["trials"]}
+    trials = {t["id"]: t for t in trial_records(cfg["trials"])}
     if cmu and all((CMU / trials[i]["amc"]).is_file() and (CMU / trials[i]["asf"]).is_file() for i in W1):
         from animsynth.io import read_amc, read_asf
 

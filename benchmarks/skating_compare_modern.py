@@ -33,6 +33,7 @@ import yaml
 from threadpoolctl import threadpool_limits
 
 from animsynth.compare import protocol, scoring
+from animsynth.config import trial_records
 from animsynth.compare.generators.registry import make_generator
 from animsynth.compare.generators.motionmatching import make_motion_matching
 from animsynth.io import read_amc, read_asf
@@ -51,7 +52,7 @@ def _config() -> tuple[dict, dict, dict, dict]:
     for layer in (cmu.get("compare", {}), paper.get("compare", {})):
         cfg.update({k: v for k, v in layer.items() if k not in ("subsets", "resequencing")})
     cfg["master_seed"] = int(paper.get("seed", cmu.get("seed", base["seed"])))
-    trials = {t["id"]: t for t in cmu["trials"]}
+    trials = {t["id"]: t for t in trial_records(cmu["trials"])}
     return cfg, dict(cmu["subsets"]), dict(cmu["resequencing_trials"]), trials
 
 

@@ -10,7 +10,8 @@ third-party file:
   translation) over a 6-channel ``Hips`` that carries the motion; Bandai-Namco
   names (``UpperLeg_L`` ...), centimetres.
 * ``every6``: 6 channels on every joint (Truebones / 3ds Max ``Bip01_`` names,
-  which the built-in role map does not know: the trial names its roles); the
+  found by the role map since it drops Biped's prefix; the trials still name
+  their roles, the spine's as the Biped's Spine2 for the chest); the
   spine's positions wobble by 0.1 mm, the clavicles really move (2.5 cm).
 * ``rest_x``: the rest pose lies along +X (LAFAN1): every offset turned by a
   fixed rotation, the joint rotations compensating, so the motion is Y up.

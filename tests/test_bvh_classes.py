@@ -120,7 +120,7 @@ def test_resequencing_trials_take_any_subset():
     # an id the user set that is not a trial stays an error naming the key
     cfg = _cfg(walk="typo")
     normalise_resequencing_trials(cfg, {"walk": "syn35_01"})
-    with pytest.raises(ConfigError, match="resequencing_trials.walk': unknown trial id 'typo'"):
+    with pytest.raises(ConfigError, match="resequencing_trials.walk': trial 'typo' has no record in 'trials'"):
         check_config(cfg)
 
 

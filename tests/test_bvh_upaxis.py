@@ -76,14 +76,22 @@ def test_crab_is_kept_as_it_is_warned_and_not_tipped_over(caplog):
     assert standing_height(m.skeleton, m.values) == pytest.approx(_true_height(path), rel=1e-3)
 
 
-def test_ambiguous_body_that_is_not_a_biped_keeps_the_files_axes(caplog):
-    """No head or feet by role (Bip01 names without joint_roles) and no clear legs: +y kept, warned."""
-    path = DATA / "every6_bip.bvh"
+def test_ambiguous_body_that_is_not_a_biped_keeps_the_files_axes(tmp_path, caplog):
+    """No head or feet by role (joint names the role map does not know, no joint_roles) and no clear legs: +y
+    kept, warned."""
+    from bvh_classes import renamed
+
+    bip = read_bvh(DATA / "every6_bip.bvh")
+    path = tmp_path / "unnamed.bvh"
+    write_bvh(path, renamed(bip, {j.name: f"part{k}" for k, j in enumerate(bip.skeleton.joints)}))
     raw = read_bvh(path)
     axis, info = detect_up_axis(raw.skeleton, raw.values)
     assert axis == "+y" and not info["biped"] and info["ambiguous"] and info["sign_from"] == "file"
     m, msgs, warns = _load(path, caplog, bvh_length_to_m=0.01)
     assert any("ambiguous: the file's own axes are kept" in s and str(path) in s and "up_axis" in s for s in warns)
+    # the 3ds Max Biped names themselves are known (Bip01_L_Thigh ...): a biped, up from its roles
+    axis, info = detect_up_axis(bip.skeleton, bip.values)
+    assert axis == "+y" and info["biped"] and info["sign_from"] == "roles"
     # the same file on its side is kept as it is too (nothing tells which way is up without roles or legs)
     from scipy.spatial.transform import Rotation
 
@@ -124,3 +132,63 @@ def test_cli_names_the_up_axis_option(tmp_path, capsys, caplog):
                      "--out", str(tmp_path / "r.bvh")]) == 0
     w = [r.getMessage() for r in caplog.records if "given up axis" in r.getMessage()]
     assert w and "--up-axis" in w[0] and "z_up.bvh" in w[0]
+
+
+#: a two-legged bird whose joint names the role map does not know: two leg-like chains are too few to tell its up
+#: axis (the file's own axes are kept), yet a given up axis along which no leg stands is wrong
+BIRD = [("Body", None, (0.0, 0.6, 0.0), (0.0, 0.05, 0.3)),
+        ("NeckB", "Body", (0.0, 0.05, 0.3), (0.0, 0.25, 0.1)), ("Beak", "NeckB", (0.0, 0.25, 0.1), (0.0, 0.0, 0.12)),
+        ("TailB", "Body", (0.0, 0.0, -0.1), (0.0, 0.05, -0.3))]
+for _side, _x in (("A", 0.12), ("B", -0.12)):
+    BIRD += [(f"Thigh{_side}", "Body", (_x, -0.05, 0.05), (0.0, -0.3, 0.05)),
+             (f"Shank{_side}", f"Thigh{_side}", (0.0, -0.3, 0.05), (0.0, -0.25, -0.03)),
+             (f"Wing{_side}", "Body", (_x, 0.05, 0.1), (_x * 2, 0.0, -0.1))]
+
+
+@pytest.mark.parametrize("given, says", [("+x", "0 leg-like chains end on the floor along +x, 2 along +y"),
+                                         ("-y", "1 leg-like chains end on the floor along -y, 2 along +y"),  # the neck points up
+                                         ("+y", None)])
+def test_a_wrong_given_up_axis_on_an_animal_whose_axis_is_ambiguous_is_warned(tmp_path, caplog, given, says):
+    from bvh_classes import creature
+
+    path = tmp_path / "bird.bvh"
+    write_bvh(path, creature(BIRD, swing=6.0))
+    raw = read_bvh(path)
+    axis, info = detect_up_axis(raw.skeleton, raw.values)
+    assert axis == "+y" and not info["biped"] and info["ambiguous"] and info["leg_counts"]["+y"] == 2
+    _m, _msgs, warns = _load(path, caplog, up_axis=given)
+    w = [s for s in warns if "with the given up axis" in s]
+    assert (w == []) if says is None else (len(w) == 1 and says in w[0] and str(path) in w[0]), warns
+
+
+def _leaning_take(tmp_path, lean_deg: float):
+    """A LAFAN1-like file (rest pose along +X, Hips names) of a walk leaning ``lean_deg`` forward throughout."""
+    from scipy.spatial.transform import Rotation
+
+    from animsynth.kinematics import root_rotation, root_translation, set_root
+    from animsynth.motion import Motion
+    from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+    from bvh_classes import convert
+
+    m = convert(generate_motion("walk_straight", 120, 0, cmu_like_skeleton("lafan", 1)), "rest_x")
+    sk = m.skeleton
+    values = set_root(sk, m.values, Rotation.from_euler("x", lean_deg, degrees=True) * root_rotation(sk, m.values),
+                      root_translation(sk, m.values))
+    path = tmp_path / f"lean{lean_deg:g}.bvh"
+    write_bvh(path, Motion(values, sk, m.fps, "take"))
+    return path
+
+
+def test_the_roles_decide_a_leaning_bipeds_up_axis_without_an_ambiguity_warning(tmp_path, caplog):
+    """A crouched walk leaning 38 degrees: the head-to-feet vector's forward part is over 0.7 of its upward part
+    (once "ambiguous"), but the head is above the feet along +y in every frame and the legs stand along +y: the
+    roles decide, no warning. Leaning 50 degrees, the head-to-feet vector points forward: still ambiguous."""
+    path = _leaning_take(tmp_path, 38.0)
+    raw = read_bvh(path)
+    axis, info = detect_up_axis(raw.skeleton, raw.values)
+    assert axis == "+y" and info["biped"] and not info["ambiguous"]
+    _m, _msgs, warns = _load(path, caplog, bvh_length_to_m=0.05644)
+    assert not [w for w in warns if "ambiguous" in w], warns
+    raw = read_bvh(_leaning_take(tmp_path, 50.0))
+    axis, info = detect_up_axis(raw.skeleton, raw.values)
+    assert info["ambiguous"] and "lies between two axes" in info["why"]

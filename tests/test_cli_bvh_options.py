@@ -107,3 +107,53 @@ def test_a_preview_is_titled_by_its_input_and_a_long_clip_is_not_a_slideshow(tmp
     assert gif_timing(4800, 30.0, 4, 600, 120.0) == (8, 30.0, 2.0)  # 40 s: every 8th frame, 30 fps, x2 speed
     assert gif_timing(2400, 30.0, 4, 600, 120.0) == (4, 30.0, 1.0)  # 20 s: real time
     assert gif_timing(4800, 30.0, 4, 150, 120.0) == (32, 30.0, 8.0)  # the workflow's previews: x8, not 3.75 fps
+
+
+def _without_toes(m: Motion) -> Motion:
+    """``m`` on its skeleton without the toe joints (the foot ends its chain, as in cgspeed's CMU BVH files)."""
+    import dataclasses
+
+    from animsynth.skeleton import Skeleton
+
+    sk = m.skeleton
+    keep = [i for i, j in enumerate(sk.joints) if j.name not in ("ltoes", "rtoes")]
+    new = {old: k for k, old in enumerate(keep)}
+    joints = [dataclasses.replace(sk.joints[i], parent=new.get(sk.joints[i].parent, -1)) for i in keep]
+    cols = [c for c in sk.columns() if c.split(".")[0] not in ("ltoes", "rtoes")]
+    values = m.values[:, [sk.columns().index(c) for c in cols]]
+    return Motion(values, Skeleton(joints, length_to_m=sk.length_to_m), m.fps, m.name)
+
+
+def test_the_documented_toe_roles_of_a_skeleton_without_toes_are_not_warned(tmp_path, caplog):
+    """config/cmu.yaml's setting for cgspeed's BVH files (left_toe: the foot joint, which ends its chain) is the
+    documented one, not a mistake: an info line, no warning; the same roles on a skeleton with toe joints, and a
+    joint given two roles of different limbs, are still warned."""
+    from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+    walk = generate_motion("walk_straight", 24, 0, cmu_like_skeleton("t", 1))
+    write_bvh(tmp_path / "toeless.bvh", _without_toes(walk))
+    write_bvh(tmp_path / "toes.bvh", walk)
+    roles = {"left_toe": "lfoot", "right_toe": "rfoot"}
+    with caplog.at_level(logging.INFO, logger="animsynth"):
+        load_trial(bvh=tmp_path / "toeless.bvh", bvh_length_to_m=0.05644, joint_roles=roles)
+    said = [r for r in caplog.records if "'lfoot'" in r.getMessage() or "'rfoot'" in r.getMessage()]
+    assert [r.levelname for r in said] == ["INFO", "INFO"] and "no toe joint below it" in said[0].getMessage()
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="animsynth"):
+        load_trial(bvh=tmp_path / "toes.bvh", bvh_length_to_m=0.05644, joint_roles=roles)
+        load_trial(bvh=tmp_path / "toeless.bvh", bvh_length_to_m=0.05644, joint_roles={"left_toe": "rfoot"})
+    w = [r.getMessage() for r in caplog.records if "plays 2 roles" in r.getMessage()]
+    assert len(w) == 3 and "'rfoot' plays 2 roles (right_ankle, left_toe" in w[2], w
+
+
+def test_3ds_max_biped_names_need_no_role_option(tmp_path, capsys):
+    """``Bip01_L_Thigh``, ``Bip01 L Calf`` ...: the role map drops Biped's prefix, so ``score`` (which needs the
+    feet, the hips and the head) runs on a Biped file without one --role."""
+    out = tmp_path / "s.csv"
+    f = str(DATA / "every6_bip.bvh")
+    assert main(["score", f, "--reference", f, "--database", f, "--length-to-m", "0.01", "--out", str(out)]) == 0, \
+        capsys.readouterr().err
+    import pandas as pd
+
+    row = pd.read_csv(out).iloc[0]
+    assert np.isfinite(row["skate_share"])

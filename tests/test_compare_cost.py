@@ -43,17 +43,74 @@ def _run(tmp_path, generator, cfg, clips_file):
 def test_the_estimate_grows_as_each_method_does():
     cfg = settings.job_cfg(default_config())
     e = lambda g, n, **kw: cost.estimate_cpu_s(g, n, cfg, **kw)  # noqa: E731
-    for g in ("fairmotion", "fairmotion_fixed", "motion_graph", "isomap", "stisomap"):
+    for g in ("motion_graph", "isomap", "stisomap"):
         assert e(g, 2000) == pytest.approx(4 * e(g, 1000))  # O(frames^2)
     for g in ("delaunay", "knn", "motion_matching", "motion_matching_pose", "replay", "concat"):
         assert e(g, 2000) == pytest.approx(2 * e(g, 1000))  # O(frames)
     # GenMM: the patch search over the database for every generated frame of every seed
     assert e("genmm", 1000, length=120, seeds=5) - e("genmm", 1000) == pytest.approx(
         2 * (e("genmm", 1000, length=60, seeds=5) - e("genmm", 1000)))
-    # fairmotion at its native 60 fps: twice the working frames
+    # fairmotion at its native 60 fps: twice the working frames; its estimate counts its operations
     assert cost.model_frames("fairmotion", 1000, cfg) == 2000 and cost.model_frames("knn", 1000, cfg) == 1000
-    assert e("fairmotion", 1000) == pytest.approx(9.2e-6 * 2000 ** 2)
+    ops = cost.fairmotion_ops(1000, cfg, 60, 5)
+    c = cost.FAIRMOTION_CPU_S
+    assert e("fairmotion", 1000, length=60, seeds=5) == pytest.approx(
+        c["load_frame"] * 2000 + c["comparison"] * ops["comparisons"] + c["generated_frame"] * 600)
     assert e("mine", 1000) is None  # a user generator: no model, no guard
+
+
+def _fm(cfg, **block):
+    return dict(cfg, fairmotion=dict(cfg["fairmotion"], **block))
+
+
+def test_the_fairmotion_estimate_reads_the_peers_settings():
+    """Nodes every stride frames (base 15 at 30 fps: 30 native frames), compared pairwise at num_comparison
+    frames: a finer stride or more comparisons cost what they cost, and the loading grows with the frames."""
+    cfg = settings.job_cfg(default_config())
+    ops = cost.fairmotion_ops(2146, cfg)
+    # 4292 native frames, a node every 30 leaving 30 + 20 + 1 after it: 142 nodes; 3 compared frames per pair
+    assert (ops["load_frames"], ops["nodes"], ops["per_pair"], ops["comparisons"]) == (4292, 142, 3, 142 * 142 * 3)
+    finer = cost.fairmotion_ops(2146, _fm(cfg, stride=5))  # a node every 10 native frames: three times the nodes
+    assert finer["nodes"] == 425 and finer["comparisons"] == 425 ** 2 * 3
+    more = cost.fairmotion_ops(2146, _fm(cfg, num_comparison=6))  # every 3rd of the 21 compared frames: 7
+    assert more["per_pair"] == 7
+    longer = cost.fairmotion_ops(2146, _fm(cfg, base=30, compare=20))  # nodes of 60 frames, 41 compared frames
+    assert (longer["nodes"], longer["per_pair"]) == (70, 4)
+    # a stride of 8 native frames does not divide the base's 30: fairmotion lowers it to 6 (a clip's nodes joined)
+    assert cost.fairmotion_ops(2146, _fm(cfg, stride=4))["nodes"] == 707  # ceil((4292 - 30 - 20 - 1) / 6)
+    # per clip: a clip too short for one node adds none; one number is the clips taken as one (an upper bound)
+    assert cost.fairmotion_ops([20, 40, 100], cfg)["nodes"] == 0 + 1 + 5
+    assert cost.fairmotion_ops(160, cfg)["nodes"] >= cost.fairmotion_ops([20, 40, 100], cfg)["nodes"]
+    est = lambda c: cost.estimate_cpu_s("fairmotion", 2146, c, 60, 5)  # noqa: E731
+    assert est(_fm(cfg, stride=5)) > 8 * est(cfg) / 2 and est(_fm(cfg, base=30, compare=20)) < est(cfg)
+
+
+@pytest.mark.skipif(settings.unavailable("fairmotion") != "", reason="fairmotion is not installed")
+@pytest.mark.parametrize("block", [{}, {"stride": 5, "num_comparison": 5}])
+def test_the_comparisons_fairmotion_makes_are_the_ones_counted(block):
+    """The operation count of the estimate is fairmotion's own: every pose comparison its ``construct`` makes
+    on a small database is counted (wrapped), and equals :func:`fairmotion_ops`'s."""
+    import fairmotion.tasks.motion_graph.motion_graph as mg
+
+    from animsynth.compare.generators.fairmotion_peer import FairmotionGraph
+
+    cfg = _fm(settings.job_cfg(default_config()), **block)
+    sk = cmu_like_skeleton("ops", 4)
+    clips = [protocol.resample(generate_motion("walk_straight", 4 * n, 11 + n, sk, name=f"o{n}"), 30.0)
+             for n in (40, 50)]
+    calls = []
+    real = mg.similarity.pose_similarity
+
+    def counted(*a, **k):
+        calls.append(1)
+        return real(*a, **k)
+
+    mg.similarity.pose_similarity = counted
+    try:
+        FairmotionGraph(**cfg["fairmotion"], transitions_per_s=cfg["transitions_per_s"]).fit(clips)
+    finally:
+        mg.similarity.pose_similarity = real
+    assert len(calls) == cost.fairmotion_ops([c.n_frames for c in clips], cfg)["comparisons"] > 0
 
 
 def test_the_paper_run_passes_and_a_large_lafan1_database_is_warned():

@@ -718,9 +718,11 @@ def test_a_subject_set_is_left_one_out_or_split_in_time_by_its_size(walks):
 @pytest.mark.parametrize("sets,fragment", [
     ({"w1": ["x"]}, "compare.subjects.w1': 'w1' is the name of a subset"),
     ({"walk": ["x"]}, "compare.subjects.walk': 'walk' is the name of a subset or re-sequencing clip"),
-    ({"s99": ["99_01"]}, r"compare.subjects.s99': unknown trial id\(s\) \['99_01'\]"),
+    ({"s99": ["99_01"]}, r"compare.subjects.s99': trial\(s\) '99_01' have no record in 'trials'.*mapping keyed"),
+    ({"mix": ["syn35_16", "syn16_34"]}, r"compare.subjects.mix': mixes trials of 2 subjects \(subject syn35: "
+                                       r"syn35_16; subject syn16: syn16_34\)"),
 ])
-def test_a_subject_set_with_a_taken_name_or_an_unknown_trial_is_refused(sets, fragment):
+def test_a_subject_set_with_a_taken_name_an_unknown_trial_or_two_subjects_is_refused(sets, fragment):
     cfg = copy.deepcopy(_config())
     cfg["compare"]["subjects"] = sets
     with pytest.raises(ConfigError, match=fragment):

@@ -60,7 +60,7 @@ def test_decode_holds_the_anchors_translation_on_joints_with_position_channels()
     cols = np.concatenate([np.arange(sl[j.name].start, sl[j.name].stop)[[d in TRANS_DOFS for d in j.dofs]]
                            for j in sk.joints[1:]])
     assert cols.size  # the file has position channels below the root
-    fwd = np.array([0.0, 0.0, 1.0])  # the Biped's joint names need joint_roles: its forward given
+    fwd = np.array([0.0, 0.0, 1.0])  # the forward given (not found from the roles)
     tr = encode(m, fwd)
     c = 5
     back = decode(sk, tr.rotations[c:], tr.tilt[c:], tr.height[c:], tr.step[c:], tr.turn[c:], m.values[c - 1], fwd)

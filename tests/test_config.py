@@ -89,6 +89,13 @@ def test_snakemake_stops_on_unknown_key(tmp_path):
     assert "config key 'fsp' is not allowed (at the top level)" in out
     assert "closest valid key: 'fps'" in out
     assert len(out.splitlines()) <= 10, out
+    # once, without stack lines of the Snakefile or the library
+    assert out.count("animsynth: config error: config key 'fsp'") == 1 and 'File "' not in out, out
+    # a check of workflow/rules/common.smk's, likewise
+    res = run_snakemake(wd, "-n", "--config", "results_dir=../elsewhere")
+    out = (res.stdout + res.stderr).strip()
+    assert res.returncode == 1 and out.count("animsynth: config error: config key 'results_dir'") == 1, out
+    assert 'File "' not in out and "Traceback" not in out, out
     res = run_snakemake(wd, "-n", "--config", "fps=fast")
     out = (res.stdout + res.stderr).strip()
     assert res.returncode != 0 and "config key 'fps': 'fast' is not of type" in out

@@ -6,6 +6,7 @@ import socket
 import numpy as np
 import pytest
 
+from animsynth.config import trial_records
 from animsynth.data import DownloadError, fetch_file, load_trial, sha256_normalised
 
 
@@ -50,7 +51,7 @@ def test_real_mirror_checksums_match_cmu_config(cmu_dir, cmu_many_dir):
 
     cfg = yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())
     mirrors = {"main": cmu_dir.parent, "many": cmu_many_dir.parent}
-    for t in cfg["trials"]:
+    for t in trial_records(cfg["trials"]):
         mirror = mirrors[t.get("mirror", "main")]
         pairs = (("bvh", "sha256"),) if "bvh" in t else (("amc", "sha256"), ("asf", "asf_sha256"))
         for key, sha in pairs:
@@ -72,7 +73,7 @@ def test_real_w1_w2_r1_are_the_exact_table1_trials(cmu_dir):
     cfg = yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())
     mirror = cmu_dir.parent
     table1 = {i for name in ("w1", "w2", "r1") for i in cfg["subsets"][name]}
-    lengths = {t["id"]: load_trial(amc=mirror / t["amc"], asf=mirror / t["asf"]).n_frames for t in cfg["trials"]
+    lengths = {t["id"]: load_trial(amc=mirror / t["amc"], asf=mirror / t["asf"]).n_frames for t in trial_records(cfg["trials"])
                if t["id"] in table1}
     for name in ("w1", "w2", "r1"):
         assert [lengths[i] for i in cfg["subsets"][name]] == paper[name]
@@ -90,7 +91,7 @@ def test_cmu_yaml_bvh_trials_parse_with_their_records_settings(cmu_many_dir):
 
     cfg = yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())
     amc_frames = {"06_01": 494, "10_04": 549}  # cmu_mocap_many/SOURCE.md: BVH = AMC + 1 (the T-pose)
-    bvh = [t for t in cfg["trials"] if "bvh" in t and t["subject"] in ("06", "10")]
+    bvh = [t for t in trial_records(cfg["trials"]) if "bvh" in t and t["subject"] in ("06", "10")]
     assert sorted(t["id"] for t in bvh) == sorted(amc_frames)
     for t in bvh:
         whole = load_trial(bvh=cmu_many_dir.parent / t["bvh"], bvh_length_to_m=t["bvh_length_to_m"])

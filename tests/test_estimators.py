@@ -232,6 +232,8 @@ def test_the_interface_has_one_import_path():
     bad = []
     for p in files:
         text = p.read_text(errors="replace")
+        if p.name == "library.md":  # its one note that the module is gone, for a reader of old code
+            text = text.replace("`animsynth.compare.base` is gone", "")
         if re.search(r"compare\.base\b|from \.base import|compare import [^\n]*\bbase\b", text):
             bad.append((str(p.relative_to(root)), "compare.base"))
         for m in re.finditer(r"from (?:(?:animsynth\.compare|\.)?\.?generators)?\.registry import (?:\(([^)]*)\)|([\w ,]+))",

@@ -32,12 +32,12 @@ PKG = "animsynth"
 FAMILIES = registry.paper_families()
 LAYERS = {
     0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton", "families"],
-    1: ["config", "tables", "motion", "kinematics", "axes", "retarget", "generator"],
+    1: ["config", "tables", "motion", "kinematics", "axes", "retarget", "generator", "pace"],
     2: ["io"],
     3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "capture_check", "workflow_utils"],
     4: list(FAMILIES),
     5: [f.name for f in registry.FAMILIES if f.layer == 5],
-    6: ["report", "scale", "cli"],
+    6: ["report", "scale", "cli", "cli_inputs"],
 }
 TOP = {name: layer for layer, names in LAYERS.items() for name in names}
 

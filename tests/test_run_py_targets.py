@@ -31,3 +31,16 @@ def test_targets_before_configfile_are_left_alone(capsys):
     assert capsys.readouterr().out == ""
     run.with_targets_first(["--configfile", "mine.yaml", "t.csv"])
     assert "read as target(s), not config: t.csv" in capsys.readouterr().out
+
+
+def test_every_configfile_option_is_joined_into_one():
+    """Snakemake keeps only the last --configfile option: `python3 run.py paper --configfile mine.yaml` must run on
+    config/cmu.yaml, samba.yaml, paper.yaml and then mine.yaml, not on mine.yaml alone."""
+    run = _run_py()
+    args = ["--configfile", "a.yaml", "b.yaml", "--config", "x=1", "--configfile=mine.yaml", "-n"]
+    assert run.one_configfile_option(args) == ["--configfile", "a.yaml", "b.yaml", "mine.yaml", "--config", "x=1",
+                                               "-n"]
+    assert run.one_configfile_option(["t.csv", "-n"]) == ["t.csv", "-n"]
+    paper = run.snakemake_args("paper", ["--configfile", "mine.yaml", "results/paper/data/trials/99_01.npz"])
+    assert paper == ["results/paper/data/trials/99_01.npz", "--configfile", "config/cmu.yaml", "config/samba.yaml",
+                     "config/paper.yaml", "mine.yaml"]

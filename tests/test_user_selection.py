@@ -101,3 +101,16 @@ def test_the_workflow_prints_what_a_user_config_leaves_out_at_parse_time(tmp_pat
             "compare.subsets: null for every subset)") in err
     assert "animsynth: resequencing: clip 'run' (c) of resequencing_trials left out by resequencing.datasets" in err
     assert "animsynth: trial 'e' is in no subset" in err
+
+
+def test_the_fps_hint_offers_the_rates_that_fit_every_trial(tmp_path):
+    """Files at 24, 30 and 120 fps: 24, 12 or 8 fit the first one refused, only 6 (and 3, 2, 1) fit every file."""
+    cfg = _user_config(tmp_path / "data", {"a": 24, "b": 120, "c": 30, "d": 120})
+    cfg["compare"]["subsets"] = None
+    with pytest.raises(ConfigError) as exc:
+        settings.check(cfg)  # compare.fps 30: not a divisor of a's 24
+    msg = str(exc.value)
+    assert "30 fps is not the rate of trial 'a' (24 fps" in msg
+    assert msg.endswith("set compare.fps to one that fits every trial the comparison uses: 6, 3, 2, 1")
+    assert settings.common_rates([120, 60, 30]) == ["30", "15", "10", "6"]
+    assert settings.common_rates([25, 24]) == ["1"]

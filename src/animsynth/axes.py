@@ -108,6 +108,24 @@ def leg_chains(skeleton: Skeleton, starts: np.ndarray, ends: np.ndarray, up) -> 
     return legs
 
 
+#: The roles decide a biped's up axis, whatever its lean or extents, when its head is above its feet along that
+#: axis (the largest component of the head-to-feet vector) in at least this share of the frames ...
+ROLES_DECIDE_SHARE = 0.9
+
+
+def _roles_decide(head_to_feet: np.ndarray, axis: str, counts: dict) -> bool:
+    """Whether a biped's head-to-feet vectors ``(frames, 3)`` point along ``axis`` in :data:`ROLES_DECIDE_SHARE`
+    of the frames, and its legs do not say otherwise (two leg-like chains stand along ``axis``, or none stands
+    along any axis): a person leaning 40 degrees forward (a crouched walk), or taller across than along up in part
+    of a take, is still upright; a file turned 45 degrees is not decided."""
+    k = np.argmax(np.abs(head_to_feet), axis=1)
+    signs = np.sign(head_to_feet[np.arange(len(k)), k])
+    want = "xyz".index(axis[1]), (1.0 if axis[0] == "+" else -1.0)
+    share = float(np.mean((k == want[0]) & (signs == want[1]))) if len(k) else 0.0
+    legs_agree = counts.get(axis, 0) >= 2 or max(counts.values(), default=0) < 2
+    return share >= ROLES_DECIDE_SHARE and legs_agree
+
+
 def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) -> tuple[str, dict]:
     """The up axis of a motion, from the joint roles for a biped, from the legs otherwise.
 
@@ -119,7 +137,9 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     that vector's second largest component is more than
     :data:`AMBIGUOUS_RATIO` of its largest (the body lies diagonally), when the
     hips are not between head and feet along it, or when the body is clearly
-    tallest along another axis (a lying body).
+    tallest along another axis (a lying body); the first and the last do not
+    count when the roles decide (:func:`_roles_decide`: the head above the feet
+    along that axis in nearly every frame, the legs agreeing).
 
     *Not a biped* (no head or feet by role, or four or more leg-like chains:
     a quadruped, a crab): a four-legged body is longer than it is tall, so the
@@ -143,6 +163,7 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     info : dict
         ``extent`` (3,) median extents; ``ratio`` (second largest / largest
         extent); ``biped`` (bool); ``legs`` (leg-like chains along ``axis``);
+        ``leg_counts`` (``{signed axis: leg-like chains along it}``);
         ``sign_from`` (``"roles"``: head above feet; ``"legs"``; ``"file"``:
         kept, as nothing told); ``ambiguous`` (bool); ``why`` (str: what was
         found, for the log).
@@ -153,23 +174,27 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     ext = np.median(pos.max(axis=1) - pos.min(axis=1), axis=0)
     tall = int(np.argmax(ext))
     ratio = float(np.sort(ext)[-2] / max(ext[tall], 1e-300))
-    info = {"extent": ext, "ratio": ratio, "biped": False, "legs": 0, "ambiguous": False, "why": ""}
+    info = {"extent": ext, "ratio": ratio, "biped": False, "legs": 0, "ambiguous": False, "why": "",
+            "leg_counts": {}}
     head = role_indices(skeleton, ("head",), overrides)
     feet = (role_indices(skeleton, ("left_ankle", "right_ankle"), overrides)
             or role_indices(skeleton, ("left_toe", "right_toe"), overrides))
     chains = {ax: leg_chains(skeleton, starts, ends, ax) for ax in AXES}
     counts = {ax: len(c) for ax, c in chains.items()}
+    info["leg_counts"] = counts
     # four or more legs where the feet (by role) stand: a four-legged animal on a biped template's names
     most = max((n for ax, n in counts.items()
                 if feet is None or any(f in c for c in chains[ax] for f in feet)), default=0)
     if head is not None and feet is not None and most <= MAX_BIPED_LEGS:
-        d = np.median(starts[:, head[0]] - 0.5 * (starts[:, feet[0]] + starts[:, feet[1]]), axis=0)
+        per_frame = starts[:, head[0]] - 0.5 * (starts[:, feet[0]] + starts[:, feet[1]])
+        d = np.median(per_frame, axis=0)
         a = int(np.argmax(np.abs(d)))
         axis = ("+" if d[a] >= 0 else "-") + "xyz"[a]
         info.update(biped=True, legs=counts[axis], sign_from="roles")
         why = []
         second = float(np.sort(np.abs(d))[-2] / max(abs(d[a]), 1e-300))
-        if second > AMBIGUOUS_RATIO:
+        decided = _roles_decide(per_frame, axis, counts)
+        if second > AMBIGUOUS_RATIO and not decided:
             why.append(f"the head-to-feet vector {_fmt_vec(d)} lies between two axes")
         hips = role_indices(skeleton, ("left_hip", "right_hip"), overrides)
         if hips is not None:
@@ -179,7 +204,7 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
             hf = float(np.median(0.5 * (starts[:, feet[0]] + starts[:, feet[1]]) @ u))
             if not hf <= hh <= hd:
                 why.append("the hips are not between the head and the feet")
-        if tall != a and ratio < AMBIGUOUS_RATIO:
+        if tall != a and ratio < AMBIGUOUS_RATIO and not decided:
             why.append(f"the body is tallest along {'xyz'[tall]} (lying down?)")
         info.update(ambiguous=bool(why), why="; ".join(why) or "head above feet")
         return axis, info
@@ -205,7 +230,10 @@ def lying_down(skeleton: Skeleton, values, up, overrides: dict | None = None) ->
     For a biped by joint role (head, ankles or toes): its head not above its
     feet (median over frames), or its extent along ``up`` less than half its
     largest extent across. For any body: :func:`detect_up_axis` finding
-    another axis without ambiguity.
+    another axis without ambiguity. For a body that is not a biped, also when
+    that detection is ambiguous: more leg-like chains (two at least) ending on
+    the floor along another axis than along ``up`` (a bird, an animal whose
+    legs do not all touch the floor).
     """
     u = axis_vector(up)
     detected, info = detect_up_axis(skeleton, values, overrides)
@@ -224,6 +252,12 @@ def lying_down(skeleton: Skeleton, values, up, overrides: dict | None = None) ->
             why.append(f"it is {ext[k]:.3g} units tall along {up} but {across:.3g} across")
     if detected != parse_axis(up) and not info["ambiguous"] and not why:
         why.append(f"its {'head is above its feet' if info['biped'] else 'legs stand'} along {detected}")
+    counts = info["leg_counts"]
+    best = max(AXES, key=lambda ax: (counts.get(ax, 0), ax == parse_axis(up)))
+    if not info["biped"] and not why and counts.get(best, 0) >= 2 and counts[best] > counts.get(parse_axis(up), 0):
+        # not a biped, its up axis not told by the legs (ambiguous): still, more legs stand on another axis
+        why.append(f"{counts.get(parse_axis(up), 0)} leg-like chains end on the floor along {up}, {counts[best]} "
+                   f"along {best}")
     return "; ".join(why)
 
 

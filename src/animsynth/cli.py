@@ -31,13 +31,16 @@ from __future__ import annotations
 
 import argparse
 import logging
-import math
 import os
 import sys
 
 import numpy as np
 
+from .cli_inputs import (UsageError, _check_per_file_options, _existing_dir, _existing_file, _finite, _inputs,
+                         _load, _load_any, _load_bvh, _out_with, _split_motion_args, fps_float, index_int,
+                         positive_float, positive_int, seed_int)
 from .limits import DEFAULT_MEMORY_BUDGET_GIB, check_budget
+from .pace import pace, pace_warning
 
 MOTION_OUTPUTS = (".bvh", ".amc", ".gif")
 #: GIF frames of ``animsynth preview``: 20 s in real time at 30 GIF frames per second; a longer clip plays
@@ -45,104 +48,11 @@ MOTION_OUTPUTS = (".bvh", ".amc", ".gif")
 PREVIEW_MAX_FRAMES = 600
 
 
-class UsageError(ValueError):
-    """An argument is invalid for the data it applies to (e.g. a frame past the end)."""
-
-    def __init__(self, option: str, message: str):
-        self.option = option
-        super().__init__(f"argument {option}: {message}")
-
-
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors: ``animsynth CMD: error: argument --x: ...``."""
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-def _finite(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
-    return value
-
-
-def positive_float(text: str) -> float:
-    """argparse type: a finite number > 0 (frame rates)."""
-    value = _finite(text)
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"must be > 0, got {text!r}")
-    return value
-
-
-def fps_float(text: str) -> float:
-    """argparse type: a frame rate whose frame time a BVH file can hold (1/60 to 100,000 fps)."""
-    from .io.bvh import MAX_FRAME_TIME, MIN_FRAME_TIME
-
-    value = positive_float(text)
-    # 1 / 1e-5 is 99999.99999999999 in floating point: the stated ends are accepted as printed
-    if not 1.0 / MAX_FRAME_TIME * (1 - 1e-12) <= value <= 1.0 / MIN_FRAME_TIME * (1 + 1e-12):
-        raise argparse.ArgumentTypeError(f"must be between {1.0 / MAX_FRAME_TIME:g} and {1.0 / MIN_FRAME_TIME:g} "
-                                         f"frames per second, got {text!r}")
-    return value
-
-
-def _int(text: str) -> int:
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-
-
-def positive_int(text: str) -> int:
-    """argparse type: an integer >= 1 (counts)."""
-    value = _int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {text!r}")
-    return value
-
-
-def index_int(text: str) -> int:
-    """argparse type: an integer >= 0 (0-based frame or file index)."""
-    value = _int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0 (0-based index), got {text!r}")
-    return value
-
-
-def seed_int(text: str) -> int:
-    """argparse type: a seed for numpy, 0 <= seed < 2**32."""
-    value = _int(text)
-    if not 0 <= value < 2**32:
-        raise argparse.ArgumentTypeError(f"must be in [0, 2**32), got {text!r}")
-    return value
-
-
-def _out_with(suffixes: tuple[str, ...]):
-    def check(text: str) -> str:
-        if not text.lower().endswith(suffixes):
-            raise argparse.ArgumentTypeError(f"use a {', '.join(suffixes[:-1])} or {suffixes[-1]} file name, got {text!r}"
-                                             if len(suffixes) > 1 else f"use a {suffixes[0]} file name, got {text!r}")
-        folder = os.path.dirname(os.path.abspath(text))
-        if os.path.exists(folder) and not os.path.isdir(folder):
-            raise argparse.ArgumentTypeError(f"{folder!r} is not a folder")
-        return text
-    return check
-
-
-def _existing_file(text: str) -> str:
-    if not os.path.isfile(text):
-        raise argparse.ArgumentTypeError(f"no such file {text!r}")
-    return text
-
-
-def _existing_dir(text: str) -> str:
-    if not os.path.isdir(text):
-        raise argparse.ArgumentTypeError(f"no such folder {text!r}")
-    return text
 
 
 def _labels(text: str) -> str:
@@ -155,124 +65,6 @@ def _labels(text: str) -> str:
     if unknown:
         raise argparse.ArgumentTypeError(f"unknown CK+ emotion {unknown[0]!r} (one of {', '.join(EMOTIONS[1:])})")
     return text
-
-
-def _load(asf: str, amc: str, fps: float):
-    from .io import read_amc, read_asf
-
-    return read_amc(amc, read_asf(asf), fps=fps)
-
-
-def _per_file(values, path: str, option: str, sep: str = "="):
-    """The value of a per-file option for ``path``: ``FILE=VALUE`` entries for this file win over plain ones."""
-    plain, own = None, None
-    for v in values or []:
-        head, found, tail = v.partition(sep)
-        if found and (os.path.normpath(head) == os.path.normpath(path) or os.path.basename(path) == head):
-            own = tail
-        elif found and head.lower().endswith(".bvh"):
-            continue
-        else:
-            plain = v
-    return own if own is not None else plain
-
-
-def _roles_for(values, path: str) -> dict:
-    roles = {}
-    for v in values or []:
-        cut = v.lower().find(".bvh:")  # FILE.bvh:ROLE=JOINT (a joint name may hold ':', mixamorig:LeftArm)
-        file, rest = (v[:cut + 4], v[cut + 5:]) if cut >= 0 else ("", v)
-        if file and os.path.normpath(file) != os.path.normpath(path) and os.path.basename(path) != file:
-            continue
-        role, found, joint = rest.partition("=")
-        if not found or not role or not joint:
-            raise UsageError("--role", f"expected ROLE=JOINT or FILE.bvh:ROLE=JOINT, got {v!r}")
-        roles[role] = joint
-    return roles
-
-
-def _load_bvh(a, path: str):
-    """A BVH file as the workflow reads a trial, with this file's --length-to-m, --role and axes."""
-    from .data import load_trial
-    from .kinematics import AXES
-
-    unit = _per_file(a.length_to_m, path, "--length-to-m")
-    try:
-        unit = 1.0 if unit is None else positive_float(unit)
-    except argparse.ArgumentTypeError as exc:
-        raise UsageError("--length-to-m", str(exc)) from None
-    axes = {}
-    for opt, key in (("--up-axis", "up_axis"), ("--forward-axis", "forward_axis")):
-        v = _per_file(getattr(a, key), path, opt) or "auto"
-        if v != "auto" and v.lower() not in AXES and "+" + v.lower() not in AXES:
-            raise UsageError(opt, f"expected auto or one of {', '.join(AXES)}, got {v!r}")
-        axes[key] = v
-    return load_trial(bvh=path, joint_roles=_roles_for(a.role, path), bvh_length_to_m=unit,
-                      name=os.path.splitext(os.path.basename(path))[0], setting_names=CLI_SETTING_NAMES, **axes)
-
-
-#: How :func:`animsynth.data.load_trial` names its settings in errors and warnings from the command line.
-CLI_SETTING_NAMES = {"joint_roles": "argument --role", "up_axis": "--up-axis (e.g. --up-axis FILE=+y)",
-                     "bvh_length_to_m": "--length-to-m"}
-#: The per-file options (``FILE=VALUE``; ``--role FILE.bvh:ROLE=JOINT``) of the commands that read BVH files.
-PER_FILE_OPTIONS = (("--length-to-m", "length_to_m"), ("--up-axis", "up_axis"), ("--forward-axis", "forward_axis"),
-                    ("--role", "role"))
-
-
-def _check_per_file_options(a) -> None:
-    """Refuse a per-file option that names no input file, or gives a file no value (``walk.bvh=``).
-
-    A ``FILE=VALUE`` entry (``FILE.bvh:ROLE=JOINT`` for ``--role``) whose ``FILE`` is none of the command's
-    input files, by path or by file name, would be ignored: a typo would silently leave that file at the
-    default. Entries without a file part apply to every file and are checked where they are used.
-    """
-    inputs = [f for f in _inputs(a) if f.lower().endswith(".bvh")]
-    for option, key in PER_FILE_OPTIONS:
-        for v in getattr(a, key, None) or []:
-            if key == "role":
-                cut = v.lower().find(".bvh:")
-                if cut < 0:
-                    continue
-                head, value = v[:cut + 4], v[cut + 5:]
-            else:
-                head, found, value = v.partition("=")
-                if not found or not head.lower().endswith(".bvh"):
-                    continue
-            if not any(os.path.normpath(head) == os.path.normpath(f) or os.path.basename(f) == head
-                       for f in inputs):
-                raise UsageError(option, f"{v!r} names {head!r}, which is not one of the input files "
-                                         f"({', '.join(inputs) or 'none is a .bvh file'})")
-            if not value.strip():
-                raise UsageError(option, f"{v!r} gives {head!r} no value")
-
-
-def _split_motion_args(files: list[str], out: str | None, outputs: tuple[str, ...]):
-    """``(inputs, out)`` from positional files: the output is ``--out`` or the last file with an output suffix."""
-    files = list(files)
-    if out is None:
-        if len(files) >= 2 and files[-1].lower().endswith(outputs):
-            out = files.pop()
-        else:
-            raise UsageError("out", f"give the output file last (a {', '.join(outputs)} file name) or with --out")
-    for f in files:
-        if not os.path.isfile(f):
-            raise UsageError("input", f"no such file {f!r}")
-    try:
-        _out_with(outputs)(out)
-    except argparse.ArgumentTypeError as exc:
-        raise UsageError("out", str(exc)) from None
-    return files, out
-
-
-def _load_any(a, files: list[str]):
-    """One motion from ``files``: a .bvh file, or an .asf and an .amc file (either order)."""
-    low = [f.lower() for f in files]
-    if len(files) == 1 and low[0].endswith(".bvh"):
-        return _load_bvh(a, files[0]), files[0]
-    if len(files) == 2 and sorted(os.path.splitext(f)[1] for f in low) == [".amc", ".asf"]:
-        asf, amc = (files[0], files[1]) if low[0].endswith(".asf") else (files[1], files[0])
-        return _load(asf, amc, a.fps), amc
-    raise UsageError("input", f"expected one .bvh file or an .asf and an .amc file, got {' '.join(files)}")
 
 
 def cmd_amc2bvh(a) -> None:
@@ -336,21 +128,57 @@ def cmd_generate(a) -> None:
     n_start = train[a.start_trial].n_frames
     if a.start_frame >= n_start:
         raise UsageError("--start-frame", f"{a.start_frame} is outside {a.train[a.start_trial]} ({n_start} frames, 0-based)")
+    n_root = len(sk.joints[0].dofs)
+    first = train[a.start_trial].values[a.start_frame]  # a frame of the file, whatever --rate
+    train = _at_rate(train, a.rate, a.train)
     n_train = sum(m.n_frames for m in train)
     if a.k > n_train:
         raise UsageError("--k", f"{a.k} neighbours but the training files hold only {n_train} frames")
     if a.latent_dim > train[0].without_root().shape[1]:
         raise UsageError("--latent-dim", f"{a.latent_dim} exceeds the {train[0].without_root().shape[1]} joint angles")
-    start = train[a.start_trial].without_root()[a.start_frame] if a.start_pose is None else None
+    start = first[n_root:] if a.start_pose is None else None
     angles, info = generate_from_trials(
         [m.without_root() for m in train], method=a.method, k=a.k, latent_dim=a.latent_dim,
         steps=a.steps, start=start, seed=a.seed)
     values = np.zeros((angles.shape[0], sk.n_dof))
-    n_root = len(sk.joints[0].dofs)
     values[:, n_root:] = angles
-    values[:, :n_root] = train[a.start_trial].values[a.start_frame, :n_root]  # root held at the start pose
-    _write_motion(a.out, Motion(values, sk, train[0].fps if all(bvh) else a.fps, "generated"))
-    print(f"wrote {a.out}: {angles.shape[0]} frames ({info})")
+    values[:, :n_root] = first[:n_root]  # root held at the start pose
+    out = Motion(values, sk, train[0].fps, "generated")
+    moved = pace(out, train)
+    line = pace_warning(moved, _pace_helps(a, train[0].fps, float(train[0].meta.get("file_fps", train[0].fps))))
+    if line:
+        print(f"animsynth generate: warning: {line}", file=sys.stderr)
+    _write_motion(a.out, out)
+    print(f"wrote {a.out}: {angles.shape[0]} frames at {out.fps:g} fps ({info}; {moved.ratio:.2g} of the "
+          "capture's pace)")
+
+
+def _at_rate(clips: list, rate: float | None, names: list[str]) -> list:
+    """``clips`` at ``rate`` fps (``--rate``): every n-th frame, n = the files' rate / ``rate`` (a whole number);
+    unchanged without ``--rate``. ``meta["file_fps"]`` keeps the files' own rate."""
+    from .motion import Motion
+
+    fps = float(clips[0].fps)
+    if rate is None or abs(rate - fps) < 1e-9:
+        return [Motion(c.values, c.skeleton, c.fps, c.name, dict(c.meta, file_fps=fps)) for c in clips]
+    n = fps / rate
+    if abs(n - round(n)) > 1e-6 or round(n) < 1:
+        fits = [f"{fps / k:g}" for k in range(1, 9) if abs(fps / k - round(fps / k)) < 1e-9][:5]
+        raise UsageError("--rate", f"{rate:g} fps is not the rate of {names[0]} ({fps:g} fps) divided by a whole "
+                                   f"number; use one of {', '.join(fits)}")
+    return [Motion(c.values[::int(round(n))], c.skeleton, rate, c.name, dict(c.meta, file_fps=fps)) for c in clips]
+
+
+def _pace_helps(a, fps: float, file_fps: float) -> list[str]:
+    """What helps a field follower that stops or slows: a larger latent space, a lower rate, another method."""
+    helps = [f"--latent-dim {a.latent_dim + 1} or more (in a low-dimensional latent space the interpolated "
+             "vectors often cancel)"]
+    if fps > 30 and abs(file_fps / 30 - round(file_fps / 30)) < 1e-9:
+        helps.append(f"--rate 30 (every {round(file_fps / 30)}th frame of the {file_fps:g} fps files: each step "
+                     "then covers more motion; Gauch & Peters fitted every 120 fps frame, docs/cli.md)")
+    helps.append(f"--method {'knn' if a.method == 'delaunay' else 'delaunay'}, or a method that plays captured "
+                 "frames (animsynth resequence; the comparison's motion graph and motion matching)")
+    return helps
 
 
 def cmd_resequence(a) -> None:
@@ -505,6 +333,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--start-pose", default=None, help=argparse.SUPPRESS)
     s.add_argument("--seed", type=seed_int, default=0)
     s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
+    s.add_argument("--rate", type=fps_float, default=None,
+                   help="fit and generate at this rate: every n-th frame of the files, n = their rate / RATE (a "
+                        "whole number; default: every frame, as Gauch & Peters fitted CMU's 120 fps frames)")
     s.add_argument("--out", default=None, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_generate)
 
@@ -558,9 +389,14 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("--role", action="append", metavar="[FILE:]ROLE=JOINT",
                        help="joint role of BVH input (e.g. left_hip=Bip01_L_Thigh); repeatable")
         s.add_argument("--up-axis", action="append", metavar="[FILE=]AXIS",
-                       help="up axis of BVH input (+x -x +y -y +z -z; default: detected)")
+                       help="up axis of BVH input (+x -x +y -y +z -z; default: detected); a negative axis works "
+                            "either way: --up-axis -z or --up-axis=-z")
         s.add_argument("--forward-axis", action="append", metavar="[FILE=]AXIS",
-                       help="forward axis of BVH input (default: the smallest turn taking up to +y)")
+                       help="forward axis of BVH input (default: the smallest turn taking up to +y); a negative "
+                            "axis works either way: --forward-axis -y or --forward-axis=-y")
+        s.add_argument("--root", action="append", metavar="[FILE=]NAME",
+                       help="the skeleton to read from a BVH file that holds several (two characters, a "
+                            "character and a prop): the name of its root joint")
     for s in sub.choices.values():
         s.add_argument("--memory-budget-gib", type=positive_float, default=DEFAULT_MEMORY_BUDGET_GIB,
                        help=f"refuse requests whose arrays exceed this many GiB (default {DEFAULT_MEMORY_BUDGET_GIB:g})")
@@ -569,15 +405,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 #: The option whose size a command's arrays grow with (named when memory runs out anyway).
 SIZE_OPTIONS = {"generate": "--steps", "resequence": "--length"}
-
-
-def _inputs(a) -> list[str]:
-    """The input files a command was given: ``--asf``/``amc``, the training files or the positional files."""
-    names = [getattr(a, k, None) for k in ("asf", "amc")]
-    names += list(getattr(a, "train", None) or []) + list(getattr(a, "files", None) or [])
-    names += list(getattr(a, "generated", None) or []) + [getattr(a, "reference", None)]
-    names += list(getattr(a, "database", None) or [])
-    return [n for n in dict.fromkeys(names) if n]
 
 
 def _check_out_is_not_an_input(a) -> None:
@@ -602,9 +429,28 @@ def _out_of_memory(a) -> str:
             "to be told which input is too large")
 
 
+#: The options whose value may be a negative axis (``-y``), which argparse would take for an option.
+AXIS_OPTIONS = ("--up-axis", "--forward-axis")
+
+
+def _negative_axes_joined(argv: list[str]) -> list[str]:
+    """``argv`` with ``--forward-axis -y`` written ``--forward-axis=-y`` (argparse reads a value starting with
+    ``-`` as an option, and ``-y`` is not a number)."""
+    out, i = [], 0
+    while i < len(argv):
+        if argv[i] in AXIS_OPTIONS and i + 1 < len(argv) and argv[i + 1].lower() in ("-x", "-y", "-z"):
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(argv[i])
+            i += 1
+    return out
+
+
 def main(argv=None) -> int:
     """Run one command; return the exit status (0 ok, 2 bad argument or input)."""
     parser = build_parser()
+    argv = _negative_axes_joined(list(sys.argv[1:] if argv is None else argv))
     try:
         # files may come after options too (resequence walk.bvh --start 10 --end 300 out.bvh): argparse leaves
         # the ones after an option over; they join the command's file list

@@ -23,18 +23,57 @@ def derive_seed(master: int, *names) -> int:
     return int.from_bytes(hashlib.sha256(text.encode()).digest()[:4], "little")
 
 
+def trial_records(trials) -> list[dict]:
+    """The trial records of ``trials`` as a list, in config order.
+
+    ``trials`` is a list of records (each with its ``id``), or a mapping trial id -> record: Snakemake merges
+    mappings across ``--configfile`` files, so a config over ``config/cmu.yaml`` adds records by id without
+    repeating the shipped ones (a later record of the same id replaces the earlier one, and ``ID: null`` drops
+    it), while a list replaces every earlier config's trials. :func:`validate_config` turns the mapping into the
+    list every other function reads.
+
+    Raises
+    ------
+    ConfigError
+        A mapping key that YAML read as a number (``35_16:`` is the integer 3516: quote it), or a record whose
+        ``id`` differs from its key; the message names the key.
+    """
+    if not isinstance(trials, dict):
+        return list(trials or [])
+    out = []
+    for key, rec in trials.items():
+        if not isinstance(key, str):
+            raise ConfigError(f"config key 'trials': the trial id {key!r} was read as a number (YAML reads 35_16 as "
+                              f"3516); quote the id: \"{key}\":")
+        if rec is None:  # dropped by a later config
+            continue
+        if "id" in rec and str(rec["id"]) != key:
+            raise ConfigError(f"config key 'trials.{key}.id': {rec['id']!r} differs from its key {key!r} (in the "
+                              "mapping form the key is the id; leave 'id' out)")
+        out.append({"id": key, **{k: v for k, v in rec.items() if k != "id"}})
+    return out
+
+
+#: What an error about a trial id that has no record says about where to add one.
+ADD_TRIAL = ("add its record to 'trials' in your config: as a mapping keyed by the quoted id (trials: {'ID': "
+             "{subject: ..., kind: ..., amc: ..., asf: ...}}), which adds to the trials of the configs before it; "
+             "a list of records replaces them all (docs/data.md, 'Adding a subject')")
+
+
 #: Trial fields that name a file below ``data_dir`` / ``cmu_mirror``.
 TRIAL_FILE_KEYS = ("amc", "asf", "bvh")
 
 
 def resolve_inside(root: str, rel: str, key: str) -> str:
-    """Join ``rel`` below ``root``, refusing any path that leaves ``root``.
+    """Join ``rel`` below ``root``, refusing any path text that leaves ``root``.
 
     ``rel`` must be a relative path that stays inside ``root`` after
     normalisation (no absolute path, drive letter, ``~`` or ``..`` escape).
-    When ``root`` is a local folder that exists, symbolic links are resolved
-    too, so a link inside ``root`` cannot point outside it. ``root`` may also
-    be a URL (a mirror); then the check is on the path text only.
+    Symbolic links below ``root`` are followed wherever they point: a mirror
+    may be a folder of links to the files of other mirrors (a merged mirror),
+    and these files are only ever read (copied by the download job and checked
+    against the record's SHA-256 when it gives one), never written. ``root`` may also be a URL
+    (a mirror); the check is on the path text then too.
 
     Parameters
     ----------
@@ -64,14 +103,7 @@ def resolve_inside(root: str, rel: str, key: str) -> str:
         raise ConfigError(f"config key '{key}': {rel!r} leaves {root!r}; paths must stay inside it")
     if "://" in root:
         return root.rstrip("/") + "/" + norm
-    path = os.path.join(root, *norm.split("/"))
-    if os.path.isdir(root):
-        real_root = os.path.realpath(root)
-        real = os.path.realpath(path)
-        if os.path.commonpath([real_root, real]) != real_root:
-            raise ConfigError(f"config key '{key}': {rel!r} resolves to {real!r}, outside {root!r} "
-                              "(a symbolic link leaving the folder)")
-    return path
+    return os.path.join(root, *norm.split("/"))
 
 
 #: Largest number of values a config may expand to (YAML aliases counted at
@@ -368,10 +400,12 @@ def check_config(config: dict) -> None:
     for name, members in subsets.items():
         bad = [m for m in members if m not in known]
         if bad:
-            raise ConfigError(f"config key 'subsets.{name}': unknown trial id(s) {bad}")
+            raise ConfigError(f"config key 'subsets.{name}': trial(s) {', '.join(map(repr, bad))} have no record in "
+                              f"'trials' ({len(known)} records); {ADD_TRIAL}")
     for name, tid in config["resequencing_trials"].items():
         if tid not in known:
-            raise ConfigError(f"config key 'resequencing_trials.{name}': unknown trial id {tid!r}")
+            raise ConfigError(f"config key 'resequencing_trials.{name}': trial {tid!r} has no record in 'trials'; "
+                              f"{ADD_TRIAL}")
 
 
 def unused_trials(config: dict) -> list[str]:
@@ -476,7 +510,8 @@ def validate_config(config: dict, schema_path: str) -> None:
 
     Wraps :func:`snakemake.utils.validate` (which also sets defaults) so that
     a violation raises a :class:`ConfigError` of a few lines (see
-    :func:`explain_schema_error`) instead of the validator's dump.
+    :func:`explain_schema_error`) instead of the validator's dump. Afterwards
+    ``trials`` is a list (:func:`trial_records`: the mapping form becomes one).
     """
     import yaml
     from snakemake.utils import validate
@@ -493,3 +528,5 @@ def validate_config(config: dict, schema_path: str) -> None:
         if short is None:
             short = "\n".join(str(exc).splitlines()[:5])
         raise ConfigError(short) from None
+    if "trials" in config:
+        config["trials"] = trial_records(config["trials"])

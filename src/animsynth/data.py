@@ -121,7 +121,7 @@ def _rename_path(exc: Exception, files: dict, shown: dict):
 def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "", joint_roles: dict | None = None,
                bvh_length_to_m: float = 1.0, up_axis: str | None = "auto", forward_axis: str | None = "auto",
                source_files: dict | None = None, first_frame: int = 0,
-               setting_names: dict | None = None) -> Motion:
+               setting_names: dict | None = None, bvh_root: str | None = None) -> Motion:
     """Parse one trial (ASF+AMC, or BVH) into a :class:`Motion` in the canonical frame (+y up, +z forward).
 
     Parameters
@@ -137,6 +137,10 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     bvh_length_to_m : float
         A BVH file's metres per length unit (0.01 centimetres, 0.05644
         cgspeed's CMU conversions, which keep the ASF unit).
+    bvh_root : str, optional
+        The skeleton to read from a BVH file that holds several (two
+        characters): the name of its root joint (:func:`animsynth.io.bvh.read_bvh`,
+        ``root``; config ``bvh_root`` on the trial, command line ``--root``).
     up_axis, forward_axis : str or None
         The file's world axes (``"+z"``, ...), or ``"auto"``/None. For BVH,
         ``auto`` detects the up axis from the motion
@@ -189,7 +193,7 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         if bvh is not None:
             from .io.bvh import read_bvh
 
-            m = read_bvh(bvh)
+            m = read_bvh(bvh, root=bvh_root)
             m.skeleton.length_to_m = float(bvh_length_to_m)
         else:
             m = read_amc(amc, read_asf(asf), fps=fps)
@@ -265,7 +269,11 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
 
 
 def _warn_shared_roles(skeleton, overrides: dict, where: str, setting: str) -> None:
-    """Log a warning for every joint that plays two roles or more (given or found by name)."""
+    """Log a warning for every joint that plays two roles or more (given or found by name).
+
+    One case is the documented setting, not a mistake, and is an info line: a toe role given to the joint that is
+    the same side's ankle when that joint ends its chain (a skeleton without toe joints, e.g. cgspeed's CMU BVH
+    files: the foot's End Site is the toe tip), so the foot's contacts are measured at the ankle joint."""
     from .joints import ROLES, JointRoleError, resolve_role
 
     played: dict[str, list[str]] = {}
@@ -275,10 +283,17 @@ def _warn_shared_roles(skeleton, overrides: dict, where: str, setting: str) -> N
         except JointRoleError:
             continue
     for joint, rs in played.items():
-        if len(rs) > 1:
-            given = [r for r in rs if r in (overrides or {})]
-            log.warning("%s: joint %r plays %d roles (%s%s); each role should be its own joint: check %s", where,
-                        joint, len(rs), ", ".join(rs), f"; given: {', '.join(given)}" if given else "", setting)
+        if len(rs) <= 1:
+            continue
+        given = [r for r in rs if r in (overrides or {})]
+        side = rs[0].split("_")[0]
+        if sorted(rs) == [f"{side}_ankle", f"{side}_toe"] and given == [f"{side}_toe"] and \
+                not skeleton.children(skeleton.names.index(joint)):
+            log.info("%s: joint %r is %s and, as given, %s (the skeleton has no toe joint below it)", where, joint,
+                     rs[0], rs[1])
+            continue
+        log.warning("%s: joint %r plays %d roles (%s%s); each role should be its own joint: check %s", where,
+                    joint, len(rs), ", ".join(rs), f"; given: {', '.join(given)}" if given else "", setting)
 
 
 def _fmt(a) -> str:

@@ -21,7 +21,7 @@ head             head        Head                          head
 left_hip         lfemur      LeftUpLeg, LeftThigh          thigh.L, upper_leg.L
 left_knee        ltibia      LeftLeg, LeftShin             shin.L, lower_leg.L
 left_ankle       lfoot       LeftFoot                      foot.L
-left_toe         ltoes       LeftToeBase, LeftToe          toe.L
+left_toe         ltoes       LeftToeBase, LeftToe, Toe0    toe.L
 left_shoulder    lhumerus    LeftArm, LeftUpArm, lShldr    upper_arm.L
 left_elbow       lradius     LeftForeArm                   forearm.L, lower_arm.L
 left_wrist       lwrist      LeftHand                      hand.L
@@ -33,7 +33,10 @@ joint is ``LeftArm``. In cgspeed's 3ds Max-friendly CMU conversions
 (``LeftCollar``, ``LeftShoulder``, ``LeftElbow``) ``LeftShoulder`` is the upper
 arm: name it with ``joint_roles`` (config/cmu.yaml does for 131). Names match case-insensitively, after dropping a
 namespace prefix (``mixamorig:LeftArm``) and the separators ``_ - . space``
-(``upper_arm.L`` = ``upperarml``). ``pelvis`` falls back to the skeleton's
+(``upper_arm.L`` = ``upperarml``), and 3ds Max Biped's ``Bip01`` prefix
+(``Bip01_L_Thigh`` = ``lthigh``, ``Bip01 L Calf``, ``Bip01 L Foot``,
+``Bip01 L Toe0``, ``Bip01 L UpperArm``, ``Bip01 Pelvis``, ``Bip01 Spine1``
+...). ``pelvis`` falls back to the skeleton's
 root joint. Anything else that does not resolve raises :class:`JointRoleError`
 naming the role, the names looked for and the joints available.
 """
@@ -56,7 +59,7 @@ _SIDED = {
              "lowerleg{s}", "calf{s}", "{s}shin", "{s}lowerleg", "{s}knee", "{s}calf", "{s}leg"],
     "ankle": ["{s}foot", "{side}foot", "{side}ankle", "foot{s}", "ankle{s}", "{s}ankle"],
     "toe": ["{s}toes", "{side}toebase", "{side}toe", "{side}toes", "{side}toeend", "toe{s}", "toes{s}", "{s}toe",
-            "{s}toebase"],
+            "{s}toebase", "{s}toe0"],
     "shoulder": ["{s}humerus", "{side}arm", "{side}uparm", "{side}upperarm", "upperarm{s}", "uparm{s}",
                  "{s}upperarm", "{s}uparm", "{s}humerus", "{s}shldr", "{side}shldr"],
     "elbow": ["{s}radius", "{side}forearm", "{side}lowerarm", "{side}elbow", "forearm{s}", "lowerarm{s}",
@@ -83,8 +86,10 @@ FOOT_ROLES = ("left_ankle", "left_toe", "right_ankle", "right_toe")
 
 
 def normalise_name(name: str) -> str:
-    """Joint name as matched against :data:`ROLES`: namespace dropped, lower case, no ``_ - . space``."""
-    return re.sub(r"[\s_.\-]+", "", str(name).rsplit(":", 1)[-1].rsplit("|", 1)[-1]).lower()
+    """Joint name as matched against :data:`ROLES`: namespace dropped, lower case, no ``_ - . space``, and 3ds
+    Max Biped's prefix ``Bip01`` (``Bip001``, ...) dropped when a name is left (``Bip01 L Thigh`` = ``lthigh``)."""
+    norm = re.sub(r"[\s_.\-]+", "", str(name).rsplit(":", 1)[-1].rsplit("|", 1)[-1]).lower()
+    return re.sub(r"^bip\d+(?=[a-z])", "", norm)
 
 
 def _names_and_overrides(skeleton_or_names, overrides):

@@ -103,9 +103,23 @@ def probe_source(source: str | os.PathLike | None, probe: str | None = None, tim
     p = Path(s)
     if not p.exists():
         return False, f"{p} does not exist"
-    if probe and p.is_dir() and not (p / probe).exists():
-        return False, f"{p / probe} does not exist"
+    if probe and not p.is_dir():  # a mirror (files below it) that is a file
+        return False, f"{p} is a file, not a folder"
+    if probe and not (p / probe).is_file():
+        return False, f"{p / probe} does not exist" if not (p / probe).exists() else f"{p / probe} is not a file"
     return True, ""
+
+
+def missing_below(source: str | os.PathLike | None, paths) -> list[str]:
+    """The ``paths`` (relative) that are not readable files below the local folder ``source``, in order; none for a
+    URL or no source (a URL is probed once, by :func:`probe_source`: asking it for every file would take minutes).
+
+    A symbolic link to a readable file counts as that file (a mirror may be a folder of links).
+    """
+    if not source or is_url(str(source)):
+        return []
+    root = Path(source)
+    return [p for p in paths if not (root / p).is_file() or not os.access(root / p, os.R_OK)]
 
 
 def list_frames(folder: str | os.PathLike) -> list[Path]:

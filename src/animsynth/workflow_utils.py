@@ -66,3 +66,21 @@ def setup_logging(snakemake=None, name: str = "animsynth", log_path: str | None 
 
     sys.excepthook = _hook
     return logger
+
+
+class config_errors_stop_the_run:
+    """Context manager for the workflow's config checks at parse time: a :class:`animsynth.config.ConfigError`
+    prints its message once, ``animsynth: config error: ...`` (its own lines only: the key, what is wrong,
+    what to do), and stops Snakemake with exit status 1, without the stack lines of the Snakefile and the
+    library that Snakemake would print with it. Any other exception (a bug) keeps its traceback."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        from .config import ConfigError
+
+        if kind is not None and issubclass(kind, ConfigError):
+            print(f"animsynth: config error: {exc}", file=sys.stderr, flush=True)
+            raise SystemExit(1)
+        return False

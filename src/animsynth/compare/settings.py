@@ -14,12 +14,14 @@ log = logging.getLogger("animsynth.compare")
 
 __all__ = ["check", "groups", "clip_ids", "subject_sets", "showcase", "run_generators", "clips_cfg", "native_rates",
            "job_cfg", "unavailable", "user_generators", "generator_order", "user_job_cfg", "left_out", "trial_rate",
-           "check_trial_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
+           "check_subject_sets", "check_trial_rates", "common_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
 
 def subject_sets(config: dict) -> dict:
-    """``{name: [trial ids]}`` of ``compare.subjects`` (the comparison's own per-subject sets), in config order."""
-    return {k: list(v) for k, v in (config["compare"].get("subjects") or {}).items()}
+    """``{name: [trial ids]}`` of ``compare.subjects`` (the comparison's own per-subject sets), in config order.
+
+    A later config drops one set with ``name: null`` and every set with ``subjects: null`` (configs merge)."""
+    return {k: list(v) for k, v in (config["compare"].get("subjects") or {}).items() if v is not None}
 
 
 def groups(config: dict, missing=()) -> tuple[dict, dict]:
@@ -216,16 +218,7 @@ def check(config: dict) -> None:
             parse_spec(spec)
         except ValueError as exc:
             raise ConfigError(f"config key 'compare.user_generators.{name}': {exc}") from None
-    known = {t["id"] for t in config["trials"]}
-    taken = set(config["subsets"]) | set(config["resequencing_trials"])
-    for name, ids in subject_sets(config).items():
-        if name in taken:
-            raise ConfigError(f"config key 'compare.subjects.{name}': {name!r} is the name of a subset or "
-                              "re-sequencing clip; give the set another name")
-        bad = [t for t in ids if t not in known]
-        if bad:
-            raise ConfigError(f"config key 'compare.subjects.{name}': unknown trial id(s) {bad} (every trial of "
-                              "the comparison is a record of 'trials', so it is fetched and parsed)")
+    check_subject_sets(config)
     subsets, reseq = groups(config)
     if not subsets and not reseq:
         raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': no clip to compare")
@@ -286,6 +279,38 @@ def check(config: dict) -> None:
     from .claims import check_claims
 
     check_claims(config)  # the declared claims against the metric table and the configured rows
+
+
+def check_subject_sets(config: dict) -> None:
+    """Refuse a ``compare.subjects`` set that is not one subject's trials with records: a name taken by a subset or
+    re-sequencing clip, a trial without a record in ``trials``, or trials of two subjects (their records'
+    ``subject``) in one set, which would count two independent units as one.
+
+    Raises
+    ------
+    ConfigError
+        naming ``compare.subjects.<set>``
+    """
+    from ..config import ADD_TRIAL
+
+    records = {t["id"]: t for t in config["trials"]}
+    taken = set(config["subsets"]) | set(config["resequencing_trials"])
+    for name, ids in subject_sets(config).items():
+        key = f"config key 'compare.subjects.{name}'"
+        if name in taken:
+            raise ConfigError(f"{key}: {name!r} is the name of a subset or re-sequencing clip; give the set another "
+                              "name")
+        bad = [t for t in ids if t not in records]
+        if bad:
+            raise ConfigError(f"{key}: trial(s) {', '.join(map(repr, bad))} have no record in 'trials' (every trial "
+                              f"of the comparison is fetched and parsed); {ADD_TRIAL}")
+        subjects = {}
+        for t in ids:
+            subjects.setdefault(str(records[t]["subject"]), []).append(t)
+        if len(subjects) > 1:
+            parts = "; ".join(f"subject {s}: {', '.join(ts)}" for s, ts in subjects.items())
+            raise ConfigError(f"{key}: mixes trials of {len(subjects)} subjects ({parts}); a set is one subject "
+                              "(one independent unit of the verdicts): give each subject a set of its own")
 
 
 def _flow(values) -> str:
@@ -352,7 +377,8 @@ def check_trial_rates(config: dict) -> None:
     Raises
     ------
     ConfigError
-        naming ``compare.fps``, the trial and its rate
+        naming ``compare.fps``, the first trial it does not fit and its rate, and the rates that fit every trial
+        the comparison uses (:func:`common_rates`)
     """
     if config["mocap_source"] != "user":
         return
@@ -360,16 +386,43 @@ def check_trial_rates(config: dict) -> None:
     subsets, reseq = groups(config)
     used = list(dict.fromkeys([t for ids in subsets.values() for t in ids] + list(reseq.values())))
     records = {t["id"]: t for t in config["trials"]}
+    rates = {}
     for tid in used:
-        if tid not in records:
-            continue  # an unknown id: animsynth.config.check_config names it
-        fps, where = trial_rate(config, records[tid])
-        if fps is None:
-            continue
-        ratio = fps / want
-        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
-            divisors = [f"{fps / n:g}" for n in range(1, 7) if abs(fps / n - round(fps / n)) < 1e-9][:4] or [f"{fps:g}"]
-            raise ConfigError(f"config key 'compare.fps': {config['compare']['fps']} fps is not the rate of trial "
-                              f"{tid!r} ({fps:g} fps, {where}) divided by a whole number (the comparison keeps every "
-                              f"n-th frame); set compare.fps to one of {', '.join(divisors)}, or leave the trial out "
-                              "of compare.subsets / compare.resequencing")
+        if tid in records:  # an unknown id: animsynth.config.check_config names it
+            fps, where = trial_rate(config, records[tid])
+            if fps is not None:
+                rates[tid] = (fps, where)
+    bad = [(tid, fps, where) for tid, (fps, where) in rates.items() if not _divides(fps, want)]
+    if bad:
+        tid, fps, where = bad[0]
+        fits = common_rates([f for f, _w in rates.values()])
+        hint = (f"set compare.fps to one that fits every trial the comparison uses: {', '.join(fits)}" if fits
+                else "no rate fits every trial the comparison uses (" + ", ".join(
+                    sorted({f"{f:g}" for f, _w in rates.values()})) + " fps): leave the trials of another rate out "
+                "of compare.subsets / compare.resequencing")
+        more = f" (and {len(bad) - 1} more trial(s))" if len(bad) > 1 else ""
+        raise ConfigError(f"config key 'compare.fps': {config['compare']['fps']} fps is not the rate of trial "
+                          f"{tid!r} ({fps:g} fps, {where}){more} divided by a whole number (the comparison keeps "
+                          f"every n-th frame); {hint}")
+
+
+def _divides(fps: float, rate: float) -> bool:
+    ratio = fps / rate
+    return abs(ratio - round(ratio)) <= 1e-6 and round(ratio) >= 1
+
+
+def common_rates(rates, most: int = 4) -> list[str]:
+    """The working rates (whole frames per second, highest first, at most ``most``) that every rate of ``rates``
+    divides by a whole number: e.g. 6 for files at 24, 30 and 120 fps."""
+    rates = [float(r) for r in rates]
+    if not rates:
+        return []
+    low = min(rates)
+    out = []
+    for n in range(1, int(low) + 1):
+        r = low / n
+        if abs(r - round(r)) < 1e-9 and all(_divides(f, r) for f in rates):
+            out.append(f"{r:g}")
+        if len(out) == most:
+            break
+    return out

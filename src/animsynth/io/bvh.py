@@ -252,7 +252,7 @@ def _parse_frame_time(ft_s: str, path, line: int) -> float:
     return ftime
 
 
-def read_bvh(path, fps: float | None = None) -> Motion:
+def read_bvh(path, fps: float | None = None, root: str | None = None) -> Motion:
     """Read a BVH file into a generic skeleton and motion (see module docstring).
 
     Parameters
@@ -260,6 +260,10 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     path : path
     fps : float, optional
         Override the frame rate given by the file's frame time.
+    root : str, optional
+        The skeleton to read from a file that holds several (two characters, a character and a prop): the name
+        of one of its ``ROOT`` joints, or of a root bone under a dummy root without channels (Blender's armature
+        with several root bones). Not needed for a file of one skeleton.
 
     Returns
     -------
@@ -376,10 +380,12 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     if kw != "ROOT":
         raise MotionFormatError(path, ln, f"expected ROOT, got {kw!r}")
     parse_joint(-1, kw, ln)
+    while pos < len(toks) and toks[pos][0] == "ROOT":  # another character (or prop) in the same file
+        kw, ln = nxt()
+        parse_joint(-1, kw, ln)
     if pos < len(toks):
         t, ln = toks[pos]
-        what = "a second ROOT (one skeleton per file is supported)" if t == "ROOT" else repr(t)
-        raise MotionFormatError(path, ln, f"{what} after the root joint's closing brace")
+        raise MotionFormatError(path, ln, f"{t!r} after the root joint's closing brace")
     # motion header
     i = motion_line
 
@@ -416,6 +422,7 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     if len(rows) != nframes:
         raise MotionFormatError(path, len(raw), f"header says {nframes} frames, file has {len(rows)} (truncated?)")
     data = np.array(rows, float).reshape(nframes, ncols)
+    joints, data = _pick_skeleton(path, joints, data, root)
     joints, data = _drop_dummy_root(path, joints, data)
     joints, data = _merge_dummy_root(path, joints, data)
     data = _constant_child_positions(path, joints, data)
@@ -445,6 +452,38 @@ def read_bvh(path, fps: float | None = None) -> Motion:
     return Motion(values, sk, float(fps) if fps is not None else _frame_rate(ft_s, ftime), sk.name)
 
 
+def _pick_skeleton(path, joints: list[dict], data: np.ndarray, root: str | None):
+    """The joints and columns of the one skeleton ``root`` names, from a file that may hold several (``ROOT``
+    blocks, or root bones under a dummy root without channels); a file of several and no ``root`` is refused,
+    naming them and how to pick one."""
+    tops = [k for k, r in enumerate(joints) if r["parent"] == -1]
+    bones = {k: [c for c, r in enumerate(joints) if r["parent"] == k] for k in tops}
+    picks = [c for k in tops for c in (bones[k] if not joints[k]["channels"] and len(bones[k]) > 1 else [k])]
+    names = [joints[k]["name"] for k in picks]
+    how = "name one with root= (command line: --root NAME; config: bvh_root on the trial)"
+    if root is None:
+        if len(tops) > 1:
+            raise MotionFormatError(path, joints[tops[1]]["line"], f"a second ROOT {joints[tops[1]]['name']!r}: the "
+                                    f"file holds {len(tops)} skeletons ({', '.join(map(repr, names))}); {how}")
+        return joints, data
+    if root not in names:
+        raise MotionFormatError(path, joints[0]["line"], f"root={root!r} is none of the file's skeletons "
+                                f"({', '.join(map(repr, names))})")
+    pick = picks[names.index(root)]
+    top = pick if joints[pick]["parent"] == -1 else joints[pick]["parent"]
+    keep = []
+    for k, r in enumerate(joints):  # file order: a parent comes before its children
+        if k in (top, pick) or (r["parent"] in keep and (r["parent"] != top or top == pick)):
+            keep.append(k)
+    start = np.cumsum([0] + [len(r["channels"]) for r in joints])
+    cols = [c for k in keep for c in range(start[k], start[k + 1])]
+    new = {k: i for i, k in enumerate(keep)}
+    out = [dict(joints[k], parent=new.get(joints[k]["parent"], -1)) for k in keep]
+    log.info("%s: skeleton %r read (root=%r) of the %d in the file: %s", os.fspath(path), root, root, len(names),
+             ", ".join(names))
+    return out, data[:, cols]
+
+
 def _drop_dummy_root(path, joints: list[dict], data: np.ndarray):
     """Drop a root without channels that has one child (see module docstring)."""
     root = joints[0]
@@ -456,7 +495,8 @@ def _drop_dummy_root(path, joints: list[dict], data: np.ndarray):
         raise MotionFormatError(path, root["line"],
                                 f"root joint {root['name']!r} has no channels and {len(kids)} children ({names}): "
                                 "an armature with several root bones (Blender writes them under a dummy root); "
-                                "one skeleton with one root per file is supported, export one root bone")
+                                "read one with root=NAME (command line: --root NAME; config: bvh_root on the "
+                                "trial), or export one root bone")
     if not kids:
         return joints, data
     child = joints[1]  # the only child comes first in file order

@@ -12,6 +12,7 @@ import os
 import numpy as np
 import pandas as pd
 
+from ..config import trial_records
 from ..published import PublishedError, read_table
 from ..tables import add_paper_differences
 from .features import SIGN_MODES
@@ -46,7 +47,7 @@ def paper_comparable(config: dict, trials: dict) -> dict[str, bool]:
         for that dataset (``35_01.amc``); ``False`` for anything else: a user's own capture is not the motion
         the paper measured, so its min k is not comparable with the paper's.
     """
-    records = {str(t.get("id")): t for t in config.get("trials") or []}
+    records = {str(t.get("id")): t for t in trial_records(config.get("trials"))}
     out = {}
     for dataset, tid in trials.items():
         if config.get("mocap_source") == "synthetic":

@@ -13,6 +13,7 @@ genmm           generative motion matching (Li et al. 2023)
 poses           the pose representation motion matching and GenMM share
 references      the two reference rows: replay (the held-out capture) and concat (random segments)
 user            your own generator in the comparison (``compare.user_generators``: a file and a class)
+user_guard      what keeps a user class inside its job: the write and signal guard, the watchdog (standard library)
 
 Every generator is an :class:`animsynth.generator.Generator` (the one import path of the interface).
 """

@@ -35,6 +35,7 @@ import numpy as np
 
 from ...motion import Motion
 from ...generator import Database, Generator, check_generated
+from .user_guard import STOP, inside, install_guard
 
 __all__ = ["UserGeneratorError", "UserGenerator", "UserProcess", "user_process", "close_processes", "parse_spec",
            "resolve_path", "file_sha256", "load_class"]
@@ -200,70 +201,10 @@ def _generate_raw(model, name: str, spec: str, start: Motion, length: int, seed:
 
 # ----------------------------------------------------------------------------- the child process
 
-#: audit events that change a file, and the positions of their path arguments
-_WRITE_EVENTS = {"os.rename": (0, 1), "os.replace": (0, 1), "os.remove": (0,), "os.unlink": (0,), "os.rmdir": (0,),
-                 "os.mkdir": (0,), "shutil.rmtree": (0,), "os.truncate": (0,), "os.symlink": (1,), "os.link": (1,),
-                 "os.chmod": (0,), "os.utime": (0,), "shutil.copyfile": (1,), "shutil.move": (0, 1)}
-_WRITE_FLAGS = os.O_WRONLY | os.O_RDWR | os.O_CREAT | os.O_TRUNC | os.O_APPEND
-
-
-def _inside(path: str, root: str) -> bool:
-    try:
-        return os.path.commonpath([path, root]) == root
-    except ValueError:  # different drives
-        return False
-
-
-def _guarded_path(path, guard: list[str], allow: list[str]) -> str | None:
-    """The resolved ``path`` if it lies inside a guarded folder and no allowed one (else None); compiled-bytecode
-    caches (``__pycache__``) are never guarded (Python's import writes them)."""
-    if path is None or isinstance(path, int):
-        return None
-    try:
-        p = os.path.realpath(os.fsdecode(path))
-    except (TypeError, ValueError):
-        return None
-    if "__pycache__" in Path(p).parts:
-        return None
-    if any(_inside(p, a) for a in allow):
-        return None
-    return next((p for g in guard if _inside(p, g)), None)
-
-
-def _install_write_guard(guard: list[str], allow: list[str], refused: list) -> None:
-    """Refuse (PermissionError) and record every file change inside ``guard`` and outside ``allow`` made through
-    Python's audited calls (``open`` for writing, rename, remove, mkdir, ...) in this process."""
-    busy = []
-
-    def hook(event, args):
-        if busy:
-            return
-        if event == "open":
-            path, mode, flags = (tuple(args) + (None, None, None))[:3]
-            writes = (any(c in mode for c in "wax+") if isinstance(mode, str)
-                      else isinstance(flags, int) and bool(flags & _WRITE_FLAGS))
-            paths = [path] if writes else []
-        elif event in _WRITE_EVENTS:
-            paths = [args[i] for i in _WRITE_EVENTS[event] if i < len(args)]
-        else:
-            return
-        busy.append(1)
-        try:
-            hit = next((h for h in (_guarded_path(p, guard, allow) for p in paths) if h), None)
-        finally:
-            busy.pop()
-        if hit:
-            refused.append(hit)
-            raise PermissionError(f"a user generator may not change files inside the run's project or results folder "
-                                  f"({event} {hit}); write below its working directory or use an absolute path "
-                                  "elsewhere")
-
-    sys.addaudithook(hook)
-
-
-def _child_main(fd: int, name: str, spec: str, base: str, guard: list, allow: list) -> None:
+def _child_main(fd: int, job_pid: int, name: str, spec: str, base: str, guard: list, allow: list) -> None:
     """The child process of one job's user generator: answers ``("fit", clips)`` and ``("generate", start, length,
-    seed)`` requests on the connection ``fd`` until ``("stop",)`` or the end of the connection.
+    seed)`` requests on the connection ``fd`` until ``("stop",)`` or the end of the connection. Started by
+    :class:`UserProcess` after :func:`.user_guard.watch_parent` has tied it to the job ``job_pid``.
 
     Each reply is ``(status, result, cpu_s, peak_rss_mb, refused writes)``: ``status`` ``"ok"`` (the fit's result
     is None, the generation's the user's returned object) or ``"error"`` (``result``: the one-line message)."""
@@ -273,7 +214,7 @@ def _child_main(fd: int, name: str, spec: str, base: str, guard: list, allow: li
 
     conn = Connection(fd)
     refused: list = []
-    _install_write_guard(guard, allow, refused)
+    install_guard(guard, allow, refused, job_pid)
     model = None
     while True:
         try:
@@ -329,19 +270,27 @@ class UserProcess:
         user_dir = str(_spec_path(spec, self.base).resolve().parent)
         guard = [os.path.realpath(g) for g in guard]
         # the file's own folder may be written (a cache beside the module) unless a guarded folder lies in it
-        allow = [os.path.realpath(self.workdir)] + ([user_dir] if not any(_inside(g, user_dir) for g in guard)
+        allow = [os.path.realpath(self.workdir)] + ([user_dir] if not any(inside(g, user_dir) for g in guard)
                                                     else [])
         mine, theirs = socket.socketpair()
-        code = ("import sys; sys.path[:0] = {path!r}; from animsynth.compare.generators.user import _child_main; "
-                "_child_main({fd}, {name!r}, {spec!r}, {base!r}, {guard!r}, {allow!r})").format(
-            path=[p for p in sys.path if p], fd=theirs.fileno(), name=name, spec=spec, base=self.base, guard=guard,
-            allow=allow)
+        # the lifeline: the job alone holds its write end, so the class's watchdog sees it end with the job
+        life_r, self.lifeline = os.pipe()
+        head = _head(name, spec)
+        code = ("import sys; sys.path[:0] = {path!r}; from animsynth.compare.generators.user_guard import "
+                "watch_parent; watch_parent({life}, {job}, {head!r}); from animsynth.compare.generators.user "
+                "import _child_main; _child_main({fd}, {job}, {name!r}, {spec!r}, {base!r}, {guard!r}, "
+                "{allow!r})").format(path=[p for p in sys.path if p], life=life_r, job=os.getpid(), head=head,
+                                     fd=theirs.fileno(), name=name, spec=spec, base=self.base, guard=guard,
+                                     allow=allow)
         env = dict(os.environ)
         for var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):  # one thread, as the job
             env.setdefault(var, "1")
-        self.proc = subprocess.Popen([sys.executable, "-c", code], cwd=self.workdir, pass_fds=[theirs.fileno()],
-                                     env=env, start_new_session=True)
-        theirs.close()
+        try:
+            self.proc = subprocess.Popen([sys.executable, "-c", code], cwd=self.workdir,
+                                         pass_fds=[theirs.fileno(), life_r], env=env, start_new_session=True)
+        finally:
+            theirs.close()
+            os.close(life_r)
         from multiprocessing.connection import Connection
 
         self.conn = Connection(mine.detach())
@@ -392,19 +341,21 @@ class UserProcess:
         return result, cpu, rss
 
     def kill(self) -> None:
-        """Stop the child and every process it started (its own session)."""
+        """Stop the child and every process in its process group (what the class started, its watchdog), whether
+        the child is still running or not."""
         import signal
 
-        if self.proc.poll() is None:
-            try:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
+        try:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):  # the group is gone
+            if self.proc.poll() is None:
                 self.proc.kill()
         self.proc.wait()
 
     def close(self) -> None:
-        """Ask the child to stop (killed after 5 s), and remove its working directory if the class left nothing
-        there (else keep it and say where)."""
+        """Ask the child to stop (killed after 5 s), end its whole process group (the watchdog, and any background
+        process the class started there, also when the child has ended already), and remove its working directory
+        if the class left nothing there (else keep it and say where)."""
         import shutil
         import subprocess
 
@@ -413,7 +364,12 @@ class UserProcess:
             self.proc.wait(timeout=5)
         except (OSError, ValueError, subprocess.TimeoutExpired):
             pass
-        self.kill()
+        try:  # the watchdog ends the group quietly (the job ended normally) ...
+            os.write(self.lifeline, STOP)
+        except OSError:
+            pass
+        self.kill()  # ... and so does the job, in case the watchdog is gone
+        os.close(self.lifeline)
         self.conn.close()
         try:
             left = sorted(os.listdir(self.workdir))
@@ -433,7 +389,10 @@ def user_process(name: str, spec: str, guard=()) -> UserProcess:
     """The job's child process of user generator ``name`` (started on the first call, then reused)."""
     key = (name, spec)
     proc = _PROCESSES.get(key)
-    if proc is None or proc.proc.poll() is not None:
+    if proc is not None and proc.proc.poll() is not None:  # it ended (an exit inside the class): its group too
+        _PROCESSES.pop(key).close()
+        proc = None
+    if proc is None:
         proc = _PROCESSES[key] = UserProcess(name, spec, guard)
     return proc
 
