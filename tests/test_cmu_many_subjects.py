@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 import yaml
 
+from animsynth.config import trial_records
+
 from animsynth.axes import standing_height
 from animsynth.capture_check import check_capture
 from animsynth.data import load_trial
@@ -34,7 +36,7 @@ EXPECTED_FLAGS = {
 
 
 def _records():
-    return yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())["trials"]
+    return trial_records(yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())["trials"])
 
 
 def _load(t, first_frame=None):
