@@ -86,7 +86,7 @@ from ...joints import resolve_roles
 from ...kinematics import (decay_spring, forward_kinematics, ground_heading, qexp, qinv, qlog, qmul, rest_forward,
                           spring_angle, spring_position, wrap_radians, yaw_rotation)
 from ...motion import Motion
-from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
+from .footlock import contact_labels, contact_points, hip_knee_ankle, lock_contacts, place_feet
 from ...generator import Database, Generator
 from .poses import Track, decode, encode
 
@@ -303,7 +303,7 @@ class MotionMatching(Generator):
         if float(self.ik_max_length_buffer_m) < 0 or float(self.contact_filter_s) < 0:
             raise ValueError("motion matching: ik_max_length_buffer_m and contact_filter_s must be >= 0")
         sk, fps = db.skeleton, db.fps
-        self.legs_ = leg_chains(sk)
+        self.legs_ = hip_knee_ankle(sk)
         pts = [contact_points(sk, c.values, self.legs_) for c in db.clips]
         self.contacts_ = np.vstack([contact_labels(p, fps, float(self.contact_speed_m_s), float(self.contact_filter_s))
                                     for p in pts])
