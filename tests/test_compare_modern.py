@@ -12,10 +12,10 @@ from animsynth.compare import protocol
 from animsynth.compare.generators.footlock import contact_points, hip_knee_ankle, lock_contacts, place_feet, two_bone_ik
 from animsynth.compare.generators.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
 from animsynth.compare.generators.motionmatching import MotionMatching, make_motion_matching
-from animsynth.kinematics import spring_angle, spring_position
+from animsynth.springs import decay_spring, spring_angle, spring_position
 from animsynth.compare.generators.poses import decode, encode
 from animsynth.compare.generators.references import Replay
-from animsynth.kinematics import bone_lengths, decay_spring, forward_kinematics, root_translation
+from animsynth.kinematics import bone_lengths, forward_kinematics, root_translation
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 

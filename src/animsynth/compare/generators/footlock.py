@@ -43,8 +43,9 @@ from scipy.ndimage import median_filter
 from scipy.spatial.transform import Rotation
 
 from ...joints import resolve_roles
-from ...kinematics import UP, decay_spring, forward_kinematics, joint_euler, nearest_euler, wrap_degrees
+from ...kinematics import UP, forward_kinematics, joint_euler, nearest_euler, wrap_degrees
 from ...skeleton import ROT_DOFS
+from ...springs import decay_spring
 
 __all__ = ["hip_knee_ankle", "contact_points", "contact_labels", "lock_contacts", "two_bone_ik", "place_feet"]
 

@@ -83,8 +83,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...joints import resolve_roles
-from ...kinematics import (decay_spring, forward_kinematics, ground_heading, qexp, qinv, qlog, qmul, rest_forward,
-                          spring_angle, spring_position, wrap_radians, yaw_rotation)
+from ...kinematics import (forward_kinematics, ground_heading, qexp, qinv, qlog, qmul, rest_forward, wrap_radians,
+                          yaw_rotation)
+from ...springs import decay_spring, spring_angle, spring_position
 from ...motion import Motion
 from .footlock import contact_labels, contact_points, hip_knee_ankle, lock_contacts, place_feet
 from ...generator import Database, Generator
