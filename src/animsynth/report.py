@@ -366,30 +366,60 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
     """
     from .scoreboard import sanity_checks, scoreboard_rows
 
-    names: dict[str, list[str]] = {}
-    for path in map(str, report_outputs):
-        names.setdefault(Path(path).name, []).append(path)
-    family_figures = family_figures or {}
-    family_data = family_data or {}
-    family_tables = family_tables or {}
+    links = _ReportLinks(report_outputs)
+    out = [".. raw:: html", "", "   " + HOME_STYLE, ""]
+    out += _home_top_rst(banner, scoreboard_png, provenance, links)
+    sanity = sanity_checks(claims) if len(claims) else pd.Series(dtype=bool)
+    ids = _ids(claims) if len(claims) else pd.Series(dtype=str)
+    for title, mask in (("Claims on real data", claims["real"]), ("Claims on synthetic data", ~claims["real"])):
+        out += _claims_list_rst(title, claims[mask.astype(bool)] if len(claims) else claims, sanity, ids)
+    fams = scoreboard_rows(claims) if len(claims) else []
+    if side_by_side is not None and "compare" not in fams:
+        fams.append("compare")
+    for fam in fams:
+        part = claims[claims["family"].astype(str) == fam] if len(claims) else claims
+        data = (family_data or {}).get(fam) or (side_by_side_data if fam == "compare" else "")
+        real = bool(part["real"].iloc[0]) if len(part) else (side_by_side_real if fam == "compare" else False)
+        out += _family_head_rst(fam, data, real, (family_figures or {}).get(fam, []), (family_tables or {}).get(fam),
+                                links)
+        if fam == "compare" and side_by_side is not None:
+            out += _side_by_side_rst(side_by_side, side_by_side_data)
+        out += _claims_in_full_rst(FAMILY_SECTION.get(fam, fam), part, sanity, ids, links)
+    return "\n".join(out) + "\n"
 
-    def target(src: str) -> str:
-        paths = names.get(Path(src).name, [])
+
+class _ReportLinks:
+    """Links from the home page into the report: a path becomes a link when a report output (``report(...)`` in
+    the workflow) ends with it and its file name is unique among the report's files (the report names its
+    entries by file name only)."""
+
+    def __init__(self, report_outputs):
+        self.names: dict[str, list[str]] = {}
+        for path in map(str, report_outputs):
+            self.names.setdefault(Path(path).name, []).append(path)
+
+    def target(self, src: str) -> str:
+        """The report entry's link target for ``src`` (``"name_"``), or "" when there is none."""
+        paths = self.names.get(Path(src).name, [])
         return f"{Path(src).name}_" if src and len(paths) == 1 and paths[0].endswith(src) else ""
 
-    def link(src: str) -> str:
+    def link(self, src: str) -> str:
+        """``src`` as a link into the report, else as literal text ("" for no path)."""
         if not src:
             return ""
-        t = target(src)
+        t = self.target(src)
         return f"`{t[:-1]}`_" if t else f"``{_rst_cell(src)}``"
 
-    out = [".. raw:: html", "", "   " + HOME_STYLE, ""]
+
+def _home_top_rst(banner: str, scoreboard_png, provenance: pd.DataFrame | None, links: _ReportLinks) -> list[str]:
+    """The home page's top: the run's banner, the scoreboard and what each part ran on."""
+    out = []
     if banner:
         out += [_rst_cell(banner).replace("\\*\\*", "**"), ""]
     if scoreboard_png is not None:
         out += ["Scoreboard", "~~~~~~~~~~", ""]
         out += _rst_image(png_data_uri(scoreboard_png, 1400), "Scoreboard: one cell per claim, coloured by verdict",
-                          target("scoreboard.png"))
+                          links.target("scoreboard.png"))
         out += ["One cell per claim, coloured by its verdict, one row per paper and one for the generators side by "
                 "side; hatched cells and grey rows ran on synthetic data. The ids are those of the tables below; "
                 "the counts per row are in ``scoreboard.csv``.", ""]
@@ -398,64 +428,65 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
         for _, r in provenance.iterrows():
             out.append(f"- **{_rst_cell(r['family'])}**: {_rst_cell(r['data'])} ({_rst_cell(r['status'])})")
         out.append("")
-    sanity = sanity_checks(claims) if len(claims) else pd.Series(dtype=bool)
-    ids = _ids(claims) if len(claims) else pd.Series(dtype=str)
-    for title, mask in (("Claims on real data", claims["real"]), ("Claims on synthetic data", ~claims["real"])):
-        mask = mask.astype(bool)
-        out += [title, "~" * len(title), ""]
-        part = claims[mask] if len(claims) else claims
-        if part.empty:
-            out += ["(none in this run)", ""]
-            continue
-        out += [OURS_MEANS, "",
-                ".. list-table::", "   :header-rows: 1", "   :widths: 6 12 40 14 18 10", "",
-                "   * - id", "     - paper", "     - claim", "     - paper's number", "     - ours", "     - verdict"]
-        for idx, r in part.iterrows():
-            cid = ids.loc[idx]
-            verdict = _rst_cell(shorten(r["verdict"], CELL_LIMITS["verdict"]))
-            if sanity.loc[idx]:
-                verdict += " (sanity check)"
-            cells = [f"`{cid} <#{claim_anchor(cid)}>`__", _rst_cell(FAMILY_SHORT.get(str(r["family"]), r["paper"])),
-                     _rst_cell(shorten(r["claim"], CELL_LIMITS["claim"])),
-                     _rst_cell(shorten(r["paper_value"], CELL_LIMITS["paper_value"])),
-                     _rst_cell(shorten(r["ours"], CELL_LIMITS["ours"])), f"**{verdict}**" if verdict else ""]
-            out.append(f"   * - {cells[0]}")
-            out += [f"     - {c}".rstrip() for c in cells[1:]]
-        out.append("")
-    fams = scoreboard_rows(claims) if len(claims) else []
-    if side_by_side is not None and "compare" not in fams:
-        fams.append("compare")
-    for fam in fams:
-        part = claims[claims["family"].astype(str) == fam] if len(claims) else claims
-        heading = FAMILY_SECTION.get(fam, fam)
-        out += [heading, "~" * len(heading), ""]
-        data = family_data.get(fam) or (side_by_side_data if fam == "compare" else "")
-        real = bool(part["real"].iloc[0]) if len(part) else (side_by_side_real if fam == "compare" else False)
-        if data:
-            out += [f"**Data:** {_rst_cell(data)} ({'real' if real else 'synthetic'} data).", ""]
-        for fig in family_figures.get(fam, []):
-            out += _rst_image(png_data_uri(fig["png"]), fig.get("caption", ""), target(fig["src"]))
-            out += [f"*{Path(fig['src']).name}:* {_rst_cell(fig.get('caption', ''))}", ""]
-        if family_tables.get(fam):
-            out += ["**Key table:** " + ", ".join(link(t) for t in family_tables[fam])
-                    + " (the menu's categories hold every table and figure).", ""]
-        if fam == "compare" and side_by_side is not None:
-            out += _side_by_side_rst(side_by_side, side_by_side_data)
-        if len(part):
-            sub = f"{heading}: claims in full"
-            out += [sub, "^" * len(sub), ""]
-            for idx, r in part.iterrows():
-                cid = ids.loc[idx]
-                kind = "real data" if bool(r["real"]) else "synthetic data"
-                if sanity.loc[idx]:
-                    kind += "; sanity check, not counted among the findings"
-                out += [f".. _{claim_anchor(cid)}:", "",
-                        f"**{cid} / {_rst_cell(r['verdict'])}** ({kind}): {_rst_cell(r['claim'])}", ""]
-                fields = [(label, _rst_cell(r[col])) for col, label in _FULL_FIELDS if str(r[col]).strip()]
-                if str(r["source"]).strip():
-                    fields.append(("table / figure", link(str(r["source"]).strip())))
-                out += [f":{label}: {text}" for label, text in fields] + [""]
-    return "\n".join(out) + "\n"
+    return out
+
+
+def _claims_list_rst(title: str, part: pd.DataFrame, sanity: pd.Series, ids: pd.Series) -> list[str]:
+    """One line per claim of ``part`` (a list table under ``title``), each id linked to the claim in full."""
+    out = [title, "~" * len(title), ""]
+    if part.empty:
+        return out + ["(none in this run)", ""]
+    out += [OURS_MEANS, "",
+            ".. list-table::", "   :header-rows: 1", "   :widths: 6 12 40 14 18 10", "",
+            "   * - id", "     - paper", "     - claim", "     - paper's number", "     - ours", "     - verdict"]
+    for idx, r in part.iterrows():
+        cid = ids.loc[idx]
+        verdict = _rst_cell(shorten(r["verdict"], CELL_LIMITS["verdict"]))
+        if sanity.loc[idx]:
+            verdict += " (sanity check)"
+        cells = [f"`{cid} <#{claim_anchor(cid)}>`__", _rst_cell(FAMILY_SHORT.get(str(r["family"]), r["paper"])),
+                 _rst_cell(shorten(r["claim"], CELL_LIMITS["claim"])),
+                 _rst_cell(shorten(r["paper_value"], CELL_LIMITS["paper_value"])),
+                 _rst_cell(shorten(r["ours"], CELL_LIMITS["ours"])), f"**{verdict}**" if verdict else ""]
+        out.append(f"   * - {cells[0]}")
+        out += [f"     - {c}".rstrip() for c in cells[1:]]
+    return out + [""]
+
+
+def _family_head_rst(fam: str, data: str, real: bool, figures: list, tables, links: _ReportLinks) -> list[str]:
+    """A family's section heading, what it ran on, its key figures (embedded) and key tables (linked)."""
+    heading = FAMILY_SECTION.get(fam, fam)
+    out = [heading, "~" * len(heading), ""]
+    if data:
+        out += [f"**Data:** {_rst_cell(data)} ({'real' if real else 'synthetic'} data).", ""]
+    for fig in figures:
+        out += _rst_image(png_data_uri(fig["png"]), fig.get("caption", ""), links.target(fig["src"]))
+        out += [f"*{Path(fig['src']).name}:* {_rst_cell(fig.get('caption', ''))}", ""]
+    if tables:
+        out += ["**Key table:** " + ", ".join(links.link(t) for t in tables)
+                + " (the menu's categories hold every table and figure).", ""]
+    return out
+
+
+def _claims_in_full_rst(heading: str, part: pd.DataFrame, sanity: pd.Series, ids: pd.Series,
+                        links: _ReportLinks) -> list[str]:
+    """Every claim of ``part`` in full (the targets of the claim list's links), under ``heading``."""
+    if not len(part):
+        return []
+    sub = f"{heading}: claims in full"
+    out = [sub, "^" * len(sub), ""]
+    for idx, r in part.iterrows():
+        cid = ids.loc[idx]
+        kind = "real data" if bool(r["real"]) else "synthetic data"
+        if sanity.loc[idx]:
+            kind += "; sanity check, not counted among the findings"
+        out += [f".. _{claim_anchor(cid)}:", "",
+                f"**{cid} / {_rst_cell(r['verdict'])}** ({kind}): {_rst_cell(r['claim'])}", ""]
+        fields = [(label, _rst_cell(r[col])) for col, label in _FULL_FIELDS if str(r[col]).strip()]
+        if str(r["source"]).strip():
+            fields.append(("table / figure", links.link(str(r["source"]).strip())))
+        out += [f":{label}: {text}" for label, text in fields] + [""]
+    return out
 
 
 def scoreboard_markdown(counts: pd.DataFrame, png: str | None) -> list[str]:
