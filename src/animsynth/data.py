@@ -176,9 +176,8 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     degrees gets the multiple of 360 that removes the jump; logged when it
     happens), so no method sees a wrap. Translations are untouched.
     """
-    from .joints import check_role_overrides
-    from .axes import detect_forward_axis, to_canonical_frame
-    from .kinematics import CANONICAL_FORWARD, CANONICAL_UP, translated_joints
+    from .axes import to_canonical_frame
+    from .kinematics import CANONICAL_FORWARD, CANONICAL_UP
     from .retarget import unwrap_angles
 
     shown = dict(source_files or {})
@@ -186,30 +185,47 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     m = _read_trial_files(amc, asf, bvh, fps, bvh_length_to_m, shown)
     m = _drop_first_frames(m, int(first_frame), where)
     names = dict(CONFIG_SETTING_NAMES, **(setting_names or {}))
-    try:
-        check_role_overrides(m.skeleton.names, joint_roles, where=names["joint_roles"])
-    except ValueError as exc:
-        raise ConfigError(f"{exc} (in {where})") from None
-    m.skeleton.roles = dict(joint_roles or {})
-    roles = m.skeleton.roles
-    _warn_shared_roles(m.skeleton, roles, where, names["joint_roles"])
+    roles = _set_roles(m.skeleton, joint_roles, where, names)
     sk, v = m.skeleton, m.values
     up, fwd, how = _file_axes(sk, v, roles, bvh is not None, up_axis, forward_axis, where, names)
     if (up, fwd) != (CANONICAL_UP, CANONICAL_FORWARD):
         sk, v = to_canonical_frame(sk, v, up, fwd)
         m = Motion(v, sk, m.fps, m.name, m.meta)
-    faces, src = detect_forward_axis(sk, v, CANONICAL_UP, roles)
-    log.info("%s: up axis %s (%s), forward axis %s%s; turned to +y up, +z forward; the body faces mostly %s in the "
-             "result (from the %s)", where, up, how, fwd, " (given)" if forward_axis not in (None, "auto") else "",
-             faces, src)
-    moved = translated_joints(sk)
-    if moved:
-        log.info("%s: joints other than the root with translation over the frames: %s (their translation is part "
-                 "of the pose: see config/README.md, BVH files, for how each family uses it)", where, ", ".join(moved))
+    _log_frame(sk, v, roles, where, f"up axis {up} ({how}), forward axis {fwd}"
+               + (" (given)" if forward_axis not in (None, "auto") else ""))
     if bvh is not None:
         _check_height(sk, v, up, bvh_length_to_m, where, names)
     m.name = name or m.name
     return unwrap_angles(m, where)
+
+
+def _set_roles(skeleton, joint_roles: dict | None, where, names: dict) -> dict:
+    """Check the given joint roles against ``skeleton`` and store them on it (:attr:`Skeleton.roles`), warning about
+    a joint that plays two roles; returns the roles."""
+    from .joints import check_role_overrides
+
+    try:
+        check_role_overrides(skeleton.names, joint_roles, where=names["joint_roles"])
+    except ValueError as exc:
+        raise ConfigError(f"{exc} (in {where})") from None
+    skeleton.roles = dict(joint_roles or {})
+    _warn_shared_roles(skeleton, skeleton.roles, where, names["joint_roles"])
+    return skeleton.roles
+
+
+def _log_frame(sk, v, roles: dict, where, axes: str) -> None:
+    """Log the file's ``axes`` (as found) with the way the body faces once turned to the canonical frame, and the
+    joints other than the root that translate."""
+    from .axes import detect_forward_axis
+    from .kinematics import CANONICAL_UP, translated_joints
+
+    faces, src = detect_forward_axis(sk, v, CANONICAL_UP, roles)
+    log.info("%s: %s; turned to +y up, +z forward; the body faces mostly %s in the result (from the %s)", where,
+             axes, faces, src)
+    moved = translated_joints(sk)
+    if moved:
+        log.info("%s: joints other than the root with translation over the frames: %s (their translation is part "
+                 "of the pose: see config/README.md, BVH files, for how each family uses it)", where, ", ".join(moved))
 
 
 def _read_trial_files(amc, asf, bvh, fps: float, bvh_length_to_m: float, shown: dict) -> Motion:
