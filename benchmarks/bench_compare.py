@@ -15,7 +15,7 @@ load average are in the row's ``baseline`` text):
   (:class:`animsynth.compare.generators.fairmotion_peer.FairmotionGraph.fit`: BVH writing and fairmotion's BVH loading,
   its velocities, ``construct`` and ``reduce("scc")``), CPU including its worker process (fairmotion compares
   node pairs in a ``multiprocessing`` pool, here of one process); ratio = fairmotion / ours (lower is better:
-  above 1, ours is faster; :func:`animsynth.tables.benchmark_row`). When fairmotion
+  above 1, ours is faster; :func:`animsynth.benchmark_tables.benchmark_row`). When fairmotion
   is not installed the row says why and has no baseline.
 * ``motion_graph_build_cpu_s_<data>_walk_run_dance_120fps`` (full size only, report only): the same build at
   the capture rate (1,648 frames), to show how the all-pairs step grows.
@@ -37,7 +37,7 @@ from animsynth.config import trial_records
 from animsynth.compare.generators.fairmotion_peer import FairmotionGraph, FairmotionUnavailable
 from animsynth.compare.generators.motiongraph import MotionGraph
 from animsynth.motion import Motion
-from animsynth.tables import benchmark_row
+from animsynth.benchmark_tables import benchmark_row
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 REPO = Path(__file__).resolve().parents[1]

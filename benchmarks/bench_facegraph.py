@@ -20,7 +20,7 @@
   complete graph) from a complete graph on 1,500 poses, against the paper's ~1.9 s.
 
 Every row's ratio is baseline / value (lower is better: above 1, the row's value beats its baseline;
-:func:`animsynth.tables.benchmark_row`). Timings are machine-dependent; they belong in benchmarks.csv, not in
+:func:`animsynth.benchmark_tables.benchmark_row`). Timings are machine-dependent; they belong in benchmarks.csv, not in
 result tables.
 """
 
@@ -35,7 +35,7 @@ from animsynth.facegraph import FaceGraphBaseline, FaceGraphModel, FacePreproces
 from animsynth.facegraph.evaluate import evaluate_resynthesis
 from animsynth.facegraph.jobs import face_graph_nbytes, subset_database
 from animsynth.synth.faces import generate_sequences
-from animsynth.tables import benchmark_row
+from animsynth.benchmark_tables import benchmark_row
 
 FAMILY = "facegraph"
 

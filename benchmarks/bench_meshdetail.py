@@ -2,7 +2,7 @@
 the measured comparison of our SGPLVM+GPDM with GPy (the library evaluated first).
 
 Each row's ``ratio`` compares against a baseline measured in the same run (baseline / ours for times and
-errors, ours / baseline for rates: above 1, ours is better; :func:`animsynth.tables.benchmark_row`):
+errors, ours / baseline for rates: above 1, ours is better; :func:`animsynth.benchmark_tables.benchmark_row`):
 
 * ``train_s_per_100_frames`` (5 % control level): our shared GPDM + inverse GP,
   target < 30 s (ours); the paper's reported ~30 min is quoted as the
@@ -33,7 +33,7 @@ from animsynth.meshdetail.gp import GPRegression
 from animsynth.meshdetail.models import HybridModel, MeshContext, mean_vertex_error, reconstruction_seconds_per_frame
 from animsynth.skinning import default_rig
 from animsynth.synth.character import SkirtParams, build_character, procedural_motion, simulate
-from animsynth.tables import benchmark_row
+from animsynth.benchmark_tables import benchmark_row
 
 
 def _data(frames=120):

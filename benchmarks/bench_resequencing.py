@@ -1,7 +1,7 @@
 """resequencing benchmarks: geodesics + embedding, and the exact minimum k, each against what a user would otherwise run.
 
 Each row's ``ratio`` = baseline time / our time (lower is better: above 1, ours is faster;
-:func:`animsynth.tables.benchmark_row`), both measured in this run
+:func:`animsynth.benchmark_tables.benchmark_row`), both measured in this run
 (best of three; both under the same single BLAS thread, the workflow's setting
 on a shared machine):
 
@@ -44,7 +44,7 @@ from animsynth.resequencing.distances import l2_distances, lee_distances
 from animsynth.resequencing.embedding import PrecomputedIsomap, STIsomap, min_connected_k
 from animsynth.resequencing.features import motion_features
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
-from animsynth.tables import benchmark_row
+from animsynth.benchmark_tables import benchmark_row
 
 REPO = Path(__file__).resolve().parents[1]
 CMU = Path(os.environ.get("ANIMSYNTH_SHARED_DATA", REPO.parent / "shared" / "data")) / "cmu_mocap" / "subjects"

@@ -52,7 +52,7 @@ from animsynth.simplicial.folds import fit_pca  # noqa: E402
 from animsynth.simplicial.field import FieldStack, VectorField, training_vectors  # noqa: E402
 from animsynth.simplicial.path import follow_batch  # noqa: E402
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion  # noqa: E402
-from animsynth.tables import benchmark_row  # noqa: E402
+from animsynth.benchmark_tables import benchmark_row  # noqa: E402
 
 K = 16
 # full size (the performance targets) and demo size (seconds, for the default and tiny runs)

@@ -33,7 +33,7 @@ def cost_table(per_family_csv) -> str:
 
 def benchmark_table(benchmarks_csv) -> str:
     """The performance targets of a run's ``benchmarks.csv``: ours, which direction is better, the in-run baseline,
-    ratio (above 1: ours is better; :func:`animsynth.tables.benchmark_row`), target, met."""
+    ratio (above 1: ours is better; :func:`animsynth.benchmark_tables.benchmark_row`), target, met."""
     df = pd.read_csv(benchmarks_csv)
     if "better" not in df:
         raise ValueError(f"{benchmarks_csv}: no column 'better' (written before the one ratio convention; "
@@ -53,7 +53,7 @@ def provenance_line(path) -> str:
     """When and where a table was made: the file's modification date and this machine (run it where the run ran)."""
     import datetime
 
-    from animsynth.report import machine_label
+    from animsynth.benchmark_tables import machine_label
 
     when = datetime.datetime.fromtimestamp(Path(path).stat().st_mtime).strftime("%Y-%m-%d")
     return f"Measured {when} on {machine_label()} (`{path}`)."

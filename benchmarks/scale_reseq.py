@@ -20,7 +20,7 @@ from __future__ import annotations
 import sys
 
 from animsynth import scale
-from animsynth.tables import benchmark_row
+from animsynth.benchmark_tables import benchmark_row
 
 DEFAULT_CFG = {"trial_frames": 1000,
                "resequencing": {"metric": "l2", "method": "isomap", "n_candidates": 20, "k": 10, "n_landmarks": 500,

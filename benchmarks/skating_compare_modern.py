@@ -86,10 +86,10 @@ def _by_lock(clip, ref, motion, mcfg) -> dict:
     locked = motion.meta["contact_locked"][:, foot]
     label = motion.meta["contact_states"][:, foot] & ~locked
     moving = ~motion.meta["contact_states"][:, foot]
-    from animsynth.compare.generators.footlock import contact_points, leg_chains
+    from animsynth.compare.generators.footlock import contact_points, hip_knee_ankle
 
     sk = motion.skeleton
-    miss = np.linalg.norm(contact_points(sk, motion.values, leg_chains(sk)) - motion.meta["contact_targets"], axis=-1)
+    miss = np.linalg.norm(contact_points(sk, motion.values, hip_knee_ankle(sk)) - motion.meta["contact_targets"], axis=-1)
     miss = miss[motion.meta["contact_locked"]]
     out = {"locked_frames": int(miss.size), "lock_miss_mm_sum": 1000 * float(miss.sum()),
            "lock_miss_under_1mm": int((miss < 0.001).sum())}

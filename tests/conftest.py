@@ -15,6 +15,7 @@ process cannot block a CI job forever."""
 from __future__ import annotations
 
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -172,6 +173,63 @@ def tiny_without_papers(tiny_workflow, tmp_path_factory):
     if res.returncode != 0:
         pytest.fail("rebuilding the paper tables failed:\n" + res.stdout[-4000:] + "\n" + res.stderr[-8000:])
     return wd
+
+
+def pytest_addoption(parser):
+    parser.addoption("--cpu-report", metavar="CSV", default=None,
+                     help="write each test phase's CPU seconds (user + system of the test process and of every "
+                          "subprocess it waited for, e.g. snakemake runs) and wall seconds to CSV, slowest first; "
+                          "a fixture's setup is charged to the first test that asks for it")
+
+
+def _cpu_seconds() -> float:
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_setup(item):
+    return (yield from _timed(item, "setup"))
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item):
+    return (yield from _timed(item, "call"))
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_teardown(item, nextitem):
+    return (yield from _timed(item, "teardown"))
+
+
+def _timed(item, phase: str):
+    """Run one phase of a test (the generator-style hook wrapper's ``yield``) and, with ``--cpu-report``, keep its
+    CPU and wall seconds."""
+    import time
+
+    if item.config.getoption("--cpu-report") is None:
+        return (yield)
+    c0, t0 = _cpu_seconds(), time.perf_counter()
+    try:
+        return (yield)
+    finally:
+        item.config.stash.setdefault(_CPU_ROWS, []).append(
+            (item.nodeid, phase, _cpu_seconds() - c0, time.perf_counter() - t0))
+
+
+_CPU_ROWS = pytest.StashKey[list]()
+
+
+def pytest_sessionfinish(session):
+    path = session.config.getoption("--cpu-report")
+    rows = session.config.stash.get(_CPU_ROWS, [])
+    if path and rows:
+        import csv
+
+        with open(path, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["test", "phase", "cpu_s", "wall_s"])
+            w.writerows((t, ph, f"{c:.2f}", f"{s:.2f}") for t, ph, c, s in sorted(rows, key=lambda r: -r[2]))
 
 
 def pytest_collection_modifyitems(config, items):

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from animsynth.report import run_benchmarks
+from animsynth.benchmark_tables import run_benchmarks
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -93,7 +93,7 @@ def test_cost_table_sums_families_and_names_date_and_machine(tmp_path):
 
 
 def test_benchmark_row_states_the_better_direction_and_one_ratio_convention():
-    from animsynth.tables import BENCHMARK_COLUMNS, benchmark_row
+    from animsynth.benchmark_tables import BENCHMARK_COLUMNS, benchmark_row
 
     t = benchmark_row("f", "build_s", 2.0, "s", better="lower", baseline="theirs", baseline_value=10.0)
     assert list(t) == list(BENCHMARK_COLUMNS) and (t["better"], t["ratio"]) == ("lower", 5.0)  # 5x faster
@@ -119,7 +119,7 @@ def test_the_benchmark_table_shows_the_direction(tmp_path):
     sys.path.insert(0, str(REPO / "benchmarks"))
     import cost_table
 
-    from animsynth.tables import benchmark_row
+    from animsynth.benchmark_tables import benchmark_row
 
     csv = tmp_path / "benchmarks.csv"
     import pandas as pd

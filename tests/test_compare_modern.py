@@ -9,13 +9,13 @@ import pytest
 
 from animsynth.compare.generators import registry as G
 from animsynth.compare import protocol
-from animsynth.compare.generators.footlock import contact_points, leg_chains, lock_contacts, place_feet, two_bone_ik
+from animsynth.compare.generators.footlock import contact_points, hip_knee_ankle, lock_contacts, place_feet, two_bone_ik
 from animsynth.compare.generators.genmm import GenMM, extract_patches, make_genmm, match_patches, vote
 from animsynth.compare.generators.motionmatching import MotionMatching, make_motion_matching
-from animsynth.kinematics import spring_angle, spring_position
+from animsynth.springs import decay_spring, spring_angle, spring_position
 from animsynth.compare.generators.poses import decode, encode
 from animsynth.compare.generators.references import Replay
-from animsynth.kinematics import bone_lengths, decay_spring, forward_kinematics, root_translation
+from animsynth.kinematics import bone_lengths, forward_kinematics, root_translation
 from animsynth.motion import Motion
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
@@ -124,7 +124,7 @@ def test_motion_matching_on_a_clip_of_its_database_with_the_true_trajectory_is_t
     assert np.array_equal(locked.meta["source_frames"], m.meta["source_frames"])
     sk = clip.skeleton
     sl = sk.dof_slices()
-    legs = {sk.joints[j].name for j in leg_chains(sk).ravel()}
+    legs = {sk.joints[j].name for j in hip_knee_ankle(sk).ravel()}
     other = [c for j in sk.joints if j.name not in legs for c in range(sl[j.name].start, sl[j.name].stop)]
     assert _angle_diff(locked.values[:, other], replay.values[:, other]) < 1e-8
 
@@ -177,7 +177,7 @@ def _hip_and_ball(sk, values, chain, effector="ball"):
     starts = forward_kinematics(sk, values, ends=False) * sk.length_to_m
     if effector == "heel":
         return starts[:, chain[0]], starts[:, chain[2]]
-    return starts[:, chain[0]], contact_points(sk, values, leg_chains(sk))[:, list(leg_chains(sk)[:, 0]).index(
+    return starts[:, chain[0]], contact_points(sk, values, hip_knee_ankle(sk))[:, list(hip_knee_ankle(sk)[:, 0]).index(
         chain[0])]
 
 
@@ -190,7 +190,7 @@ def _cols(sk, joints):
 def test_two_bone_ik_reaches_a_reachable_target_exactly_and_keeps_bone_lengths(walks, effector):
     m = walks[1]
     sk, values = m.skeleton, np.asarray(m.values[:12], float)
-    legs = leg_chains(sk)
+    legs = hip_knee_ankle(sk)
     for f, chain in enumerate(legs):
         hip, ball = _hip_and_ball(sk, values, chain, effector)
         # nearer the hip and off to the side: inside the leg's reach, not on its current circle
@@ -207,7 +207,7 @@ def test_two_bone_ik_reaches_a_reachable_target_exactly_and_keeps_bone_lengths(w
 def test_placing_a_foot_keeps_its_world_orientation(walks):
     m = walks[1]
     sk, values = m.skeleton, np.asarray(m.values[:12], float)
-    chain = leg_chains(sk)[0]
+    chain = hip_knee_ankle(sk)[0]
     hip, ball = _hip_and_ball(sk, values, chain)
     targets = hip + 0.85 * (ball - hip) + np.array([0.04, 0.03, -0.05])
     out = place_feet(sk, values, chain, targets)
@@ -232,7 +232,7 @@ def test_placing_a_foot_keeps_its_world_orientation(walks):
 def test_two_bone_ik_stretches_the_leg_towards_an_unreachable_target(walks, buffer_m):
     m = walks[1]
     sk, values = m.skeleton, np.asarray(m.values[3:4], float)
-    chain = leg_chains(sk)[0]
+    chain = hip_knee_ankle(sk)[0]
     hip, ball = _hip_and_ball(sk, values, chain)
     target = hip + np.array([[0.6, -2.5, 0.9]])  # metres away: out of reach
     out = two_bone_ik(sk, values, chain, target, max_length_buffer_m=buffer_m)

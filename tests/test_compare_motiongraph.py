@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from animsynth.compare.generators import fairmotion_load as fl
 from animsynth.compare.generators.fairmotion_fixes import FIXES
 from animsynth.compare.generators.motiongraph import MotionGraph, kovar_alpha
 from animsynth.compare.generators.point_clouds import apply_floor_transform, floor_alignment, pair_terms, window_clouds
@@ -405,12 +406,12 @@ def test_fairmotion_cut_copy_fix_keeps_the_walks_clips_in_place(sk, monkeypatch)
 
     seen = []
 
-    class Seen(fp._CopyOnRead):  # the clips one walk reads (its copies of the loaded clips)
+    class Seen(fl.CopyOnRead):  # the clips one walk reads (its copies of the loaded clips)
         def __init__(self, motions):
             super().__init__(motions)
             seen.append(self)
 
-    monkeypatch.setattr(fp, "_CopyOnRead", Seen)
+    monkeypatch.setattr(fp, "CopyOnRead", Seen)
 
     def poses(m):
         return np.array([np.asarray(p.data) for p in m.poses])
@@ -448,7 +449,7 @@ def test_fairmotion_runs_at_its_native_rate_and_answers_at_ours(sk):
 
 
 def test_upsample_keeps_every_frame_and_interpolates_between():
-    from animsynth.compare.generators.fairmotion_peer import upsample
+    from animsynth.compare.generators.fairmotion_load import upsample
 
     sk = cmu_like_skeleton("up", 2)
     m = generate_motion("walk_straight", 20, 3, sk, fps=FPS)
@@ -499,14 +500,14 @@ def test_fairmotion_loads_a_shared_trial_once_and_builds_what_a_fresh_load_build
                                fixes=FIXES).fit(db)
         return g, g.transitions_.to_numpy(), [g.generate(start, 30, seed=s).values for s in (1, 2)]
 
-    fp._LOADED.clear()
+    fl.LOADED.clear()
     _, cold_tr, cold_walks = build([c, b])
-    assert len(fp._LOADED) == 2
-    fp._LOADED.clear()
+    assert len(fl.LOADED) == 2
+    fl.LOADED.clear()
     g1, _, _ = build([a, b])  # b loaded here, then its poses walked over
     g1.generate(Motion(a.values[:10], sk, FPS, "s"), 30, seed=7)
     _, warm_tr, warm_walks = build([c, b])
-    assert len(fp._LOADED) == 3  # a, b, c: b was loaded once
+    assert len(fl.LOADED) == 3  # a, b, c: b was loaded once
     assert np.array_equal(cold_tr, warm_tr)
     assert all(np.array_equal(x, y) for x, y in zip(cold_walks, warm_walks))
 
@@ -527,12 +528,12 @@ def test_fairmotion_reuses_its_construction_across_rows_and_budgets(sk):
 
     cold = {}
     for budget, fixes in ((2.0, ()), (2.0, FIXES), (4.0, FIXES)):
-        fp._CONSTRUCTED.clear()
-        fp._LOADED.clear()
+        fl.CONSTRUCTED.clear()
+        fl.LOADED.clear()
         g, tr, walks = build(budget, fixes)
         assert not g.construct_reused_
         cold[budget, fixes] = (g.threshold_, g.n_nodes_, tr, walks)
-    fp._CONSTRUCTED.clear()
+    fl.CONSTRUCTED.clear()
     reused = []
     for budget, fixes in ((2.0, ()), (2.0, FIXES), (4.0, FIXES)):
         g, tr, walks = build(budget, fixes)
@@ -542,10 +543,10 @@ def test_fairmotion_reuses_its_construction_across_rows_and_budgets(sk):
         assert np.array_equal(tr, tr0)
         assert all(np.array_equal(x, y) for x, y in zip(walks, w0))
     assert reused == [False, True, True]
-    assert len(fp._CONSTRUCTED) == 1
+    assert len(fl.CONSTRUCTED) == 1
     # another comparison count is another graph
     fp.FairmotionGraph(base=8, blend=4, compare=4, transitions_per_s=2.0, native_fps=60.0, num_comparison=2).fit([a, b])
-    assert len(fp._CONSTRUCTED) == 2
+    assert len(fl.CONSTRUCTED) == 2
 
 
 @pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
@@ -560,13 +561,13 @@ def test_fairmotion_construct_in_process_equals_its_pool(sk):
     start = Motion(a.values[:10], sk, FPS, "start")
     graphs = {}
     for pool in (True, False):
-        fp._CONSTRUCTED.clear()
-        fp._LOADED.clear()
+        fl.CONSTRUCTED.clear()
+        fl.LOADED.clear()
         g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
                                fixes=FIXES, pool=pool).fit([a, b, c])
         assert not g.construct_reused_
-        key = next(iter(fp._CONSTRUCTED))
-        graphs[pool] = (fp._CONSTRUCTED[key], g.transitions_.to_numpy(),
+        key = next(iter(fl.CONSTRUCTED))
+        graphs[pool] = (fl.CONSTRUCTED[key], g.transitions_.to_numpy(),
                         [g.generate(start, 30, seed=s).values for s in (1, 2)])
     (nodes_p, edges_p), tr_p, walks_p = graphs[True]
     (nodes_s, edges_s), tr_s, walks_s = graphs[False]
@@ -580,7 +581,7 @@ def test_fairmotion_construct_in_process_equals_its_pool(sk):
 
 @pytest.mark.skipif(bool(_fairmotion_reason()), reason=_fairmotion_reason() or "fairmotion installed")
 def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
-    """Each walk copies a clip the first time it reads it (``_CopyOnRead``, one memo: the clips' shared skeleton
+    """Each walk copies a clip the first time it reads it (``CopyOnRead``, one memo: the clips' shared skeleton
     copied once) and walks exactly as on a deep copy of every clip; the loaded clips stay untouched."""
     from animsynth.compare.generators import fairmotion_peer as fp
 
@@ -595,20 +596,20 @@ def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
                for x, m in zip(before, g._loaded_))
     seen = []
 
-    class Whole(fp._CopyOnRead):  # the copy before: every clip deep-copied at once
+    class Whole(fl.CopyOnRead):  # the copy before: every clip deep-copied at once
         def __init__(self, motions):
             super().__init__(motions)
             whole = copy.deepcopy(self._src)
             self._copies = dict(enumerate(whole))
             seen.append(self)
 
-    monkeypatch.setattr(fp, "_CopyOnRead", Whole)
+    monkeypatch.setattr(fp, "CopyOnRead", Whole)
     whole = [g.generate(start, 40, seed=s).values for s in (1, 2, 3)]
     assert len(seen) == 3
     assert all(np.array_equal(x, y) for x, y in zip(lazy, whole))
     monkeypatch.undo()
     # a walk reads some clips: those are copied, with one skeleton between them
-    view = fp._CopyOnRead(g._loaded_)
+    view = fl.CopyOnRead(g._loaded_)
     m0, m2 = view[0], view[np.int64(2)]
     assert view[0] is m0 and m0 is not g._loaded_[0]
     assert m0.skel is m2.skel and m0.skel is not g._loaded_[0].skel

@@ -12,6 +12,7 @@ from scipy.optimize import OptimizeWarning
 from scipy.special import expit
 
 from animsynth.config import ConfigError
+from conftest import default_config
 from animsynth.facegraph import (FaceGraphBaseline, FaceGraphModel, FacePreprocessor, FaceSynthesizer,
                                  SynthesisError, load_graphs, node_similarity, pose_similarity, save_graphs, vinfl)
 from animsynth.facegraph.evaluate import compare, velocity_angle_difference
@@ -27,17 +28,6 @@ from animsynth.facegraph.search import step_halving_search
 from animsynth.facegraph.synthesis import hop_neighbours, resample
 from animsynth.io.ckplus import EMOTIONS
 from animsynth.synth.faces import generate_sequences
-
-
-def default_config() -> dict:
-    """config/config.yaml validated against config/schema.yaml (every default filled), as the workflow sees it."""
-    import yaml
-
-    from animsynth.config import validate_config
-
-    cfg = yaml.safe_load(open("config/config.yaml"))
-    validate_config(cfg, "config/schema.yaml")
-    return cfg
 
 
 @pytest.fixture(scope="module")
@@ -468,49 +458,34 @@ def _old_curve_fit(t, y, p0):
     return popt
 
 
-def _curve_fit_reference(d, min_range=1.0):
-    """fit_sigmoid_landmarks as it was with ``scipy.optimize.curve_fit``: fitted displacements, statuses and, per
-    refined landmark, (data, start, curve_fit's parameters or the type of the exception it raised)."""
-    from animsynth.facegraph.preprocess import _GRID_K, sigmoid_grid_fit
+def _curve_fit_reference(d, monkeypatch):
+    """fit_sigmoid_landmarks as it was with ``scipy.optimize.curve_fit``: the production function with its refinement
+    (``_sigmoid_xy_fit``) replaced by curve_fit on the model it was given. Returns the fitted displacements, the
+    statuses and, per refined landmark, (data, start, curve_fit's parameters or the type of the exception it raised)."""
+    from animsynth.facegraph import preprocess
 
-    d = np.asarray(d, float)
-    n, L, _ = d.shape
-    t = np.arange(n, dtype=float)
-    tt = np.concatenate([t, t])
-    a, b, k, c = sigmoid_grid_fit(d)
-    k_max = _GRID_K[-1] / max(n - 1, 1)
-    out = np.empty_like(d)
-    status, fits = [], {}
-    for i in range(L):
-        di = d[:, i]
-        if np.ptp(np.sqrt((di ** 2).sum(-1))) < min_range and np.ptp(di, axis=0).max() < min_range:
-            out[:, i] = di.mean(0)
-            status.append("static")
-            continue
-        grid_y = a[i] + b[i] * expit(k[i] * (t - c[i]))[:, None]
-        p0 = (a[i, 0], a[i, 1], b[i, 0], b[i, 1], k[i], c[i])
-        y = np.concatenate([di[:, 0], di[:, 1]])
+    calls = []
+
+    def refine(t, y, p0, jac):
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", OptimizeWarning)
-                warnings.simplefilter("ignore", RuntimeWarning)
                 popt = _old_curve_fit(t, y, p0)
-            fits[i] = (y, p0, popt)
-            fitted = _old_sigmoid_xy(tt, *popt).reshape(2, n).T
-            steep_ok = abs(popt[4]) <= k_max
-            if (steep_ok and np.all(np.isfinite(fitted))
-                    and ((fitted - di) ** 2).sum() <= ((grid_y - di) ** 2).sum() + 1e-9):
-                out[:, i] = fitted
-                status.append("fit")
-                continue
         except (RuntimeError, ValueError) as e:
-            fits[i] = (y, p0, type(e))
-        out[:, i] = grid_y
-        status.append("grid")
-    return out, status, fits
+            calls.append((y, p0, type(e)))
+            raise
+        calls.append((y, p0, popt))
+        return popt
+
+    with monkeypatch.context() as m:
+        m.setattr(preprocess, "_sigmoid_xy_fit", refine)
+        out, status = preprocess.fit_sigmoid_landmarks(d)
+    refined = [i for i, s in enumerate(status) if s != "static"]  # refined in landmark order, the static ones not
+    assert len(refined) == len(calls)
+    return out, status, dict(zip(refined, calls))
 
 
-def test_sigmoid_fit_is_curve_fits_bit_for_bit():
+def test_sigmoid_fit_is_curve_fits_bit_for_bit(monkeypatch):
     # fit_sigmoid_landmarks calls scipy's leastsq itself (no covariance, no curve_fit wrappers): the fitted
     # displacements, statuses and parameters are curve_fit's exactly (np.array_equal, not a tolerance)
     from animsynth.facegraph.preprocess import _sigmoid_xy_fit, _sigmoid_xy_jac_buffer
@@ -530,7 +505,7 @@ def test_sigmoid_fit_is_curve_fits_bit_for_bit():
     seen, n_params, n_raised = set(), 0, 0
     for d in samples:
         fit, status = fit_sigmoid_landmarks(d)
-        ref, ref_status, fits = _curve_fit_reference(d)
+        ref, ref_status, fits = _curve_fit_reference(d, monkeypatch)
         assert status == ref_status
         assert np.array_equal(fit, ref)
         seen.update(status)

@@ -24,7 +24,7 @@ import copy
 import numpy as np
 import pytest
 
-from animsynth.facegraph import FaceGraphModel, FacePreprocessor, kernels
+from animsynth.facegraph import FaceGraphModel, FacePreprocessor, kernels, merge_kernels
 from animsynth.facegraph import merging, model as model_mod
 from animsynth.facegraph.merging import Merger, _finish_graph, _rigid2d
 from animsynth.facegraph.model import _nn_similarity
@@ -206,7 +206,8 @@ def numpy_nn_similarity(nodes, red, rng, k=256):
     return out[np.isfinite(out)]
 
 
-KERNELS = ("alg1_all", "alg1_walk", "merge_sample", "undo_merge", "edge_weights", "nearest_other_sample")
+KERNELS = {kernels: ("alg1_all", "alg1_walk", "edge_weights", "nearest_other_sample"),
+           merge_kernels: ("merge_sample", "undo_merge")}
 
 
 @pytest.fixture
@@ -221,8 +222,9 @@ def numpy_route(monkeypatch):
     def compiled(*a, **k):
         raise AssertionError("a compiled kernel ran on the numpy route")
 
-    for name in KERNELS:
-        monkeypatch.setattr(kernels, name, compiled)
+    for module, names in KERNELS.items():
+        for name in names:
+            monkeypatch.setattr(module, name, compiled)
 
 
 # ----------------------------------------------------------------------------- data

@@ -8,13 +8,13 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from animsynth import skinning
-from animsynth.kinematics import (continuous_euler, continuous_sign, decay_spring, dof_values_from_local,
-                                  forward_kinematics, from_rot6d, ground_heading, halflife_to_damping, heading,
-                                  hip_forward, joint_euler, joint_starts, local_rotations, matrix_to_xyz_euler,
-                                  nearest_euler, other_euler_branch, qexp, qinv, qlog, qmul, rest_forward,
-                                  root_rotation, root_translation, rot6d, set_root, rotation_heading, spring_angle,
-                                  tree_forward, tree_local, wrap_degrees, xyz_euler_rotation, xyz_euler_to_matrix,
-                                  yaw_rotation)
+from animsynth.kinematics import (continuous_euler, continuous_sign, dof_values_from_local, forward_kinematics,
+                                  from_rot6d, ground_heading, heading, hip_forward, joint_euler, joint_starts,
+                                  local_rotations, matrix_to_xyz_euler, nearest_euler, other_euler_branch, qexp, qinv,
+                                  qlog, qmul, rest_forward, root_rotation, root_translation, rot6d, set_root,
+                                  rotation_heading, tree_forward, tree_local, wrap_degrees, xyz_euler_rotation,
+                                  xyz_euler_to_matrix, yaw_rotation)
+from animsynth.springs import decay_spring, halflife_to_damping, spring_angle
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
 
 

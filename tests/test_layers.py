@@ -5,8 +5,8 @@ dependency). Layers, bottom to top:
 
 0. plain helpers with no animsynth import: atomic writes, file-format errors, limits, the verdict format,
    the published-table reader, joint roles, the skeleton, the family registry;
-1. config checks, tables, the Motion container, kinematics (pose math), the up and forward axes of a file,
-   angle continuity and retargeting, the generator interface;
+1. config checks, tables (benchmark rows too), the Motion container, kinematics (pose math) and its springs, the up
+   and forward axes of a file, angle continuity and retargeting, the generator interface;
 2. io (file formats; knows no method);
 3. shared machinery on top of io: synthetic data, skinning, drawing (the scoreboard too), data sources, the data layer,
    the capture check, workflow logging;
@@ -32,7 +32,7 @@ PKG = "animsynth"
 FAMILIES = registry.paper_families()
 LAYERS = {
     0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton", "families"],
-    1: ["config", "tables", "motion", "kinematics", "axes", "retarget", "generator", "pace"],
+    1: ["config", "tables", "benchmark_tables", "motion", "kinematics", "springs", "axes", "retarget", "generator", "pace"],
     2: ["io"],
     3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "capture_check", "workflow_utils"],
     4: list(FAMILIES),

@@ -3,15 +3,9 @@
 import pandas as pd
 import pytest
 
+from animsynth.benchmark_tables import aggregate_rule_benchmarks, family_benchmark_summary, rule_benchmark_summary
 from animsynth.verdicts import VerdictError
-from animsynth.report import (
-    aggregate_rule_benchmarks,
-    build_summary,
-    claims_rst,
-    claims_table,
-    family_benchmark_summary,
-    rule_benchmark_summary,
-)
+from animsynth.report import build_summary, claims_rst, claims_table
 
 TSV = ("s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
        "{s}\t0:00:01\t{m}\t200\t1\t1\t0\t0\t50\t{s}\n")

@@ -11,7 +11,7 @@ import pytest
 from scipy.spatial import procrustes
 
 from animsynth.families import scaled
-from animsynth.resequencing import landmark, sparse
+from animsynth.resequencing import landmark, sparse, sparse_st
 from animsynth.resequencing.distances import l2_distances, lee_distances
 from animsynth.resequencing.embedding import (DisconnectedGraphError, knn_graph, min_connected_k, neighbor_ranks,
                                               spatio_temporal_distances, temporal_adjacency)
@@ -129,7 +129,7 @@ def test_st_lists_give_the_dense_st_isomap_graph(database):
     def pair(i, j):
         return np.linalg.norm(X[i] - X[j], axis=1)
 
-    sd, si, n_ctn = sparse.st_neighbours(dist, idx, np.zeros(n, int), pair_distance=pair, **kw)
+    sd, si, n_ctn = sparse_st.st_neighbours(dist, idx, np.zeros(n, int), pair_distance=pair, **kw)
     assert n_ctn == int(np.count_nonzero(np.triu(ctn)))
     assert sparse.sparse_min_connected_k(si) == min_connected_k(Dst)
     for k in (2, 5):
@@ -148,8 +148,8 @@ def test_sparse_st_isomap_keeps_the_adjacent_temporal_edges_like_the_dense_one(d
     def pair(i, j):
         return np.linalg.norm(X[i] - X[j], axis=1)
 
-    sd, si, _ = sparse.st_neighbours(dist, idx, np.zeros(n, int), pair_distance=pair, **kw)
-    pairs, w = sparse.st_always_edges(np.zeros(n, int), 1, 10.0, pair)
+    sd, si, _ = sparse_st.st_neighbours(dist, idx, np.zeros(n, int), pair_distance=pair, **kw)
+    pairs, w = sparse_st.st_always_edges(np.zeros(n, int), 1, 10.0, pair)
     assert pairs.shape == (n - 1, 2) and np.all(pairs[:, 1] - pairs[:, 0] == 1)
     always = temporal_adjacency(n, 1)
     # one sequence is a chain of always-present edges: connected at k = 1, as in the dense version
@@ -164,7 +164,7 @@ def test_sparse_st_isomap_keeps_the_adjacent_temporal_edges_like_the_dense_one(d
     X2 = np.vstack([database[0].linearised(False), database[1].linearised(False)])
     seq = np.repeat([0, 1], [database[0].n_frames, database[1].n_frames])
     d2, i2 = sparse.l2_neighbours(X2, 30)
-    p2 = sparse.temporal_pairs(seq, 1)
+    p2 = sparse_st.temporal_pairs(seq, 1)
     assert not np.any(seq[p2[:, 0]] != seq[p2[:, 1]]) and len(p2) == len(seq) - 2
     k2 = sparse.sparse_min_connected_k(i2, always=p2)
     A2 = np.zeros((len(seq), len(seq)), bool)
@@ -182,7 +182,7 @@ def test_st_temporal_neighbours_stay_inside_each_sequence(database):
     def pair(i, j):
         return np.linalg.norm(X[i] - X[j], axis=1)
 
-    sd, si, _ = sparse.st_neighbours(dist, idx, seq, c_atn=1e6, c_ctn=10.0, pair_distance=pair)
+    sd, si, _ = sparse_st.st_neighbours(dist, idx, seq, c_atn=1e6, c_ctn=10.0, pair_distance=pair)
     # with a huge c_atn the nearest is a temporal neighbour, never across a boundary (except
     # for exact copies at distance 0: every linearised trial starts at the zero vector)
     first = si[:, 0]

@@ -65,11 +65,6 @@ def _leaf_chains(skeleton: Skeleton) -> list[tuple[int, int]]:
     return out
 
 
-def count_legs(skeleton: Skeleton, starts: np.ndarray, ends: np.ndarray, up) -> int:
-    """How many leg-like chains :func:`leg_chains` finds."""
-    return len(leg_chains(skeleton, starts, ends, up))
-
-
 def leg_chains(skeleton: Skeleton, starts: np.ndarray, ends: np.ndarray, up) -> list[set[int]]:
     """Leg-like chains of a body for the signed axis ``up``: leaf chains (:func:`_leaf_chains`) that point
     down (:data:`LEG_DOWN_COS`, median over frames) and end on the floor (within :data:`LEG_FLOOR_SHARE` of

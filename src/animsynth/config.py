@@ -237,11 +237,6 @@ def normalise_resequencing_trials(config: dict, defaults: dict | None = None) ->
     return notes
 
 
-#: Values of a trial record's ``mirror`` field: ``main`` reads it from ``cmu_mirror``, ``many`` from
-#: ``cmu_many_mirror`` (``cmu_mirror`` when that is null).
-TRIAL_MIRRORS = ("main", "many")
-
-
 def trial_mirror(config: dict, trial: dict) -> str | None:
     """Where one real trial's files are read from.
 

@@ -180,15 +180,65 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     degrees gets the multiple of 360 that removes the jump; logged when it
     happens), so no method sees a wrap. Translations are untouched.
     """
-    from .errors import MotionFormatError
-    from .joints import check_role_overrides
-    from .axes import default_forward, detect_forward_axis, detect_up_axis, lying_down, standing_height, to_canonical_frame
-    from .kinematics import CANONICAL_FORWARD, CANONICAL_UP, parse_axis, translated_joints
+    from .axes import to_canonical_frame
+    from .kinematics import CANONICAL_FORWARD, CANONICAL_UP
     from .retarget import unwrap_angles
 
-    files = {"amc": amc, "asf": asf, "bvh": bvh}
     shown = dict(source_files or {})
     where = shown.get("bvh") or shown.get("asf") or bvh or asf
+    m = _read_trial_files(amc, asf, bvh, fps, bvh_length_to_m, shown, bvh_root)
+    m = _drop_first_frames(m, int(first_frame), where)
+    names = dict(CONFIG_SETTING_NAMES, **(setting_names or {}))
+    roles = _set_roles(m.skeleton, joint_roles, where, names)
+    sk, v = m.skeleton, m.values
+    up, fwd, how = _file_axes(sk, v, roles, bvh is not None, up_axis, forward_axis, where, names)
+    if (up, fwd) != (CANONICAL_UP, CANONICAL_FORWARD):
+        sk, v = to_canonical_frame(sk, v, up, fwd)
+        m = Motion(v, sk, m.fps, m.name, m.meta)
+    _log_frame(sk, v, roles, where, f"up axis {up} ({how}), forward axis {fwd}"
+               + (" (given)" if forward_axis not in (None, "auto") else ""))
+    if bvh is not None:
+        _check_height(sk, v, up, bvh_length_to_m, where, names)
+    m.name = name or m.name
+    return unwrap_angles(m, where)
+
+
+def _set_roles(skeleton, joint_roles: dict | None, where, names: dict) -> dict:
+    """Check the given joint roles against ``skeleton`` and store them on it (:attr:`Skeleton.roles`), warning about
+    a joint that plays two roles; returns the roles."""
+    from .joints import check_role_overrides
+
+    try:
+        check_role_overrides(skeleton.names, joint_roles, where=names["joint_roles"])
+    except ValueError as exc:
+        raise ConfigError(f"{exc} (in {where})") from None
+    skeleton.roles = dict(joint_roles or {})
+    _warn_shared_roles(skeleton, skeleton.roles, where, names["joint_roles"])
+    return skeleton.roles
+
+
+def _log_frame(sk, v, roles: dict, where, axes: str) -> None:
+    """Log the file's ``axes`` (as found) with the way the body faces once turned to the canonical frame, and the
+    joints other than the root that translate."""
+    from .axes import detect_forward_axis
+    from .kinematics import CANONICAL_UP, translated_joints
+
+    faces, src = detect_forward_axis(sk, v, CANONICAL_UP, roles)
+    log.info("%s: %s; turned to +y up, +z forward; the body faces mostly %s in the result (from the %s)", where,
+             axes, faces, src)
+    moved = translated_joints(sk)
+    if moved:
+        log.info("%s: joints other than the root with translation over the frames: %s (their translation is part "
+                 "of the pose: see config/README.md, BVH files, for how each family uses it)", where, ", ".join(moved))
+
+
+def _read_trial_files(amc, asf, bvh, fps: float, bvh_length_to_m: float, shown: dict,
+                      bvh_root: str | None = None) -> Motion:
+    """The motion of a BVH file (its lengths in metres by ``bvh_length_to_m``; the skeleton under ``bvh_root``
+    when the file holds several) or of an ASF + AMC pair (at ``fps``), as read; a format error names the user's
+    own file (``shown``) instead of the copy read."""
+    from .errors import MotionFormatError
+
     try:
         if bvh is not None:
             from .io.bvh import read_bvh
@@ -198,28 +248,33 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         else:
             m = read_amc(amc, read_asf(asf), fps=fps)
     except MotionFormatError as exc:
-        raise _rename_path(exc, files, shown) from None
-    first_frame = int(first_frame)
-    if first_frame:
-        if not 0 < first_frame < m.n_frames:
-            raise ConfigError(f"config key 'first_frame': {first_frame} leaves no frame of the {m.n_frames} "
-                              f"in {where}")
-        m = Motion(m.values[first_frame:], m.skeleton, m.fps, m.name, m.meta)
-        log.info("%s: the first %d frame(s) dropped (first_frame), %d left", where, first_frame,
-                 m.n_frames)
-    names = dict(CONFIG_SETTING_NAMES, **(setting_names or {}))
-    try:
-        check_role_overrides(m.skeleton.names, joint_roles, where=names["joint_roles"])
-    except ValueError as exc:
-        raise ConfigError(f"{exc} (in {where})") from None
-    m.skeleton.roles = dict(joint_roles or {})
-    roles = m.skeleton.roles
-    _warn_shared_roles(m.skeleton, roles, where, names["joint_roles"])
-    sk, v = m.skeleton, m.values
+        raise _rename_path(exc, {"amc": amc, "asf": asf, "bvh": bvh}, shown) from None
+    return m
+
+
+def _drop_first_frames(m: Motion, first_frame: int, where) -> Motion:
+    """``m`` without its frames before ``first_frame`` (config key ``first_frame``; 0 keeps every frame)."""
+    if not first_frame:
+        return m
+    if not 0 < first_frame < m.n_frames:
+        raise ConfigError(f"config key 'first_frame': {first_frame} leaves no frame of the {m.n_frames} "
+                          f"in {where}")
+    m = Motion(m.values[first_frame:], m.skeleton, m.fps, m.name, m.meta)
+    log.info("%s: the first %d frame(s) dropped (first_frame), %d left", where, first_frame,
+             m.n_frames)
+    return m
+
+
+def _file_axes(sk, v, roles: dict, is_bvh: bool, up_axis, forward_axis, where, names: dict):
+    """``(up, forward, how)``: the file's up and forward axes and how the up axis was found, given
+    (``up_axis``, ``forward_axis``) or detected (:func:`load_trial`'s rules), with its warnings."""
+    from .axes import default_forward, detect_up_axis, lying_down
+    from .kinematics import CANONICAL_UP, parse_axis
+
     auto_up = up_axis in (None, "auto")
     detected, info = detect_up_axis(sk, v, roles)
     override = names["up_axis"]
-    if bvh is None and auto_up:
+    if not is_bvh and auto_up:
         up = CANONICAL_UP
         if detected != up and not info["ambiguous"]:
             log.warning("%s: the motion looks %s up (%s; median extents x y z: %s), ASF/AMC is read +y up; set %s "
@@ -228,8 +283,8 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         up = detected if auto_up else parse_axis(up_axis)
     fwd = default_forward(up) if forward_axis in (None, "auto") else parse_axis(forward_axis)
     how = (f"detected ({info['why']}; median extents x y z {_fmt(info['extent'])})"
-           if auto_up and bvh is not None else "given" if not auto_up else "ASF/AMC")
-    if auto_up and bvh is not None:
+           if auto_up and is_bvh else "given" if not auto_up else "ASF/AMC")
+    if auto_up and is_bvh:
         if not info["biped"]:
             log.warning("%s: the body is not a biped (%s); %s; set %s if that is wrong%s", where, info["why"],
                         f"up axis {up} from its legs" if info["sign_from"] == "legs" else
@@ -244,28 +299,23 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         if lying:
             log.warning("%s: with the given up axis %s the body lies down or stands on its head (%s); check %s",
                         where, up, lying, override)
-    if (up, fwd) != (CANONICAL_UP, CANONICAL_FORWARD):
-        sk, v = to_canonical_frame(sk, v, up, fwd)
-        m = Motion(v, sk, m.fps, m.name, m.meta)
-    faces, src = detect_forward_axis(sk, v, CANONICAL_UP, roles)
-    log.info("%s: up axis %s (%s), forward axis %s%s; turned to +y up, +z forward; the body faces mostly %s in the "
-             "result (from the %s)", where, up, how, fwd, " (given)" if forward_axis not in (None, "auto") else "",
-             faces, src)
-    moved = translated_joints(sk)
-    if moved:
-        log.info("%s: joints other than the root with translation over the frames: %s (their translation is part "
-                 "of the pose: see config/README.md, BVH files, for how each family uses it)", where, ", ".join(moved))
-    height = standing_height(sk, v, CANONICAL_UP) * sk.length_to_m if bvh is not None else None
-    if height is not None:
-        log.info("%s: stands %.3g m tall (median over frames along the up axis) with bvh_length_to_m=%g", where,
-                 height, bvh_length_to_m)
-    if height is not None and not HEIGHT_RANGE_M[0] <= height <= HEIGHT_RANGE_M[1]:
+    return up, fwd, how
+
+
+def _check_height(sk, v, up, bvh_length_to_m: float, where, names: dict) -> None:
+    """Log a BVH skeleton's standing height in metres, and warn when it lies outside :data:`HEIGHT_RANGE_M`
+    (the file's unit is probably not ``bvh_length_to_m``)."""
+    from .axes import standing_height
+    from .kinematics import CANONICAL_UP
+
+    height = standing_height(sk, v, CANONICAL_UP) * sk.length_to_m
+    log.info("%s: stands %.3g m tall (median over frames along the up axis) with bvh_length_to_m=%g", where,
+             height, bvh_length_to_m)
+    if not HEIGHT_RANGE_M[0] <= height <= HEIGHT_RANGE_M[1]:
         log.warning("%s: the skeleton stands %.3g m tall (median over frames along the up axis %s) with "
                     "bvh_length_to_m=%g; set %s to the file's unit (0.01 for centimetres, 0.0254 for "
                     "inches, 0.05644 for cgspeed's CMU conversions)", where, height, up, bvh_length_to_m,
                     names["bvh_length_to_m"])
-    m.name = name or m.name
-    return unwrap_angles(m, where)
 
 
 def _warn_shared_roles(skeleton, overrides: dict, where: str, setting: str) -> None:

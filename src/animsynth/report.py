@@ -1,11 +1,8 @@
-"""Summary, benchmark aggregation: everything generated from the CSVs, never typed by hand."""
+"""Summary and report pages: everything generated from the CSVs, never typed by hand."""
 
 from __future__ import annotations
 
-import importlib.util
 import logging
-import os
-import platform
 from pathlib import Path
 
 import numpy as np
@@ -21,112 +18,6 @@ log = logging.getLogger("animsynth.report")
 FAMILY_PAPERS = {f.name: f.paper for f in families.report_order()}
 #: the section of summary.md and of the report's home page that puts the generators side by side
 SIDE_BY_SIDE = families.get("compare").section
-
-
-def aggregate_rule_benchmarks(paths, root: str = "benchmarks/rules") -> pd.DataFrame:
-    """Collect Snakemake ``benchmark:`` TSVs into one table (one row per job).
-
-    ``paths`` are the benchmark files of exactly the jobs of one run (the
-    workflow declares them as inputs); a missing or empty file is an error,
-    never a silently shorter table.
-
-    Columns: rule, job (the file's path below the rule folder), seconds,
-    max_rss_mb (peak resident memory), and the other columns Snakemake writes.
-    """
-    rows = []
-    for p in sorted(map(str, paths)):
-        try:
-            df = pd.read_csv(p, sep="\t")
-        except pd.errors.EmptyDataError:
-            raise ValueError(f"{p}: empty benchmark file (the job that writes it was interrupted?)") from None
-        rel = os.path.relpath(p, root)
-        parts = rel.split(os.sep)
-        # layout: <family>/<step>.tsv (one job) or <family>/<step>/<job>.tsv
-        step = parts[1][:-4] if len(parts) == 2 else parts[1]
-        job = "/".join(parts[2:])[:-4] if len(parts) > 2 else ""
-        for _, r in df.iterrows():
-            rows.append({"family": parts[0], "rule": f"{parts[0]}/{step}", "job": job,
-                         "seconds": float(r.get("s", np.nan)), "max_rss_mb": float(r.get("max_rss", np.nan)),
-                         "max_vms_mb": float(r.get("max_vms", np.nan)), "cpu_time_s": float(r.get("cpu_time", np.nan))})
-    cols = ["family", "rule", "job", "seconds", "max_rss_mb", "max_vms_mb", "cpu_time_s"]
-    return pd.DataFrame(rows, columns=cols)
-
-
-def rule_benchmark_summary(df: pd.DataFrame) -> pd.DataFrame:
-    """Per rule: jobs, total and max runtime, peak memory."""
-    if df.empty:
-        return pd.DataFrame(columns=["rule", "jobs", "total_seconds", "max_seconds", "peak_rss_mb"])
-    g = df.groupby("rule", sort=True)
-    return pd.DataFrame({
-        "rule": list(g.groups),
-        "jobs": g.size().values,
-        "total_seconds": g["seconds"].sum().round(2).values,
-        "max_seconds": g["seconds"].max().round(2).values,
-        "peak_rss_mb": g["max_rss_mb"].max().round(1).values,
-    })
-
-
-def family_benchmark_summary(df: pd.DataFrame) -> pd.DataFrame:
-    """Per family (data, simplicial, ...): jobs, summed wall and CPU seconds, peak memory of one job."""
-    cols = ["family", "jobs", "wall_s", "cpu_s", "peak_rss_mb"]
-    if df.empty:
-        return pd.DataFrame(columns=cols)
-    g = df.groupby("family", sort=True)
-    return pd.DataFrame({
-        "family": list(g.groups),
-        "jobs": g.size().values,
-        "wall_s": g["seconds"].sum().round(1).values,
-        "cpu_s": g["cpu_time_s"].sum().round(1).values,
-        "peak_rss_mb": g["max_rss_mb"].max().round(1).values,
-    })[cols]
-
-
-def machine_label() -> str:
-    """Where a benchmark ran: architecture, core count and Python, e.g. ``x86_64 2 cores, CPython 3.12.3``."""
-    return f"{platform.machine()} {os.cpu_count()} cores, {platform.python_implementation()} {platform.python_version()}"
-
-
-BENCHMARK_SIZES = ("full", "demo")
-
-
-def run_benchmarks(files, size: str = "full") -> pd.DataFrame:
-    """Import each ``benchmarks/bench_*.py`` and call its ``run(size)``; one row per measurement.
-
-    ``size`` is "full" (the sizes the performance targets are stated for: the
-    paper run and ``python3 run.py bench``) or "demo" (seconds, for the default
-    and tiny runs). Demo rows keep their measured values and ratios but judge no
-    target (``meets_target`` empty): a target holds or fails at full size only.
-    Every row carries the machine it ran on and its size, so quoted figures say
-    where they came from. The rows come from :func:`animsynth.tables.benchmark_row`:
-    ``better`` says which direction is better, and ``ratio`` above 1 always means
-    the value beats its baseline.
-    """
-    if size not in BENCHMARK_SIZES:
-        raise ValueError(f"benchmark size must be one of {BENCHMARK_SIZES}, got {size!r}")
-    rows = []
-    machine = machine_label()
-    for f in sorted(map(str, files)):
-        name = Path(f).stem
-        spec = importlib.util.spec_from_file_location(f"animsynth_bench_{name}", f)
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)  # type: ignore[union-attr]
-        log.info("running %s (%s size)", f, size)
-        for r in mod.run(size=size):
-            r = dict(r)
-            r.setdefault("family", name.replace("bench_", ""))
-            if size != "full":
-                r["meets_target"] = np.nan
-                r["target"] = f"{r.get('target', '')} (judged at full size only: python3 run.py bench)"
-            r["size"] = size
-            r["machine"] = machine
-            rows.append(r)
-    cols = ["family", "benchmark", "size", "value", "unit", "better", "baseline", "baseline_value", "ratio",
-            "target", "meets_target", "machine"]
-    df = pd.DataFrame(rows)
-    for c in cols:
-        if c not in df:
-            df[c] = np.nan
-    return df[cols + [c for c in df.columns if c not in cols]]
 
 
 PAPER_RUN_COMMAND = ("python3 run.py paper --config cmu_mirror=../shared/data/cmu_mocap "
@@ -475,30 +366,60 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
     """
     from .scoreboard import sanity_checks, scoreboard_rows
 
-    names: dict[str, list[str]] = {}
-    for path in map(str, report_outputs):
-        names.setdefault(Path(path).name, []).append(path)
-    family_figures = family_figures or {}
-    family_data = family_data or {}
-    family_tables = family_tables or {}
+    links = _ReportLinks(report_outputs)
+    out = [".. raw:: html", "", "   " + HOME_STYLE, ""]
+    out += _home_top_rst(banner, scoreboard_png, provenance, links)
+    sanity = sanity_checks(claims) if len(claims) else pd.Series(dtype=bool)
+    ids = _ids(claims) if len(claims) else pd.Series(dtype=str)
+    for title, mask in (("Claims on real data", claims["real"]), ("Claims on synthetic data", ~claims["real"])):
+        out += _claims_list_rst(title, claims[mask.astype(bool)] if len(claims) else claims, sanity, ids)
+    fams = scoreboard_rows(claims) if len(claims) else []
+    if side_by_side is not None and "compare" not in fams:
+        fams.append("compare")
+    for fam in fams:
+        part = claims[claims["family"].astype(str) == fam] if len(claims) else claims
+        data = (family_data or {}).get(fam) or (side_by_side_data if fam == "compare" else "")
+        real = bool(part["real"].iloc[0]) if len(part) else (side_by_side_real if fam == "compare" else False)
+        out += _family_head_rst(fam, data, real, (family_figures or {}).get(fam, []), (family_tables or {}).get(fam),
+                                links)
+        if fam == "compare" and side_by_side is not None:
+            out += _side_by_side_rst(side_by_side, side_by_side_data)
+        out += _claims_in_full_rst(FAMILY_SECTION.get(fam, fam), part, sanity, ids, links)
+    return "\n".join(out) + "\n"
 
-    def target(src: str) -> str:
-        paths = names.get(Path(src).name, [])
+
+class _ReportLinks:
+    """Links from the home page into the report: a path becomes a link when a report output (``report(...)`` in
+    the workflow) ends with it and its file name is unique among the report's files (the report names its
+    entries by file name only)."""
+
+    def __init__(self, report_outputs):
+        self.names: dict[str, list[str]] = {}
+        for path in map(str, report_outputs):
+            self.names.setdefault(Path(path).name, []).append(path)
+
+    def target(self, src: str) -> str:
+        """The report entry's link target for ``src`` (``"name_"``), or "" when there is none."""
+        paths = self.names.get(Path(src).name, [])
         return f"{Path(src).name}_" if src and len(paths) == 1 and paths[0].endswith(src) else ""
 
-    def link(src: str) -> str:
+    def link(self, src: str) -> str:
+        """``src`` as a link into the report, else as literal text ("" for no path)."""
         if not src:
             return ""
-        t = target(src)
+        t = self.target(src)
         return f"`{t[:-1]}`_" if t else f"``{_rst_cell(src)}``"
 
-    out = [".. raw:: html", "", "   " + HOME_STYLE, ""]
+
+def _home_top_rst(banner: str, scoreboard_png, provenance: pd.DataFrame | None, links: _ReportLinks) -> list[str]:
+    """The home page's top: the run's banner, the scoreboard and what each part ran on."""
+    out = []
     if banner:
         out += [_rst_cell(banner).replace("\\*\\*", "**"), ""]
     if scoreboard_png is not None:
         out += ["Scoreboard", "~~~~~~~~~~", ""]
         out += _rst_image(png_data_uri(scoreboard_png, 1400), "Scoreboard: one cell per claim, coloured by verdict",
-                          target("scoreboard.png"))
+                          links.target("scoreboard.png"))
         out += ["One cell per claim, coloured by its verdict, one row per paper and one for the generators side by "
                 "side; hatched cells and grey rows ran on synthetic data. The ids are those of the tables below; "
                 "the counts per row are in ``scoreboard.csv``.", ""]
@@ -507,64 +428,65 @@ def claims_rst(claims: pd.DataFrame, provenance: pd.DataFrame | None, report_out
         for _, r in provenance.iterrows():
             out.append(f"- **{_rst_cell(r['family'])}**: {_rst_cell(r['data'])} ({_rst_cell(r['status'])})")
         out.append("")
-    sanity = sanity_checks(claims) if len(claims) else pd.Series(dtype=bool)
-    ids = _ids(claims) if len(claims) else pd.Series(dtype=str)
-    for title, mask in (("Claims on real data", claims["real"]), ("Claims on synthetic data", ~claims["real"])):
-        mask = mask.astype(bool)
-        out += [title, "~" * len(title), ""]
-        part = claims[mask] if len(claims) else claims
-        if part.empty:
-            out += ["(none in this run)", ""]
-            continue
-        out += [OURS_MEANS, "",
-                ".. list-table::", "   :header-rows: 1", "   :widths: 6 12 40 14 18 10", "",
-                "   * - id", "     - paper", "     - claim", "     - paper's number", "     - ours", "     - verdict"]
-        for idx, r in part.iterrows():
-            cid = ids.loc[idx]
-            verdict = _rst_cell(shorten(r["verdict"], CELL_LIMITS["verdict"]))
-            if sanity.loc[idx]:
-                verdict += " (sanity check)"
-            cells = [f"`{cid} <#{claim_anchor(cid)}>`__", _rst_cell(FAMILY_SHORT.get(str(r["family"]), r["paper"])),
-                     _rst_cell(shorten(r["claim"], CELL_LIMITS["claim"])),
-                     _rst_cell(shorten(r["paper_value"], CELL_LIMITS["paper_value"])),
-                     _rst_cell(shorten(r["ours"], CELL_LIMITS["ours"])), f"**{verdict}**" if verdict else ""]
-            out.append(f"   * - {cells[0]}")
-            out += [f"     - {c}".rstrip() for c in cells[1:]]
-        out.append("")
-    fams = scoreboard_rows(claims) if len(claims) else []
-    if side_by_side is not None and "compare" not in fams:
-        fams.append("compare")
-    for fam in fams:
-        part = claims[claims["family"].astype(str) == fam] if len(claims) else claims
-        heading = FAMILY_SECTION.get(fam, fam)
-        out += [heading, "~" * len(heading), ""]
-        data = family_data.get(fam) or (side_by_side_data if fam == "compare" else "")
-        real = bool(part["real"].iloc[0]) if len(part) else (side_by_side_real if fam == "compare" else False)
-        if data:
-            out += [f"**Data:** {_rst_cell(data)} ({'real' if real else 'synthetic'} data).", ""]
-        for fig in family_figures.get(fam, []):
-            out += _rst_image(png_data_uri(fig["png"]), fig.get("caption", ""), target(fig["src"]))
-            out += [f"*{Path(fig['src']).name}:* {_rst_cell(fig.get('caption', ''))}", ""]
-        if family_tables.get(fam):
-            out += ["**Key table:** " + ", ".join(link(t) for t in family_tables[fam])
-                    + " (the menu's categories hold every table and figure).", ""]
-        if fam == "compare" and side_by_side is not None:
-            out += _side_by_side_rst(side_by_side, side_by_side_data)
-        if len(part):
-            sub = f"{heading}: claims in full"
-            out += [sub, "^" * len(sub), ""]
-            for idx, r in part.iterrows():
-                cid = ids.loc[idx]
-                kind = "real data" if bool(r["real"]) else "synthetic data"
-                if sanity.loc[idx]:
-                    kind += "; sanity check, not counted among the findings"
-                out += [f".. _{claim_anchor(cid)}:", "",
-                        f"**{cid} / {_rst_cell(r['verdict'])}** ({kind}): {_rst_cell(r['claim'])}", ""]
-                fields = [(label, _rst_cell(r[col])) for col, label in _FULL_FIELDS if str(r[col]).strip()]
-                if str(r["source"]).strip():
-                    fields.append(("table / figure", link(str(r["source"]).strip())))
-                out += [f":{label}: {text}" for label, text in fields] + [""]
-    return "\n".join(out) + "\n"
+    return out
+
+
+def _claims_list_rst(title: str, part: pd.DataFrame, sanity: pd.Series, ids: pd.Series) -> list[str]:
+    """One line per claim of ``part`` (a list table under ``title``), each id linked to the claim in full."""
+    out = [title, "~" * len(title), ""]
+    if part.empty:
+        return out + ["(none in this run)", ""]
+    out += [OURS_MEANS, "",
+            ".. list-table::", "   :header-rows: 1", "   :widths: 6 12 40 14 18 10", "",
+            "   * - id", "     - paper", "     - claim", "     - paper's number", "     - ours", "     - verdict"]
+    for idx, r in part.iterrows():
+        cid = ids.loc[idx]
+        verdict = _rst_cell(shorten(r["verdict"], CELL_LIMITS["verdict"]))
+        if sanity.loc[idx]:
+            verdict += " (sanity check)"
+        cells = [f"`{cid} <#{claim_anchor(cid)}>`__", _rst_cell(FAMILY_SHORT.get(str(r["family"]), r["paper"])),
+                 _rst_cell(shorten(r["claim"], CELL_LIMITS["claim"])),
+                 _rst_cell(shorten(r["paper_value"], CELL_LIMITS["paper_value"])),
+                 _rst_cell(shorten(r["ours"], CELL_LIMITS["ours"])), f"**{verdict}**" if verdict else ""]
+        out.append(f"   * - {cells[0]}")
+        out += [f"     - {c}".rstrip() for c in cells[1:]]
+    return out + [""]
+
+
+def _family_head_rst(fam: str, data: str, real: bool, figures: list, tables, links: _ReportLinks) -> list[str]:
+    """A family's section heading, what it ran on, its key figures (embedded) and key tables (linked)."""
+    heading = FAMILY_SECTION.get(fam, fam)
+    out = [heading, "~" * len(heading), ""]
+    if data:
+        out += [f"**Data:** {_rst_cell(data)} ({'real' if real else 'synthetic'} data).", ""]
+    for fig in figures:
+        out += _rst_image(png_data_uri(fig["png"]), fig.get("caption", ""), links.target(fig["src"]))
+        out += [f"*{Path(fig['src']).name}:* {_rst_cell(fig.get('caption', ''))}", ""]
+    if tables:
+        out += ["**Key table:** " + ", ".join(links.link(t) for t in tables)
+                + " (the menu's categories hold every table and figure).", ""]
+    return out
+
+
+def _claims_in_full_rst(heading: str, part: pd.DataFrame, sanity: pd.Series, ids: pd.Series,
+                        links: _ReportLinks) -> list[str]:
+    """Every claim of ``part`` in full (the targets of the claim list's links), under ``heading``."""
+    if not len(part):
+        return []
+    sub = f"{heading}: claims in full"
+    out = [sub, "^" * len(sub), ""]
+    for idx, r in part.iterrows():
+        cid = ids.loc[idx]
+        kind = "real data" if bool(r["real"]) else "synthetic data"
+        if sanity.loc[idx]:
+            kind += "; sanity check, not counted among the findings"
+        out += [f".. _{claim_anchor(cid)}:", "",
+                f"**{cid} / {_rst_cell(r['verdict'])}** ({kind}): {_rst_cell(r['claim'])}", ""]
+        fields = [(label, _rst_cell(r[col])) for col, label in _FULL_FIELDS if str(r[col]).strip()]
+        if str(r["source"]).strip():
+            fields.append(("table / figure", links.link(str(r["source"]).strip())))
+        out += [f":{label}: {text}" for label, text in fields] + [""]
+    return out
 
 
 def scoreboard_markdown(counts: pd.DataFrame, png: str | None) -> list[str]:

@@ -168,7 +168,6 @@ def draw_scoreboard(claims: pd.DataFrame, title: str = "", per_line: int = 24):
         The counts under each row (:func:`scoreboard_counts`), one row per scoreboard row.
     """
     import matplotlib.pyplot as plt
-    from matplotlib.patches import FancyBboxPatch, Patch, Rectangle
 
     claims = claims.reset_index(drop=True)
     if "id" not in claims:
@@ -176,89 +175,120 @@ def draw_scoreboard(claims: pd.DataFrame, title: str = "", per_line: int = 24):
     counts = scoreboard_counts(claims)
     words = [c for c in counts.columns if c not in ("family", "paper", "data", "claims", "sanity_checks")]
     sanity = sanity_checks(claims)
-    any_sanity = bool(sanity.any())
-    cell, gap = 0.40, 0.06  # inches
-    n_sanity_cols = max([int(sanity[claims["family"] == f].sum()) for f in counts["family"]] or [0])
-    n_sanity_cols = min(n_sanity_cols, 6)
-    left = 0.25
-    sanity_w = (0.35 + n_sanity_cols * (cell + gap) + 0.1) if any_sanity else 0.0
-    width = max(left + per_line * (cell + gap) + sanity_w + 0.25, 8.0)
-    # layout pass: the height of every row block
-    blocks = []
-    y = 0.85 if title != "-" else 0.25
-    for fam in counts["family"]:
-        part = claims[claims["family"].astype(str) == fam]
-        find = part[~sanity.loc[part.index]]
-        san = part[sanity.loc[part.index]]
-        lines = max(1, int(np.ceil(len(find) / per_line)), int(np.ceil(len(san) / max(n_sanity_cols, 1))))
-        h = 0.32 + lines * (cell + gap) + 0.30
-        blocks.append((fam, find, san, y, lines))
-        y += h + 0.12
-    n_handles = len(_verdict_words(claims)) + 2 + int(any_sanity)
-    legend_h = 0.5 if n_handles <= 7 else 0.75
-    height = y + legend_h
-    fig = plt.figure(figsize=(width, height), dpi=100)
+    lay = _Layout(claims, counts, sanity, title, per_line)
+    fig = plt.figure(figsize=(lay.width, lay.height), dpi=100)
     ax = fig.add_axes((0, 0, 1, 1))
-    ax.set_xlim(0, width)
-    ax.set_ylim(height, 0)
+    ax.set_xlim(0, lay.width)
+    ax.set_ylim(lay.height, 0)
     ax.axis("off")
-    renderer = fig.canvas.get_renderer()
     n_find = int((~sanity).sum())
     n_real = int((claims["real"].map(_real) & ~sanity).sum())
     if title != "-":
         head = title or (f"{n_find} claims tested: {n_real} on real data, {n_find - n_real} on synthetic data"
-                         + (f"; {int(sanity.sum())} sanity checks apart" if any_sanity else ""))
-        ax.text(left, 0.42, head, fontsize=13, fontweight="bold", va="center", ha="left")
-    cells_x0 = left
-    sanity_x0 = left + per_line * (cell + gap) + 0.35
-    for (fam, find, san, y0, lines), (_, crow) in zip(blocks, counts.iterrows()):
-        synthetic_row = crow["data"] == "synthetic data"
-        block_h = 0.32 + lines * (cell + gap) + 0.30
-        if synthetic_row:  # a light band behind every row on synthetic data
-            ax.add_patch(Rectangle((0.08, y0 - 0.06), width - 0.16, block_h + 0.06, facecolor="#f2f2f2",
-                                   edgecolor="none", zorder=0))
-        name = ax.text(left, y0 + 0.13, str(crow["paper"]), fontsize=11, fontweight="bold", va="center",
-                       ha="left")
-        badge = crow["data"].upper()
-        # the badge right after the paper's name: its position from the name's rendered width (inches)
-        name_w = name.get_window_extent(renderer).width / fig.dpi + 0.15
-        ax.text(left + name_w, y0 + 0.13, f" {badge} ", fontsize=8, fontweight="bold", va="center", ha="left",
-                color="white" if not synthetic_row else "0.25",
-                bbox=dict(boxstyle="round,pad=0.25", facecolor="#2b5d8a" if not synthetic_row else "white",
-                          edgecolor="#2b5d8a" if not synthetic_row else "0.3", linewidth=0.8))
-        for group, x0, ncol in ((find, cells_x0, per_line), (san, sanity_x0, max(n_sanity_cols, 1))):
-            for k, (_, r) in enumerate(group.iterrows()):
-                cx = x0 + (k % ncol) * (cell + gap)
-                cy = y0 + 0.32 + (k // ncol) * (cell + gap)
-                verdict = str(r["verdict"])
-                real = _real(r["real"])
-                ax.add_patch(FancyBboxPatch((cx, cy), cell, cell, boxstyle="round,pad=0,rounding_size=0.05",
-                                            facecolor=_colour(verdict), edgecolor="0.25",
-                                            linewidth=0.8, hatch=None if real else HATCH, zorder=2,
-                                            gid=f"cell:{r['id']}"))
-                # on a hatched cell the id sits on a light patch, so it stays readable
-                ax.text(cx + cell / 2, cy + cell / 2, str(r["id"]), fontsize=7, ha="center", va="center",
-                        color="white" if verdict in _DARK and real else "black", zorder=3,
-                        bbox=None if real else dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85,
-                                                    edgecolor="none"))
-        ax.text(left, y0 + 0.32 + lines * (cell + gap) + 0.1, counts_text(crow, words), fontsize=9, va="center",
-                ha="left", color="0.15")
-        if any_sanity and len(san):
-            ax.text(sanity_x0, y0 + 0.13, "sanity checks", fontsize=8, va="center", ha="left", color="0.3",
-                    style="italic")
-    if any_sanity:
-        ax.plot([sanity_x0 - 0.2] * 2, [0.7, height - legend_h + 0.05], color="0.6", lw=0.8, ls="--")
-    # legend: every verdict word with its total over the findings, then real / synthetic, then sanity checks
+                         + (f"; {int(sanity.sum())} sanity checks apart" if lay.any_sanity else ""))
+        ax.text(lay.left, 0.42, head, fontsize=13, fontweight="bold", va="center", ha="left")
+    for (fam, find, san, y0, lines), (_, crow) in zip(lay.blocks, counts.iterrows()):
+        _draw_row(fig, ax, lay, crow, find, san, y0, lines, words)
+    if lay.any_sanity:
+        ax.plot([lay.sanity_x0 - 0.2] * 2, [0.7, lay.height - lay.legend_h + 0.05], color="0.6", lw=0.8, ls="--")
+    _draw_legend(ax, lay, counts, words, int(sanity.sum()))
+    return fig, counts
+
+
+class _Layout:
+    """Where the scoreboard's parts go (inches, y down): the page's size, the cells' size and spacing, the
+    column of sanity checks, and one block ``(family, findings, sanity checks, top, lines)`` per row."""
+
+    cell, gap, left = 0.40, 0.06, 0.25
+
+    def __init__(self, claims: pd.DataFrame, counts: pd.DataFrame, sanity: pd.Series, title: str, per_line: int):
+        cell, gap, left = self.cell, self.gap, self.left
+        self.per_line = per_line
+        self.any_sanity = bool(sanity.any())
+        n_sanity_cols = max([int(sanity[claims["family"] == f].sum()) for f in counts["family"]] or [0])
+        self.n_sanity_cols = min(n_sanity_cols, 6)
+        sanity_w = (0.35 + self.n_sanity_cols * (cell + gap) + 0.1) if self.any_sanity else 0.0
+        self.width = max(left + per_line * (cell + gap) + sanity_w + 0.25, 8.0)
+        self.blocks = []
+        y = 0.85 if title != "-" else 0.25
+        for fam in counts["family"]:
+            part = claims[claims["family"].astype(str) == fam]
+            find = part[~sanity.loc[part.index]]
+            san = part[sanity.loc[part.index]]
+            lines = max(1, int(np.ceil(len(find) / per_line)), int(np.ceil(len(san) / max(self.n_sanity_cols, 1))))
+            self.blocks.append((fam, find, san, y, lines))
+            y += self.block_height(lines) + 0.12
+        n_handles = len(_verdict_words(claims)) + 2 + int(self.any_sanity)
+        self.legend_h = 0.5 if n_handles <= 7 else 0.75
+        self.height = y + self.legend_h
+        self.sanity_x0 = left + per_line * (cell + gap) + 0.35
+
+    def block_height(self, lines: int) -> float:
+        """A row block's height: the name line, ``lines`` lines of cells, the counts line."""
+        return 0.32 + lines * (self.cell + self.gap) + 0.30
+
+
+def _draw_row(fig, ax, lay: _Layout, crow: pd.Series, find: pd.DataFrame, san: pd.DataFrame, y0: float, lines: int,
+              words) -> None:
+    """One scoreboard row from its top ``y0``: the paper's name and data badge, a cell per finding and per
+    sanity check, and the counts line under them."""
+    from matplotlib.patches import Rectangle
+
+    cell, gap, left = lay.cell, lay.gap, lay.left
+    synthetic_row = crow["data"] == "synthetic data"
+    if synthetic_row:  # a light band behind every row on synthetic data
+        ax.add_patch(Rectangle((0.08, y0 - 0.06), lay.width - 0.16, lay.block_height(lines) + 0.06,
+                               facecolor="#f2f2f2", edgecolor="none", zorder=0))
+    name = ax.text(left, y0 + 0.13, str(crow["paper"]), fontsize=11, fontweight="bold", va="center",
+                   ha="left")
+    badge = crow["data"].upper()
+    # the badge right after the paper's name: its position from the name's rendered width (inches)
+    name_w = name.get_window_extent(fig.canvas.get_renderer()).width / fig.dpi + 0.15
+    ax.text(left + name_w, y0 + 0.13, f" {badge} ", fontsize=8, fontweight="bold", va="center", ha="left",
+            color="white" if not synthetic_row else "0.25",
+            bbox=dict(boxstyle="round,pad=0.25", facecolor="#2b5d8a" if not synthetic_row else "white",
+                      edgecolor="#2b5d8a" if not synthetic_row else "0.3", linewidth=0.8))
+    for group, x0, ncol in ((find, left, lay.per_line), (san, lay.sanity_x0, max(lay.n_sanity_cols, 1))):
+        for k, (_, r) in enumerate(group.iterrows()):
+            _draw_cell(ax, r, x0 + (k % ncol) * (cell + gap), y0 + 0.32 + (k // ncol) * (cell + gap), cell)
+    ax.text(left, y0 + 0.32 + lines * (cell + gap) + 0.1, counts_text(crow, words), fontsize=9, va="center",
+            ha="left", color="0.15")
+    if lay.any_sanity and len(san):
+        ax.text(lay.sanity_x0, y0 + 0.13, "sanity checks", fontsize=8, va="center", ha="left", color="0.3",
+                style="italic")
+
+
+def _draw_cell(ax, r: pd.Series, cx: float, cy: float, cell: float) -> None:
+    """One claim's cell at ``(cx, cy)``: coloured by its verdict, hatched on synthetic data, its id inside."""
+    from matplotlib.patches import FancyBboxPatch
+
+    verdict = str(r["verdict"])
+    real = _real(r["real"])
+    ax.add_patch(FancyBboxPatch((cx, cy), cell, cell, boxstyle="round,pad=0,rounding_size=0.05",
+                                facecolor=_colour(verdict), edgecolor="0.25",
+                                linewidth=0.8, hatch=None if real else HATCH, zorder=2,
+                                gid=f"cell:{r['id']}"))
+    # on a hatched cell the id sits on a light patch, so it stays readable
+    ax.text(cx + cell / 2, cy + cell / 2, str(r["id"]), fontsize=7, ha="center", va="center",
+            color="white" if verdict in _DARK and real else "black", zorder=3,
+            bbox=None if real else dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.85,
+                                        edgecolor="none"))
+
+
+def _draw_legend(ax, lay: _Layout, counts: pd.DataFrame, words, n_sanity: int) -> None:
+    """The legend: every verdict word with its total over the findings, then real / synthetic, then sanity
+    checks."""
+    from matplotlib.patches import Patch
+
     handles = [Patch(facecolor=_colour(w), edgecolor="0.25", label=f"{w} ({int(counts[w].sum())})") for w in words]
     handles += [Patch(facecolor="white", edgecolor="0.25", label="real data"),
                 Patch(facecolor="white", edgecolor="0.25", hatch=HATCH, label="synthetic data")]
-    if any_sanity:
+    if lay.any_sanity:
         handles.append(Patch(facecolor="white", edgecolor="0.6", linestyle="--",
-                             label=f"sanity check, right of the line ({int(sanity.sum())}, not counted)"))
-    ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(left / width, 0.02 / height),
+                             label=f"sanity check, right of the line ({n_sanity}, not counted)"))
+    ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(lay.left / lay.width, 0.02 / lay.height),
               ncol=len(handles) if len(handles) <= 7 else int(np.ceil(len(handles) / 2)), fontsize=8.5, frameon=False,
               handlelength=1.6, columnspacing=1.2)
-    return fig, counts
 
 
 def scoreboard_figure(claims: pd.DataFrame, path, title: str = "", per_line: int = 24) -> pd.DataFrame:

@@ -11,7 +11,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import pandas as pd  # noqa: E402
 
-from animsynth.report import run_benchmarks  # noqa: E402
+from animsynth.benchmark_tables import run_benchmarks  # noqa: E402
 from animsynth.tables import write_table  # noqa: E402
 from animsynth.workflow_utils import setup_logging  # noqa: E402
 

@@ -1,5 +1,5 @@
 """Aggregate the benchmark files of this run's jobs (declared inputs: runtime, peak memory), per rule and per family."""
-from animsynth.report import aggregate_rule_benchmarks, family_benchmark_summary, rule_benchmark_summary
+from animsynth.benchmark_tables import aggregate_rule_benchmarks, family_benchmark_summary, rule_benchmark_summary
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 

@@ -3,7 +3,7 @@ import importlib.util
 
 import pandas as pd
 
-from animsynth.report import machine_label
+from animsynth.benchmark_tables import machine_label
 from animsynth.tables import write_table
 from animsynth.workflow_utils import setup_logging
 

@@ -8,8 +8,8 @@ graphs, merging, compression-driven thresholds, one graph per region) ->
 recovery, coherent noise). The family's rooms: :mod:`.settings` (config checks,
 configurations, the published Table 1), :mod:`.jobs` (the workflow steps: Table 1,
 the baseline comparison, the uniqueness study), :mod:`.verdicts` (the paper's
-claims decided), :mod:`.plots` (figures) and :mod:`.kernels` (the compiled loops of
-graph creation).
+claims decided), :mod:`.plots` (figures), :mod:`.kernels` and :mod:`.merge_kernels` (the
+compiled loops of graph creation).
 """
 
 from .._lazy import lazy_exports

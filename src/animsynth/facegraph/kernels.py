@@ -4,8 +4,9 @@ Algorithm 1 (a walk pose by pose), the merge of sample graphs (node by node,
 each decision changing the state the next one sees) and the threshold searches
 around them are sequential; numpy can only vectorise them across samples,
 which costs many small array operations per step. No library offers these
-loops, so they are written here once, compiled with ``numba.njit(cache=True)``
-(the first process compiles and caches them; later processes load the cache).
+loops, so they are written here once (the merge loop in :mod:`.merge_kernels`),
+compiled with ``numba.njit(cache=True)`` (the first process compiles and caches
+them; later processes load the cache).
 
 **Same results, bit for bit.** The loops reproduce the floating-point
 operations of the numpy code they replace, in the same order:
@@ -166,6 +167,19 @@ def py_hypot(x, y):
 # ---------------------------------------------------------------------------
 # Algorithm 1
 @njit(cache=True)
+def _first_node(X, U, OK, mean, cnt, ent_u, ent_ok, ent_n):
+    """Node 0 of a walk: the first pose, with its velocity as the one entering velocity."""
+    for l in range(X.shape[1]):
+        mean[0, l, 0] = X[0, l, 0]
+        mean[0, l, 1] = X[0, l, 1]
+        ent_u[0, 0, l, 0] = U[0, l, 0]
+        ent_u[0, 0, l, 1] = U[0, l, 1]
+        ent_ok[0, 0, l] = OK[0, l]
+    cnt[0] = 1.0
+    ent_n[0] = 1
+
+
+@njit(cache=True)
 def alg1_walk(X, U, OK, n, thr, lam, Q, out, mean, cnt, ent_u, ent_ok, ent_n, sc, dist, prod):
     """Algorithm 1 for one sample of one region; node indices written to ``out``.
 
@@ -191,14 +205,7 @@ def alg1_walk(X, U, OK, n, thr, lam, Q, out, mean, cnt, ent_u, ent_ok, ent_n, sc
     falls back to all of them when a farther node could win).
     """
     L = X.shape[1]
-    for l in range(L):
-        mean[0, l, 0] = X[0, l, 0]
-        mean[0, l, 1] = X[0, l, 1]
-        ent_u[0, 0, l, 0] = U[0, l, 0]
-        ent_u[0, 0, l, 1] = U[0, l, 1]
-        ent_ok[0, 0, l] = OK[0, l]
-    cnt[0] = 1.0
-    ent_n[0] = 1
+    _first_node(X, U, OK, mean, cnt, ent_u, ent_ok, ent_n)
     nn = 1
     cur = 0
     out[0] = 0
@@ -282,297 +289,6 @@ def alg1_all(X, U, OK, lengths, thr, lam, Q, out):
                 if n > 0:
                     alg1_walk(X[r, s], U[r, s], OK[r, s], n, thr[b, r, s], lam, Q, out[b, r, s],
                               mean, cnt, ent_u, ent_ok, ent_n, sc, dist, prod)
-
-
-# ---------------------------------------------------------------------------
-# merging (state arrays of merging.Merger; ``st`` = [n, ne, trial, n0, ne0, n_undo_nodes, n_undo_vins, stamp])
-@njit(cache=True)
-def _rotate_rows(qv, R, qvt, n):
-    """``qv[:n] = qv[:n] @ R.T`` in place (rows are 2-D vectors), rounded as numpy's
-    ``(n, 2) @ (2, 2)`` product does (module docstring); ``qvt`` is scratch."""
-    for l in range(n):
-        x0 = qv[l, 0]
-        x1 = qv[l, 1]
-        qvt[l, 0] = fma(x1, R[0, 1], x0 * R[0, 0])
-        qvt[l, 1] = fma(x1, R[1, 1], x0 * R[1, 0])
-    qv[:n, :] = qvt[:n, :]
-
-
-@njit(cache=True)
-def merge_sample(s, T, trial, lam, eps, procrustes, st,
-                 visit_node, visit_vel, visit_first, ndisp, ncount, first, red, M,
-                 Dsum, Dmean, Dred, cnt, node_map, visit_map,
-                 vin_sum, vin_mean, vin_nrm, vin_cnt, vin_owner, vin_prev, vin_next, vin_oldtail, head, tail,
-                 u_node, u_Dsum, u_cnt, node_stamp, u_vin, u_vsum, u_vcnt, u_vmean, u_vnrm, vin_stamp):
-    """:meth:`merging.Merger.merge` of sample ``s`` -> its merge compression (%).
-
-    Candidate final nodes are those whose reduced-landmark Frobenius distance
-    (computed from differences, so without cancellation) is within the
-    threshold; among them the distance sum and then eq. 3 decide, with
-    numpy's arithmetic (module docs). ``trial`` keeps an undo log
-    (:func:`undo_merge`).
-    """
-    Lf = M.shape[0]
-    Lr = red.shape[0]
-    T2 = T * T
-    n = st[0]
-    ne = st[1]
-    n0 = n
-    if trial:
-        st[2] = 1
-        st[3] = n
-        st[4] = ne
-        st[5] = 0
-        st[6] = 0
-        st[7] += 1
-    else:
-        st[2] = 0
-    stamp = st[7]
-    R = np.empty((2, 2))
-    tr = np.empty(2)
-    Ra = np.empty((2, 2))
-    ta = np.empty(2)
-    tmp = np.empty((2, 2))
-    has_R = False
-    qd = np.empty((Lf, 2))
-    a = np.empty((Lf, 2))
-    qv = np.empty((Lr, 2))
-    qvt = np.empty((Lr, 2))
-    qdr = np.empty((Lr, 2))
-    cdist = np.empty(Lr)
-    qn = np.empty(Lr)
-    prod = np.empty(Lr)
-    buf = np.empty(2 * Lf)
-    ma = np.empty(2)
-    mb = np.empty(2)
-    prev = -1
-    for vi_ in range(visit_first[s], visit_first[s + 1]):
-        g = visit_node[vi_]
-        for l in range(Lr):
-            qv[l, 0] = visit_vel[vi_, l, 0]
-            qv[l, 1] = visit_vel[vi_, l, 1]
-        if has_R:
-            _rotate_rows(qv, R, qvt, Lr)
-        f = node_map[g]
-        if f < 0:
-            if has_R:
-                for l in range(Lf):
-                    a0 = M[l, 0] + ndisp[g, l, 0]
-                    a1 = M[l, 1] + ndisp[g, l, 1]
-                    qd[l, 0] = ((fma(a1, R[0, 1], a0 * R[0, 0])) + tr[0]) - M[l, 0]
-                    qd[l, 1] = ((fma(a1, R[1, 1], a0 * R[1, 0])) + tr[1]) - M[l, 1]
-            else:
-                qd[:, :] = ndisp[g]
-            for l in range(Lr):
-                qdr[l, 0] = qd[red[l], 0]
-                qdr[l, 1] = qd[red[l], 1]
-            best = -1
-            bsc = np.inf
-            for l in range(Lr):
-                qn[l] = math.sqrt(qv[l, 0] * qv[l, 0] + qv[l, 1] * qv[l, 1])
-            lim = T2 * (1.0 + 1e-9) + 1e-12
-            for j in range(n):
-                d2 = 0.0
-                for l in range(Lr):
-                    e0 = Dred[j, 2 * l] - qdr[l, 0]
-                    e1 = Dred[j, 2 * l + 1] - qdr[l, 1]
-                    d2 += e0 * e0 + e1 * e1
-                if d2 > lim:
-                    continue
-                for l in range(Lr):
-                    e0 = Dred[j, 2 * l] - qdr[l, 0]
-                    e1 = Dred[j, 2 * l + 1] - qdr[l, 1]
-                    cdist[l] = math.sqrt(e0 * e0 + e1 * e1)
-                if not (pw_sum(cdist, Lr) <= T):
-                    continue
-                e = head[j]
-                while e >= 0:
-                    for l in range(Lr):
-                        nb = vin_nrm[e, l]
-                        if qn[l] > eps and nb > eps:
-                            c = (qv[l, 0] * vin_mean[e, l, 0] + qv[l, 1] * vin_mean[e, l, 1]) / (qn[l] * nb)
-                        else:
-                            c = 1.0
-                        vi = 1.0 - min(abs(c), 1.0)
-                        prod[l] = cdist[l] * (1.0 + lam * vi)
-                    v = pw_sum(prod, Lr)
-                    if v < bsc:
-                        bsc = v
-                        best = j
-                    e = vin_next[e]
-            if not (bsc <= T):
-                best = -1
-            c = ncount[g]
-            if best >= 0:
-                if procrustes:
-                    ma[0] = 0.0
-                    ma[1] = 0.0
-                    mb[0] = 0.0
-                    mb[1] = 0.0
-                    for l in range(Lf):
-                        a[l, 0] = M[l, 0] + qd[l, 0]
-                        a[l, 1] = M[l, 1] + qd[l, 1]
-                        ma[0] += a[l, 0]
-                        ma[1] += a[l, 1]
-                        mb[0] += M[l, 0] + Dmean[best, l, 0]
-                        mb[1] += M[l, 1] + Dmean[best, l, 1]
-                    ma[0] /= Lf
-                    ma[1] /= Lf
-                    mb[0] /= Lf
-                    mb[1] /= Lf
-                    for l in range(Lf):
-                        buf[2 * l] = (a[l, 0] - ma[0]) * ((M[l, 0] + Dmean[best, l, 0]) - mb[0])
-                        buf[2 * l + 1] = (a[l, 1] - ma[1]) * ((M[l, 1] + Dmean[best, l, 1]) - mb[1])
-                    dot = pw_sum(buf, 2 * Lf)
-                    for l in range(Lf):
-                        buf[l] = ((a[l, 0] - ma[0]) * ((M[l, 1] + Dmean[best, l, 1]) - mb[1])
-                                  - (a[l, 1] - ma[1]) * ((M[l, 0] + Dmean[best, l, 0]) - mb[0]))
-                    cross = pw_sum(buf, Lf)
-                    h = py_hypot(dot, cross)
-                    if h > 0:
-                        cs = dot / h
-                        sn = cross / h
-                    else:
-                        cs = 1.0
-                        sn = 0.0
-                    Ra[0, 0] = cs
-                    Ra[0, 1] = -sn
-                    Ra[1, 0] = sn
-                    Ra[1, 1] = cs
-                    ta[0] = mb[0] - fma(Ra[0, 0], ma[0], Ra[0, 1] * ma[1])
-                    ta[1] = mb[1] - fma(Ra[1, 0], ma[0], Ra[1, 1] * ma[1])
-                    for l in range(Lf):
-                        a0 = a[l, 0]
-                        a1 = a[l, 1]
-                        qd[l, 0] = ((fma(a1, Ra[0, 1], a0 * Ra[0, 0])) + ta[0]) - M[l, 0]
-                        qd[l, 1] = ((fma(a1, Ra[1, 1], a0 * Ra[1, 0])) + ta[1]) - M[l, 1]
-                    _rotate_rows(qv, Ra, qvt, Lr)
-                    if not has_R:
-                        R[:, :] = Ra
-                        tr[0] = ta[0]
-                        tr[1] = ta[1]
-                        has_R = True
-                    else:
-                        for i in range(2):
-                            for j in range(2):
-                                tmp[i, j] = fma(Ra[i, 1], R[1, j], Ra[i, 0] * R[0, j])
-                        t0 = fma(Ra[0, 0], tr[0], Ra[0, 1] * tr[1]) + ta[0]
-                        t1 = fma(Ra[1, 0], tr[0], Ra[1, 1] * tr[1]) + ta[1]
-                        R[:, :] = tmp
-                        tr[0] = t0
-                        tr[1] = t1
-                f = best
-                if trial and f < n0 and node_stamp[f] != stamp:
-                    node_stamp[f] = stamp
-                    k = st[5]
-                    u_node[k] = f
-                    u_Dsum[k] = Dsum[f]
-                    u_cnt[k] = cnt[f]
-                    st[5] = k + 1
-                for l in range(Lf):
-                    Dsum[f, l, 0] += c * qd[l, 0]
-                    Dsum[f, l, 1] += c * qd[l, 1]
-                cnt[f] += c
-            else:
-                f = n
-                n += 1
-                for l in range(Lf):
-                    Dsum[f, l, 0] = c * qd[l, 0]
-                    Dsum[f, l, 1] = c * qd[l, 1]
-                cnt[f] = c
-                head[f] = -1
-                tail[f] = -1
-            for l in range(Lf):
-                Dmean[f, l, 0] = Dsum[f, l, 0] / cnt[f]
-                Dmean[f, l, 1] = Dsum[f, l, 1] / cnt[f]
-            for l in range(Lr):
-                Dred[f, 2 * l] = Dmean[f, red[l], 0]
-                Dred[f, 2 * l + 1] = Dmean[f, red[l], 1]
-            node_map[g] = f
-        # incoming-edge velocity of (f, prev)
-        e = head[f]
-        while e >= 0 and vin_prev[e] != prev:
-            e = vin_next[e]
-        if e < 0:
-            e = ne
-            ne += 1
-            vin_owner[e] = f
-            vin_prev[e] = prev
-            vin_cnt[e] = 1.0
-            for l in range(Lr):
-                vin_sum[e, l, 0] = qv[l, 0]
-                vin_sum[e, l, 1] = qv[l, 1]
-                vin_mean[e, l, 0] = qv[l, 0]
-                vin_mean[e, l, 1] = qv[l, 1]
-                vin_nrm[e, l] = math.sqrt(qv[l, 0] * qv[l, 0] + qv[l, 1] * qv[l, 1])
-            vin_next[e] = -1
-            vin_oldtail[e] = tail[f]
-            if tail[f] >= 0:
-                vin_next[tail[f]] = e
-            else:
-                head[f] = e
-            tail[f] = e
-        else:
-            if trial and e < st[4] and vin_stamp[e] != stamp:
-                vin_stamp[e] = stamp
-                k = st[6]
-                u_vin[k] = e
-                u_vsum[k] = vin_sum[e]
-                u_vcnt[k] = vin_cnt[e]
-                u_vmean[k] = vin_mean[e]
-                u_vnrm[k] = vin_nrm[e]
-                st[6] = k + 1
-            vin_cnt[e] += 1.0
-            for l in range(Lr):
-                vin_sum[e, l, 0] += qv[l, 0]
-                vin_sum[e, l, 1] += qv[l, 1]
-                m0 = vin_sum[e, l, 0] / vin_cnt[e]
-                m1 = vin_sum[e, l, 1] / vin_cnt[e]
-                vin_mean[e, l, 0] = m0
-                vin_mean[e, l, 1] = m1
-                vin_nrm[e, l] = math.sqrt(m0 * m0 + m1 * m1)
-        visit_map[vi_] = f
-        prev = f
-    st[0] = n
-    st[1] = ne
-    k = first[s + 1] - first[s]
-    return 100.0 * (1.0 - (n - n0) / max(k, 1))
-
-
-@njit(cache=True)
-def undo_merge(s, st, first, red, Dsum, Dmean, Dred, cnt, node_map,
-               vin_sum, vin_mean, vin_nrm, vin_cnt, vin_owner, vin_next, vin_oldtail, tail,
-               u_node, u_Dsum, u_cnt, u_vin, u_vsum, u_vcnt, u_vmean, u_vnrm):
-    """Revert the last trial :func:`merge_sample` of sample ``s``."""
-    n0, ne0 = st[3], st[4]
-    Lf = Dsum.shape[1]
-    for k in range(st[5]):
-        f = u_node[k]
-        Dsum[f] = u_Dsum[k]
-        cnt[f] = u_cnt[k]
-        for l in range(Lf):
-            Dmean[f, l, 0] = Dsum[f, l, 0] / cnt[f]
-            Dmean[f, l, 1] = Dsum[f, l, 1] / cnt[f]
-        for l in range(red.shape[0]):
-            Dred[f, 2 * l] = Dmean[f, red[l], 0]
-            Dred[f, 2 * l + 1] = Dmean[f, red[l], 1]
-    for k in range(st[6]):
-        e = u_vin[k]
-        vin_sum[e] = u_vsum[k]
-        vin_cnt[e] = u_vcnt[k]
-        vin_mean[e] = u_vmean[k]
-        vin_nrm[e] = u_vnrm[k]
-    for e in range(st[1] - 1, ne0 - 1, -1):
-        f = vin_owner[e]
-        if f < n0:
-            t = vin_oldtail[e]
-            tail[f] = t
-            vin_next[t] = -1
-    for g in range(first[s], first[s + 1]):
-        node_map[g] = -1
-    st[0] = n0
-    st[1] = ne0
-    st[2] = 0
 
 
 # ---------------------------------------------------------------------------

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from . import kernels
+from . import kernels, merge_kernels
 from .regiongraph import EDGE_EPS, RegionGraph
 from .samplegraphs import RegionData, SampleNodes
 
@@ -50,7 +50,7 @@ class Merger:
     with ``trial=True`` keeps an undo log and is reverted by :meth:`undo`, so
     a per-sample threshold search can try thresholds on the real state.
 
-    The visit loop is compiled (:func:`.kernels.merge_sample`, numpy's arithmetic
+    The visit loop is compiled (:func:`.merge_kernels.merge_sample`, numpy's arithmetic
     reproduced); the state lives in preallocated arrays: node sums and means
     (G, Lf, 2), reduced means (G, 2 Lr), and per incoming edge (at most one
     per visit) the velocity sum, mean (V, Lr, 2) and speeds (V, Lr), chained
@@ -110,7 +110,7 @@ class Merger:
         """Merge sample ``s`` with ``threshold``; return its merge compression
         (%): ``100 * (1 - new final nodes / nodes of the sample)``."""
         self._s = int(s)
-        return float(kernels.merge_sample(
+        return float(merge_kernels.merge_sample(
             int(s), float(threshold), bool(trial), self.lam, self.eps, bool(self.procrustes), self._st,
             *self._nodes[:5], self._nodes[5], self.red, self.M,
             self.Dsum, self.Dmean, self.Dred, self.cnt, self.node_map, self.visit_map,
@@ -123,7 +123,7 @@ class Merger:
         """Revert the last ``trial`` merge."""
         if not self._st[2]:
             raise RuntimeError("no trial merge to undo")
-        kernels.undo_merge(self._s, self._st, self._nodes[5], self.red, self.Dsum, self.Dmean, self.Dred, self.cnt,
+        merge_kernels.undo_merge(self._s, self._st, self._nodes[5], self.red, self.Dsum, self.Dmean, self.Dred, self.cnt,
                         self.node_map, self.vin_sum, self.vin_mean, self.vin_nrm, self.vin_cnt, self.vin_owner,
                         self._vin_next, self._vin_oldtail, self._tail, self._u_node, self._u_Dsum, self._u_cnt,
                         self._u_vin, self._u_vsum, self._u_vcnt, self._u_vmean, self._u_vnrm)

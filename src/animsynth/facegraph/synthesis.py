@@ -302,32 +302,9 @@ class FaceSynthesizer:
         t0 = 0
         prev_dur = None
         for si, code in enumerate(codes):
-            trajs, moving, durs = {}, [], []
+            trajs, durs = {}, []
             for r, g in self.graphs.items():
-                peaks = g.peak_nodes(code)
-                if peaks.size == 0:
-                    raise SynthesisError(f"region {r!r}: no peak node for label {EMOTIONS[code]!r} "
-                                         "(no database sample has that label)")
-                dist, pred = dijkstra(g.csr(), directed=True, indices=cur[r], return_predecessors=True)
-                reach = peaks[np.isfinite(dist[peaks])]
-                if reach.size == 0:
-                    alt = self._neutral_reaching(g, code)
-                    if alt is None:
-                        raise SynthesisError(f"region {r!r}: no {EMOTIONS[code]!r} peak node is reachable from "
-                                             f"node {cur[r]} nor from any neutral node (graph not connected)")
-                    log.warning("region %s: no %s peak reachable from node %d; restarting from neutral node %d",
-                                r, EMOTIONS[code], cur[r], alt)
-                    jumps.append((si, r, int(cur[r]), alt))
-                    cur[r] = alt
-                    dist, pred = dijkstra(g.csr(), directed=True, indices=cur[r], return_predecessors=True)
-                    reach = peaks[np.isfinite(dist[peaks])]
-                if peak_nodes is not None and si == 0:
-                    target = int(peak_nodes[r])
-                    if target not in set(reach.tolist()):
-                        raise SynthesisError(f"region {r!r}: requested peak node {target} is not a reachable "
-                                             f"{EMOTIONS[code]!r} peak node")
-                else:
-                    target = int(reach[peak_rng.integers(reach.size)])
+                target, pred = self._peak_target(r, g, code, si, cur, peak_nodes, peak_rng, jumps)
                 p = _path(pred, cur[r], target)
                 raw[r].append(p)
                 if self.noise_share > 0:
@@ -335,23 +312,10 @@ class FaceSynthesizer:
                 paths[r].append(p)
                 trajs[r] = self._expand(g, p, si == 0)
                 durs.append(self._duration(g, target, rng))
-                if len(p) > 1:
-                    moving.append(r)
                 cur[r] = target
             # step 3: every region to the longest region path
             longest = max(len(t) for t in trajs.values())
-            # step 2: the segment lasts the peak nodes' neutral-to-peak duration
-            mus = np.array([d[0] for d in durs])
-            sds = np.array([d[1] for d in durs])
-            if np.isfinite(mus).any():
-                mu, sd = float(np.nanmean(mus)), float(np.nanmean(np.where(np.isfinite(mus), sds, np.nan)))
-                d = rng.normal(mu, sd) if (self.duration_noise and sd > 0) else mu
-                if si > 0 and prev_dur is not None:
-                    d = self.peak_weights[0] * prev_dur + self.peak_weights[1] * d
-                n = max(1, int(np.rint(d)))
-                prev_dur = d
-            else:
-                n = longest
+            n, prev_dur = self._segment_frames(durs, si, prev_dur, longest, rng)
             seg = np.zeros((n, 68, 2))
             for r, g in self.graphs.items():
                 seg[:, g.landmarks] = resample(resample(trajs[r], longest), n)
@@ -360,3 +324,46 @@ class FaceSynthesizer:
             t0 += n
         disp = self._smooth(np.concatenate(parts, axis=0), segments)
         return Animation(disp, segments, paths, raw, jumps)
+
+    def _peak_target(self, r, g, code: int, si: int, cur: dict, peak_nodes, peak_rng, jumps: list):
+        """``(peak node, shortest-path predecessors from cur[r])`` of region ``r`` for label ``code`` (the
+        ``si``-th): a random peak node reachable from ``cur[r]`` (or the given ``peak_nodes`` for the first label),
+        restarting from a neutral node (logged in ``jumps``, ``cur[r]`` moved) when none is reachable."""
+        peaks = g.peak_nodes(code)
+        if peaks.size == 0:
+            raise SynthesisError(f"region {r!r}: no peak node for label {EMOTIONS[code]!r} "
+                                 "(no database sample has that label)")
+        dist, pred = dijkstra(g.csr(), directed=True, indices=cur[r], return_predecessors=True)
+        reach = peaks[np.isfinite(dist[peaks])]
+        if reach.size == 0:
+            alt = self._neutral_reaching(g, code)
+            if alt is None:
+                raise SynthesisError(f"region {r!r}: no {EMOTIONS[code]!r} peak node is reachable from "
+                                     f"node {cur[r]} nor from any neutral node (graph not connected)")
+            log.warning("region %s: no %s peak reachable from node %d; restarting from neutral node %d",
+                        r, EMOTIONS[code], cur[r], alt)
+            jumps.append((si, r, int(cur[r]), alt))
+            cur[r] = alt
+            dist, pred = dijkstra(g.csr(), directed=True, indices=cur[r], return_predecessors=True)
+            reach = peaks[np.isfinite(dist[peaks])]
+        if peak_nodes is not None and si == 0:
+            target = int(peak_nodes[r])
+            if target not in set(reach.tolist()):
+                raise SynthesisError(f"region {r!r}: requested peak node {target} is not a reachable "
+                                     f"{EMOTIONS[code]!r} peak node")
+            return target, pred
+        return int(reach[peak_rng.integers(reach.size)]), pred
+
+    def _segment_frames(self, durs: list, si: int, prev_dur, longest: int, rng) -> tuple[int, float | None]:
+        """``(frames, duration)`` of the ``si``-th segment (step 2): the peak nodes' mean neutral-to-peak duration
+        (drawn with its spread when ``duration_noise``, blended with the previous segment's by ``peak_weights``),
+        or the longest region path when no node knows a duration."""
+        mus = np.array([d[0] for d in durs])
+        sds = np.array([d[1] for d in durs])
+        if not np.isfinite(mus).any():
+            return longest, prev_dur
+        mu, sd = float(np.nanmean(mus)), float(np.nanmean(np.where(np.isfinite(mus), sds, np.nan)))
+        d = rng.normal(mu, sd) if (self.duration_noise and sd > 0) else mu
+        if si > 0 and prev_dur is not None:
+            d = self.peak_weights[0] * prev_dur + self.peak_weights[1] * d
+        return max(1, int(np.rint(d))), d

@@ -43,7 +43,6 @@ _EXPORTS = {
     "motion_features": ".features",
     "pad_path": ".paths",
     "pass_jumps": ".metrics",
-    "quat_log": ".features",
     "residual_variance": ".embedding",
     "shortest_path_frames": ".paths",
     "sign_flips": ".features",

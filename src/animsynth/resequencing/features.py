@@ -21,11 +21,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..kinematics import qinv, qmul, quaternions, root_translation, translated_joints
+from ..kinematics import qinv, qlog, qmul, quaternions, root_translation, translated_joints
 
 log = logging.getLogger("animsynth.resequencing")
 
-__all__ = ["quat_log", "relative_log", "linearize_quaternions", "MotionFeatures", "motion_features",
+__all__ = ["relative_log", "linearize_quaternions", "MotionFeatures", "motion_features",
            "angular_velocity", "SIGN_MODES", "matrix_naive_quaternions", "naive_quat_log",
            "sign_flips"]
 
@@ -33,25 +33,11 @@ __all__ = ["quat_log", "relative_log", "linearize_quaternions", "MotionFeatures"
 SIGN_MODES = ("continuous", "matrix_naive")
 
 
-def quat_log(q) -> np.ndarray:
-    """Quaternion logarithm ``(theta/2) * axis`` of unit quaternions ``(..., 4)`` (x, y, z, w).
-
-    Returns ``(..., 3)``; the shortest rotation is used (``q`` and ``-q`` agree).
-    """
-    q = np.asarray(q, float)
-    shape = q.shape[:-1]
-    rv = Rotation.from_quat(q.reshape(-1, 4)).as_rotvec()  # full angle, shortest (|angle| <= pi)
-    return (0.5 * rv).reshape(shape + (3,))
-
-
 def relative_log(qa, qb) -> np.ndarray:
-    """``log(qa^{-1} qb)`` for quaternion arrays of equal shape ``(..., 4)`` -> ``(..., 3)``."""
-    qa = np.asarray(qa, float)
-    qb = np.asarray(qb, float)
-    shape = qa.shape[:-1]
-    ra = Rotation.from_quat(qa.reshape(-1, 4))
-    rb = Rotation.from_quat(qb.reshape(-1, 4))
-    return (0.5 * (ra.inv() * rb).as_rotvec()).reshape(shape + (3,))
+    """``log(qa^{-1} qb)`` for quaternion arrays of equal shape ``(..., 4)`` -> ``(..., 3)``: half the rotation
+    vector of the relative rotation, the shorter way round (:func:`animsynth.kinematics.qlog`, the package's one
+    quaternion logarithm, halved)."""
+    return 0.5 * qlog(qmul(qinv(np.asarray(qa, float)), np.asarray(qb, float)))
 
 
 def matrix_naive_quaternions(q) -> np.ndarray:
@@ -152,7 +138,7 @@ def angular_velocity(q, fps: float) -> np.ndarray:
 
     Central differences inside, one-sided at the ends; half-angle convention
     (radians / s, i.e. half the physical angular speed), the same as
-    :func:`quat_log`. Shape ``(frames, joints, 3)`` for ``q`` ``(frames, joints, 4)``.
+    :func:`relative_log`. Shape ``(frames, joints, 3)`` for ``q`` ``(frames, joints, 4)``.
     """
     q = np.asarray(q, float)
     n = q.shape[0]

@@ -18,7 +18,7 @@ time. Landmark Isomap needs geodesics from ``n`` landmarks only:
    ``Delta_n``. Landmarks are placed exactly where step 3 put them.
 
 The same applies to ST-Isomap: give the graph of the *adjusted* neighbour list
-(:func:`.sparse.st_neighbours`).
+(:func:`.sparse_st.st_neighbours`).
 
 Residual variance ``1 - R^2`` (geodesic vs embedded distances) of a landmark
 embedding is estimated **on the landmark pairs only** (all ``N^2`` pairs are

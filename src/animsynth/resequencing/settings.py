@@ -59,7 +59,7 @@ def left_out(config: dict) -> list[str]:
 
 def st_parameters(st: dict, fps: float) -> dict:
     """Keyword arguments of ST-Isomap (:func:`~animsynth.resequencing.embedding.spatio_temporal_distances`,
-    :func:`~animsynth.resequencing.sparse.st_neighbours`; counts in frames) from the ``stisomap`` config block
+    :func:`~animsynth.resequencing.sparse_st.st_neighbours`; counts in frames) from the ``stisomap`` config block
     (durations in seconds) at ``fps`` frames per second.
 
     ``ctn_min_gap`` is at least ``temporal_window`` and ``ctn_reach`` at least one frame.

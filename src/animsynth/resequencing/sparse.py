@@ -45,24 +45,9 @@ many candidates are needed at least.
 
 ST-Isomap
 ---------
-:func:`st_neighbours` applies Jenkins & Mataric's adjustment
-(:func:`.embedding.spatio_temporal_distances`) to a neighbour list of a
-database of several sequences: temporal neighbours (same sequence, ``|i - j|
-<= temporal_window``) are added to the lists and divided by ``c_atn``; common
-temporal neighbours are found among the candidates (non-trivial, within the
-frame's reach, persistent one frame earlier and later) and divided by
-``c_ctn``. Pairs not in a list keep their (larger) distance and are never
-adjusted, so the first ``m`` entries of the re-sorted lists are the exact
-adjusted neighbours. Sequence boundaries count as the ends of a sequence.
-As in the dense version (``always=`` of :func:`.embedding.knn_graph`), the
-adjacent temporal neighbours are edges whatever k: :func:`st_always_edges`
-gives them, and :func:`sparse_min_connected_k` / :func:`sparse_knn_graph`
-take them as ``always=`` (so one sequence alone has minimum k 1).
-
-Paths
------
-:func:`shortest_path` is :func:`.paths.shortest_path_frames` (single-source
-Dijkstra, scipy) on the sparse graph.
+Jenkins & Mataric's adjustment on neighbour lists lives in :mod:`.sparse_st`
+(:func:`.sparse_st.st_neighbours`, :func:`.sparse_st.st_always_edges`);
+:func:`sparse_graph` applies it.
 """
 
 from __future__ import annotations
@@ -77,16 +62,16 @@ from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import connected_components, minimum_spanning_tree
 
 from .distances import PAPER_WEIGHTS, joint_weights
-from .embedding import DisconnectedGraphError, check_st_params
+from .embedding import DisconnectedGraphError
 from .features import MotionFeatures, angular_velocity
 from .paths import shortest_path_frames
+from .sparse_st import st_always_edges, st_neighbours
 
 log = logging.getLogger("animsynth.resequencing")
 
 __all__ = ["CandidateCountError", "concat_features", "l2_neighbours", "lee_index_vectors", "lee_pair_metric",
-           "lee_neighbours", "sparse_knn_graph", "sparse_min_connected_k", "st_always_edges", "st_neighbours",
-           "shortest_path", "temporal_pairs", "SparseGraph", "sparse_graph",
-           "LEE_INDEX_RATIO"]
+           "lee_neighbours", "sparse_knn_graph", "sparse_min_connected_k", "shortest_path", "SparseGraph",
+           "sparse_graph", "LEE_INDEX_RATIO"]
 
 #: Upper bound of lee / index-distance (squared metric): (pi/2)^2 (module docstring).
 LEE_INDEX_RATIO = (math.pi / 2.0) ** 2
@@ -352,7 +337,7 @@ def sparse_knn_graph(dist, idx, k: int, always=None) -> csr_matrix:
     by the distances. Symmetric CSR ``(frames, frames)``.
 
     ``always``: optional ``(pairs (E, 2), weights (E,))``, edges present whatever
-    ``k`` (ST-Isomap's adjacent temporal neighbours, :func:`st_always_edges`).
+    ``k`` (ST-Isomap's adjacent temporal neighbours, :func:`.sparse_st.st_always_edges`).
     A pair that is also listed keeps the smaller of its two weights.
 
     Raises
@@ -401,7 +386,7 @@ def sparse_min_connected_k(idx, n_components_check: bool = True, always=None) ->
 
     MST bottleneck over ``K_ij = min(r_i(j), r_j(i))`` on the sparse graph of
     listed pairs (module docstring); ``always`` (int pairs ``(E, 2)``, e.g. the
-    first item of :func:`st_always_edges`) are edges at every k, as in
+    first item of :func:`.sparse_st.st_always_edges`) are edges at every k, as in
     :func:`.embedding.min_connected_k`. 0 for one frame.
 
     Raises
@@ -440,162 +425,6 @@ def sparse_min_connected_k(idx, n_components_check: bool = True, always=None) ->
     return max(1, int(math.ceil(mst.data.max()))) if mst.nnz else 1
 
 
-# ----------------------------------------------------------------------------- ST-Isomap
-
-
-def _check_sequence(sequence, n: int | None = None) -> np.ndarray:
-    seq = np.asarray(sequence, np.int64)
-    if seq.ndim != 1 or (n is not None and seq.shape != (n,)) or np.any(np.diff(seq) < 0):
-        raise ValueError("sequence must be (frames,) with each sequence's frames contiguous")
-    return seq
-
-
-def temporal_pairs(sequence, temporal_window: int = 1) -> np.ndarray:
-    """Adjacent temporal neighbours of a database: frame pairs ``(i, j)``, ``i < j``,
-    of one sequence with ``j - i <= temporal_window``. Int array ``(E, 2)``."""
-    seq = _check_sequence(sequence)
-    frame = np.arange(seq.size)
-    stop = np.searchsorted(seq, seq, side="right")
-    out = [np.zeros((0, 2), np.int64)]
-    for lag in range(1, int(temporal_window) + 1):
-        a = frame[frame + lag < stop]
-        out.append(np.stack([a, a + lag], 1))
-    return np.concatenate(out)
-
-
-def st_always_edges(sequence, temporal_window: int = 1, c_atn: float = 10.0, pair_distance=None):
-    """ST-Isomap's always-present edges: the adjacent temporal neighbours
-    (:func:`temporal_pairs`) weighted by their base distance divided by ``c_atn``,
-    the same weight :func:`st_neighbours` lists them with.
-
-    Returns ``(pairs (E, 2), weights (E,))`` for ``always=`` of
-    :func:`sparse_knn_graph` (and ``pairs`` for :func:`sparse_min_connected_k`).
-    """
-    if pair_distance is None:
-        raise ValueError("pair_distance is required (the base metric for arbitrary frame pairs)")
-    if not c_atn > 0:
-        raise ValueError(f"c_atn must be > 0, got {c_atn!r}")
-    p = temporal_pairs(sequence, temporal_window)
-    w = pair_distance(p[:, 0], p[:, 1]) / float(c_atn) if p.size else np.zeros(0)
-    return p, np.asarray(w, float)
-
-
-def st_neighbours(dist, idx, sequence, temporal_window: int = 1, c_atn: float = 10.0, c_ctn: float = 10.0,
-                  ctn_neighbors: int = 4, ctn_min_gap: int = 30, ctn_tolerance: int = 2, ctn_reach: int = 6,
-                  pair_distance=None):
-    """ST-Isomap's adjustment (Jenkins & Mataric 2004) on a neighbour list of a database.
-
-    The rules are those of :func:`.embedding.spatio_temporal_distances`, with
-    the non-trivial neighbours of a frame searched among its candidates, and
-    frames of different sequences never temporal and always non-trivial.
-
-    Parameters
-    ----------
-    dist, idx : the neighbour list ``(frames, m)`` of the base metric
-    sequence : int array (frames,), sequence id of each frame (frames of one
-        sequence contiguous and in time order)
-    pair_distance : callable ``(i, j) -> distances`` of the base metric for
-        frame-index arrays (needed for the temporal neighbours and the reach
-        test; e.g. ``lambda i, j: np.linalg.norm(X[i] - X[j], axis=1)`` for L2)
-    other parameters : as :func:`.embedding.spatio_temporal_distances`
-
-    Returns
-    -------
-    dist_st, idx_st : arrays ``(frames, m)``, the exact adjusted neighbour list
-    n_ctn : int, number of common-temporal-neighbour pairs (each counted once)
-    """
-    dist = np.asarray(dist, float)
-    idx = np.asarray(idx, np.int64)
-    n, m = idx.shape
-    seq = _check_sequence(sequence, n)
-    check_st_params(c_atn, c_ctn, temporal_window, ctn_neighbors, ctn_min_gap, ctn_tolerance, ctn_reach)
-    if pair_distance is None:
-        raise ValueError("pair_distance is required (the base metric for arbitrary frame pairs)")
-    frame = np.arange(n)
-    start = np.searchsorted(seq, seq, side="left")
-    stop = np.searchsorted(seq, seq, side="right")  # one past the sequence's last frame
-
-    def same_seq_lag(a, b):
-        """|a - b| for frames of one sequence, a huge lag across sequences."""
-        return np.where(seq[a] == seq[b], np.abs(a - b), np.iinfo(np.int64).max // 4)
-
-    # --- common temporal neighbours among the candidates
-    M = np.full((n, max(ctn_neighbors, 0)), -1, np.int64)
-    if ctn_neighbors > 0 and n > 2:
-        back = np.full(n, np.inf)
-        fwd = np.full(n, np.inf)
-        hb = frame - ctn_reach >= start
-        hf = frame + ctn_reach < stop
-        back[hb] = pair_distance(frame[hb], frame[hb] - ctn_reach)
-        fwd[hf] = pair_distance(frame[hf], frame[hf] + ctn_reach)
-        reach = np.minimum(back, fwd)
-        filled = np.zeros(n, np.int64)
-        for t in range(m):
-            j = idx[:, t]
-            ok = (same_seq_lag(frame, j) > ctn_min_gap) & (dist[:, t] < reach) & (filled < ctn_neighbors)
-            for s in range(ctn_neighbors):  # a pass already represented is trivial
-                a = M[:, s]
-                ok &= ~((a >= 0) & (same_seq_lag(a, j) <= ctn_min_gap))
-            rows = np.flatnonzero(ok)
-            M[rows, filled[rows]] = j[rows]
-            filled[rows] += 1
-        # persistence one frame earlier and later (within the tolerance), where those frames exist
-        ci, cs = np.nonzero(M >= 0)
-        cj = M[ci, cs]
-
-        def follows(src, dst, has):
-            res = np.ones(src.size, bool)
-            h = has
-            near = np.abs(M[src[h]] - dst[h][:, None]) <= ctn_tolerance
-            near &= M[src[h]] >= 0
-            near &= seq[M[src[h]].clip(0)] == seq[dst[h]][:, None]
-            res[h] = near.any(axis=1)
-            return res
-
-        has_prev = (ci - 1 >= start[ci]) & (cj - 1 >= start[cj])
-        has_next = (ci + 1 < stop[ci]) & (cj + 1 < stop[cj])
-        keep = follows(ci - 1, cj - 1, has_prev) & follows(ci + 1, cj + 1, has_next)
-        ci, cj = ci[keep], cj[keep]
-        pairs = np.unique(np.stack([np.minimum(ci, cj), np.maximum(ci, cj)], 1), axis=0)
-        pairs = pairs[same_seq_lag(pairs[:, 0], pairs[:, 1]) > ctn_min_gap]
-    else:
-        pairs = np.zeros((0, 2), np.int64)
-    n_ctn = int(pairs.shape[0])
-
-    # --- temporal neighbours: every same-sequence pair within the window
-    tp = temporal_pairs(seq, temporal_window)
-    ti = np.concatenate([tp[:, 0], tp[:, 1]])
-    tj = np.concatenate([tp[:, 1], tp[:, 0]])
-    td = pair_distance(ti, tj) / c_atn if ti.size else np.zeros(0)
-    ci = np.concatenate([pairs[:, 0], pairs[:, 1]])
-    cj = np.concatenate([pairs[:, 1], pairs[:, 0]])
-
-    # --- merge: listed pairs (base distance), temporal and CTN pairs (adjusted), per row
-    rows = np.concatenate([np.repeat(frame, m), ti, ci])
-    cols = np.concatenate([idx.ravel(), tj, cj])
-    vals = np.concatenate([dist.ravel(), td, np.zeros(ci.size)])
-    kind = np.concatenate([np.zeros(n * m, np.int8), np.ones(ti.size, np.int8), np.full(ci.size, 2, np.int8)])
-    # a CTN pair's value: its base distance (from the list, or computed) / c_ctn
-    if ci.size:
-        vals[kind == 2] = pair_distance(ci, cj) / c_ctn
-    # one entry per (row, col): the adjusted value wins over the listed one (it is smaller or equal)
-    order = np.lexsort((-kind, cols, rows))
-    r_s, c_s = rows[order], cols[order]
-    first = np.ones(r_s.size, bool)
-    first[1:] = (r_s[1:] != r_s[:-1]) | (c_s[1:] != c_s[:-1])
-    sel = order[first]
-    rows, cols, vals = rows[sel], cols[sel], vals[sel]
-    # per row: sort by (value, col) and keep the first m
-    order = np.lexsort((cols, vals, rows))
-    rows, cols, vals = rows[order], cols[order], vals[order]
-    counts = np.bincount(rows, minlength=n)
-    if counts.min() < m:
-        raise CandidateCountError("a frame has fewer adjusted candidates than the list width")  # cannot happen
-    offs = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    take = (offs[:, None] + np.arange(m)[None, :]).ravel()
-    return vals[take].reshape(n, m), cols[take].reshape(n, m), n_ctn
-
-
 def shortest_path(graph, start: int, end: int):
     """Single-source Dijkstra re-sequencing on a sparse graph: ``(frame path, cost)``.
 
@@ -630,8 +459,8 @@ def _untimed(name: str, **info):
 def sparse_graph(neighbours, sequence, method: str = "isomap", n_candidates: int = 20, k=None,
                  st: dict | None = None, grow: bool = True, step=_untimed) -> SparseGraph:
     """The Isomap / ST-Isomap neighbourhood graph of a database from neighbour lists, the steps in order:
-    list the candidates (``neighbours``), ST-Isomap's adjustment (:func:`st_neighbours`) and always-kept edges
-    (:func:`st_always_edges`), the smallest connecting k (:func:`sparse_min_connected_k`), the k-NN graph
+    list the candidates (``neighbours``), ST-Isomap's adjustment (:func:`.sparse_st.st_neighbours`) and always-kept edges
+    (:func:`.sparse_st.st_always_edges`), the smallest connecting k (:func:`sparse_min_connected_k`), the k-NN graph
     (:func:`sparse_knn_graph`) at ``max(min k, k)``.
 
     Used by :class:`.generator.Resequencer` (``grow=True``) and the cost harness (:mod:`.cost`, ``grow=False``,
@@ -647,7 +476,7 @@ def sparse_graph(neighbours, sequence, method: str = "isomap", n_candidates: int
     method : {"isomap", "stisomap"}
     n_candidates : int, candidates listed per frame
     k : int or None, neighbours of the graph; fewer than the smallest connecting k (or None) gives that k
-    st : dict, optional, ST-Isomap's parameters in frames (keyword arguments of :func:`st_neighbours`); the
+    st : dict, optional, ST-Isomap's parameters in frames (keyword arguments of :func:`.sparse_st.st_neighbours`); the
         always-kept edges read ``temporal_window`` and ``c_atn`` with their defaults (1, 10.0) where absent
     grow : bool
         ``True`` (the estimator): at most ``frames - 1`` candidates, doubled until the smallest connecting k

@@ -344,52 +344,66 @@ def run_fold_ensemble(train: list, test, variants, *, n_starts: int = 16, jitter
         group = [v for v in variants if v.latent_dim == dim]
         ctx = prepare_fold(train, test, dim, dup_tol, rank_tol, held_out)
         starts = jittered_starts(ctx.T[0], n_starts, jitter, ctx.diag, seed)
-        M = starts.shape[0]
         objs = [_variant_objects(ctx, v, dup_tol, rank_tol) for v in group]
-        fld_idx = [i for i, v in enumerate(group) if v.generation == "field"]
-        paths: dict[int, list] = {}
-        if fld_idx:
-            n = steps_for(steps, len(ctx.T))
-            which = np.repeat(np.arange(len(fld_idx)), M)
-            # every member of every variant at once: the batched form of FieldFollower.follow (follow_field is
-            # follow_batch of one path), one step loop over the variants' fields
-            bp = follow_batch([objs[i][0].field_ for i in fld_idx], np.tile(starts, (len(fld_idx), 1)), n, which)
-            for j, i in enumerate(fld_idx):
-                paths[i] = [(bp.path(j * M + m), "") for m in range(M)]
+        paths = _ensemble_paths(ctx, group, objs, starts, steps, max_all_pairs)
         for i, v in enumerate(group):
-            if v.generation == "target":
-                planner = TargetPlanner(max_all_pairs).fit(objs[i][1])
-                paths[i] = []
-                for m in range(M):
-                    pth, info = planner.plan(starts[m], ctx.T[-1])
-                    paths[i].append((pth, bool(info["reached"])))
-        norm = ctx.diag if ctx.diag > 0 else np.nan
-        for i, v in enumerate(group):
-            p0 = paths[i][0][0].points
-            vm = []
-            for m, (pth, _) in enumerate(paths[i]):
-                a = error_a(ctx.T, pth.points)[0]
-                f = error_f(ctx.T, pth.points)
-                if m == 0 or member_pose is True or (not isinstance(member_pose, bool) and v.name in member_pose):
-                    gp = ctx.pca.inverse_transform(pth.points)
-                    ap, fp = error_a(ctx.test, gp)[0], error_f(ctx.test, gp)
-                else:
-                    ap = fp = np.nan
-                L = min(len(p0), len(pth.points))
-                sep = np.linalg.norm(pth.points[:L] - p0[:L], axis=1) / norm
-                vm.append({"dataset": dataset, "held_out": held_out, "fold": int(fold), "variant": v.name,
-                           "method": v.method, "k": int(v.k), "latent_dim": int(v.latent_dim),
-                           "derivative": v.derivative, "weights": v.weights, "generation": v.generation,
-                           "member": m, "steps": pth.steps, "fallback_steps": pth.fallback_steps,
-                           "error_a_norm": a / norm, "error_f_norm": f / norm, "error_a_pose": ap, "error_f_pose": fp,
-                           "sep_initial_rel": float(sep[0]), "sep_final_rel": float(sep[-1]),
-                           "sep_max_rel": float(sep.max())})
-            vm = pd.DataFrame(vm, columns=MEMBER_COLUMNS)
+            pose = member_pose is True or (not isinstance(member_pose, bool) and v.name in member_pose)
+            vm = _member_rows(ctx, v, paths[i], pose, dict(dataset=dataset, held_out=held_out, fold=int(fold)))
             row = _fold_row(ctx, v, paths[i][0][0], objs[i][1], paths[i][0][1], dataset=dataset, held_out=held_out,
                             fold=fold)
             rows.append(_ensemble_columns(row, vm))
             mrows.append(vm)
     return rows, pd.concat(mrows, ignore_index=True)
+
+
+def _ensemble_paths(ctx, group: list, objs: list, starts: np.ndarray, steps, max_all_pairs: int) -> dict:
+    """``{variant index: [(path, reached), ...]}``, one path per start: every field variant's members followed at
+    once (``reached`` ""), every target variant's planned to the held-out end (``reached`` True or False)."""
+    M = starts.shape[0]
+    fld_idx = [i for i, v in enumerate(group) if v.generation == "field"]
+    paths: dict[int, list] = {}
+    if fld_idx:
+        n = steps_for(steps, len(ctx.T))
+        which = np.repeat(np.arange(len(fld_idx)), M)
+        # every member of every variant at once: the batched form of FieldFollower.follow (follow_field is
+        # follow_batch of one path), one step loop over the variants' fields
+        bp = follow_batch([objs[i][0].field_ for i in fld_idx], np.tile(starts, (len(fld_idx), 1)), n, which)
+        for j, i in enumerate(fld_idx):
+            paths[i] = [(bp.path(j * M + m), "") for m in range(M)]
+    for i, v in enumerate(group):
+        if v.generation == "target":
+            planner = TargetPlanner(max_all_pairs).fit(objs[i][1])
+            paths[i] = []
+            for m in range(M):
+                pth, info = planner.plan(starts[m], ctx.T[-1])
+                paths[i].append((pth, bool(info["reached"])))
+    return paths
+
+
+def _member_rows(ctx, v, paths: list, pose: bool, where: dict) -> pd.DataFrame:
+    """One :data:`MEMBER_COLUMNS` row per member path of variant ``v``: latent errors, pose errors (member 0
+    always, the others when ``pose``) and the separation from member 0; ``where``: dataset, held_out, fold."""
+    norm = ctx.diag if ctx.diag > 0 else np.nan
+    p0 = paths[0][0].points
+    vm = []
+    for m, (pth, _) in enumerate(paths):
+        a = error_a(ctx.T, pth.points)[0]
+        f = error_f(ctx.T, pth.points)
+        if m == 0 or pose:
+            gp = ctx.pca.inverse_transform(pth.points)
+            ap, fp = error_a(ctx.test, gp)[0], error_f(ctx.test, gp)
+        else:
+            ap = fp = np.nan
+        L = min(len(p0), len(pth.points))
+        sep = np.linalg.norm(pth.points[:L] - p0[:L], axis=1) / norm
+        vm.append({**where, "variant": v.name,
+                   "method": v.method, "k": int(v.k), "latent_dim": int(v.latent_dim),
+                   "derivative": v.derivative, "weights": v.weights, "generation": v.generation,
+                   "member": m, "steps": pth.steps, "fallback_steps": pth.fallback_steps,
+                   "error_a_norm": a / norm, "error_f_norm": f / norm, "error_a_pose": ap, "error_f_pose": fp,
+                   "sep_initial_rel": float(sep[0]), "sep_final_rel": float(sep[-1]),
+                   "sep_max_rel": float(sep.max())})
+    return pd.DataFrame(vm, columns=MEMBER_COLUMNS)
 
 
 def run_subset(trials: dict, variants, *, dataset: str, steps="held_out", dup_tol=1e-9, rank_tol=1e-9,

@@ -291,42 +291,64 @@ class SafeDelaunay:
             return s, bary
         on_hull = resid <= self.tol_
         if r == 1:
-            x = y[:, 0]
-            lo, hi = self._sorted[0], self._sorted[-1]
-            inside = on_hull & (x >= lo - self.tol_) & (x <= hi + self.tol_)
-            k = np.clip(np.searchsorted(self._sorted, x, side="right") - 1, 0, len(self._sorted) - 2)
-            a, b = self._sorted[k], self._sorted[k + 1]
-            t = np.clip((x - a) / np.where(b > a, b - a, 1.0), 0.0, 1.0)
-            s[inside] = k[inside]
-            bary[inside, 0] = 1.0 - t[inside]
-            bary[inside, 1] = t[inside]
-            return s, bary
-        tri = self._tri
+            return self._find_on_line(y[:, 0], on_hull, s, bary)
         s_all = np.full(m, -1, int)
-        todo = np.arange(m)
-        if hint is not None:
-            # warm start: the hint simplex, then up to HINT_WALK steps across the face opposite the most
-            # negative barycentric coordinate (scipy's directed walk, vectorised over points)
-            h = np.asarray(hint, int).copy()
-            cand = np.flatnonzero((h >= 0) & on_hull)
-            TT = self._barycentric_transform()
-            nbr = tri.neighbors
-            done = np.zeros(m, bool)
-            for _ in range(HINT_WALK):
-                if not cand.size:
-                    break
-                T = TT[h[cand]]
-                b = np.einsum("mij,mj->mi", T[:, :r, :], y[cand] - T[:, r, :])
-                full = np.concatenate([b, 1.0 - b.sum(axis=1, keepdims=True)], axis=1)
-                bmin = full.min(axis=1)
-                keep = bmin > HINT_EPS
-                s_all[cand[keep]] = h[cand[keep]]
-                done[cand[keep]] = True
-                rest = ~keep & np.isfinite(bmin)
-                cand, full = cand[rest], full[rest]
-                h[cand] = nbr[h[cand], np.argmin(full, axis=1)]
-                cand = cand[h[cand] >= 0]
-            todo = np.flatnonzero(~done)
+        todo = np.arange(m) if hint is None else self._find_from_hints(y, hint, on_hull, s_all)
+        self._search(y, todo, on_hull, s_all)
+        s_all[~on_hull] = -1
+        ok = s_all >= 0
+        s[ok] = s_all[ok]
+        if ok.any():
+            T = self._barycentric_transform()[s[ok]]  # (mk, r+1, r)
+            b = np.einsum("mij,mj->mi", T[:, :r, :], y[ok] - T[:, r, :])
+            bary[ok, :r] = b
+            bary[ok, r] = 1.0 - b.sum(axis=1)
+            if m > 1:
+                self._relocate_on_faces(q, y, ok, s, bary)
+        return s, bary
+
+    def _find_on_line(self, x, on_hull, s, bary):
+        """:meth:`find` on a one-dimensional complex: the segment between sorted vertices holding each ``x``."""
+        lo, hi = self._sorted[0], self._sorted[-1]
+        inside = on_hull & (x >= lo - self.tol_) & (x <= hi + self.tol_)
+        k = np.clip(np.searchsorted(self._sorted, x, side="right") - 1, 0, len(self._sorted) - 2)
+        a, b = self._sorted[k], self._sorted[k + 1]
+        t = np.clip((x - a) / np.where(b > a, b - a, 1.0), 0.0, 1.0)
+        s[inside] = k[inside]
+        bary[inside, 0] = 1.0 - t[inside]
+        bary[inside, 1] = t[inside]
+        return s, bary
+
+    def _find_from_hints(self, y, hint, on_hull, s_all) -> np.ndarray:
+        """The warm start: the hint simplex, then up to :data:`HINT_WALK` steps across the face opposite the most
+        negative barycentric coordinate (scipy's directed walk, vectorised over points). Points found strictly
+        inside a simplex get it in ``s_all``; returns the points still to search."""
+        r, m = self.rank_, y.shape[0]
+        h = np.asarray(hint, int).copy()
+        cand = np.flatnonzero((h >= 0) & on_hull)
+        TT = self._barycentric_transform()
+        nbr = self._tri.neighbors
+        done = np.zeros(m, bool)
+        for _ in range(HINT_WALK):
+            if not cand.size:
+                break
+            T = TT[h[cand]]
+            b = np.einsum("mij,mj->mi", T[:, :r, :], y[cand] - T[:, r, :])
+            full = np.concatenate([b, 1.0 - b.sum(axis=1, keepdims=True)], axis=1)
+            bmin = full.min(axis=1)
+            keep = bmin > HINT_EPS
+            s_all[cand[keep]] = h[cand[keep]]
+            done[cand[keep]] = True
+            rest = ~keep & np.isfinite(bmin)
+            cand, full = cand[rest], full[rest]
+            h[cand] = nbr[h[cand], np.argmin(full, axis=1)]
+            cand = cand[h[cand] >= 0]
+        return np.flatnonzero(~done)
+
+    def _search(self, y, todo, on_hull, s_all) -> None:
+        """scipy's ``find_simplex`` for the points ``todo`` (into ``s_all``), after leaving out those outside a hull
+        facet, and again by brute force and then exactly for points on the hull it missed."""
+        tri, m = self._tri, y.shape[0]
         if todo.size and self._hull_eq is not None:
             # scipy's find_simplex is slow for points outside the hull (about 0.4 ms each in scipy 1.17):
             # points outside a hull facet by more than the tolerance are outside, without a search
@@ -334,7 +356,7 @@ class SafeDelaunay:
             out_h = np.any(y[todo] @ A.T + c > self.tol_, axis=1)
             todo = todo[~out_h]
         if todo.size == m:
-            s_all = tri.find_simplex(y)
+            s_all[:] = tri.find_simplex(y)
         elif todo.size:
             s_all[todo] = tri.find_simplex(y[todo])
         bad = np.flatnonzero((s_all < 0) & on_hull)
@@ -347,27 +369,20 @@ class SafeDelaunay:
             still = bad[s_all[bad] < 0]
             for i in still:
                 s_all[i] = self._exact_locate(y[i])
-        s_all[~on_hull] = -1
-        ok = s_all >= 0
-        s[ok] = s_all[ok]
-        if ok.any():
-            T = self._barycentric_transform()[s[ok]]  # (mk, r+1, r)
-            b = np.einsum("mij,mj->mi", T[:, :r, :], y[ok] - T[:, r, :])
-            bary[ok, :r] = b
-            bary[ok, r] = 1.0 - b.sum(axis=1)
-            if m > 1:
-                # A point on a shared face lies in several simplices, and scipy's walk (which starts where the
-                # previous point of the batch ended) may pick any of them. Such points are located again one
-                # by one, so the answer never depends on the other points of a batch.
-                edge = np.flatnonzero(ok)[bary[ok].min(axis=1) <= HINT_EPS]
-                for i in edge:
-                    j = self.find_one(q[i] if np.ndim(q) == 2 else q)
-                    s[i] = j
-                    if j >= 0:
-                        Tj = self._barycentric_transform()[j]
-                        bj = Tj[:r, :] @ (y[i] - Tj[r, :])
-                        bary[i, :r], bary[i, r] = bj, 1.0 - bj.sum()
-        return s, bary
+
+    def _relocate_on_faces(self, q, y, ok, s, bary) -> None:
+        """A point on a shared face lies in several simplices, and scipy's walk (which starts where the previous
+        point of the batch ended) may pick any of them. Such points are located again one by one, so the answer
+        never depends on the other points of a batch."""
+        r = self.rank_
+        edge = np.flatnonzero(ok)[bary[ok].min(axis=1) <= HINT_EPS]
+        for i in edge:
+            j = self.find_one(q[i] if np.ndim(q) == 2 else q)
+            s[i] = j
+            if j >= 0:
+                Tj = self._barycentric_transform()[j]
+                bj = Tj[:r, :] @ (y[i] - Tj[r, :])
+                bary[i, :r], bary[i, r] = bj, 1.0 - bj.sum()
 
     def _barycentric_transform(self) -> np.ndarray:
         """scipy's ``Delaunay.transform`` (r+1, r per simplex), computed once with one stacked inverse.

@@ -327,74 +327,93 @@ def simulate(char: Character, root_t: np.ndarray, angles: np.ndarray, fps: float
     T = joint_transforms(rig, W, S)
     body = lbs(char.weights, char.rest, T)  # (F, V, 3)
     F = len(root_t)
-    sk = char.skirt
-    n_r, n_a = sk.shape
-    idx = sk.ravel()
-    rest = char.rest[idx]
-    # rigid skirt target: attached to the hips
-    tgt = np.einsum("fab,nb->fna", W[:, 0], rest - rig.starts[0]) + S[:, 0, None]
-    u = np.repeat(np.linspace(0, 1, n_r), n_a)
-    om_h, om_w = 2 * np.pi * p.hem_frequency, 2 * np.pi * p.waist_frequency
-    k = (om_h + (om_w - om_h) * (1 - u) ** 2) ** 2
-    pinned = u == 0
-    # structural edges (rings, verticals) and shear diagonals
-    g = np.arange(n_r * n_a).reshape(n_r, n_a)
-    edges = np.concatenate([np.stack([g.ravel(), np.roll(g, -1, 1).ravel()], 1),
-                            np.stack([g[:-1].ravel(), g[1:].ravel()], 1),
-                            np.stack([g[:-1].ravel(), np.roll(g[1:], -1, 1).ravel()], 1)])
-    L0 = np.linalg.norm(rest[edges[:, 0]] - rest[edges[:, 1]], axis=1)
-    inv_m = (~pinned).astype(float)
-    wsum = inv_m[edges[:, 0]] + inv_m[edges[:, 1]]
-    ok = wsum > 0
-    edges, L0, wsum = edges[ok], L0[ok], wsum[ok]
-    deg = np.bincount(edges.ravel(), minlength=len(idx)).astype(float)
-    J = {n: i for i, n in enumerate(JOINTS)}
-    legs = [J[n] for n in ("l_thigh", "l_shin", "r_thigh", "r_shin")]
-    leg_r = np.array([0.085, 0.055, 0.085, 0.055]) * (rig.ends[J["head"], 1] / 1.72) + p.collision_margin
-    seg_len = np.linalg.norm(rig.ends[legs] - rig.starts[legs], axis=1)
-    dt = 1.0 / (fps * p.substeps)
-    decay = np.exp(-p.damping * dt)
-    out = np.empty((F, len(idx), 3))
-    x = tgt[0].copy()
+    cloth = _Skirt(char, W, S, fps, p)
+    out = np.empty((F, len(cloth.idx), 3))
+    x = cloth.tgt[0].copy()
     xp = x.copy()
+    for f in [0] * max(preroll, 0):
+        x, xp = cloth.step(f, x, xp)
+    for f in range(F):
+        x, xp = cloth.step(f, x, xp)
+        out[f] = x
+    verts = body.copy()
+    verts[:, cloth.idx] = out
+    return verts
 
-    def run(frames_range, x, xp, record):
-        for f in frames_range:
-            f0 = max(f - 1, 0)
-            for s in range(1, p.substeps + 1):
-                a = s / p.substeps
-                tg = (1 - a) * tgt[f0] + a * tgt[f]
-                xn = x + decay * (x - xp) + (dt * dt) * k[:, None] * (tg - x)
-                xn[pinned] = tg[pinned]
-                for _ in range(p.constraint_iterations):
-                    d = xn[edges[:, 1]] - xn[edges[:, 0]]
-                    ln = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
-                    corr = ((ln - L0) / (ln * wsum))[:, None] * d
-                    acc = np.zeros_like(xn)
-                    for c in range(3):
-                        acc[:, c] = np.bincount(edges[:, 0], corr[:, c] * inv_m[edges[:, 0]], len(xn)) - \
-                            np.bincount(edges[:, 1], corr[:, c] * inv_m[edges[:, 1]], len(xn))
-                    xn += 1.5 * acc / np.maximum(deg, 1)[:, None]
-                # collisions with leg capsules (joint positions interpolated between frames)
-                for li, j in enumerate(legs):
-                    a0 = (1 - a) * S[f0, j] + a * S[f, j]
-                    Wj = W[f, j]
-                    axis = Wj @ (rig.ends[j] - rig.starts[j]) / seg_len[li]
-                    v = xn - a0
-                    tpar = np.clip(v @ axis, 0, seg_len[li])
-                    radial = v - tpar[:, None] * axis
-                    dist = np.linalg.norm(radial, axis=1)
-                    hit = (dist < leg_r[li]) & ~pinned
-                    if np.any(hit):
-                        xn[hit] += radial[hit] * ((leg_r[li] - dist[hit]) / np.maximum(dist[hit], 1e-9))[:, None]
-                xp, x = x, xn
-            if record:
-                out[f] = x
+
+class _Skirt:
+    """The skirt of :func:`simulate` as a mass-spring cloth (position Verlet): its vertices drawn towards a
+    rigid skirt attached to the hips (stiffer at the waist), kept at their rest lengths along the rings,
+    verticals and shear diagonals, and pushed out of capsules around the legs."""
+
+    def __init__(self, char: Character, W, S, fps: float, p: SkirtParams):
+        rig, sk = char.rig, char.skirt
+        n_r, n_a = sk.shape
+        self.idx = idx = sk.ravel()
+        rest = char.rest[idx]
+        self.W, self.S, self.p, self.rig = W, S, p, rig
+        # rigid skirt target: attached to the hips
+        self.tgt = np.einsum("fab,nb->fna", W[:, 0], rest - rig.starts[0]) + S[:, 0, None]
+        u = np.repeat(np.linspace(0, 1, n_r), n_a)
+        om_h, om_w = 2 * np.pi * p.hem_frequency, 2 * np.pi * p.waist_frequency
+        self.k = (om_h + (om_w - om_h) * (1 - u) ** 2) ** 2
+        self.pinned = pinned = u == 0
+        # structural edges (rings, verticals) and shear diagonals
+        g = np.arange(n_r * n_a).reshape(n_r, n_a)
+        edges = np.concatenate([np.stack([g.ravel(), np.roll(g, -1, 1).ravel()], 1),
+                                np.stack([g[:-1].ravel(), g[1:].ravel()], 1),
+                                np.stack([g[:-1].ravel(), np.roll(g[1:], -1, 1).ravel()], 1)])
+        L0 = np.linalg.norm(rest[edges[:, 0]] - rest[edges[:, 1]], axis=1)
+        self.inv_m = (~pinned).astype(float)
+        wsum = self.inv_m[edges[:, 0]] + self.inv_m[edges[:, 1]]
+        ok = wsum > 0
+        self.edges, self.L0, self.wsum = edges[ok], L0[ok], wsum[ok]
+        self.deg = np.bincount(self.edges.ravel(), minlength=len(idx)).astype(float)
+        J = {n: i for i, n in enumerate(JOINTS)}
+        self.legs = [J[n] for n in ("l_thigh", "l_shin", "r_thigh", "r_shin")]
+        self.leg_r = np.array([0.085, 0.055, 0.085, 0.055]) * (rig.ends[J["head"], 1] / 1.72) + p.collision_margin
+        self.seg_len = np.linalg.norm(rig.ends[self.legs] - rig.starts[self.legs], axis=1)
+        self.dt = 1.0 / (fps * p.substeps)
+        self.decay = np.exp(-p.damping * self.dt)
+
+    def step(self, f: int, x, xp):
+        """``(x, x_previous)`` after frame ``f`` (``p.substeps`` substeps from frame ``f - 1``'s pose)."""
+        p, dt, tgt, pinned = self.p, self.dt, self.tgt, self.pinned
+        f0 = max(f - 1, 0)
+        for s in range(1, p.substeps + 1):
+            a = s / p.substeps
+            tg = (1 - a) * tgt[f0] + a * tgt[f]
+            xn = x + self.decay * (x - xp) + (dt * dt) * self.k[:, None] * (tg - x)
+            xn[pinned] = tg[pinned]
+            for _ in range(p.constraint_iterations):
+                self._keep_lengths(xn)
+            self._collide(xn, f0, f, a)
+            xp, x = x, xn
         return x, xp
 
-    if preroll > 0:
-        x, xp = run([0] * preroll, x, xp, record=False)
-    run(range(F), x, xp, record=True)
-    verts = body.copy()
-    verts[:, idx] = out
-    return verts
+    def _keep_lengths(self, xn) -> None:
+        """One iteration of the rest-length constraints on ``xn`` (in place)."""
+        edges, inv_m = self.edges, self.inv_m
+        d = xn[edges[:, 1]] - xn[edges[:, 0]]
+        ln = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
+        corr = ((ln - self.L0) / (ln * self.wsum))[:, None] * d
+        acc = np.zeros_like(xn)
+        for c in range(3):
+            acc[:, c] = np.bincount(edges[:, 0], corr[:, c] * inv_m[edges[:, 0]], len(xn)) - \
+                np.bincount(edges[:, 1], corr[:, c] * inv_m[edges[:, 1]], len(xn))
+        xn += 1.5 * acc / np.maximum(self.deg, 1)[:, None]
+
+    def _collide(self, xn, f0: int, f: int, a: float) -> None:
+        """Push ``xn`` (in place) out of the leg capsules (joint positions interpolated between frames)."""
+        rig, S = self.rig, self.S
+        for li, j in enumerate(self.legs):
+            a0 = (1 - a) * S[f0, j] + a * S[f, j]
+            Wj = self.W[f, j]
+            axis = Wj @ (rig.ends[j] - rig.starts[j]) / self.seg_len[li]
+            v = xn - a0
+            tpar = np.clip(v @ axis, 0, self.seg_len[li])
+            radial = v - tpar[:, None] * axis
+            dist = np.linalg.norm(radial, axis=1)
+            hit = (dist < self.leg_r[li]) & ~self.pinned
+            if np.any(hit):
+                xn[hit] += radial[hit] * ((self.leg_r[li] - dist[hit]) / np.maximum(dist[hit], 1e-9))[:, None]

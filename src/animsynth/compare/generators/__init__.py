@@ -1,12 +1,13 @@
 """The generators the comparison runs, one module each, and the registry that builds them by row name.
 
 registry        row names -> estimators and their settings (``make_generator``), no method code
-names           the row names (``GENERATORS``, ``GRAPHS``, ``FAIRMOTION_ROWS``, ``REFERENCES``, ``DETERMINISTIC``): a
+names           the row names (``GENERATORS``, ``FAIRMOTION_ROWS``, ``REFERENCES``, ``DETERMINISTIC``): a
                 leaf module the harness reads without importing a generator
 motiongraph     the classic motion graph (Kovar, Gleicher & Pighin 2002)
 point_clouds    joint-position point clouds and their closed-form floor alignment (both graphs compare with it)
 fairmotion_peer fairmotion's motion graph on the same clips (the peer row), when it can be imported
 fairmotion_fixes the named fixes of fairmotion's walk (the row fairmotion_fixed) and the recorder of its walk
+fairmotion_load the clips fed to fairmotion (BVH, upsampling) and its loading and construction memos
 motionmatching  motion matching with inertialization (Clavet 2016; Holden et al. 2020); footlock: its foot locking
                 and leg IK
 genmm           generative motion matching (Li et al. 2023)

@@ -51,7 +51,7 @@ passes them (``fit(database, native_clips=...)``, ``generate(..., native_start=.
 ``input_rate = "native"`` says the peer takes them): fairmotion builds its graph and walks on the captured 60 fps
 frames, and the start node is chosen by the 60 fps start. Without them (a source rate that is not a whole multiple
 of 60, or a caller that has only the working-rate clips) every database clip is upsampled from the working rate by
-``k`` before it is written to BVH (:func:`upsample`: joint rotations slerped, the root translation interpolated
+``k`` before it is written to BVH (:func:`.fairmotion_load.upsample`: joint rotations slerped, the root translation interpolated
 linearly between neighbouring frames). Either way lengths stay in seconds and the walk's output is taken back to
 the working rate by keeping every ``k``-th frame (native frame ``i * k`` is working frame ``i``).
 ``native_fps=None`` feeds the working rate unchanged.
@@ -76,26 +76,22 @@ import contextlib
 import copy
 import io
 import logging
-import os
 import random
-import tempfile
 
 import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
 from ...generator import Database, Generator, check_generated
-from ...io.bvh import write_bvh
 from ...kinematics import dof_values_from_local
 from ...motion import Motion
-from ...skeleton import Skeleton
-from ...kinematics import local_rotations, root_translation, yaw_rotation
+from ...kinematics import yaw_rotation
 from .fairmotion_fixes import check_fixes, walk_patches
+from .fairmotion_load import CONSTRUCTED, CONSTRUCTED_MAX, CopyOnRead, fairmotion_input, load_clips, run_serially
 from .motiongraph import budget_keep
 from .point_clouds import apply_floor_transform, pair_terms, positions_m, transform_from_terms, window_clouds
 
-__all__ = ["FairmotionGraph", "FairmotionUnavailable", "INSTALL_COMMAND", "FAIRMOTION_VERSION", "NATIVE_FPS",
-           "upsample"]
+__all__ = ["FairmotionGraph", "FairmotionUnavailable", "INSTALL_COMMAND", "FAIRMOTION_VERSION", "NATIVE_FPS"]
 
 #: The fairmotion release this peer is written for (the only one on the package index).
 FAIRMOTION_VERSION = "0.0.4"
@@ -146,150 +142,6 @@ def _fairmotion():
     return found, bvh, velocity, motion_ops, motion_graph
 
 
-def _bvh_ready(motion: Motion) -> Motion:
-    """The motion on a copy of its skeleton where every joint without DOF has three zero rotation DOF."""
-    sk = copy.deepcopy(motion.skeleton)
-    sl = motion.skeleton.dof_slices()
-    blocks = []
-    for i, j in enumerate(sk.joints):
-        if not j.dofs and i > 0:
-            j.dofs = ["rx", "ry", "rz"]
-            blocks.append(np.zeros((motion.n_frames, 3)))
-        else:
-            blocks.append(np.asarray(motion.values, float)[:, sl[j.name]])
-    sk = Skeleton(sk.joints, sk.length_to_m, sk.angle_unit, sk.name, sk.file_angle_unit, dict(sk.roles))
-    return Motion(np.hstack(blocks), sk, motion.fps, motion.name)
-
-
-def upsample(motion: Motion, factor: int) -> Motion:
-    """``motion`` at ``factor`` times its frame rate: ``(T - 1) * factor + 1`` frames, every joint's local rotation
-    slerped and the root translation interpolated linearly between neighbouring frames (no frame is made
-    after the last one). Written here because our Motion stores DOF values, not poses; fairmotion's own
-    ``ops.motion.resample`` in 0.0.4 runs ``fps * frames`` seconds (the same rate-for-period slip as its blend)."""
-    k = int(factor)
-    if k < 1:
-        raise ValueError(f"upsampling factor must be a whole number >= 1, got {factor!r}")
-    if k == 1 or motion.n_frames < 2:
-        return motion
-    sk = motion.skeleton
-    T = motion.n_frames
-    frac = np.arange(k) / k
-    rots = []
-    for r in local_rotations(sk, motion.values):
-        q = r.as_quat()
-        r0, r1 = Rotation.from_quat(q[:-1]), Rotation.from_quat(q[1:])
-        step = (r0.inv() * r1).as_rotvec()  # the shortest turn from frame t to t + 1
-        parts = [r0 * Rotation.from_rotvec(step * f) for f in frac]
-        mats = np.stack([p.as_quat() for p in parts], axis=1).reshape(-1, 4)
-        rots.append(Rotation.from_quat(np.vstack([mats, q[-1:]])))
-    root = np.asarray(root_translation(sk, motion.values), float)
-    t_new = np.arange((T - 1) * k + 1) / k
-    root_new = np.stack([np.interp(t_new, np.arange(T), root[:, c]) for c in range(3)], axis=1)
-    return Motion(dof_values_from_local(sk, rots, root_new), sk, float(motion.fps) * k, motion.name)
-
-
-#: fairmotion's loading of a clip (:func:`_load_native`), kept for the rest of the process: ``{key: motion}``.
-_LOADED: dict = {}
-_LOADED_MAX = 64
-
-
-def _native_key(clip: Motion, up: int, on=None) -> str:
-    """The key of :func:`_load_native`'s memo: the clip's values, rate and skeleton, ``up`` and the skeleton
-    it is put on."""
-    import hashlib
-
-    h = hashlib.sha256()
-    parts = [np.ascontiguousarray(clip.values, np.float64).tobytes(), repr(float(clip.fps)).encode(),
-             str(int(up)).encode(), clip.skeleton.to_json().encode(), repr(clip.skeleton.length_to_m).encode()]
-    put_on = clip if on is None else on[0]  # the skeleton the velocities are computed on (a first clip: its own)
-    parts += [put_on.skeleton.to_json().encode(), repr(put_on.skeleton.length_to_m).encode()]
-    for part in parts:
-        h.update(part)
-        h.update(b"\0")
-    return h.hexdigest()
-
-
-#: fairmotion's constructed graph of a database (:meth:`FairmotionGraph.fit`), kept for the rest of the
-#: process: ``{key: (nodes, edges)}``, the nodes' attributes and the ``(u, v, weights)`` edges in the order
-#: ``construct`` added them.
-_CONSTRUCTED: dict = {}
-_CONSTRUCTED_MAX = 64
-
-
-def _load_native(clip: Motion, up: int, bvh, velocity, on=None, key: str | None = None):
-    """fairmotion's ``MotionWithVelocity`` of ``clip`` at ``up`` times its rate: the clip upsampled
-    (:func:`upsample`), written to BVH, read by fairmotion's loader, put on the skeleton ``on`` and given
-    fairmotion's velocities (``MotionWithVelocity.from_motion``), as :meth:`FairmotionGraph.fit` needs it.
-
-    ``on``: ``(first clip, its fairmotion Skeleton)`` of the database, whose skeleton every clip is put on
-    before its velocities (fairmotion's ``set_skeleton``); ``None`` for the first clip itself.
-
-    Remembered for the rest of the process, keyed on the clip's values, rate and skeleton and the skeleton
-    it is put on (the first clip's, equal in a database of one subject), and handed out as a deep copy: the
-    leave-one-out databases of a subset share their trials (each trial is in three of the four databases), so
-    fairmotion's loading and velocities (most of a graph's build) run once per trial and job, not once per
-    database. The copy is what fairmotion would have computed again: the same file, read and differentiated by
-    the same code (a test checks the graph and the walks equal those of a fresh load)."""
-    key = _native_key(clip, up, on) if key is None else key  # the caller's, when it has hashed the clip already
-    if key not in _LOADED:
-        with tempfile.TemporaryDirectory(prefix="animsynth_fairmotion_") as tmp:
-            f = os.path.join(tmp, "clip.bvh")
-            write_bvh(f, _bvh_ready(upsample(clip, up)), scale=clip.skeleton.length_to_m)
-            m = bvh.load(f)
-        skel = m.skel if on is None else on[1]
-        for j in skel.joints:
-            if not hasattr(j, "child_joint"):
-                j.child_joint = j.child_joints  # the attribute 0.0.4's Skeleton.num_end_effectors reads
-        m.set_skeleton(skel)
-        if len(_LOADED) >= _LOADED_MAX:
-            _LOADED.pop(next(iter(_LOADED)))
-        _LOADED[key] = velocity.MotionWithVelocity.from_motion(m)
-    return copy.deepcopy(_LOADED[key])
-
-
-class _CopyOnRead:
-    """The loaded clips as one walk sees them (``MotionGraph.motions`` during :meth:`FairmotionGraph.generate`):
-    clip ``i`` is deep-copied from ``motions`` the first time the walk reads it, every copy with one shared memo,
-    so the clips a walk reads are exactly what ``copy.deepcopy(motions)`` makes of them (objects the clips share,
-    their skeleton, copied once and shared). 0.0.4's walk moves the poses it appends in place, hence a copy per
-    walk; a walk reads a few of the database's clips, hence copies on first read (a whole deep copy was a tenth
-    of a walk's CPU)."""
-
-    def __init__(self, motions):
-        self._src = list(motions)
-        self._copies: dict = {}
-        self._memo: dict = {}
-
-    def __len__(self) -> int:
-        return len(self._src)
-
-    def _index(self, i) -> int:
-        i = int(i)
-        if not -len(self._src) <= i < len(self._src):
-            raise IndexError(f"clip index {i} out of range for {len(self._src)} clips")
-        return i % len(self._src)
-
-    def __getitem__(self, i):
-        i = self._index(i)
-        if i not in self._copies:
-            self._copies[i] = copy.deepcopy(self._src[i], self._memo)
-        return self._copies[i]
-
-    def __setitem__(self, i, motion) -> None:
-        self._copies[self._index(i)] = motion
-
-    def __iter__(self):
-        return (self[i] for i in range(len(self._src)))
-
-
-def _run_serially(func, iterable, num_cpus=1, **kwargs):
-    """fairmotion's ``utils.run_parallel`` for one worker, in this process: ``[func(x, **kwargs) for x in
-    iterable]``. Its own runs ``Pool(1).map``, which pickles the clips to a worker process once per chunk; the
-    functions it maps (``create_nodes``, ``compare_and_connect_edge``) only read the clips, so the results are
-    the same (a test compares the graphs)."""
-    return [func(x, **kwargs) for x in iterable]
-
-
 class FairmotionGraph(Generator):
     """fairmotion 0.0.4's motion graph behind the compare generator interface (see the module docstring).
 
@@ -326,7 +178,7 @@ class FairmotionGraph(Generator):
     pool : bool
         Run ``construct`` as released: its node comparisons in a ``multiprocessing`` pool of one worker process,
         to which the clips are pickled once per chunk (what a user of fairmotion runs; the build benchmark).
-        ``False`` (default): the same functions mapped in this process (:func:`_run_serially`); the graph is
+        ``False`` (default): the same functions mapped in this process (:func:`run_serially`); the graph is
         the same (tested), without the pickling and the worker.
 
     Attributes
@@ -406,13 +258,7 @@ class FairmotionGraph(Generator):
             ``i``, ``k = native_fps / rate``), fed to fairmotion instead of the working clips upsampled.
         """
         found, bvh, velocity, _, motion_graph = _fairmotion()
-        stride = self.base if self.stride is None else self.stride
-        if not (self.base >= stride >= 1 and self.base > self.blend >= 1 and self.compare >= self.blend):
-            raise ValueError(f"fairmotion needs base >= stride >= 1, base > blend >= 1 and compare >= blend "
-                             f"(frames), got base={self.base}, stride={stride}, blend={self.blend}, "
-                             f"compare={self.compare}")
-        if not 0.0 < float(self.threshold_quantile) <= 1.0:
-            raise ValueError(f"threshold_quantile must be in (0, 1], got {self.threshold_quantile!r}")
+        stride = self._check_lengths()
         clips = list(database)
         if not clips:
             raise ValueError("fairmotion graph: the database is empty")
@@ -424,42 +270,58 @@ class FairmotionGraph(Generator):
         db = Database(clips)
         fixes = self._fixes()
         fps = float(first.fps)
-        native = fps if self.native_fps is None else float(self.native_fps)
-        up = native / fps
-        if abs(up - round(up)) > 1e-9 or round(up) < 1:
-            raise ValueError(f"fairmotion native_fps {native:g} must be a whole multiple of the database's "
-                             f"{fps:g} fps")
-        up = int(round(up))
-        src, load_up = clips, up  # what is written for fairmotion: the working clips, upsampled by up
-        if native_clips is not None and up > 1:
-            src, load_up = list(native_clips), 1  # the native-rate clips from the source, as they are
-            if len(src) != len(clips):
-                raise ValueError(f"fairmotion graph: {len(src)} native-rate clips for {len(clips)} database clips")
-            for c, n in zip(clips, src):
-                if (not np.isclose(n.fps, native) or n.skeleton.columns() != first.skeleton.columns()
-                        or n.n_frames < (c.n_frames - 1) * up + 1):
-                    raise ValueError(f"fairmotion graph: native clip {n.name!r} is not clip {c.name!r} at {native:g} fps "
-                                     f"(its rate {n.fps:g}, {n.n_frames} frames, need >= {(c.n_frames - 1) * up + 1})")
+        native, up = self._native_rate(fps)
+        src, load_up = fairmotion_input(clips, native_clips, native, up)
         native_db = Database(src) if src is not clips else None  # the clips fairmotion is given, when not upsampled
-        # each clip's memo key, hashed once: the loading memo's and, together, the construction memo's below
-        keys = [_native_key(c, load_up, None if i == 0 else (src[0], None)) for i, c in enumerate(src)]
-        loaded = [_load_native(src[0], load_up, bvh, velocity, key=keys[0])]
-        loaded += [_load_native(c, load_up, bvh, velocity, on=(src[0], loaded[0].skel), key=k)
-                   for c, k in zip(src[1:], keys[1:])]
-        for c, m in zip(clips, loaded):
-            if not np.isclose(m.fps, native):
-                raise ValueError(f"fairmotion read clip {c.name!r} at {m.fps} fps, not {native:g} (its BVH loader "
-                                 "rounds the frame rate to an integer)")
-        skel = loaded[0].skel
-        for m in loaded:
-            m.set_skeleton(skel)
-        motions = loaded
+        keys, motions = load_clips(clips, src, load_up, native, bvh, velocity)
+        skel = motions[0].skel
         files = [f"clip{i:03d}.bvh" for i in range(len(clips))]  # names only: fairmotion keeps them, never reads them
         graph = motion_graph.MotionGraph(
             motions=motions, motion_files=files, skel=skel, fps=native,
             base_length=self._seconds(self.base * up, native), stride_length=self._seconds(stride * up, native),
             blend_length=self._seconds(self.blend * up, native), compare_length=self._seconds(self.compare * up, native),
             verbose=False)
+        self._construct(graph, motion_graph, skel, keys, native)
+        self._reduce(graph, sum(c.n_frames for c in clips) / fps, up)
+        self._graph_ = graph
+        self._loaded_ = copy.deepcopy(graph.motions)
+        self._names_ = [j.name for j in skel.joints]
+        self._pos_ = [positions_m(c) for c in clips]
+        self._native_pos_ = [positions_m(c) for c in src] if src is not clips else None
+        self.native_input_ = "source" if src is not clips else "upsampled"
+        self.fairmotion_version_ = found
+        self.skeleton_ = first.skeleton
+        self.fps_ = fps
+        self.native_fps_ = native
+        self.upsample_ = up
+        self.fixes_ = fixes
+        self.db_, self.native_db_ = db, native_db
+        return self
+
+    def _check_lengths(self) -> int:
+        """The stride in frames, once the node, stride, blend and comparison lengths and the threshold quantile
+        are checked."""
+        stride = self.base if self.stride is None else self.stride
+        if not (self.base >= stride >= 1 and self.base > self.blend >= 1 and self.compare >= self.blend):
+            raise ValueError(f"fairmotion needs base >= stride >= 1, base > blend >= 1 and compare >= blend "
+                             f"(frames), got base={self.base}, stride={stride}, blend={self.blend}, "
+                             f"compare={self.compare}")
+        if not 0.0 < float(self.threshold_quantile) <= 1.0:
+            raise ValueError(f"threshold_quantile must be in (0, 1], got {self.threshold_quantile!r}")
+        return stride
+
+    def _native_rate(self, fps: float) -> tuple[float, int]:
+        """``(native, k)``: the rate fairmotion runs at and its whole multiple ``k`` of the database's ``fps``."""
+        native = fps if self.native_fps is None else float(self.native_fps)
+        up = native / fps
+        if abs(up - round(up)) > 1e-9 or round(up) < 1:
+            raise ValueError(f"fairmotion native_fps {native:g} must be a whole multiple of the database's "
+                             f"{fps:g} fps")
+        return native, int(round(up))
+
+    def _construct(self, graph, motion_graph, skel, keys: list, native: float) -> None:
+        """fairmotion's graph construction at an infinite threshold (every node pair's distance), or the one this
+        process built already for the same clips, lengths, weights and comparison count (``construct_reused_``)."""
         weights = dict(w_joint_pos=self.w_joint_pos, w_joint_vel=self.w_joint_vel, w_root_pos=self.w_root_pos,
                        w_root_vel=self.w_root_vel, w_ee_pos=self.w_ee_pos, w_ee_vel=self.w_ee_vel,
                        w_trajectory=self.w_trajectory)
@@ -468,29 +330,34 @@ class FairmotionGraph(Generator):
         # it once per process (the edges kept are then chosen per threshold below)
         key = repr((keys, native, graph.base_length, graph.stride_length, graph.blend_length, graph.compare_length,
                     sorted(weights.items()), int(self.num_comparison)))
-        if key in _CONSTRUCTED:
-            node_list, edge_list = _CONSTRUCTED[key]
+        if key in CONSTRUCTED:
+            node_list, edge_list = CONSTRUCTED[key]
             graph.skel = skel
             graph.graph.add_nodes_from(node_list)
             graph.graph.add_edges_from((u, v, {"weights": w}) for u, v, w in edge_list)
             for name, value in dict(w_joints=None, **weights).items():
                 setattr(graph, name, value)
             self.construct_reused_ = True
-        else:
-            parallel = motion_graph.utils.run_parallel
-            if not self.pool:
-                motion_graph.utils.run_parallel = _run_serially  # one worker: no Pool, no pickled clips (same graph)
-            try:
-                with contextlib.redirect_stderr(io.StringIO()):  # its tqdm progress bars
-                    graph.construct(w_joints=None, **weights, diff_threshold=np.inf,
-                                    num_comparison=self.num_comparison, num_workers=1)
-            finally:
-                motion_graph.utils.run_parallel = parallel
-            if len(_CONSTRUCTED) >= _CONSTRUCTED_MAX:
-                _CONSTRUCTED.pop(next(iter(_CONSTRUCTED)))
-            _CONSTRUCTED[key] = ([(n, dict(a)) for n, a in graph.graph.nodes(data=True)],
-                                 [(u, v, d["weights"]) for u, v, d in graph.graph.edges(data=True)])
-            self.construct_reused_ = False
+            return
+        parallel = motion_graph.utils.run_parallel
+        if not self.pool:
+            motion_graph.utils.run_parallel = run_serially  # one worker: no Pool, no pickled clips (same graph)
+        try:
+            with contextlib.redirect_stderr(io.StringIO()):  # its tqdm progress bars
+                graph.construct(w_joints=None, **weights, diff_threshold=np.inf,
+                                num_comparison=self.num_comparison, num_workers=1)
+        finally:
+            motion_graph.utils.run_parallel = parallel
+        if len(CONSTRUCTED) >= CONSTRUCTED_MAX:
+            CONSTRUCTED.pop(next(iter(CONSTRUCTED)))
+        CONSTRUCTED[key] = ([(n, dict(a)) for n, a in graph.graph.nodes(data=True)],
+                             [(u, v, d["weights"]) for u, v, d in graph.graph.edges(data=True)])
+        self.construct_reused_ = False
+
+    def _reduce(self, graph, seconds: float, up: int) -> None:
+        """Keep the transitions under the threshold (or the budget over ``seconds`` of database), then the largest
+        strongly connected component; sets ``threshold_``, ``n_below_threshold_``, ``n_nodes_``,
+        ``largest_scc_share_`` and ``transitions_`` (frames at the database's rate: ``up`` native frames each)."""
         nodes = graph.graph.nodes
         n_before = graph.graph.number_of_nodes()
         if n_before == 0:
@@ -507,7 +374,7 @@ class FairmotionGraph(Generator):
         if jumps.size == 0:
             raise ValueError("fairmotion graph: no pair of nodes to connect")
         if self.transitions_per_s is not None:
-            keep = budget_keep(jumps, float(self.transitions_per_s), sum(c.n_frames for c in clips) / fps)
+            keep = budget_keep(jumps, float(self.transitions_per_s), seconds)
             self.threshold_ = float(jumps[keep].max())
             graph.graph.remove_edges_from([(u, v) for (u, v, _w), k in zip(jump_edges, keep) if not k])
         else:
@@ -525,20 +392,6 @@ class FairmotionGraph(Generator):
                  nodes[v]["frame_start"] // up, d["weights"])
                 for u, v, d in graph.graph.edges(data=True) if not plays_on(u, v)]
         self.transitions_ = pd.DataFrame(rows, columns=["from_clip", "from_frame", "to_clip", "to_frame", "distance"])
-        self._graph_ = graph
-        self._loaded_ = copy.deepcopy(graph.motions)
-        self._names_ = [j.name for j in skel.joints]
-        self._pos_ = [positions_m(c) for c in clips]
-        self._native_pos_ = [positions_m(c) for c in src] if src is not clips else None
-        self.native_input_ = "source" if src is not clips else "upsampled"
-        self.fairmotion_version_ = found
-        self.skeleton_ = first.skeleton
-        self.fps_ = fps
-        self.native_fps_ = native
-        self.upsample_ = up
-        self.fixes_ = fixes
-        self.db_, self.native_db_ = db, native_db
-        return self
 
     def run_notes(self) -> dict:
         """``transitions_kept``: the node pairs kept at the threshold (``n_below_threshold_``, before the
@@ -599,17 +452,28 @@ class FairmotionGraph(Generator):
             raise ValueError(f"length must be an integer >= 1 (frames), got {length!r}")
         length = int(length)
         node, place = self._start(start, native_start)
-        _, _, velocity, motion_ops, _ = _fairmotion()
         up = self.upsample_
         n_native = (length - 1) * up + 1
-
-        def velocity_default_fps() -> float:
-            return float(velocity.MotionWithVelocity().fps)
-
-        graph = self._graph_
-        nodes = graph.graph.nodes
-        blend_sources = []
+        nodes = self._graph_.graph.nodes
         self.fixes_ = self._fixes()  # the fixes act on the walk only: read at every walk (one graph for both rows)
+        out, visited, pieces, blend_sources = self._walk(node, seed, n_native)
+        src, seams = self._source_frames(out, visited, pieces, length)
+        values = self._walk_values(out, length, place)
+        self.last_walk_ = {"out_fps": float(out.fps), "pieces": [(int(a), int(b)) for a, b, _bl in pieces],
+                           "blend_sources": np.array(blend_sources).reshape(-1, 3)}
+        meta = {"seams": seams, "source_frames": src, "generator": "fairmotion",
+                "start_node": (int(nodes[node]["motion_idx"]), int(nodes[node]["frame_start"]) // up),
+                "fairmotion_version": self.fairmotion_version_, "fixes": self.fixes_}
+        return check_generated(Motion(values, self.skeleton_, self.fps_, f"fairmotion_walk_seed{seed}", meta), length,
+                               self.db_.skeleton, self.name)
+
+    def _walk(self, node, seed: int, n_native: int):
+        """fairmotion's ``create_random_motion`` from ``node`` for ``n_native`` frames at the native rate, with the
+        fixes of ``fixes_`` patched in and Python's ``random`` seeded by ``seed`` (both restored afterwards):
+        ``(out, visited, pieces, blend_sources)`` (the appended pieces and blends, :func:`walk_patches`)."""
+        _, _, velocity, motion_ops, _ = _fairmotion()
+        graph = self._graph_
+        blend_sources = []
         pieces, swap = walk_patches(motion_ops, self.fixes_, blend_sources)
         saved = {name: getattr(motion_ops, name) for name in swap}
         state = random.getstate()
@@ -619,8 +483,8 @@ class FairmotionGraph(Generator):
             # the walk stops once its output, at the output's frame rate (0.0.4: its default 60 fps whatever
             # the data's), lasts the requested seconds: ask for the frames at that rate, then, if the output is
             # built at the walk's rate (the output_rate fix, or a later release), at that rate
-            for rate in dict.fromkeys((velocity_default_fps(), self.native_fps_)):
-                graph.motions = _CopyOnRead(self._loaded_)  # 0.0.4's walk moves the poses it appends in place
+            for rate in dict.fromkeys((float(velocity.MotionWithVelocity().fps), self.native_fps_)):
+                graph.motions = CopyOnRead(self._loaded_)  # 0.0.4's walk moves the poses it appends in place
                 pieces.clear()
                 blend_sources.clear()
                 random.seed(seed)
@@ -632,14 +496,19 @@ class FairmotionGraph(Generator):
                 setattr(motion_ops, name, f)
             random.setstate(state)
             graph.motions = self._loaded_
-        n_out = out.num_frames()
-        if n_out < n_native:
-            raise ValueError(f"fairmotion's walk stopped after {n_out} of {n_native} frames at {self.native_fps_:g} "
-                             "fps (a dead end)")
+        if out.num_frames() < n_native:
+            raise ValueError(f"fairmotion's walk stopped after {out.num_frames()} of {n_native} frames at "
+                             f"{self.native_fps_:g} fps (a dead end)")
+        return out, visited, pieces, blend_sources
+
+    def _source_frames(self, out, visited, pieces, length: int):
+        """``(source_frames, seams)`` of a walk's output at the database's rate: the clip and frame each output
+        frame plays ((length, 2), -1 for blended frames) and the output frames where a blended piece starts."""
+        up, nodes, n_out = self.upsample_, self._graph_.graph.nodes, out.num_frames()
         n_blend, t = 0, 0.0  # the frames append_and_blend blends: its running time, summed as it sums it
         while True:
             t += 1 / self.native_fps_
-            if t > graph.blend_length:
+            if t > self._graph_.blend_length:
                 break
             n_blend += 1
         src = np.full((n_out, 2), -1, int)
@@ -652,12 +521,17 @@ class FairmotionGraph(Generator):
             if blended:
                 src[first:min(first + n_blend, stop)] = -1
                 seams.append(first)
-        keep = np.arange(length) * up  # back to the database's rate
-        src = src[keep]
+        src = src[np.arange(length) * up]  # back to the database's rate
         src[:, 1] = np.where(src[:, 1] >= 0, src[:, 1] // up, -1)
         src[src[:, 1] < 0] = -1
-        mats = np.array([np.asarray(out.poses[i].data, float) for i in keep])  # (length, joints, 4, 4), local
-        idx = {name: i for i, name in enumerate(self._names_)}
+        seams = np.unique([-(-s // up) for s in seams]).astype(int)
+        return src, seams[(seams > 0) & (seams < length)]
+
+    def _walk_values(self, out, length: int, place) -> np.ndarray:
+        """The DOF values ``(length, n_dof)`` of a walk's output at the database's rate, its root placed on the
+        start (``place``: yaw and ground offset of :meth:`_start`)."""
+        mats = np.array([np.asarray(out.poses[i].data, float) for i in np.arange(length) * self.upsample_])
+        idx = {name: i for i, name in enumerate(self._names_)}  # mats: (length, joints, 4, 4), local
         rots = []
         for j in self.skeleton_.joints:
             rots.append(Rotation.from_matrix(mats[:, idx[j.name], :3, :3]) if j.name in idx
@@ -667,13 +541,4 @@ class FairmotionGraph(Generator):
         theta, x0, z0 = place
         rots[0] = yaw_rotation(theta)[0] * rots[0]
         root = apply_floor_transform(root[:, None, :], theta, x0, z0)[:, 0] / scale
-        values = dof_values_from_local(self.skeleton_, rots, root)
-        seams = np.unique([-(-s // up) for s in seams]).astype(int)
-        seams = seams[(seams > 0) & (seams < length)]
-        self.last_walk_ = {"out_fps": float(out.fps), "pieces": [(int(a), int(b)) for a, b, _bl in pieces],
-                           "blend_sources": np.array(blend_sources).reshape(-1, 3)}
-        meta = {"seams": seams, "source_frames": src, "generator": "fairmotion",
-                "start_node": (int(nodes[node]["motion_idx"]), int(nodes[node]["frame_start"]) // up),
-                "fairmotion_version": self.fairmotion_version_, "fixes": self.fixes_}
-        return check_generated(Motion(values, self.skeleton_, self.fps_, f"fairmotion_walk_seed{seed}", meta), length,
-                               self.db_.skeleton, self.name)
+        return dof_values_from_local(self.skeleton_, rots, root)

@@ -43,13 +43,14 @@ from scipy.ndimage import median_filter
 from scipy.spatial.transform import Rotation
 
 from ...joints import resolve_roles
-from ...kinematics import UP, decay_spring, forward_kinematics, joint_euler, nearest_euler, wrap_degrees
+from ...kinematics import UP, forward_kinematics, joint_euler, nearest_euler, wrap_degrees
 from ...skeleton import ROT_DOFS
+from ...springs import decay_spring
 
-__all__ = ["leg_chains", "contact_points", "contact_labels", "lock_contacts", "two_bone_ik", "place_feet"]
+__all__ = ["hip_knee_ankle", "contact_points", "contact_labels", "lock_contacts", "two_bone_ik", "place_feet"]
 
 
-def leg_chains(skeleton) -> np.ndarray:
+def hip_knee_ankle(skeleton) -> np.ndarray:
     """``(2, 3)`` joint indices (hip, knee, ankle) of the left and right legs, from the joint roles.
 
     Raises ``ValueError`` when a knee's parent is not its hip, an ankle's parent not its knee, or a hip has
@@ -201,7 +202,7 @@ def two_bone_ik(skeleton, values, chain, targets, max_length_buffer_m: float = 0
     ----------
     skeleton : Skeleton
     values : ndarray (T, n_dof)
-    chain : 3 ints, hip, knee, ankle (:func:`leg_chains`)
+    chain : 3 ints, hip, knee, ankle (:func:`hip_knee_ankle`)
     targets : ndarray (T, 3), world targets in metres
     max_length_buffer_m : float, metres kept short of full extension (the reference: 0.015)
     effector : "ball" (the ankle segment's end) or "heel" (the ankle joint)

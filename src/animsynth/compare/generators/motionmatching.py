@@ -83,10 +83,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...joints import resolve_roles
-from ...kinematics import (decay_spring, forward_kinematics, ground_heading, qexp, qinv, qlog, qmul, rest_forward,
-                          spring_angle, spring_position, wrap_radians, yaw_rotation)
+from ...kinematics import (forward_kinematics, ground_heading, qexp, qinv, qlog, qmul, rest_forward, wrap_radians,
+                          yaw_rotation)
+from ...springs import decay_spring, spring_angle, spring_position
 from ...motion import Motion
-from .footlock import contact_labels, contact_points, leg_chains, lock_contacts, place_feet
+from .footlock import contact_labels, contact_points, hip_knee_ankle, lock_contacts, place_feet
 from ...generator import Database, Generator
 from .poses import Track, decode, encode
 
@@ -303,7 +304,7 @@ class MotionMatching(Generator):
         if float(self.ik_max_length_buffer_m) < 0 or float(self.contact_filter_s) < 0:
             raise ValueError("motion matching: ik_max_length_buffer_m and contact_filter_s must be >= 0")
         sk, fps = db.skeleton, db.fps
-        self.legs_ = leg_chains(sk)
+        self.legs_ = hip_knee_ankle(sk)
         pts = [contact_points(sk, c.values, self.legs_) for c in db.clips]
         self.contacts_ = np.vstack([contact_labels(p, fps, float(self.contact_speed_m_s), float(self.contact_filter_s))
                                     for p in pts])
@@ -376,28 +377,17 @@ class MotionMatching(Generator):
         m = float(sk.length_to_m)
         st = encode(start, self.forward_)
         sq, svec = self._state(st, fps, m)
-        s_w = self._angular_velocity(sq, fps)[-1]
-        s_d = self._vec_velocity(svec, fps)[-1]
+        # the start's last frame as a source of offsets: rotations, angular velocity, root vector, its velocity
+        start_src = (sq[-1], self._angular_velocity(sq, fps)[-1], svec[-1], self._vec_velocity(svec, fps)[-1])
         s_pose = pose_features(start, st.yaw)[-1]
         # generated root history (ground in metres, yaw), the start's first
         ground = list(st.ground * m)
         yaws = list(st.yaw)
-        if trajectory is None:
-            goal_v, goal_yaw = self._gamepad(st.ground * m, float(st.yaw[-1]), fps)
-            fut_ground = fut_yaw = None
-        else:
-            if trajectory.columns != start.columns:
-                raise ValueError("motion matching: the trajectory's DOF columns differ from the start's")
-            joined = Motion(np.vstack([start.values, trajectory.values]), sk, fps, "trajectory")
-            ft = encode(joined, self.forward_)
-            fut_ground, fut_yaw = ft.ground * m, ft.yaw
+        goals = self._goals(start, st, trajectory, fps, m)
         hl = float(self.inertialize_halflife_s)
         dt = 1.0 / fps
         n_j = sq.shape[1]
-        off_q = np.tile([0.0, 0.0, 0.0, 1.0], (n_j, 1))
-        off_w = np.zeros((n_j, 3))
-        off_x = np.zeros(4)
-        off_v = np.zeros(4)
+        off = (np.tile([0.0, 0.0, 0.0, 1.0], (n_j, 1)), np.zeros((n_j, 3)), np.zeros(4), np.zeros(4))
         cur = -1  # database frame shown (-1: the start's last frame)
         timer = 0
         out_q = np.empty((length, n_j, 4))
@@ -408,69 +398,28 @@ class MotionMatching(Generator):
             end = cur >= 0 and cur + 1 >= self.stops_[db.clip[cur]]
             if cur < 0 or timer <= 0 or end:
                 timer = self.search_frames_
-                now = len(ground) - 1  # index of the current frame in the start + generated timeline
-                if fut_ground is None:
-                    fg, fy = self._predict(np.asarray(ground[-2:]), np.asarray(yaws[-2:]), goal_v, goal_yaw, fps)
-                else:
-                    k = np.minimum(now + self.future_frames_, fut_ground.shape[0] - 1)
-                    fg, fy = fut_ground[k], fut_yaw[k]
-                traj = trajectory_features(np.asarray(ground[-1])[None, :], np.array([yaws[-1]]), fg[None],
-                                           fy[None])[0]
-                pose = s_pose if cur < 0 else None
-                if cur < 0:
-                    q = self._normalise(np.concatenate([pose, traj]))
-                else:
-                    q = self.features_[cur].copy()
-                    q[15:] = self._normalise(np.concatenate([np.zeros(15), traj]))[15:]
-                cost = np.sum((self.features_ - q) ** 2, axis=1)
-                ok = self.candidates_.copy()
-                best_cost = np.inf
-                if cur >= 0:
-                    same = db.clip == db.clip[cur]
-                    ok &= ~(same & (np.abs(db.frame - db.frame[cur]) < self.exclude_frames_))
-                    if not end:
-                        best_cost = float(cost[cur])
-                best = cur if np.isfinite(best_cost) else -1
-                if ok.any():
-                    j = int(np.flatnonzero(ok)[np.argmin(cost[ok])])
-                    if cost[j] < best_cost:
-                        best, best_cost = j, float(cost[j])
-                if best < 0:  # pragma: no cover - fit ensures candidates exist
-                    raise RuntimeError("motion matching: no frame to play")
+                q = self._query(cur, s_pose, ground, yaws, goals, fps)
+                best, best_cost = self._best_frame(q, cur, end)
                 costs.append(best_cost)
                 searched.append(t)
                 if best != cur:
                     switches += 1
-                    # offsets between the pose shown now and the matched frame
-                    if cur < 0:
-                        src_q, src_w, src_x, src_v = sq[-1], s_w, svec[-1], s_d
-                    else:
-                        src_q, src_w, src_x, src_v = self.rot_[cur], self.angular_velocity_[cur], self.vec_[cur], \
-                            self.root_velocity_[cur]
-                    oq = qmul(qmul(off_q, src_q), qinv(self.rot_[best]))
-                    oq[oq[:, 3] < 0] *= -1
-                    off_q = oq
-                    off_w = off_w + src_w - self.angular_velocity_[best]
-                    off_x = off_x + src_x - self.vec_[best]
-                    off_v = off_v + src_v - self.root_velocity_[best]
+                    off = self._switch_offsets(off, start_src if cur < 0 else self._source(cur), best)
                     if t > 0:
                         seams.append(t)
                     cur = best
             # play the next frame with the decayed offsets
             cur += 1
             timer -= 1
+            off_q, off_w, off_x, off_v = off
             rv, off_w = decay_spring(qlog(off_q), off_w, hl, dt)
             off_q = qexp(rv)
             off_x, off_v = decay_spring(off_x, off_v, hl, dt)
+            off = (off_q, off_w, off_x, off_v)
             out_q[t] = qmul(off_q, self.rot_[cur])
             out_vec[t] = self.vec_[cur] + off_x
             played[t] = cur
-            # the generated root (for the next query)
-            yaw_prev = yaws[-1]
-            step = out_vec[t, 1:3] / fps
-            c, s = np.cos(yaw_prev), np.sin(yaw_prev)
-            ground.append(ground[-1] + np.array([c * step[0] + s * step[1], -s * step[0] + c * step[1]]))
-            yaws.append(yaw_prev + out_vec[t, 3] / fps)
+            _advance_root(ground, yaws, out_vec[t], fps)  # the generated root (for the next query)
         values = decode(sk, out_q[:, 1:], out_q[:, 0], out_vec[:, 0] / m, out_vec[:, 1:3] / (m * fps),
                         out_vec[:, 3] / fps, np.asarray(start.values, float)[-1], self.forward_)
         extra = {}
@@ -478,6 +427,73 @@ class MotionMatching(Generator):
             values, extra = self._lock_feet(start, values, played)
         return self._motion(values, length, seams, db.sources(played), costs=np.asarray(costs),
                             search_frames=np.asarray(searched, np.int64), switches=int(switches), **extra)
+
+    def _goals(self, start: Motion, st, trajectory: Motion | None, fps: float, m: float):
+        """What the queries steer towards: ``(goal_v, goal_yaw, None, None)`` from the gamepad (no ``trajectory``),
+        else ``(None, None, ground, yaw)`` of the start followed by the given future trajectory."""
+        if trajectory is None:
+            goal_v, goal_yaw = self._gamepad(st.ground * m, float(st.yaw[-1]), fps)
+            return goal_v, goal_yaw, None, None
+        if trajectory.columns != start.columns:
+            raise ValueError("motion matching: the trajectory's DOF columns differ from the start's")
+        joined = Motion(np.vstack([start.values, trajectory.values]), self.db_.skeleton, fps, "trajectory")
+        ft = encode(joined, self.forward_)
+        return None, None, ft.ground * m, ft.yaw
+
+    def _query(self, cur: int, s_pose, ground: list, yaws: list, goals, fps: float) -> np.ndarray:
+        """The normalised query at a search: the pose features of the frame shown (the start's last while
+        ``cur < 0``) and the trajectory features of the future the goals give (predicted from the gamepad, or
+        read from the given trajectory)."""
+        goal_v, goal_yaw, fut_ground, fut_yaw = goals
+        now = len(ground) - 1  # index of the current frame in the start + generated timeline
+        if fut_ground is None:
+            fg, fy = self._predict(np.asarray(ground[-2:]), np.asarray(yaws[-2:]), goal_v, goal_yaw, fps)
+        else:
+            k = np.minimum(now + self.future_frames_, fut_ground.shape[0] - 1)
+            fg, fy = fut_ground[k], fut_yaw[k]
+        traj = trajectory_features(np.asarray(ground[-1])[None, :], np.array([yaws[-1]]), fg[None],
+                                   fy[None])[0]
+        if cur < 0:
+            return self._normalise(np.concatenate([s_pose, traj]))
+        q = self.features_[cur].copy()
+        q[15:] = self._normalise(np.concatenate([np.zeros(15), traj]))[15:]
+        return q
+
+    def _best_frame(self, q: np.ndarray, cur: int, end: bool) -> tuple[int, float]:
+        """``(frame, cost)``: the candidate frame nearest the query ``q``, or the frame shown ``cur`` when it is at
+        least as near and its clip has not ``end``-ed; frames of the clip shown within ``exclude_frames_`` of it are
+        left out."""
+        db = self.db_
+        cost = np.sum((self.features_ - q) ** 2, axis=1)
+        ok = self.candidates_.copy()
+        best_cost = np.inf
+        if cur >= 0:
+            same = db.clip == db.clip[cur]
+            ok &= ~(same & (np.abs(db.frame - db.frame[cur]) < self.exclude_frames_))
+            if not end:
+                best_cost = float(cost[cur])
+        best = cur if np.isfinite(best_cost) else -1
+        if ok.any():
+            j = int(np.flatnonzero(ok)[np.argmin(cost[ok])])
+            if cost[j] < best_cost:
+                best, best_cost = j, float(cost[j])
+        if best < 0:  # pragma: no cover - fit ensures candidates exist
+            raise RuntimeError("motion matching: no frame to play")
+        return best, best_cost
+
+    def _source(self, cur: int):
+        """Database frame ``cur`` as a source of offsets: rotations, angular velocity, root vector, its velocity."""
+        return self.rot_[cur], self.angular_velocity_[cur], self.vec_[cur], self.root_velocity_[cur]
+
+    def _switch_offsets(self, off, src, best: int):
+        """The inertialization offsets ``(q, w, x, v)`` after switching from the pose ``src`` shown now to database
+        frame ``best``: the old offsets plus the difference between the two."""
+        off_q, off_w, off_x, off_v = off
+        src_q, src_w, src_x, src_v = src
+        oq = qmul(qmul(off_q, src_q), qinv(self.rot_[best]))
+        oq[oq[:, 3] < 0] *= -1
+        return (oq, off_w + src_w - self.angular_velocity_[best], off_x + src_x - self.vec_[best],
+                off_v + src_v - self.root_velocity_[best])
 
     def _lock_feet(self, start: Motion, values: np.ndarray, played: np.ndarray):
         """The reference's foot locking and two-bone IK on the decoded frames (:mod:`.footlock`)."""
@@ -498,6 +514,16 @@ class MotionMatching(Generator):
                                       fk=(starts[idx], [w[idx] for w in W]))
         return out, {"contact_targets": targets, "contact_locked": locked,
                      "contact_states": self.contacts_[played].copy()}
+
+
+def _advance_root(ground: list, yaws: list, vec: np.ndarray, fps: float) -> None:
+    """Append the next generated root (ground position, yaw) after one frame of the root vector ``vec`` (its
+    forward, sideways and turning rates in the body's frame)."""
+    yaw_prev = yaws[-1]
+    step = vec[1:3] / fps
+    c, s = np.cos(yaw_prev), np.sin(yaw_prev)
+    ground.append(ground[-1] + np.array([c * step[0] + s * step[1], -s * step[0] + c * step[1]]))
+    yaws.append(yaw_prev + vec[3] / fps)
 
 
 class MotionMatchingTrajectory(MotionMatching):

@@ -1,13 +1,11 @@
 """The comparison's row names: a leaf module (no import), so tables, plots, verdicts and settings read the names
 without importing a generator (:mod:`.registry` builds the estimators)."""
 
-__all__ = ["GENERATORS", "REFERENCES", "GRAPHS", "FAIRMOTION_ROWS", "DETERMINISTIC"]
+__all__ = ["GENERATORS", "REFERENCES", "FAIRMOTION_ROWS", "DETERMINISTIC"]
 
 #: every generator name, in the order of the tables
 GENERATORS = ("delaunay", "knn", "isomap", "stisomap", "motion_graph", "fairmotion", "fairmotion_fixed",
               "motion_matching", "motion_matching_pose", "motion_matching_traj", "genmm", "replay", "concat")
-#: the motion-graph generators: one transition budget for all of them
-GRAPHS = ("motion_graph", "fairmotion", "fairmotion_fixed")
 #: the generators that run fairmotion's package
 FAIRMOTION_ROWS = ("fairmotion", "fairmotion_fixed")
 #: the two reference rows (bounds, not methods)

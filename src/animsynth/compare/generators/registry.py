@@ -41,7 +41,7 @@ Generators (``GENERATORS``):
     the same with upstream's later fixes of its walk (output rate, blend source, rigid turn of the
     appended piece, ``cut`` copying its poses), each a named patch (:data:`animsynth.compare.generators.fairmotion_fixes.FIXES`).
 
-The graph generators (:data:`GRAPHS`) keep the same transition budget, ``compare.transitions_per_s``
+The graph generators (motion_graph, fairmotion, fairmotion_fixed) keep the same transition budget, ``compare.transitions_per_s``
 (:func:`animsynth.compare.generators.motiongraph.budget_count`).
 ``motion_matching``
     motion matching with inertialization and the reference's foot locking and leg IK (Clavet 2016; the
