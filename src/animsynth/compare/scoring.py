@@ -1,7 +1,8 @@
 """Scoring: every metric of one generated motion against the held-out clip it continues.
 
 The comparison scores each generator's motion with :func:`score` (its clip's database side computed once,
-:func:`reference`; L2P normalised by the whole run's database, :func:`run_stats`). ``animsynth score`` scores motions
+:func:`reference`; L2P normalised by the clip's own database, so a clip's scores do not depend on what else the
+run holds). ``animsynth score`` scores motions
 made anywhere (a BVH file from any tool) the same way (:func:`score_motions`): a generated motion is scored against
 the held-out capture it should continue, as a generator's motion is scored in the comparison: its first ``context``
 frames are the start (the frames the generator was given, as in the protocol: the same frames as the
@@ -13,8 +14,8 @@ What a scored file cannot give is left empty, by what each metric needs (:attr:`
 seeds. The metrics that read the database (:data:`DATABASE_METRICS`: L2P's normalisation, coverage, novelty) and
 foot skating (:data:`SKATING_METRICS`: the floor from the database's feet) are left empty without one; foot skating
 is scored without a database when the floor height is given (``compare.metrics.floor_m``). With the database and
-the settings of a compare run, a motion of that run's BVH folder scores as in its ``metrics.csv`` (L2P: when the
-run's database is this clip's, as in a run of one clip; the comparison normalises L2P by the whole run's database).
+the settings of a compare run, a motion of that run's BVH folder scores as in its ``metrics.csv`` (given the clip's
+whole database: the comparison normalises L2P by the clip's own database).
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ class Reference:
     foot_idx : int array, the foot joints
     floor : float, the floor height (m)
     jumps : metrics.JumpReference, the database's own frame-to-frame jumps
-    std : ndarray (J, 3), LAFAN1 position statistics of the whole run's database windows (:func:`run_stats`)
+    std : ndarray (J, 3), LAFAN1 position statistics of the clip's database windows (the comparison's; or given)
     capture_max : (float, float), the held-out capture's largest velocity and acceleration jump
     features : list of ndarray, the database clips' pose features
     truth_pos, truth_q : the ground truth's positions (m) and global quaternions
@@ -180,7 +181,7 @@ def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray
 
 
 def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict,
-          roles: dict | None = None) -> tuple[dict, np.ndarray]:
+          roles: dict | None = None, entry_seam: bool = True) -> tuple[dict, np.ndarray]:
     """Every per-seed metric of one generated motion; returns the row and its pose features.
 
     The row has one value per record of :data:`~animsynth.compare.measures.metric_table.METRICS` but those a run gives
@@ -189,7 +190,8 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
 
     The start and the generated frames are scored together where a measure needs frames before the
     first generated one (foot speed at the first frame, the jump at the entry seam); the entry
-    (generated frame 0) is a seam for every generator but ``replay``.
+    (generated frame 0) is a seam when ``entry_seam`` (the generator's declared
+    :attr:`animsynth.generator.Generator.entry_seam`: every generator but the replay of the capture).
     """
     from . import measures as M
 
@@ -200,7 +202,7 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     pos, q = M.positions_and_quaternions(joined.skeleton, joined.values, start=c)
     gen_pos = pos[c:]
     seams = np.asarray(motion.meta.get("seams", []), np.int64)
-    if generator != "replay":
+    if entry_seam:
         seams = np.union1d(seams, [0])
     row = {}
     height, speed = float(mcfg["contact_height_m"]), float(mcfg["skate_speed_m_s"])
