@@ -491,6 +491,7 @@ def test_summary_and_winners_tables():
     (lambda c: c["compare"]["motion_matching"].update(weights=[0, 0, 0, 1, 1.5]), "compare.motion_matching.weights"),
     (lambda c: c["compare"]["genmm"].update(patch_size=10), "compare.genmm.patch_size"),
     (lambda c: c["compare"]["genmm"].update(patch_size=21), "compare.genmm.patch_size"),
+    (lambda c: c["compare"].update(max_clips_per_subject=2), "compare.min_clips_per_subject"),
 ])
 def test_settings_check_names_the_key(mutate, key):
     cfg = _config()

@@ -283,6 +283,10 @@ def check(config: dict) -> None:
         if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
             raise ConfigError(f"config key 'compare.fps': {cmp['fps']} must be the trials' rate (fps: "
                               f"{config['fps']}) divided by a whole number")
+    cap = cmp.get("max_clips_per_subject")
+    if cap is not None and cmp["min_clips_per_subject"] > cap:
+        raise ConfigError(f"config key 'compare.min_clips_per_subject': {cmp['min_clips_per_subject']} exceeds "
+                          f"compare.max_clips_per_subject ({cap}): no subject could enter the declared tests")
     if cmp["min_length"] > cmp["length"]:
         raise ConfigError(f"config key 'compare.min_length': {cmp['min_length']} exceeds compare.length "
                           f"({cmp['length']})")
