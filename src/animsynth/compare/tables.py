@@ -281,7 +281,8 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
         out += ["## Sanity checks", "", "Claims true by construction, decided the same way; not findings.", "",
                 to_markdown(sanity[["claim", "ours", "verdict", "evidence"]]), ""]
     out += [
-            "## Clips", "", to_markdown(clips), "",
+            "## Clips", "", to_markdown(clips[[c for c in ("clip", "subject", "group", "protocol", "held_out", "database",
+                                                          "length", "note") if c in clips]]), "",
             "Per clip x seed values: `metrics.csv`; medians and spreads: `summary.csv`; build time, generation "
             "speed and memory: `cost_timing.csv` (machine-dependent, not shown here).", ""]
     return "\n".join(out)
