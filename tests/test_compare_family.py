@@ -664,7 +664,7 @@ def test_the_claims_against_the_peer_quote_the_budget_sweep():
     assert (v["verdict"] == without["verdict"]).all()  # evidence, not a vote: decided at the default budget
 
 
-# --- one group per CMU subject: the paper run's 12 subjects -----------------
+# --- one group per CMU subject: the paper run's 18 subjects -----------------
 
 def _paper_config() -> dict:
     """config.yaml, cmu.yaml, samba.yaml and paper.yaml merged as the paper run merges them, validated."""
@@ -692,15 +692,16 @@ def _clips_table_of(config: dict, missing=()) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def test_the_paper_configs_clips_make_one_group_per_subject_twelve_in_all():
+def test_the_paper_configs_clips_make_one_group_per_subject_eighteen_in_all():
     cfg = _paper_config()
     settings.check(cfg)
     table = _clips_table_of(cfg)
     assert [c.split("@")[0] for c in table["clip"]] == settings.held_out_trials(cfg)
     groups = GR.independent_groups(table)
     subjects = {c.split("/")[1].split("_")[0] for c in table["clip"]}
-    assert subjects == {"35", "16", "127", "05", "02", "09", "07", "12", "49", "17", "06", "10"}
-    assert len(set(groups.values())) == 12
+    assert subjects == {"35", "16", "127", "05", "02", "09", "07", "12", "49", "17", "06", "10", "26", "27", "32",
+                        "36", "91", "131"}
+    assert len(set(groups.values())) == 18
     for clip, label in groups.items():  # each group is one subject, named by it
         assert label.startswith(f"subject {clip.split('/')[1].split('_')[0]} ("), (clip, label)
     # the Table I subsets and re-sequencing clips are as before; the new subjects come after them
@@ -709,8 +710,10 @@ def test_the_paper_configs_clips_make_one_group_per_subject_twelve_in_all():
         settings.held_out_trials(dict(cfg, compare=dict(cfg["compare"], subjects={})))
     proto = dict(zip(table["group"], table["protocol"]))
     assert proto["s09"] == proto["s07"] == proto["s02"] == "leave one out"
-    assert proto["s17"] == proto["s06"] == proto["s10"] == "temporal split"
-    assert len(table) == 19 + (3 + 4 + 3 + 3 + 3) + 3
+    assert proto["s17"] == proto["s06"] == proto["s10"] == proto["s26"] == proto["s27"] == proto["s36"] == \
+        "temporal split"
+    assert proto["s32"] == proto["s91"] == proto["s131"] == "leave one out"
+    assert len(table) == 19 + (3 + 4 + 3 + 3 + 3 + 2 + 2 + 2) + 6
     # a mirror that cannot be read: its subjects' groups are left out, the others stay
     many = [t["id"] for t in cfg["trials"] if t.get("mirror") == "many"]
     left = GR.independent_groups(_clips_table_of(cfg, many))

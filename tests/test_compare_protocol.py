@@ -203,6 +203,7 @@ def test_genmm_has_its_levels_on_every_clip_of_the_paper_protocol():
     import yaml
     from snakemake.utils import update_config
 
+    from animsynth.capture_check import check_capture
     from animsynth.config import validate_config
     from animsynth.data import load_trial
     from conftest import REPO
@@ -227,7 +228,8 @@ def test_genmm_has_its_levels_on_every_clip_of_the_paper_protocol():
             kw = {k: r[k] for k in ("first_frame", "bvh_length_to_m") if k in r}
             roles = {**(config.get("joint_roles") or {}), **(r.get("joint_roles") or {})}
             trials[t] = load_trial(**files, fps=config["fps"], name=t, joint_roles=roles, **kw)
-        clips = protocol.prepare_clips(trials, loo, split, cc, subjects=settings.trial_subjects(config))
+        checks = {t: check_capture(m, t, config["capture_check"]).usable for t, m in trials.items()}
+        clips = protocol.prepare_clips(trials, loo, split, cc, subjects=settings.trial_subjects(config), usable=checks)
         for c in clips:
             n = _levels(c, gm)
             rows.append(protocol.clips_table([c]).iloc[0])

@@ -80,8 +80,9 @@ def _docs_toy() -> str:
 @pytest.mark.workflow
 def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp_path_factory):
     """The docs' toy generator and a broken one added to a copy of the finished tiny run: only their jobs run (one
-    per subject), the broken one is one error line per job and empty rows, the toy is in every table, figure and the BVH folder, the
-    family's rows and claims are byte for byte the same; then animsynth score reads the toy's BVH file back."""
+    per subject), the broken one is one error line per job and empty rows, the toy is in every table, figure and the
+    BVH folder, the family's rows and claims are byte for byte the same; then animsynth score reads the toy's BVH
+    file back."""
     import numpy as np
 
     from animsynth import cli

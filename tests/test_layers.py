@@ -9,7 +9,7 @@ dependency). Layers, bottom to top:
    angle continuity and retargeting, the generator interface;
 2. io (file formats; knows no method);
 3. shared machinery on top of io: synthetic data, skinning, drawing (the scoreboard too), data sources, the data layer,
-   workflow logging;
+   the capture check, workflow logging;
 4. the four families of the papers, which never import each other;
 5. compare, which scores the families' generators side by side (the one package that imports them);
 (layers 4 and 5 as the family registry, :mod:`animsynth.families`, gives them: adding a family adds it here)
@@ -34,7 +34,7 @@ LAYERS = {
     0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton", "families"],
     1: ["config", "tables", "motion", "kinematics", "axes", "retarget", "generator"],
     2: ["io"],
-    3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "workflow_utils"],
+    3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "capture_check", "workflow_utils"],
     4: list(FAMILIES),
     5: [f.name for f in registry.FAMILIES if f.layer == 5],
     6: ["report", "scale", "cli"],

@@ -22,14 +22,16 @@ left_hip         lfemur      LeftUpLeg, LeftThigh          thigh.L, upper_leg.L
 left_knee        ltibia      LeftLeg, LeftShin             shin.L, lower_leg.L
 left_ankle       lfoot       LeftFoot                      foot.L
 left_toe         ltoes       LeftToeBase, LeftToe          toe.L
-left_shoulder    lhumerus    LeftArm, LeftUpArm            upper_arm.L
+left_shoulder    lhumerus    LeftArm, LeftUpArm, lShldr    upper_arm.L
 left_elbow       lradius     LeftForeArm                   forearm.L, lower_arm.L
 left_wrist       lwrist      LeftHand                      hand.L
 ===============  ==========  ===========================  =========================
 
 and the same with ``right_`` / ``r`` / ``Right`` / ``.R``. Note that the BVH
 joint ``LeftShoulder`` is the *clavicle* (CMU ``lclavicle``); the shoulder
-joint is ``LeftArm``. Names match case-insensitively, after dropping a
+joint is ``LeftArm``. In cgspeed's 3ds Max-friendly CMU conversions
+(``LeftCollar``, ``LeftShoulder``, ``LeftElbow``) ``LeftShoulder`` is the upper
+arm: name it with ``joint_roles`` (config/cmu.yaml does for 131). Names match case-insensitively, after dropping a
 namespace prefix (``mixamorig:LeftArm``) and the separators ``_ - . space``
 (``upper_arm.L`` = ``upperarml``). ``pelvis`` falls back to the skeleton's
 root joint. Anything else that does not resolve raises :class:`JointRoleError`
@@ -56,7 +58,7 @@ _SIDED = {
     "toe": ["{s}toes", "{side}toebase", "{side}toe", "{side}toes", "{side}toeend", "toe{s}", "toes{s}", "{s}toe",
             "{s}toebase"],
     "shoulder": ["{s}humerus", "{side}arm", "{side}uparm", "{side}upperarm", "upperarm{s}", "uparm{s}",
-                 "{s}upperarm", "{s}uparm", "{s}humerus"],
+                 "{s}upperarm", "{s}uparm", "{s}humerus", "{s}shldr", "{side}shldr"],
     "elbow": ["{s}radius", "{side}forearm", "{side}lowerarm", "{side}elbow", "forearm{s}", "lowerarm{s}",
               "{s}forearm", "{s}lowerarm", "{s}elbow"],
     "wrist": ["{s}wrist", "{side}hand", "{side}wrist", "hand{s}", "wrist{s}", "{s}hand"],

@@ -314,3 +314,66 @@ def compare_skeletons(a: Skeleton, b: Skeleton, tol_m: float = SAME_SKELETON_TOL
     cos = np.sum(qa[ok] * vb[ok], axis=1) / (la[ok] * lb[ok])
     angle = float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max()) if ok.any() else 0.0
     return SkeletonDifference(True, "", big, where, Q, angle, tol_m)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# one figure for several subjects? (a converter that retargets every subject onto its generic skeleton)
+# ---------------------------------------------------------------------------------------------------------------
+def shared_figure_pairs(skeletons: dict, subjects: dict, tol_m: float = SAME_SKELETON_TOL_M) -> list[tuple]:
+    """Pairs of trials of *different* subjects whose skeletons are the same (:func:`compare_skeletons`).
+
+    Two real people never share every bone length to ``tol_m``; trials of two subjects on one skeleton were
+    retargeted onto a generic figure (cgspeed's ``ROOT hip`` BVH release puts every subject on one), so their
+    foot heights and skating are the figure's, not the subjects'. Trials of one subject share a skeleton by
+    design and are not paired.
+
+    Parameters
+    ----------
+    skeletons : {trial id: Skeleton}
+        Each trial's skeleton as parsed (lengths times its ``length_to_m``, so the unit does not matter).
+    subjects : {trial id: subject}
+        Every trial of ``skeletons``.
+    tol_m : float
+        Metres (default :data:`SAME_SKELETON_TOL_M`): every rest offset and End Site within it.
+
+    Returns
+    -------
+    list of (trial_a, trial_b, largest_m)
+        ``trial_a`` before ``trial_b`` in the order of ``skeletons``; ``largest_m`` the largest rest-vector
+        difference (metres).
+    """
+    missing = [t for t in skeletons if t not in subjects]
+    if missing:
+        raise KeyError(f"trial {missing[0]!r} has a skeleton but no subject")
+    trials = list(skeletons)
+    names = {t: sorted(skeletons[t].names) for t in trials}
+    out = []
+    for i, a in enumerate(trials):
+        for b in trials[i + 1:]:
+            if str(subjects[a]) == str(subjects[b]) or names[a] != names[b]:  # compare_skeletons' first test
+                continue
+            d = compare_skeletons(skeletons[a], skeletons[b], tol_m)
+            if d.same:
+                out.append((a, b, float(d.largest_m)))
+    return out
+
+
+def shared_figures(skeletons: dict, subjects: dict, tol_m: float = SAME_SKELETON_TOL_M) -> dict[str, list[str]]:
+    """For every subject, the other subjects it shares a skeleton with (:func:`shared_figure_pairs`).
+
+    Returns
+    -------
+    dict
+        ``{subject: sorted list of other subjects}`` for every subject of ``subjects`` (in first-seen order); an
+        empty list: the subject is on its own figure (``own``), otherwise on a generic one (``generic``).
+    """
+    out: dict[str, set] = {str(subjects[t]): set() for t in subjects}
+    for a, b, _ in shared_figure_pairs(skeletons, subjects, tol_m):
+        out[str(subjects[a])].add(str(subjects[b]))
+        out[str(subjects[b])].add(str(subjects[a]))
+    return {s: sorted(v) for s, v in out.items()}
+
+
+def figure_kinds(shared: dict) -> dict[str, str]:
+    """``{subject: "own" | "generic"}`` from :func:`shared_figures` (``generic``: it shares its figure)."""
+    return {s: ("generic" if others else "own") for s, others in shared.items()}

@@ -9,8 +9,8 @@
 # tables and docs say why. Every job gets only the config keys it uses. Resources: measured on CMU (the paper run)
 # with headroom.
 from animsynth.compare.generators.names import FAIRMOTION_ROWS
-from animsynth.compare.settings import (clips_cfg, generator_order, groups, run_generators, showcase, subject_groups,
-                                        trial_subjects, user_generators)
+from animsynth.compare.settings import (clips_cfg, first_frames, generator_order, groups, run_generators, showcase,
+                                        subject_groups, trial_subjects, user_generators)
 
 CMP = config["compare"]
 # the leave-one-out groups and temporal splits (the Table I subsets, the re-sequencing clips, then the comparison's
@@ -64,11 +64,13 @@ rule compare_clips:
     output:
         clips=CMP_CLIPS,
         table=R("compare/clips/{cmpsubj}.csv"),
+        captures=R("compare/clips/{cmpsubj}_captures.csv"),
     params:
         subsets=lambda w: CMP_BY_SUBJECT[w.cmpsubj][0],
         resequencing=lambda w: CMP_BY_SUBJECT[w.cmpsubj][1],
         trials=compare_subject_trial_ids,
         subjects=lambda w: {t: trial_subjects(config)[t] for t in compare_subject_trial_ids(w)},
+        first_frames=lambda w: {t: first_frames(config)[t] for t in compare_subject_trial_ids(w)},
         cfg=clips_cfg(config),
     threads: 1
     resources:
@@ -183,6 +185,9 @@ CMP_SWEEP_FILES = [CMP_SWEEP_OUT.format(cmpsubj=s, cmpgen=g, budget=b) for b in 
 rule compare_tables:
     input:
         clips=expand(R("compare/clips/{cmpsubj}.csv"), cmpsubj=CMP_SUBJECTS),
+        # the subjects' clips files: their held-out trials' skeletons, for the figure check (own or generic)
+        clip_files=expand(CMP_CLIPS, cmpsubj=CMP_SUBJECTS),
+        captures=expand(R("compare/clips/{cmpsubj}_captures.csv"), cmpsubj=CMP_SUBJECTS),
         metrics=CMP_METRICS,
         timing=CMP_TIMING,
         # the budget sweep's runs: quoted as evidence in the claims against the peer
@@ -194,6 +199,7 @@ rule compare_tables:
             category="The generators side by side",
         ),
         clips_md=R("compare/clips.md"),
+        captures=R("compare/capture_checks.csv"),
         metrics=report(
             R("compare/metrics.csv"),
             caption="../report/compare_metrics.rst",

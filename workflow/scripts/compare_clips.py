@@ -11,5 +11,5 @@ trials = {t: Motion.load_npz(f) for t, f in zip(p.trials, snakemake.input)}
 for t, m in trials.items():
     m.name = t
 clips = clips_job(trials, dict(p.subsets), dict(p.resequencing), dict(p.cfg), dict(snakemake.output),
-                  subjects=dict(p.subjects))
+                  subjects=dict(p.subjects), first_frames=dict(p.first_frames))
 log.info("subject %s: %d held-out clips", snakemake.wildcards.cmpsubj, len(clips))

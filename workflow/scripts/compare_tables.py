@@ -6,6 +6,6 @@ from animsynth.workflow_utils import setup_logging
 log = setup_logging(snakemake)
 p = snakemake.params
 inp = snakemake.input
-tables_job({"clips": list(inp.clips), "metrics": list(inp.metrics), "timing": list(inp.timing),
-            "sweep": list(inp.sweep)}, dict(snakemake.output), list(p.generators), dict(p.left_out), dict(p.cfg),
-           p.source, dict(p.sweep))
+tables_job({"clips": list(inp.clips), "clip_files": list(inp.clip_files), "captures": list(inp.captures),
+            "metrics": list(inp.metrics), "timing": list(inp.timing), "sweep": list(inp.sweep)},
+           dict(snakemake.output), list(p.generators), dict(p.left_out), dict(p.cfg), p.source, dict(p.sweep))

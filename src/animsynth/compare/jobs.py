@@ -23,16 +23,24 @@ __all__ = ["clips_job", "run_job", "tables_job", "sweep_job", "figures_job", "ga
 
 
 def clips_job(trials: dict, subsets: dict, resequencing: dict, cfg: dict, out: dict, subjects: dict | None = None,
-              usable: dict | None = None) -> list:
-    """One subject's held-out clips (:func:`animsynth.compare.protocol.prepare_clips`; ``trials``: {trial id:
-    Motion}; ``subjects``: {trial id: subject}; ``usable``: the capture check's usable frames per trial) into
-    ``out``: ``clips`` (the ``.npz``), ``table`` (its rows of the clips table). Returns the clips."""
+              first_frames: dict | None = None) -> list:
+    """One subject's held-out clips into ``out``: ``clips`` (the ``.npz``), ``table`` (its rows of the clips table)
+    and ``captures`` (its rows of ``capture_checks.csv``). Returns the clips.
+
+    Every trial (``trials``: {trial id: Motion at its own rate}) is checked first
+    (:func:`animsynth.capture_check.check_capture` with ``cfg["capture_check"]``; ``first_frames``: {trial id: the
+    record's ``first_frame``}, for the notes), and its flagged frames stay out of held-out windows and databases
+    (:func:`animsynth.compare.protocol.prepare_clips`; ``subjects``: {trial id: subject})."""
+    from ..capture_check import check_capture, checks_table
     from ..tables import write_table
     from .protocol import clips_table, prepare_clips, save_clips
 
+    checks = [check_capture(m, t, cfg["capture_check"], (first_frames or {}).get(t, 0)) for t, m in trials.items()]
+    usable = {c.trial: c.usable for c in checks}
     clips = prepare_clips(trials, subsets, resequencing, cfg, subjects, usable)
     save_clips(out["clips"], clips)
     write_table(clips_table(clips, int(cfg.get("min_clips_per_subject") or 0)), out["table"], md=False)
+    write_table(checks_table(checks), out["captures"], md=False)
     return clips
 
 
@@ -70,17 +78,26 @@ def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, 
     sweep_figure(table, out["figure"], float(default_budget))
 
 
-def gather_clips(paths, cfg: dict):
-    """The clips table of the run from every subject's rows (``paths``, in subject order), with each clip's note
-    completed: where GenMM runs (``cfg["generators"]``) and a clip's database is too short for its pyramid floor
+def gather_clips(paths, cfg: dict, clip_files=()):
+    """The clips table of the run from every subject's rows (``paths``, in subject order), with ``figure``: ``own``,
+    or ``generic`` for a subject whose skeleton another subject's trials share (a generic figure, not the subject's
+    own bones: :func:`animsynth.skeleton.shared_figures` on the held-out trials' skeletons of ``clip_files``, the
+    subjects' ``.npz``; without them every subject is ``own``), and each clip's note completed: where GenMM runs
+    (``cfg["generators"]``) and a clip's database is too short for its pyramid floor
     (:func:`animsynth.compare.generators.genmm.pyramid_note`, on the ``database_longest`` column), the note says
     so."""
     import pandas as pd
 
+    from ..skeleton import figure_kinds, shared_figures
     from .generators.genmm import pyramid_note
+    from .protocol import load_skeletons
 
     clips = pd.concat([pd.read_csv(p, dtype={"held_out": str, "subject": str}, keep_default_na=False)
                        for p in paths], ignore_index=True)
+    skeletons = {t: sk for f in clip_files for t, sk in load_skeletons(f).items()}
+    trial_subject = {t: s for t, s in zip(clips["held_out"].str.split(" ").str[0], clips["subject"])}
+    kinds = figure_kinds(shared_figures(skeletons, {t: trial_subject[t] for t in skeletons})) if skeletons else {}
+    clips.insert(clips.columns.get_loc("subject") + 1, "figure", [kinds.get(s, "own") for s in clips["subject"]])
     if "genmm" in cfg.get("generators", ()) and "genmm" in cfg:
         gm = cfg["genmm"]
         notes = [pyramid_note(n, gm["patch_size"], gm["min_coarse_patches"], gm["min_levels"])
@@ -96,11 +113,16 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``), ``cost`` (+ ``cost_md``), ``verdicts``
     (+ ``verdicts_md``), ``claims_stats``, ``exploratory`` (+ ``exploratory_md``), ``sanity`` (+ ``sanity_md``),
     ``sensitivity`` (+ ``sensitivity_md``), ``summary_md`` (the family's page)."""
+    import pandas as pd
+
     from ..atomic import atomic_write_text
     from ..tables import write_table
     from .tables import family_tables
 
-    write_table(gather_clips(inp["clips"], cfg), out["clips"], md=out["clips_md"])
+    write_table(gather_clips(inp["clips"], cfg, inp.get("clip_files", ())), out["clips"], md=out["clips_md"])
+    if "captures" in inp:  # every subject's capture checks, gathered
+        write_table(pd.concat([pd.read_csv(p, keep_default_na=False) for p in inp["captures"]], ignore_index=True),
+                    out["captures"], md=False)
     t = family_tables(dict(inp, clips=out["clips"]), generators, left_out, cfg, source, sweep)
     write_table(t["metrics"], out["metrics"], md=False)
     write_table(t["metrics_timing"], out["metrics_timing"], md=False)

@@ -51,7 +51,8 @@ from ..motion import Motion
 from ..skeleton import Skeleton
 
 __all__ = ["NativeRate", "Clip", "resample", "prepare_clips", "save_clips", "load_clips", "clips_table", "clip_seeds",
-           "split_blocks", "window_offsets", "share", "choose_windows", "working_usable", "group_subject"]
+           "split_blocks", "window_offsets", "share", "choose_windows", "working_usable", "group_subject",
+           "load_skeletons"]
 
 log = logging.getLogger("animsynth.compare.protocol")
 
@@ -151,16 +152,15 @@ def resample(motion: Motion, fps: float, key: str = "compare.fps") -> Motion:
 
 
 def working_usable(usable, step: int, n: int) -> np.ndarray:
-    """Which of ``n`` frames kept by a frame step ``step`` are usable: working frame ``i`` stands for the source
-    frames ``i * step .. i * step + step - 1`` and is usable when every one of them is (``usable``: bool per source
-    frame, or ``None``: all)."""
+    """Which of ``n`` frames kept by a frame step ``step`` are usable (``usable``: bool per source frame, or
+    ``None``: all): frame ``j`` (source frame ``j * step``) when every source frame within ``step - 1`` of it is, so
+    two consecutive usable frames span only usable source frames
+    (:meth:`animsynth.capture_check.CaptureCheck.usable_every`)."""
+    from ..capture_check import CaptureCheck
+
     if usable is None:
         return np.ones(n, bool)
-    u = np.asarray(usable, bool)
-    out = np.ones(n, bool)
-    for i in range(n):
-        out[i] = bool(u[i * step:min((i + 1) * step, u.size)].all())
-    return out
+    return CaptureCheck("", 0.0, np.asarray(usable, bool)).usable_every(int(step))[:n]
 
 
 # ----------------------------------------------------------------------------- windows and shares
@@ -559,6 +559,13 @@ def load_clips(path) -> list[Clip]:
                                        int(c["length"]), list(e["database_names"]), nat, e["subject"],
                                        e["database_id"], int(c["frame"]))
     return [out[i] for i in sorted(out)]
+
+
+def load_skeletons(path) -> dict:
+    """``{held-out trial: Skeleton}`` of a clips file (:func:`save_clips`), without reading its motions."""
+    with np.load(path, allow_pickle=False) as z:
+        manifest = json.loads(str(z["manifest"]))
+        return {e["trial"]: Skeleton.from_json(str(z[e["skeleton"]])) for e in manifest}
 
 
 def clips_table(clips: list[Clip], min_clips: int = 0) -> pd.DataFrame:

@@ -12,7 +12,7 @@ from ..config import ConfigError
 
 log = logging.getLogger("animsynth.compare")
 
-__all__ = ["check", "groups", "held_out_trials", "trial_subjects", "subject_groups", "subject_showcase",
+__all__ = ["check", "groups", "held_out_trials", "trial_subjects", "first_frames", "subject_groups", "subject_showcase",
            "subject_sets", "showcase", "run_generators", "clips_cfg", "native_rates",
            "job_cfg", "unavailable", "user_generators", "generator_order", "user_job_cfg", "left_out", "trial_rate",
            "check_trial_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
@@ -193,9 +193,16 @@ def native_rates(config: dict) -> list[float]:
 
 
 def clips_cfg(config: dict) -> dict:
-    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block) and, as ``native_fps``, the
-    native rates its clips also carry (:func:`native_rates`)."""
-    return {**{k: config["compare"][k] for k in CLIP_KEYS}, "native_fps": native_rates(config)}
+    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block), as ``native_fps`` the native
+    rates its clips also carry (:func:`native_rates`), and the ``capture_check`` block (every trial is checked
+    before clips are cut: :func:`animsynth.capture_check.check_capture`)."""
+    return {**{k: config["compare"][k] for k in CLIP_KEYS}, "native_fps": native_rates(config),
+            "capture_check": dict(config["capture_check"])}
+
+
+def first_frames(config: dict) -> dict:
+    """``{trial id: first_frame}`` of the trial records (the frames a file has before the parsed motion)."""
+    return {str(t["id"]): int(t.get("first_frame", 0) or 0) for t in config["trials"]}
 
 
 def job_cfg(config: dict, generator: str | None = None, budget: float | None = None) -> dict:
