@@ -90,18 +90,18 @@ def test_unusable_frames_stay_out_of_windows_and_databases():
     sk = cmu_like_skeleton("cmp", 3)
     trials = {f"t{i}": _walk(i, 480, f"t{i}", sk) for i in range(3)}  # 120 frames at 30 fps
     usable = {t: np.ones(480, bool) for t in trials}
-    usable["t0"][:10] = False  # the first 10 source frames: working frames 0-2
-    usable["t1"][200:206] = False  # working frames 50 and 51
+    usable["t0"][:10] = False  # the first 10 source frames: working frames 0-3 (each within 3 of a flagged one)
+    usable["t1"][200:206] = False  # working frames 50-52
     cfg = {"fps": 30, "context": 8, "length": 30, "min_length": 8, "split_blocks": 3}
     clips = protocol.prepare_clips(trials, {"s": ["t0", "t1", "t2"]}, {}, cfg, usable=usable)
     t0 = [c for c in clips if c.trial == "t0"]
-    assert [c.frame for c in t0] == [3, 41, 79]  # from the first usable frame on
+    assert [c.frame for c in t0] == [4, 42, 80]  # from the first usable frame on
     t1 = [c for c in clips if c.trial == "t1"]
     assert all(not (c.frame <= 50 < c.frame + c.context + c.length) for c in t1)
-    assert [(c.frame, c.length) for c in t1] == [(0, 30), (52, 30), (90, 22)]
+    assert [(c.frame, c.length) for c in t1] == [(0, 30), (53, 30), (91, 21)]
     for c in clips:
         for d in c.database:
-            bad = {"t0": range(0, 3), "t1": range(50, 52)}.get(d.name.split("[")[0], range(0))
+            bad = {"t0": range(0, 4), "t1": range(50, 53)}.get(d.name.split("[")[0], range(0))
             if "[" in d.name:
                 a, b = (int(x) for x in d.name.split("[")[1].rstrip("]").split(":"))
                 assert not set(range(a, b)) & set(bad), (c.clip, d.name)
