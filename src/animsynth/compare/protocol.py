@@ -4,7 +4,7 @@ Protocol (docs/compare.md, "Protocol"):
 
 * Every trial is resampled to the working rate ``compare.fps`` by keeping every n-th frame
   (n = trial fps / working fps, an integer); frames a capture check flags (``usable``) stay out of held-out
-  windows and databases.
+  windows and databases (a database piece is a usable stretch of at least ``context + min_length`` frames).
 * **Leave one out** (each Gauch & Peters subset of ``compare.subsets`` and each set of two or more trials of
   ``compare.subjects``): every trial is held out in turn; its database is the set's other trials.
 * **Temporal split** (each re-sequencing clip of ``compare.resequencing`` and each one-trial set of
@@ -322,7 +322,7 @@ def _loo_part(T: _Trials, group: str, t: str, others: list, subject: str, cfg: d
     branch of the first database trial, capped at ``compare.max_database_s``)."""
     from ..retarget import align_angle_branches, retarget
 
-    fps, floor = T.fps, max(4, int(cfg["context"]))
+    fps, floor = T.fps, _piece_floor(cfg)
     db = {o: resample(retarget(T.full[o], T.full[t].skeleton, f"trial {o}", f"trial {t}"), fps) for o in others}
     ref = db[others[0]]
     db = {o: align_angle_branches(d, ref) for o, d in db.items()}
@@ -349,7 +349,7 @@ def _loo_part(T: _Trials, group: str, t: str, others: list, subject: str, cfg: d
 def _split_parts(T: _Trials, group: str, t: str, subject: str, cfg: dict) -> list[_Part]:
     """Trial ``t`` cut into blocks (:func:`split_blocks`), each held out in turn with the rest of the trial (its
     usable stretches before and after the block) as its database."""
-    fps, context, floor = T.fps, int(cfg["context"]), max(4, int(cfg["context"]))
+    fps, context, floor = T.fps, int(cfg["context"]), _piece_floor(cfg)
     m, u = T.work[t], T.usable[t]
     n, win_min = m.n_frames, context + int(cfg["min_length"])
     blocks = split_blocks(n, int(cfg["split_blocks"]), win_min)
@@ -378,6 +378,13 @@ def _split_parts(T: _Trials, group: str, t: str, subject: str, cfg: dict) -> lis
         parts.append(_Part(f"{group}/{t}#{i}", group, "temporal split", t, subject, held, s, u[s:e],
                            T.pieces({t: m}, pieces, fps), _names(T, pieces), native))
     return parts
+
+
+def _piece_floor(cfg: dict) -> int:
+    """The fewest frames of a database piece: a usable stretch shorter than a held-out window's minimum, ``context +
+    min_length``, is dropped (a capture check's flag inside a trial can leave a few frames, too short for a graph's
+    window or a patch)."""
+    return max(4, int(cfg["context"]) + int(cfg["min_length"]))
 
 
 def _cap_frames(cfg: dict, fps: float) -> int | None:
