@@ -92,6 +92,7 @@ def test_unusable_frames_stay_out_of_windows_and_databases():
     usable = {t: np.ones(480, bool) for t in trials}
     usable["t0"][:10] = False  # the first 10 source frames: working frames 0-3 (each within 3 of a flagged one)
     usable["t1"][200:206] = False  # working frames 50-52
+    usable["t2"][36:38] = False  # working frames 8-10: leaves a stretch of 8 frames, too short to be a database piece
     cfg = {"fps": 30, "context": 8, "length": 30, "min_length": 8, "split_blocks": 3}
     clips = protocol.prepare_clips(trials, {"s": ["t0", "t1", "t2"]}, {}, cfg, usable=usable)
     t0 = [c for c in clips if c.trial == "t0"]
@@ -99,9 +100,12 @@ def test_unusable_frames_stay_out_of_windows_and_databases():
     t1 = [c for c in clips if c.trial == "t1"]
     assert all(not (c.frame <= 50 < c.frame + c.context + c.length) for c in t1)
     assert [(c.frame, c.length) for c in t1] == [(0, 30), (53, 30), (91, 21)]
+    assert [c.frame for c in clips if c.trial == "t2"] == [11, 49, 87]
+    pieces = {d.name for c in clips for d in c.database}
+    assert "t2[11:120]" in pieces and not any(p.startswith("t2[0:") for p in pieces)  # 8 frames < 8 + 8: dropped
     for c in clips:
         for d in c.database:
-            bad = {"t0": range(0, 4), "t1": range(50, 53)}.get(d.name.split("[")[0], range(0))
+            bad = {"t0": range(0, 4), "t1": range(50, 53), "t2": range(8, 11)}.get(d.name.split("[")[0], range(0))
             if "[" in d.name:
                 a, b = (int(x) for x in d.name.split("[")[1].rstrip("]").split(":"))
                 assert not set(range(a, b)) & set(bad), (c.clip, d.name)
