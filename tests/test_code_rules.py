@@ -25,10 +25,7 @@ DOC_FILES = ("README.md", "Snakefile")
 DOC_DIRS = ("docs", "config", "workflow")
 
 #: public names no code or page uses yet, each with its reason (remove an entry once the name is used or gone)
-UNUSED_FOR_NOW = {
-    "OUTCOMES": "animsynth.verdicts: the outcome names of a_beats_b, being given their one table of words by the "
-                "verdict-words work",
-}
+UNUSED_FOR_NOW: dict[str, str] = {}
 #: functions named as a quaternion log that do not call kinematics.qlog, with the reason
 OTHER_LOGS = {
     "resequencing/features.py:naive_quat_log": "the matrix_naive reproduction of a probable artefact: acos(w) "

@@ -45,7 +45,7 @@ def fitted(walks, cfg):
     out = {}
     for name in NAMES:
         if not settings.unavailable(name):
-            out[name] = G.make_generator(name, cfg, held_out=walks[0]).fit(walks[1:])
+            out[name] = G.make_generator(name, cfg).fit(walks[1:])
     return out
 
 
@@ -54,7 +54,8 @@ def test_generator_returns_length_frames_on_the_skeleton_and_is_seeded(fitted, w
     if name not in fitted:
         pytest.skip(f"{name}: {settings.unavailable(name)}")
     gen, start, length = fitted[name], _start(walks[0]), 40
-    a = gen.generate(start, length, 5)
+    kw = runner.generation_query(gen, protocol.Clip("w/t@0", "w", "leave one out", "t", walks[0], walks[1:], 8, 40))
+    a = gen.generate(start, length, 5, **kw)
     assert a.values.shape == (length, walks[0].skeleton.n_dof)
     assert a.skeleton.columns() == walks[0].skeleton.columns() and a.fps == 30.0
     assert np.all(np.isfinite(a.values))
@@ -62,9 +63,9 @@ def test_generator_returns_length_frames_on_the_skeleton_and_is_seeded(fitted, w
     assert seams.ndim == 1 and (seams.size == 0 or (seams.min() >= 0 and seams.max() < length))
     src = np.asarray(a.meta["source_frames"])
     assert src.shape == (length, 2)
-    b = gen.generate(start, length, 5)
+    b = gen.generate(start, length, 5, **kw)
     assert np.array_equal(a.values, b.values) and np.array_equal(seams, b.meta["seams"])
-    c = gen.generate(start, length, 6)
+    c = gen.generate(start, length, 6, **kw)
     if name in N.DETERMINISTIC:  # the capture itself, or motion matching: whatever the seed
         assert np.array_equal(a.values, c.values), f"{name}: the seed changes the motion"
     else:
@@ -76,11 +77,17 @@ def test_generator_returns_length_frames_on_the_skeleton_and_is_seeded(fitted, w
     assert gap < 6 * step.max(), (name, gap, step.max())
 
 
-def test_replay_is_the_held_out_continuation_and_refuses_another_start(fitted, walks):
-    m = fitted["replay"].generate(_start(walks[0]), 10, 0)
+def test_replay_plays_the_held_out_future_it_is_given_and_declares_no_entry_seam(fitted, walks):
+    rep = fitted["replay"]
+    assert rep.query == "future_trajectory" and rep.entry_seam is False
+    assert all(fitted[g].entry_seam for g in fitted if g != "replay")
+    future = Motion(walks[0].values[8:].copy(), walks[0].skeleton, 30.0, "future")
+    m = rep.generate(_start(walks[0]), 10, 0, trajectory=future)
     assert np.array_equal(m.values, walks[0].values[8:18]) and m.meta["seams"].size == 0
-    with pytest.raises(ValueError, match="not the held-out"):
-        fitted["replay"].generate(_start(walks[1]), 10, 0)
+    with pytest.raises(ValueError, match="held-out future"):
+        rep.generate(_start(walks[0]), 10, 0)
+    with pytest.raises(ValueError, match="asked for"):
+        rep.generate(_start(walks[0]), future.n_frames + 1, 0, trajectory=future)
 
 
 def test_resequencers_copy_database_frames_and_record_their_sources(fitted, walks):
@@ -137,46 +144,68 @@ def test_unknown_generator_names_the_key(cfg):
 
 
 def test_clips_leave_one_out_and_temporal_split(walks):
+    """Leave one out: every trial's windows share the database of the other trials; a temporal split: each block
+    held out with the rest of the trial (before and after it) as its database; windows of context + length frames,
+    the last shorter one kept; the held-out frames are the trial's own (made continuous at its rate, resampled)."""
     trials = {f"t{i}": Motion(w.values, w.skeleton, 30.0, f"t{i}") for i, w in enumerate(walks)}
-    cc = {"fps": 15, "context": 4, "length": 40, "min_length": 6, "holdout_fraction": 0.3}
+    cc = {"fps": 15, "context": 4, "length": 10, "min_length": 6, "split_blocks": 3}
     clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
-    assert [c.clip for c in clips] == ["w1/t0", "w1/t1", "w1/t2", "walk/t3"]
-    c0 = clips[0]
+    # 30 frames at 15 fps: windows of 14 frames at 0 and 14, the last 2 frames too few; blocks of 10 frames
+    assert [c.clip for c in clips] == ["w1/t0@0", "w1/t0@14", "w1/t1@0", "w1/t1@14", "w1/t2@0", "w1/t2@14",
+                                       "walk/t3@0", "walk/t3@10", "walk/t3@20"]
+    c0, c1 = clips[0], clips[1]
     assert [d.name for d in c0.database] == ["t1", "t2"] and c0.held_out.fps == 15.0
-    assert c0.length == min(40, c0.held_out.n_frames - 4) and c0.start.n_frames == 4
+    assert c0.database is c1.database and c0.database_id == c1.database_id == "w1/t0"
+    assert (c0.length, c0.start.n_frames, c1.frame) == (10, 4, 14)
     # every trial's angles continuous at its own rate (the synthetic root's Euler angles wrap), then resampled
     cont = {k: unwrap_angles(m).values for k, m in trials.items()}
-    assert np.array_equal(c0.held_out.values, cont["t0"][::2])
-    t = clips[-1]
-    n = walks[3].values[::2].shape[0]
-    hold = max(round(0.3 * n), 4 + 6)
-    assert t.held_out.n_frames == hold and t.database[0].n_frames == n - hold
-    assert np.array_equal(np.vstack([t.database[0].values, t.held_out.values]), cont["t3"][::2])
-    assert np.array_equal(t.truth.values, t.held_out.values[4:4 + t.length])
+    assert np.array_equal(c1.held_out.values, cont["t0"][::2][14:])
+    assert np.array_equal(c1.truth.values, cont["t0"][::2][18:28])
+    mid = clips[-2]
+    assert mid.protocol == "temporal split" and mid.database_id == "walk/t3#1" and mid.length == 6
+    assert [d.name for d in mid.database] == ["t3[0:10]", "t3[20:30]"]
+    whole = cont["t3"][::2]
+    assert np.array_equal(np.vstack([mid.database[0].values, mid.held_out.values, mid.database[1].values]), whole)
+    assert mid.database_names == ["t3 frames 0-9", "t3 frames 20-29"]
+    assert {c.subject for c in clips} == {"w1", "walk"}  # no subjects given: each group its own
 
 
 def test_clips_round_trip_and_table(tmp_path, walks):
     trials = {f"t{i}": w for i, w in enumerate(walks)}
-    cc = {"fps": 30, "context": 6, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
-    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1"]}, {"walk": "t2"}, cc)
+    cc = {"fps": 30, "context": 6, "length": 20, "min_length": 6, "split_blocks": 3, "min_clips_per_subject": 3}
+    subjects = {"t0": "s", "t1": "s", "t2": "s"}
+    clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1"]}, {"walk": "t2"}, cc, subjects=subjects)
     protocol.save_clips(tmp_path / "c.npz", clips)
     back = protocol.load_clips(tmp_path / "c.npz")
+    assert [c.clip for c in back] == [c.clip for c in clips]
     for a, b in zip(clips, back):
-        assert (a.clip, a.protocol, a.length, a.context) == (b.clip, b.protocol, b.length, b.context)
+        assert (a.clip, a.protocol, a.length, a.context, a.subject, a.database_id, a.frame) == \
+            (b.clip, b.protocol, b.length, b.context, b.subject, b.database_id, b.frame)
         assert np.array_equal(a.held_out.values, b.held_out.values)
         assert all(np.array_equal(x.values, y.values) for x, y in zip(a.database, b.database))
         assert b.held_out.skeleton.columns() == a.held_out.skeleton.columns()
-    table = protocol.clips_table(back)
-    assert list(table["protocol"]) == ["leave one out", "leave one out", "temporal split"]
+    table = protocol.clips_table(back, 3)
+    assert set(table["protocol"]) == {"leave one out", "temporal split"} and set(table["subject"]) == {"s"}
+    assert (table["subject_clips"] == len(back)).all() and table["enough_clips"].all()
+    assert (table["held_out_frames"] == table["context"] + table["length"]).all()
+    assert list(table["held_out"])[0] == "t0 frames 0-25"
 
 
-def test_clip_errors_name_the_keys(walks):
+def test_clip_errors_name_the_keys(walks, caplog):
+    import logging
+
     trials = {"a": walks[0], "b": walks[1]}
-    cc = {"fps": 30, "context": 8, "length": 20, "min_length": 200, "holdout_fraction": 0.3}
+    cc = {"fps": 30, "context": 8, "length": 20, "min_length": 200, "split_blocks": 3}
     with pytest.raises(ValueError, match="compare.min_length"):
         protocol.prepare_clips(trials, {"w1": ["a", "b"]}, {}, cc)
+    with pytest.raises(ValueError, match="compare.split_blocks"):
+        protocol.prepare_clips(trials, {}, {"walk": "a"}, dict(cc, min_length=25))
     with pytest.raises(ValueError, match="compare.fps"):
         protocol.prepare_clips(trials, {"w1": ["a", "b"]}, {}, dict(cc, fps=7, min_length=6))
+    with caplog.at_level(logging.WARNING, logger="animsynth.compare.protocol"):
+        clips = protocol.prepare_clips(trials, {"w1": ["a", "b"]}, {}, dict(cc, min_length=6, min_clips_per_subject=9))
+    assert "fewer than compare.min_clips_per_subject (9): left out of the declared tests" in caplog.text
+    assert not protocol.clips_table(clips, 9)["enough_clips"].any()
 
 
 def test_seeds_are_the_same_for_every_generator_and_differ_by_clip():
@@ -197,13 +226,18 @@ def test_run_generator_scores_every_clip_and_seed_and_writes_a_bvh_our_reader_re
            (("metrics", ".csv"), ("timing", "_timing.csv"), ("shown", ".npz"), ("bvh", ".bvh"))}
     jobs.run_job(tmp_path / "clips.npz", "stisomap", cfg, 7, None, ("w1/t1", 1), out)
     m = pd.read_csv(out["metrics"])
-    assert len(m) == 3 * cfg["seeds"] and list(m.columns) == metric_table.KEY_COLUMNS + metric_table.METRIC_NAMES + ["note"]
+    # 60-frame trials: two windows of 28 frames each; at most 4 clips (compare.max_clips_per_subject of the demo)
+    assert [c.clip for c in clips] == ["w1/t0@0", "w1/t1@0", "w1/t1@28", "w1/t2@0"]
+    assert len(m) == 4 * cfg["seeds"] and list(m.columns) == metric_table.KEY_COLUMNS + metric_table.METRIC_NAMES + ["note"]
     assert (m["n_seams"] >= 1).all()  # the entry is a seam
     assert m["copy_share"].between(0.99, 1).all()  # a re-sequencer copies database poses
-    t = pd.read_csv(out["timing"])
-    assert len(t) == 3 and (t["peak_rss_mb"] > 10).all() and t["peak_rss_mb"].is_monotonic_increasing
-    shown = runner.load_shown(out["shown"])
+    t = pd.read_csv(out["timing"])  # one build per database: the two windows of t1 share one
+    assert list(t["database"]) == ["w1/t0", "w1/t1", "w1/t2"] and list(t["clips"]) == [1, 2, 1]
+    assert list(t["frames_generated"]) == [20 * cfg["seeds"], 40 * cfg["seeds"], 20 * cfg["seeds"]]
+    assert (t["peak_rss_mb"] > 10).all() and t["peak_rss_mb"].is_monotonic_increasing
+    shown = runner.load_shown(out["shown"])  # the first clip of the held-out trial w1/t1
     assert shown.n_frames == clips[1].context + clips[1].length and shown.meta["context"] == clips[1].context
+    assert shown.name == "stisomap w1/t1@0 seed 1"
     back = read_bvh(out["bvh"])
     assert back.n_frames == shown.n_frames and np.isclose(back.fps, shown.fps)
     a = forward_kinematics(shown.skeleton, shown.values, ends=False)
@@ -368,9 +402,12 @@ def test_motion_matching_rows_have_seed_diversity_zero_and_genmm_does_not(walks,
     clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=20))
     for name, zero in (("motion_matching", True), ("genmm", False)):
         metrics, timing, _ = runner.run_generator(clips, name, cfg, 7)
-        assert len(metrics) == 3 * cfg["seeds"] and (metrics["note"] == "").all()
-        assert ((metrics["seed_diversity_m"] == 0).all() if zero else (metrics["seed_diversity_m"] > 0).all()), name
-        assert np.isfinite(timing["generate_cpu_s"]).all() and (timing["frames_generated"] == 20 * cfg["seeds"]).all()
+        assert len(metrics) == len(clips) * cfg["seeds"] and (metrics["note"] == "").all()
+        div = metrics.groupby("clip")["seed_diversity_m"].first()
+        # motion matching is deterministic; GenMM's seeds differ (its noise), though two may meet on a clip
+        assert ((div == 0).all() if zero else (div > 0).mean() >= 0.5), (name, div)
+        assert np.isfinite(timing["generate_cpu_s"]).all()
+        assert list(timing["frames_generated"]) == [20 * cfg["seeds"] * n for n in timing["clips"]]
 
 
 def test_clips_sharing_a_trial_or_a_subject_in_a_subset_are_one_group():
@@ -475,6 +512,7 @@ def test_summary_and_winners_tables():
     (lambda c: c["compare"]["motion_matching"].update(weights=[0, 0, 0, 1, 1.5]), "compare.motion_matching.weights"),
     (lambda c: c["compare"]["genmm"].update(patch_size=10), "compare.genmm.patch_size"),
     (lambda c: c["compare"]["genmm"].update(patch_size=21), "compare.genmm.patch_size"),
+    (lambda c: c["compare"].update(max_clips_per_subject=2), "compare.min_clips_per_subject"),
 ])
 def test_settings_check_names_the_key(mutate, key):
     cfg = _config()
@@ -485,14 +523,23 @@ def test_settings_check_names_the_key(mutate, key):
         settings.check(bad)
 
 
-def test_settings_lists_clips_and_showcase():
+def test_settings_lists_held_out_trials_subjects_and_showcase():
     cfg = _config()
-    ids = settings.clip_ids(cfg)
+    ids = settings.held_out_trials(cfg)
     first = cfg["compare"]["subsets"][0] if cfg["compare"]["subsets"] else "w1"
     assert ids[0] == f"{first}/{cfg['subsets'][first][0]}" and ids[-1] == f"dance/{cfg['resequencing_trials']['dance']}"
     every = dict(cfg, compare=dict(cfg["compare"], subsets=None))
-    assert len(settings.clip_ids(every)) == sum(len(v) for v in cfg["subsets"].values() if v) + 3
-    assert settings.showcase(cfg) == (ids[0], 0)
+    assert len(settings.held_out_trials(every)) == sum(len(v) for v in cfg["subsets"].values() if v) + 3
+    # the demo: subject syn35 (r1, walk, run) and syn05 (dance), each its own clips job
+    by = settings.subject_groups(cfg)
+    assert list(by) == ["syn35", "syn05"] and list(by["syn35"][0]) == ["r1"] and list(by["syn05"][1]) == ["dance"]
+    assert settings.showcase(cfg) == (None, 0, "syn35")
+    assert settings.subject_showcase(cfg, "syn35") == [None, 0, True]
+    assert settings.subject_showcase(cfg, "syn05") == [None, 0, False]
+    dance = dict(cfg, compare=dict(cfg["compare"], showcase={"clip": "dance/syn05_02@20", "seed": 1}))
+    settings.check(dance)
+    assert settings.showcase(dance) == ("dance/syn05_02@20", 1, "syn05")
+    assert settings.subject_showcase(dance, "syn35") == [None, 1, False]
     run, left = settings.run_generators(cfg)
     assert set(run) | set(left) == set(cfg["compare"]["generators"]) and "motion_graph" in run
     assert all(why for why in left.values())
@@ -505,13 +552,16 @@ def test_a_generator_not_built_on_a_clip_keeps_its_rows_with_the_reason(walks, c
     # the w2/b clip's database is c alone: 18 frames, too short for windows of 20 frames
     mg = dict(cfg, motion_graph=dict(cfg["motion_graph"], window=20))
     metrics, timing, _ = runner.run_generator(clips, "motion_graph", mg, 7)
-    bad = metrics[metrics["clip"] == "w2/b"]
-    assert len(bad) == cfg["seeds"] and bad["note"].str.startswith("not built: ").all()
+    bad = metrics[metrics["clip"].str.startswith("w2/b@")]
+    assert len(bad) == cfg["seeds"] * bad["clip"].nunique() and bad["note"].str.startswith("not built: ").all()
     assert bad[metric_table.METRIC_NAMES].isna().all().all()
-    assert (metrics.loc[metrics["clip"] != "w2/b", "note"] == "").all()
-    assert timing.set_index("clip").loc["w2/b", "frames_generated"] == 0
+    assert (metrics.loc[~metrics["clip"].str.startswith("w2/b@"), "note"] == "").all()
+    assert timing.set_index("database").loc["w2/b", "frames_generated"] == 0
     with pytest.raises(ValueError, match="compare.showcase.clip"):
         runner.run_generator(clips, "motion_graph", mg, 7, showcase=("w2/b", 0))
+    # a subject's own showcase (not the run's) that cannot be built: its start alone, the job goes on
+    _m, _t, shown = runner.run_generator(clips, "motion_graph", mg, 7, showcase=("w2/b", 0, False))
+    assert shown.n_frames == clips[0].context and shown.meta["note"].startswith("not built: ")
 
 
 def test_root_rotation_is_the_root_of_local_rotations(walks):
@@ -582,7 +632,7 @@ def test_the_jobs_shared_kinematics_give_the_references_of_separate_computations
     from animsynth.compare import measures as M
 
     trials = {f"t{i}": Motion(w.values, w.skeleton, 30.0, f"t{i}") for i, w in enumerate(walks)}
-    cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
+    cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "split_blocks": 3}
     clips = protocol.prepare_clips(trials, {"w1": ["t0", "t1", "t2"]}, {"walk": "t3"}, cc)
     mcfg = cfg["metrics"]
     kin = scoring.DatabaseKinematics()
@@ -656,10 +706,10 @@ def _clips_table_of(config: dict, missing=()) -> pd.DataFrame:
     """The clips table's identifying columns as compare_clips writes them (clip, group, protocol, held_out,
     database), built from the config alone (no trial read: a temporal split's frame range is a placeholder)."""
     subsets, reseq = settings.groups(config, missing)
-    rows = [{"clip": f"{g}/{t}", "group": g, "protocol": "leave one out", "held_out": t,
+    rows = [{"clip": f"{g}/{t}@0", "group": g, "protocol": "leave one out", "held_out": f"{t} frames 0-67",
              "database": " ".join(o for o in ids if o != t)} for g, ids in subsets.items() for t in ids]
-    rows += [{"clip": f"{g}/{t}", "group": g, "protocol": "temporal split", "held_out": f"{t}[70:100]",
-              "database": f"{t} frames 0-69"} for g, t in reseq.items()]
+    rows += [{"clip": f"{g}/{t}@70", "group": g, "protocol": "temporal split", "held_out": f"{t} frames 70-99",
+              "database": f"{t} frames 0-69 {t} frames 100-140"} for g, t in reseq.items()]
     return pd.DataFrame(rows)
 
 
@@ -667,7 +717,7 @@ def test_the_paper_configs_clips_make_one_group_per_subject_eighteen_in_all():
     cfg = _paper_config()
     settings.check(cfg)
     table = _clips_table_of(cfg)
-    assert list(table["clip"]) == settings.clip_ids(cfg)
+    assert [c.split("@")[0] for c in table["clip"]] == settings.held_out_trials(cfg)
     groups = GR.independent_groups(table)
     subjects = {c.split("/")[1].split("_")[0] for c in table["clip"]}
     assert subjects == {"35", "16", "127", "05", "02", "09", "07", "12", "49", "17", "06", "10", "26", "27", "32",
@@ -676,8 +726,9 @@ def test_the_paper_configs_clips_make_one_group_per_subject_eighteen_in_all():
     for clip, label in groups.items():  # each group is one subject, named by it
         assert label.startswith(f"subject {clip.split('/')[1].split('_')[0]} ("), (clip, label)
     # the Table I subsets and re-sequencing clips are as before; the new subjects come after them
-    assert [c for c in table["clip"] if c.split("/")[0] in ("w1", "w2", "r1", "r2", "walk", "run", "dance")] == \
-        settings.clip_ids(dict(cfg, compare=dict(cfg["compare"], subjects={})))
+    assert [c.split("@")[0] for c in table["clip"] if c.split("/")[0] in ("w1", "w2", "r1", "r2", "walk", "run",
+                                                                            "dance")] == \
+        settings.held_out_trials(dict(cfg, compare=dict(cfg["compare"], subjects={})))
     proto = dict(zip(table["group"], table["protocol"]))
     assert proto["s09"] == proto["s07"] == proto["s02"] == "leave one out"
     assert proto["s17"] == proto["s06"] == proto["s10"] == proto["s26"] == proto["s27"] == proto["s36"] == \
@@ -705,13 +756,15 @@ def test_a_subject_set_is_left_one_out_or_split_in_time_by_its_size(walks):
     settings.check(cfg)
     subsets, reseq = settings.groups(cfg)
     assert subsets["pair"] == ids[:2] and reseq["one"] == ids[2]
-    assert settings.clip_ids(cfg)[-1] == f"one/{ids[2]}"
+    assert settings.held_out_trials(cfg)[-1] == f"one/{ids[2]}"
     trials = {t: Motion(w.values, w.skeleton, 30.0, t) for t, w in zip(ids, walks)}
-    cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "holdout_fraction": 0.3}
+    cc = {"fps": 15, "context": 4, "length": 20, "min_length": 6, "split_blocks": 3}
     clips = protocol.prepare_clips(trials, {"pair": ids[:2]}, {"one": ids[2]}, cc)
-    assert [(c.clip, c.protocol) for c in clips] == [(f"pair/{ids[0]}", "leave one out"),
-                                                     (f"pair/{ids[1]}", "leave one out"),
-                                                     (f"one/{ids[2]}", "temporal split")]
+    assert [(c.clip, c.protocol) for c in clips] == [(f"pair/{ids[0]}@0", "leave one out"),
+                                                     (f"pair/{ids[1]}@0", "leave one out"),
+                                                     (f"one/{ids[2]}@0", "temporal split"),
+                                                     (f"one/{ids[2]}@10", "temporal split"),
+                                                     (f"one/{ids[2]}@20", "temporal split")]
     assert clips[0].database_names == [ids[1]]
 
 
@@ -741,13 +794,13 @@ def test_the_runner_gives_the_held_out_future_to_a_generator_whose_query_is_it(w
     seen = []
     real = MotionMatchingTrajectory.generate
 
-    def spy(self, start, length, seed, trajectory=None):
+    def spy(self, start, length, seed, trajectory=None, native_start=None):
         seen.append(trajectory)
         return real(self, start, length, seed, trajectory=trajectory)
 
     monkeypatch.setattr(MotionMatchingTrajectory, "generate", spy)
     metrics, _, _ = runner.run_generator(clips, "motion_matching_traj", cfg, 7)
-    assert len(seen) == 3 * cfg["seeds"] and (metrics["note"] == "").all()
+    assert len(seen) == len(clips) * cfg["seeds"] and (metrics["note"] == "").all()
     assert (metrics["seed_diversity_m"] == 0).all()
     for i, c in enumerate(clips):
         got = seen[i * cfg["seeds"]]

@@ -627,7 +627,7 @@ def _trials_120(sk):
             for i, (kind, s) in enumerate((("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5)))}
 
 
-_CC = {"fps": 30, "context": 8, "length": 20, "min_length": 6, "holdout_fraction": 0.4}
+_CC = {"fps": 30, "context": 8, "length": 20, "min_length": 6, "split_blocks": 3}
 
 
 def test_clips_carry_the_native_rate_database_and_start_from_the_source(sk, tmp_path):
@@ -644,16 +644,16 @@ def test_clips_carry_the_native_rate_database_and_start_from_the_source(sk, tmp_
         src = trials[c.trial].values[::2]  # 120 -> 60 fps: every second source frame
         assert nat.start.n_frames == (c.context - 1) * 2 + 1
         assert np.array_equal(nat.start.values[::2], c.start.values)  # the same instants as the working start
-        if c.protocol == "leave one out":
-            assert np.array_equal(nat.start.values, src[:nat.start.n_frames])
-            for d, n, name in zip(c.database, nat.database, c.database_names):
+        assert np.array_equal(nat.start.values, src[2 * c.frame:2 * c.frame + nat.start.n_frames])
+        for d, n, name in zip(c.database, nat.database, c.database_names):
+            assert np.array_equal(n.values[::2], d.values) and n.fps == 60.0 and n.name == d.name
+            if c.protocol == "leave one out":  # whole trials
                 assert np.array_equal(n.values, trials[name].values[::2])
-                assert np.array_equal(n.values[::2], d.values) and n.fps == 60.0
-        else:
-            n_db = c.database[0].n_frames
-            assert np.array_equal(nat.database[0].values, src[:2 * n_db])  # nothing of the held-out part
-            assert np.array_equal(nat.start.values, src[2 * n_db:2 * n_db + nat.start.n_frames])
-    # stored and read back; a file written before the native clips loads with none
+            else:  # the trial's frames before or after the block: nothing of the held-out part
+                a, b = (int(x) for x in d.name.split("[")[1].rstrip("]").split(":"))
+                assert np.array_equal(n.values, src[2 * a:2 * b]) and not a <= c.frame < b
+    assert {c.protocol for c in clips} == {"leave one out", "temporal split"}
+    # stored and read back
     protocol.save_clips(tmp_path / "c.npz", clips)
     back = protocol.load_clips(tmp_path / "c.npz")
     for a, b in zip(clips, back):
@@ -661,20 +661,9 @@ def test_clips_carry_the_native_rate_database_and_start_from_the_source(sk, tmp_
         assert np.array_equal(x.start.values, y.start.values) and y.start.fps == 60.0
         assert all(np.array_equal(p.values, q.values) and p.name == q.name for p, q in zip(x.database, y.database))
     table = protocol.clips_table(back)
-    assert list(table["native_fps"]) == ["60"] * 4 and list(table["note"]) == [""] * 4
+    assert list(table["native_fps"]) == ["60"] * len(back) and list(table["note"]) == [""] * len(back)
     old = protocol.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, _CC)
     assert all(c.native == [] for c in old)
-    protocol.save_clips(tmp_path / "old.npz", old)
-    with np.load(tmp_path / "old.npz") as z:
-        arrays = {k: z[k] for k in z.files}
-    import json
-
-    manifest = json.loads(str(arrays["manifest"]))
-    for m in manifest:
-        del m["native"]
-    arrays["manifest"] = np.array(json.dumps(manifest))
-    np.savez_compressed(tmp_path / "older.npz", **arrays)
-    assert all(c.native == [] for c in protocol.load_clips(tmp_path / "older.npz"))
 
 
 def test_a_source_rate_that_is_no_multiple_of_the_native_rate_falls_back_with_a_note(sk, caplog):

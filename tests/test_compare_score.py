@@ -25,8 +25,9 @@ _config = default_config
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
-    """A comparison of one clip (a temporal split of one walk, so the run's database is the clip's) with the
-    project's defaults: knn, replay and a user's generator run by the family's job, each writing its BVH."""
+    """A comparison of one walk's temporal split (its first block's database is one stretch of the walk) with the
+    project's defaults: knn, replay and a user's generator run by the family's job, each writing its BVH of the
+    first clip."""
     d = tmp_path_factory.mktemp("score_run")
     (d / "mine.py").write_text("from animsynth.compare.generators.references import Concat\n\n\nclass Mine:\n"
                                "    def fit(self, database):\n        self.g = Concat().fit(database.clips)\n"
@@ -133,15 +134,15 @@ def _other_joints(d, tmp_path):
 
 @pytest.mark.parametrize("make, args, says", [
     (_other_rate, (), "fps, the reference"),
-    (_long, (), "has 36 frames to compare them with"),
+    (_long, (), "has 40 frames to compare them with"),
     (_other_joints, (), "its joints differ from the reference's"),
-    (None, ("--context", "36"), "none after the 36 start frames"),
+    (None, ("--context", "40"), "none after the 40 start frames"),
     (None, ("--database", "NODB.bvh"), "no such file"),
     (None, ("--config", "BAD.yaml"), "compare.context"),
 ])
 def test_bad_input_is_one_line_naming_it_and_writes_nothing(run, tmp_path, capsys, make, args, says):
     d, clip = run
-    assert clip.held_out.n_frames == 36
+    assert clip.held_out.n_frames == 40  # the first block of the walk's temporal split (120 frames in 3)
     gen = make(d, tmp_path) if make else d / "knn.bvh"
     (tmp_path / "BAD.yaml").write_text("compare: {context: -1}\n")
     args = [str(tmp_path / a) if a.endswith((".bvh", ".yaml")) else a for a in args]

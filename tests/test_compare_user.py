@@ -28,12 +28,13 @@ _config = default_config
 
 @pytest.fixture(scope="module")
 def clips_file(tmp_path_factory):
-    """Three short synthetic walks, leave one out (3 clips), 12 generated frames at 30 fps."""
+    """Three short synthetic walks, leave one out (3 clips, one window of each trial), 12 generated frames at 30 fps."""
     sk = cmu_like_skeleton("cmp", 3)
     walks = {f"t{s}": protocol.resample(generate_motion("walk_straight", 200, s, sk, name=f"t{s}"), 30.0) for s in range(3)}
     cfg = _config()["compare"]
-    cc = {k: cfg[k] for k in ("fps", "context", "length", "min_length", "holdout_fraction")}
-    clips = protocol.prepare_clips(walks, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=12))
+    cc = {k: cfg[k] for k in settings.CLIP_KEYS}
+    clips = protocol.prepare_clips(walks, {"w1": ["t0", "t1", "t2"]}, {}, dict(cc, length=12, max_clips_per_subject=3))
+    assert [c.clip for c in clips] == ["w1/t0@0", "w1/t1@0", "w1/t2@0"]
     path = tmp_path_factory.mktemp("user_clips") / "clips.npz"
     protocol.save_clips(path, clips)
     return path
@@ -245,9 +246,10 @@ def test_tables_show_a_user_row_and_leave_the_claims_unchanged(tmp_path, clips_f
             ("metrics", "csv"), ("metrics_timing", "csv"), ("summary", "csv"), ("winners", "csv"), ("winners_md", "md"),
             ("cost", "csv"), ("cost_md", "md"), ("verdicts", "csv"), ("verdicts_md", "md"), ("sanity", "csv"),
             ("sanity_md", "md"), ("sensitivity", "csv"), ("sensitivity_md", "md"), ("summary_md", "md"),
-            ("claims_stats", "csv"), ("exploratory", "csv"), ("exploratory_md", "md"))}
+            ("claims_stats", "csv"), ("exploratory", "csv"), ("exploratory_md", "md"), ("clips", "csv"),
+            ("clips_md", "md"))}
         users = [g for g in gens if g not in own]
-        jobs.tables_job({"clips": str(tmp_path / "clips.csv"), "metrics": [runs[g]["metrics"] for g in gens],
+        jobs.tables_job({"clips": [str(tmp_path / "clips.csv")], "metrics": [runs[g]["metrics"] for g in gens],
                            "timing": [runs[g]["timing"] for g in gens]}, out, gens, {},
                           dict(tcfg, generators=tcfg["generators"] + users), "synthetic")
         return out

@@ -81,9 +81,10 @@ def _docs_toy() -> str:
 
 @pytest.mark.workflow
 def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp_path_factory):
-    """The docs' toy generator and a broken one added to a copy of the finished tiny run: only their two jobs run,
-    the broken one is one error line and empty rows, the toy is in every table, figure and the BVH folder, the
-    family's rows and claims are byte for byte the same; then animsynth score reads the toy's BVH file back."""
+    """The docs' toy generator and a broken one added to a copy of the finished tiny run: only their jobs run (one
+    per subject), the broken one is one error line per job and empty rows, the toy is in every table, figure and the
+    BVH folder, the family's rows and claims are byte for byte the same; then animsynth score reads the toy's BVH
+    file back."""
     import numpy as np
 
     from animsynth import cli
@@ -106,7 +107,9 @@ def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-6000:]
     broken = [line for line in out.splitlines() if "user generator 'broken'" in line]
-    assert len(broken) == 1 and "(mine/toy.py:NoSuchClass): the file has no class 'NoSuchClass'" in broken[0], broken
+    # one error line per job: one job per subject (syn35, syn05)
+    assert len(broken) == 2 and all("(mine/toy.py:NoSuchClass): the file has no class 'NoSuchClass'" in b
+                                    for b in broken), broken
     assert "Traceback" not in out
     ran = {line.split("cmpgen=")[1].split(",")[0].strip() for line in out.splitlines() if "cmpgen=" in line}
     assert ran == {"toy", "broken"}  # the family's generator jobs did not run again
@@ -126,7 +129,7 @@ def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp
     page = (r / "summary.md").read_text()
     assert "Your own generators (compare.user_generators): **toy**, **broken**" in page and "**broken**: user generator" in page
     assert (wd / "results" / "summary.md").stat().st_mtime_ns > summary_before  # the report is rebuilt with them
-    clips = protocol.load_clips(r / "clips.npz")
+    clips = protocol.load_clips(r / "clips" / "syn35.npz")  # the showcase: the first subject's first clip
     show = clips[0]
     assert read_bvh(r / "bvh" / "toy.bvh").n_frames == show.context + show.length
     assert read_bvh(r / "bvh" / "broken.bvh").n_frames == show.context  # the start alone
@@ -143,11 +146,22 @@ def test_a_user_generator_and_animsynth_score_on_the_tiny_run(tiny_workflow, tmp
     assert all(np.isnan(s[c]) for c in DATABASE_METRICS)  # no --database
 
 
+def _planned(res) -> list[tuple[str, dict]]:
+    """(rule, wildcards) of every compare job a dry run plans."""
+    import re
+
+    out = []
+    for rule, block in re.findall(r"^(?:local)?rule (compare_\w+):\n((?:    .*\n)+)", res.stdout, flags=re.M):
+        w = re.search(r"^    wildcards: (.*)$", block, flags=re.M)
+        out.append((rule, dict(kv.split("=", 1) for kv in w.group(1).split(", ")) if w else {}))
+    return out
+
+
 @pytest.mark.workflow
-def test_fairmotion_rows_and_sweep_are_one_job_and_our_graph_keeps_its_own(tmp_path):
-    """With a budget sweep, fairmotion's two rows and the fixed row's further budgets are planned as one job
-    (compare_run_fairmotion, which builds each graph once); our motion graph's budgets stay compare_sweep_run jobs
-    and every other generator keeps its compare_run job."""
+def test_fairmotion_rows_and_sweep_are_one_job_per_subject_and_our_graph_keeps_its_own(tmp_path):
+    """With a budget sweep, fairmotion's two rows and the fixed row's further budgets are planned as one job per
+    subject (compare_run_fairmotion, which builds each graph once per database); our motion graph and its budgets are
+    one compare_run_graph job per subject, and every other generator keeps its compare_run job per subject."""
     import re
 
     from conftest import copy_workflow, run_snakemake
@@ -162,21 +176,59 @@ def test_fairmotion_rows_and_sweep_are_one_job_and_our_graph_keeps_its_own(tmp_p
                         "results/compare/budget_sweep.csv", "results/compare/verdicts.csv")
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-3000:]
-    jobs = re.findall(r"^(?:local)?rule (compare_\w+):\n((?:    .*\n)+)", res.stdout, flags=re.M)
-    names = [rule for rule, _ in jobs]
-    assert names.count("compare_run_fairmotion") == 1
-    block = dict(jobs)["compare_run_fairmotion"]
-    for f in ("runs/fairmotion.csv", "runs/fairmotion_fixed.csv", "sweep/fairmotion_fixed_2.csv",
-              "sweep/fairmotion_fixed_8.csv"):
-        assert f"results/compare/{f}" in block, f
-    sweeps = [b for r, b in jobs if r == "compare_sweep_run"]
-    assert len(sweeps) == 2 and all("sweep/motion_graph_" in b for b in sweeps)
-    runs = [b for r, b in jobs if r == "compare_run"]
-    assert not any("runs/fairmotion" in b for b in runs) and any("runs/motion_graph.csv" in b for b in runs)
-    # without our motion graph the sweep is fairmotion's alone: no compare_sweep_run job, and the run still plans
+    jobs = _planned(res)
+    by_rule = {}
+    for rule, w in jobs:
+        by_rule.setdefault(rule, []).append(w)
+    assert sorted(w["cmpsubj"] for w in by_rule["compare_run_fairmotion"]) == ["syn05", "syn35"]
+    assert sorted(w["cmpsubj"] for w in by_rule["compare_clips"]) == ["syn05", "syn35"]
+    blocks = dict(re.findall(r"^rule (compare_run_fairmotion):\n((?:    .*\n)+)", res.stdout, flags=re.M))
+    for f in ("runs/syn\\d+/fairmotion.csv", "runs/syn\\d+/fairmotion_fixed.csv", "sweep/syn\\d+/fairmotion_fixed_2.csv",
+              "sweep/syn\\d+/fairmotion_fixed_8.csv"):
+        assert re.search(f"results/compare/{f}", blocks["compare_run_fairmotion"]), f
+    assert [w["cmpgen"] for w in by_rule["compare_run_graph"]] == ["motion_graph", "motion_graph"]
+    runs = {w["cmpgen"] for w in by_rule["compare_run"]}
+    assert not runs & {"fairmotion", "fairmotion_fixed", "motion_graph"} and "knn" in runs
+    assert len(by_rule["compare_run"]) == 2 * len(runs)  # every generator once per subject
+    assert "compare_sweep_run" not in by_rule
+    # without our motion graph the sweep is fairmotion's alone: no compare_run_graph job, and the run still plans
     (wd / "config" / "fm_only.yaml").write_text(
         "compare:\n  budget_sweep: [2, 8]\n  generators: [delaunay, fairmotion, fairmotion_fixed, replay, concat]\n")
     res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml", "config/fm_only.yaml")
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-3000:]
-    assert "rule compare_run_fairmotion:" in res.stdout and "rule compare_sweep_run:" not in res.stdout
+    assert "rule compare_run_fairmotion:" in res.stdout and "rule compare_run_graph:" not in res.stdout
+
+
+@pytest.mark.workflow
+def test_rerunning_one_subjects_clips_reruns_only_that_subjects_jobs(tiny_workflow, tmp_path_factory):
+    """The finished tiny run (two subjects, syn35 and syn05): a changed clips file of syn05 plans syn05's generator
+    jobs and the gathering, none of syn35's; a changed trial list of syn35 (one more set of compare.subjects) plans
+    syn35's clips job and its generator jobs, none of syn05's."""
+    import shutil
+
+    from animsynth.compare import protocol
+    from conftest import copy_finished_run, run_snakemake
+
+    wd = copy_finished_run(tiny_workflow, tmp_path_factory.mktemp("tiny_rerun") / "run")
+    res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml")
+    assert res.returncode == 0 and not _planned(res), (res.stdout + res.stderr)[-3000:]  # nothing of compare to do
+    clips = wd / "results" / "compare" / "clips" / "syn05.npz"
+    kept = wd / "syn05.npz"
+    shutil.copy2(clips, kept)
+    protocol.save_clips(clips, protocol.load_clips(clips)[:-1])  # as if its clips job had cut one clip fewer
+    res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml")
+    assert res.returncode == 0, (res.stdout + res.stderr)[-3000:]
+    jobs = _planned(res)
+    subjects = {w.get("cmpsubj") for _r, w in jobs if "cmpsubj" in w}
+    assert subjects == {"syn05"}, jobs
+    rules = [r for r, _w in jobs]
+    assert "compare_clips" not in rules and {"compare_tables", "compare_figures"} <= set(rules)
+    assert rules.count("compare_run") == len({w["cmpgen"] for r, w in jobs if r == "compare_run"}) >= 10
+    shutil.copy2(kept, clips)  # back as it was
+    (wd / "config" / "more.yaml").write_text("compare:\n  subjects: {s35: [syn35_20]}\n")
+    res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml", "config/more.yaml")
+    assert res.returncode == 0, (res.stdout + res.stderr)[-3000:]
+    jobs = _planned(res)
+    assert {w.get("cmpsubj") for _r, w in jobs if "cmpsubj" in w} == {"syn35"}, jobs
+    assert ("compare_clips", {"cmpsubj": "syn35"}) in jobs

@@ -80,12 +80,12 @@ def test_a_later_config_drops_one_subject_set_or_all_of_them():
     validate_config(one, SCHEMA)
     settings.check(one)
     assert "s06" not in settings.subject_sets(one) and "s07" in settings.subject_sets(one)
-    assert not any(c.startswith(("s06/", "s10/")) for c in settings.clip_ids(one))
+    assert not any(c.startswith(("s06/", "s10/")) for c in settings.held_out_trials(one))
     none = _merged({"compare": {"subjects": None}})
     validate_config(none, SCHEMA)
     settings.check(none)
     assert settings.subject_sets(none) == {}
-    assert {c.split("/")[0] for c in settings.clip_ids(none)} == {"w1", "w2", "r1", "r2", "walk", "run", "dance"}
+    assert {c.split("/")[0] for c in settings.held_out_trials(none)} == {"w1", "w2", "r1", "r2", "walk", "run", "dance"}
     # and a set of the user's own joins, from a config after that one
     mine = _merged({"compare": {"subjects": None}}, {"trials": {"143_01": NEW}, "compare": {"subjects": {"s143": [
         "143_01"]}}})

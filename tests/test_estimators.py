@@ -147,7 +147,7 @@ def test_dense_needs_one_clip_and_sparse_needs_l2(est_walks):
 
 
 def _unfitted(name, cfg, est_walks):
-    return G.make_generator(name, cfg, held_out=est_walks[0])
+    return G.make_generator(name, cfg)
 
 
 @pytest.mark.parametrize("name", [n for n in N.GENERATORS if n not in N.FAIRMOTION_ROWS] + ["fairmotion"])
@@ -164,6 +164,47 @@ def test_estimator_conventions(name, cfg, est_walks):
     assert gen.fit(est_walks[1:]) is gen
     added = sorted(set(vars(gen)) - before)
     assert added and all(a.endswith("_") for a in added), (name, added)
+
+
+@pytest.mark.parametrize("name", [n for n in N.GENERATORS if n not in N.FAIRMOTION_ROWS] + ["fairmotion"])
+def test_every_generator_declares_what_the_runner_reads(name, cfg, est_walks):
+    """The interface (animsynth.generator.Generator) declares each thing the compare runner reads: ``query``,
+    ``native_fps``, ``entry_seam``, ``run_notes``, ``outside_cost``, ``set_label``; every ``fit`` takes
+    ``native_clips`` and every ``generate`` ``native_start``; a generator without a native rate gives the same
+    motion with them ``None`` as without them."""
+    from animsynth.compare import protocol, runner
+    from animsynth.generator import QUERY_FUTURE_TRAJECTORY, QUERY_START, Generator
+
+    if settings.unavailable(name):
+        pytest.skip(f"{name}: {settings.unavailable(name)}")
+    gen = _unfitted(name, cfg, est_walks)
+    assert isinstance(gen, Generator) and gen.query in (QUERY_START, QUERY_FUTURE_TRAJECTORY)
+    assert gen.entry_seam is (name != "replay") and (gen.native_fps is None) is (name != "fairmotion")
+    assert "native_clips" in inspect.signature(gen.fit).parameters
+    assert "native_start" in inspect.signature(gen.generate).parameters
+    assert gen.outside_cost() == {"cpu_s": 0.0, "rss_mb": 0.0} and gen.set_label("w/t@0") is None
+    clip = protocol.Clip("w/t@0", "w", "leave one out", "t", est_walks[0], est_walks[1:], 8, 12)
+    fit_kw, gen_kw = runner.native_inputs(gen, clip)  # the clip carries no native rate: None for both
+    assert fit_kw == {"native_clips": None} and gen_kw == {"native_start": None}
+    if name == "fairmotion":
+        return  # its fit and walk are tested with and without native clips in test_compare_motiongraph.py
+    query = runner.generation_query(gen, clip)
+    a = gen.fit(est_walks[1:], **fit_kw).generate(_start(est_walks[0]), 12, 3, **query, **gen_kw)
+    b = _unfitted(name, cfg, est_walks).fit(est_walks[1:]).generate(_start(est_walks[0]), 12, 3, **query)
+    assert np.array_equal(a.values, b.values)
+
+
+def test_the_runner_reads_no_generator_attribute_by_getattr_and_no_row_by_name():
+    """The compare runner reads what the interface declares: no getattr/hasattr on a generator, no row name
+    compared in the runner or in scoring; the harness reads row names from the leaf module names.py."""
+    root = Path(__file__).resolve().parents[1] / "src" / "animsynth" / "compare"
+    for f in ("runner.py", "scoring.py", "jobs.py"):
+        text = (root / f).read_text()
+        assert "getattr(gen" not in text and "hasattr(gen" not in text, f
+        assert '"replay"' not in text and '"fairmotion' not in text, f
+    for f in ("tables.py", "plots.py", "verdicts.py", "settings.py", "runner.py", "jobs.py"):
+        assert "generators.registry import" not in (root / f).read_text().replace("from .generators.registry import "
+                                                                                  "make_generator", ""), f
 
 
 def test_the_family_estimators_add_only_trailing_underscore_attributes(est_walks, capture):

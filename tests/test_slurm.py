@@ -257,6 +257,10 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
             mem, minutes, cpus = declared[rule]
             assert (job["min_memory"], _minutes(job["time_limit"]), job["cpus"]) == (mem, minutes, cpus), (jid, rule, job)
     assert rules == {r: n for r, n in expected.items() if r != "all"}, rules
+    # the comparison ran as its subjects' jobs side by side: one clips job per subject, one per subject and generator
+    subjects = {j["comment"].split("_wildcards_", 1)[1] for j in jobs.values()
+                if j["comment"].startswith("rule_compare_clips_wildcards_")}
+    assert len(subjects) >= 2 and rules["compare_run"] % len(subjects) == 0, (subjects, rules)
     # Each batch script runs this venv's interpreter (`<venv>/bin/python -m snakemake`
     # ... --executor slurm-jobstep), and each job left its SLURM log.
     venv_bin = str(Path(sys.executable).parent) + os.sep

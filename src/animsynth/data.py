@@ -135,11 +135,9 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         top-level ones); checked against the skeleton and stored on it
         (:attr:`Skeleton.roles`, see :mod:`animsynth.joints`).
     bvh_length_to_m : float
-        A BVH file's metres per length unit (0.01 centimetres, 0.05644
-        cgspeed's CMU conversions, which keep the ASF unit).
+        A BVH file's metres per length unit (0.01 centimetres, 0.05644 cgspeed's CMU conversions, the ASF unit).
     bvh_root : str, optional
-        The skeleton to read from a BVH file that holds several (two
-        characters): the name of its root joint (:func:`animsynth.io.bvh.read_bvh`,
+        The root joint of the skeleton to read from a BVH file of several (:func:`animsynth.io.bvh.read_bvh`
         ``root``; config ``bvh_root`` on the trial, command line ``--root``).
     up_axis, forward_axis : str or None
         The file's world axes (``"+z"``, ...), or ``"auto"``/None. For BVH,
@@ -162,13 +160,11 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
         and ``bvh_length_to_m`` (default :data:`CONFIG_SETTING_NAMES`, the
         config keys; the command line passes its options).
 
-    Up axis: detected by :func:`animsynth.axes.detect_up_axis` (a biped
-    by its joint roles, another body by its legs). A warning names the file
-    and the ``up_axis`` setting when the body is not a biped, when the answer
-    is ambiguous (for a body that is not a biped the file's own axes are then
-    kept, +y up), and when a given ``up_axis`` leaves the body lying down or on
-    its head (:func:`animsynth.axes.lying_down`). A joint that plays two
-    roles is warned about.
+    Up axis: detected by :func:`animsynth.axes.detect_up_axis` (a biped by its joint roles, another body by its
+    legs). A warning names the file and the ``up_axis`` setting when the body is not a biped, when the answer is
+    ambiguous (a body that is not a biped then keeps the file's own axes, +y up), and when a given ``up_axis``
+    leaves the body lying down or on its head (:func:`animsynth.axes.lying_down`). A joint that plays two roles
+    is warned about.
 
     The standing height (median over frames of the extent along the up axis,
     :func:`animsynth.axes.standing_height`) in metres outside

@@ -156,22 +156,42 @@ class Generator:
     ``length`` frames continuing ``start`` (>= 2 frames), checked by :func:`check_generated`, with
     ``meta["seams"]`` and ``meta["source_frames"]``.
 
-    ``query`` says what a generator is given besides the database: :data:`QUERY_START` (``"start"``, every
-    generator by default: the start alone) or :data:`QUERY_FUTURE_TRAJECTORY` (``"future_trajectory"``: its
-    ``generate`` takes ``trajectory=``, the held-out frames after the start, and the compare family's runner
-    passes them; information the other generators do not see).
+    What a caller (the compare family's runner) reads of a generator is declared here, with its default:
 
-    :meth:`run_notes` gives the values of a fitted generator that a run records besides its motion (empty by
-    default; the graph generators: the transitions they kept).
+    ``query``
+        what it is given besides the database: :data:`QUERY_START` (``"start"``, the default: the start alone) or
+        :data:`QUERY_FUTURE_TRAJECTORY` (``"future_trajectory"``: its ``generate`` takes ``trajectory=``, the
+        held-out frames after the start, information the other generators do not see).
+    ``native_fps``
+        the rate of the native-rate clips it reads (fps), or ``None`` (the default): it runs on the working-rate
+        clips alone. Every ``fit`` takes ``native_clips=`` (the database at ``native_fps``, taken from the
+        source) and every ``generate`` ``native_start=`` (the start at that rate); a generator whose
+        ``native_fps`` is ``None`` is given ``None`` for both and ignores them.
+    ``entry_seam``
+        whether the step from the start into its first generated frame is a seam (``True``, the default: a
+        generator starts from the start's pose, not from the capture's next frame; ``False`` only for a replay of
+        the held-out capture).
+    :meth:`run_notes`
+        the values of a fitted generator that a run records besides its motion (empty by default; the graph
+        generators: the transitions they kept).
+    :meth:`outside_cost`
+        the CPU seconds and peak memory of its last ``fit`` or ``generate`` call spent outside the caller's
+        process (a child process that has not ended; zero by default: the caller's own counters hold the cost).
+    :meth:`set_label`
+        what the caller is fitting or generating for (e.g. a clip id), for the generator's own log lines (the
+        default ignores it).
     """
 
     name = "generator"
-    query = "start"
+    query = QUERY_START
+    native_fps: float | None = None
+    entry_seam = True
 
-    def fit(self, database) -> "Generator":  # pragma: no cover - every generator overrides it
+    def fit(self, database, native_clips=None) -> "Generator":  # pragma: no cover - every generator overrides it
         raise NotImplementedError
 
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:  # pragma: no cover
+    def generate(self, start: Motion, length: int, seed: int,
+                 native_start: Motion | None = None) -> Motion:  # pragma: no cover
         raise NotImplementedError
 
     def run_notes(self) -> dict:
@@ -181,6 +201,15 @@ class Generator:
         ``transitions_kept``: the candidate transitions a graph generator keeps before pruning.
         """
         return {}
+
+    def outside_cost(self) -> dict:
+        """``{"cpu_s": ..., "rss_mb": ...}``: the CPU seconds of the last ``fit`` or ``generate`` call spent outside
+        this process and the peak resident memory (MB) of the process that spent them (both 0: none)."""
+        return {"cpu_s": 0.0, "rss_mb": 0.0}
+
+    def set_label(self, label: str) -> None:
+        """Name what the next calls are for (``label``, e.g. a clip id) in the generator's own log lines (the
+        default keeps no label)."""
 
     def _check_start(self, start: Motion, length: int, database: Database | None = None) -> None:
         """Refuse a generator that is not fitted, a start of fewer than 2 frames or of other DOF columns than

@@ -478,37 +478,45 @@ def meshdetail_benchmarks():
 
 
 # ---- compare input functions ----
-def compare_trial_npz(wildcards):
-    """The parsed trials of every held-out clip and database of the comparison (order of CMP_TRIALS)."""
-    return [trial_npz(t) for t in CMP_TRIALS]
+def compare_subject_trial_ids(wildcards):
+    """The trial ids of one subject's groups (its held-out trials and databases), in config order."""
+    loo, split = CMP_BY_SUBJECT[wildcards.cmpsubj]
+    return list(dict.fromkeys([t for ids in loo.values() for t in ids] + list(split.values())))
 
 
-def compare_job_cfg(wildcards):
-    """The config one generator job reads (animsynth.compare.settings.job_cfg, as the tests build it: a changed
-    block reruns only the jobs that read it)."""
-    from animsynth.compare.settings import job_cfg
-
-    return job_cfg(config, wildcards.cmpgen)
+def compare_subject_trials(wildcards):
+    """The parsed trials of one subject's groups (order of compare_subject_trial_ids)."""
+    return [trial_npz(t) for t in compare_subject_trial_ids(wildcards)]
 
 
-def compare_sweep_cfg(wildcards):
-    """A budget-sweep job's config: the graph generator's as in the main run, at the wildcard's budget, with
-    compare.budget_sweep_seeds seeds."""
-    from animsynth.compare.settings import job_cfg
+def compare_rows(wildcards, rows):
+    """What one generator job runs, row by row (the script's params): ``[name, config, roles, output prefix,
+    showcase]``; ``rows``: ``[(name, budget or None, prefix)]``. A budget's rows use the sweep's config (job_cfg) and
+    the config's joint_roles; the rows at the default budget have their showcase (each trial's roles are stored on
+    its skeleton)."""
+    from animsynth.compare.settings import job_cfg, subject_showcase
 
-    return job_cfg(config, wildcards.cmpgraph, budget=wildcards.budget)
+    show = subject_showcase(config, wildcards.cmpsubj, CMP_MISSING)
+    return [[name, job_cfg(config, name, budget=budget), config["joint_roles"] if budget else {}, prefix,
+             None if budget else show] for name, budget, prefix in rows]
 
 
 # Benchmark files of this family's jobs (inputs of rule_benchmarks).
 def compare_benchmarks():
+    n = len(CMP_SUBJECTS)
+
+    def per_subject(rule_name, gens):
+        pairs = [(s, g) for s in CMP_SUBJECTS for g in gens]
+        return (job_benchmarks(rule_name, cmpsubj=[s for s, _g in pairs], cmpgen=[g for _s, g in pairs])
+                if pairs else [])
+
     return (
-        job_benchmarks("compare_clips")
-        + job_benchmarks("compare_run", cmpgen=CMP_OWN_JOB)
-        + (job_benchmarks("compare_run_fairmotion") if CMP_FM else [])
+        job_benchmarks("compare_clips", cmpsubj=CMP_SUBJECTS)
+        + per_subject("compare_run", CMP_OWN_JOB)
+        + (per_subject("compare_run_graph", CMP_SWEEP_GRAPH) if CMP_SWEEP_GRAPH else [])
+        + (job_benchmarks("compare_run_fairmotion", cmpsubj=CMP_SUBJECTS) if CMP_FM and n else [])
         + job_benchmarks("compare_tables")
         + job_benchmarks("compare_figures")
-        + (job_benchmarks("compare_sweep_run", cmpgraph=[g for g, _b in CMP_OWN_SWEEP],
-                           budget=[b for _g, b in CMP_OWN_SWEEP]) if CMP_OWN_SWEEP else [])
         + (job_benchmarks("compare_sweep") if CMP_SWEEP and CMP_GRAPHS else [])
     )
 

@@ -1,20 +1,24 @@
 # Beyond the papers: every generator of the project and the classic motion graph side by side
-# (animsynth.compare, docs/compare.md). compare_clips builds every held-out clip's database and start
-# (leave one out within each Gauch & Peters subset and each compare.subjects set of 2+ trials, a temporal split of each
-# re-sequencing clip and one-trial subject set) at the
-# working rate; one job per generator fits it on every clip's database and runs every seed from the clip's
-# start, scoring each motion (its benchmark file is the generator's whole cost); compare_tables and
-# compare_figures gather them. A generator that cannot run here (fairmotion without its package) is left
-# out at parse time with one line, and the tables and docs say why. Every job gets only the config keys it
-# uses. Resources: measured on CMU (the paper run) with headroom.
+# (animsynth.compare, docs/compare.md). The unit of work is the subject: compare_clips builds one subject's held-out
+# windows and their databases (leave one out within each Gauch & Peters subset and each compare.subjects set of 2+
+# trials, a temporal split in blocks of each re-sequencing clip and one-trial subject set) at the working rate; one
+# job per subject and generator fits the generator once per database and runs every seed of every window from its
+# start, scoring each motion (its benchmark file is that job's whole cost); compare_tables, compare_figures and
+# compare_sweep gather them. Rerunning one subject's clips reruns that subject's jobs and the gathering only. A
+# generator that cannot run here (fairmotion without its package) is left out at parse time with one line, and the
+# tables and docs say why. Every job gets only the config keys it uses. Resources: measured on CMU (the paper run)
+# with headroom.
 from animsynth.compare.generators.names import FAIRMOTION_ROWS
-from animsynth.compare.settings import (clips_cfg, generator_order, groups, job_cfg, run_generators, showcase,
-                                        user_generators)
+from animsynth.compare.settings import (clips_cfg, first_frames, generator_order, groups, run_generators, showcase,
+                                        subject_groups, trial_subjects, user_generators)
 
 CMP = config["compare"]
 # the leave-one-out groups and temporal splits (the Table I subsets, the re-sequencing clips, then the comparison's
 # own per-subject sets of compare.subjects); a group holding a trial whose mirror cannot be read now is left out
 CMP_SUBSETS, CMP_RESEQ = groups(config, CMP_MISSING)
+# the same groups by subject: {subject: (leave-one-out groups, temporal splits)}, one clips job each
+CMP_BY_SUBJECT = subject_groups(config, CMP_MISSING)
+CMP_SUBJECTS = list(CMP_BY_SUBJECT)
 CMP_RUN, CMP_LEFT_OUT = run_generators(config)
 # the user's own generators (compare.user_generators), run after the family's; their job's rerun trigger is the
 # content of their file (compare_job_cfg), and they are in every table and figure, not in the verdicts
@@ -22,60 +26,60 @@ CMP_USER = user_generators(config)
 CMP_ORDER = generator_order(config)
 for _gen, _why in CMP_LEFT_OUT.items():
     print(f"animsynth: compare: generator {_gen} left out ({_why})", file=sys.stderr)
-CMP_SHOWCASE = list(showcase(config))
+# the strips figure's and BVH files' clip spec, seed index and subject
+_SPEC, _SEED, CMP_SHOWCASE_SUBJECT = showcase(config, CMP_MISSING)
 CMP_TRIALS = list(dict.fromkeys([t for ids in CMP_SUBSETS.values() for t in ids] + list(CMP_RESEQ.values())))
 # the transition budget sweep: our motion graph and fairmotion with upstream's walk fixes (the peer's method; the
 # as-released row builds the same graph) at every further budget of compare.budget_sweep, budget_sweep_seeds seeds
 CMP_GRAPHS = [g for g in ("motion_graph", "fairmotion_fixed") if g in CMP_RUN]
 CMP_SWEEP = [f"{float(b):g}" for b in CMP["budget_sweep"] if CMP["transitions_per_s"] is not None
              and float(b) != float(CMP["transitions_per_s"])]
-CMP_CLIPS = R("compare/clips.npz")
+CMP_CLIPS = R("compare/clips/{cmpsubj}.npz")
 CMP_OUT = {
-    "metrics": R("compare/runs/{cmpgen}.csv"),
-    "timing": R("compare/runs/{cmpgen}_timing.csv"),
-    "shown": R("compare/runs/{cmpgen}_showcase.npz"),
+    "metrics": R("compare/runs/{cmpsubj}/{cmpgen}.csv"),
+    "timing": R("compare/runs/{cmpsubj}/{cmpgen}_timing.csv"),
+    "shown": R("compare/runs/{cmpsubj}/{cmpgen}_showcase.npz"),
 }
-# fairmotion's rows and its budget sweep run in one job (compare_run_fairmotion): they build the same graphs, so
-# fairmotion's loading of every trial and its graph construction run once; each row and budget keeps its own
-# threshold and walks (animsynth.compare.generators.fairmotion_peer)
+CMP_SWEEP_OUT = R("compare/sweep/{cmpsubj}/{cmpgen}_{budget}.csv")
+# fairmotion's rows and its budget sweep run in one job per subject (compare_run_fairmotion): they build the same
+# graphs, so fairmotion's loading of every trial and its graph construction run once per database; each row and
+# budget keeps its own threshold and walks (animsynth.compare.generators.fairmotion_peer)
 CMP_FM = [g for g in FAIRMOTION_ROWS if g in CMP_RUN]
 CMP_FM_SWEEP = [(g, b) for b in CMP_SWEEP for g in CMP_GRAPHS if g in CMP_FM]
-CMP_OWN_JOB = [g for g in CMP_RUN if g not in CMP_FM]
-# the sweep's jobs of the other graph generators (compare_sweep_run): (generator, budget)
+# our other graph generator's further budgets run in its own job per subject (compare_run_graph), beside its row
 CMP_OWN_SWEEP = [(g, b) for b in CMP_SWEEP for g in CMP_GRAPHS if g not in CMP_FM]
+CMP_SWEEP_GRAPH = list(dict.fromkeys(g for g, _b in CMP_OWN_SWEEP))
+CMP_OWN_JOB = [g for g in CMP_RUN if g not in CMP_FM and g not in CMP_SWEEP_GRAPH]
 
 
 wildcard_constraints:
-    cmpgen="|".join(CMP_RUN),
-    cmpgraph="|".join(CMP_GRAPHS) or "none",
+    cmpsubj="|".join(CMP_SUBJECTS) or "none",
+    cmpgen="|".join(CMP_RUN) or "none",
     budget="[0-9.]+",
-
 
 
 rule compare_clips:
     input:
-        compare_trial_npz,
+        compare_subject_trials,
     output:
         clips=CMP_CLIPS,
-        table=report(
-            R("compare/clips.csv"),
-            caption="../report/compare_clips.rst",
-            category="The generators side by side",
-        ),
-        table_md=R("compare/clips.md"),
+        table=R("compare/clips/{cmpsubj}.csv"),
+        captures=R("compare/clips/{cmpsubj}_captures.csv"),
     params:
-        trials=CMP_TRIALS,
-        subsets=CMP_SUBSETS,
-        resequencing=CMP_RESEQ,
+        subsets=lambda w: CMP_BY_SUBJECT[w.cmpsubj][0],
+        resequencing=lambda w: CMP_BY_SUBJECT[w.cmpsubj][1],
+        trials=compare_subject_trial_ids,
+        subjects=lambda w: {t: trial_subjects(config)[t] for t in compare_subject_trial_ids(w)},
+        first_frames=lambda w: {t: first_frames(config)[t] for t in compare_subject_trial_ids(w)},
         cfg=clips_cfg(config),
     threads: 1
     resources:
         mem_mb=1000,
         runtime=10,
     log:
-        L("compare/clips.log"),
+        L("compare/clips/{cmpsubj}.log"),
     benchmark:
-        B("compare/clips.tsv")
+        B("compare/clips/{cmpsubj}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
@@ -91,34 +95,111 @@ rule compare_run:
         metrics=CMP_OUT["metrics"],
         timing=CMP_OUT["timing"],
         shown=CMP_OUT["shown"],
-        bvh=R("compare/bvh/{cmpgen}.bvh"),
     params:
-        cfg=compare_job_cfg,
+        rows=lambda w: compare_rows(w, [(w.cmpgen, None, "")]),
         seed=config["seed"],
-        roles={},  # each trial's roles (top-level joint_roles merged with its own) are stored on its skeleton
-        showcase=CMP_SHOWCASE,
     threads: 1
     resources:
         mem_mb=2000,
         runtime=30,
     log:
-        L("compare/run/{cmpgen}.log"),
+        L("compare/run/{cmpsubj}/{cmpgen}.log"),
     benchmark:
-        B("compare/run/{cmpgen}.tsv")
+        B("compare/run/{cmpsubj}/{cmpgen}.tsv")
     conda:
         "../envs/animsynth.yaml"
     script:
         "../scripts/compare_run.py"
 
 
+if CMP_SWEEP_GRAPH:
+
+    rule compare_run_graph:
+        wildcard_constraints:
+            cmpgen="|".join(CMP_SWEEP_GRAPH),
+        input:
+            CMP_CLIPS,
+        output:
+            metrics=CMP_OUT["metrics"],
+            timing=CMP_OUT["timing"],
+            shown=CMP_OUT["shown"],
+            **{f"sweep{i}_{k}": R(f"compare/sweep/{{cmpsubj}}/{{cmpgen}}_{b}{ext}")
+               for i, b in enumerate(CMP_SWEEP) for k, ext in (("metrics", ".csv"), ("timing", "_timing.csv"))},
+        params:
+            # its row, then each further budget of the sweep (compare_sweep_cfg's config) in the same process
+            rows=lambda w: compare_rows(w, [(w.cmpgen, None, "")] + [(w.cmpgen, b, f"sweep{i}_")
+                                                                     for i, b in enumerate(CMP_SWEEP)]),
+            seed=config["seed"],
+        threads: 1
+        resources:
+            mem_mb=2000,
+            runtime=30,
+        log:
+            L("compare/run/{cmpsubj}/{cmpgen}.log"),
+        benchmark:
+            B("compare/run/{cmpsubj}/{cmpgen}.tsv")
+        conda:
+            "../envs/animsynth.yaml"
+        script:
+            "../scripts/compare_run.py"
+
+
+if CMP_FM:
+
+    rule compare_run_fairmotion:
+        input:
+            CMP_CLIPS,
+        output:
+            **{f"{g}_{k}": CMP_OUT[k].replace("{cmpgen}", g) for g in CMP_FM for k in ("metrics", "timing", "shown")},
+            **{f"sweep{i}_{k}": R(f"compare/sweep/{{cmpsubj}}/{g}_{b}{ext}") for i, (g, b) in enumerate(CMP_FM_SWEEP)
+               for k, ext in (("metrics", ".csv"), ("timing", "_timing.csv"))},
+        params:
+            # each row's and budget's config as compare_run's (job_cfg): a changed block reruns this job only if
+            # one of them reads it
+            rows=lambda w: compare_rows(w, [(g, None, f"{g}_") for g in CMP_FM]
+                                        + [(g, b, f"sweep{i}_") for i, (g, b) in enumerate(CMP_FM_SWEEP)]),
+            seed=config["seed"],
+        # the comparison's longest jobs: started early, so they do not run alone at the end
+        priority: 10
+        threads: 1
+        resources:
+            mem_mb=2500,
+            runtime=60,
+        log:
+            L("compare/run/{cmpsubj}/fairmotion_rows_and_sweep.log"),
+        benchmark:
+            B("compare/run/{cmpsubj}/fairmotion_rows_and_sweep.tsv")
+        conda:
+            "../envs/animsynth.yaml"
+        script:
+            "../scripts/compare_run.py"
+
+
+CMP_METRICS = [CMP_OUT["metrics"].format(cmpsubj=s, cmpgen=g) for s in CMP_SUBJECTS for g in CMP_RUN]
+CMP_TIMING = [CMP_OUT["timing"].format(cmpsubj=s, cmpgen=g) for s in CMP_SUBJECTS for g in CMP_RUN]
+# the budget sweep's files: budget by budget, then graph generator, then subject (compare.tables.sweep_runs)
+CMP_SWEEP_FILES = [CMP_SWEEP_OUT.format(cmpsubj=s, cmpgen=g, budget=b) for b in CMP_SWEEP for g in CMP_GRAPHS
+                   for s in CMP_SUBJECTS]
+
+
 rule compare_tables:
     input:
-        clips=R("compare/clips.csv"),
-        metrics=expand(CMP_OUT["metrics"], cmpgen=CMP_RUN),
-        timing=expand(CMP_OUT["timing"], cmpgen=CMP_RUN),
+        clips=expand(R("compare/clips/{cmpsubj}.csv"), cmpsubj=CMP_SUBJECTS),
+        # the subjects' clips files: their held-out trials' skeletons, for the figure check (own or generic)
+        clip_files=expand(CMP_CLIPS, cmpsubj=CMP_SUBJECTS),
+        captures=expand(R("compare/clips/{cmpsubj}_captures.csv"), cmpsubj=CMP_SUBJECTS),
+        metrics=CMP_METRICS,
+        timing=CMP_TIMING,
         # the budget sweep's runs: quoted as evidence in the claims against the peer
-        sweep=[R(f"compare/sweep/{g}_{b}.csv") for b in CMP_SWEEP for g in CMP_GRAPHS],
+        sweep=CMP_SWEEP_FILES,
     output:
+        clips=report(
+            R("compare/clips.csv"),
+            caption="../report/compare_clips.rst",
+            category="The generators side by side",
+        ),
+        clips_md=R("compare/clips.md"),
+        captures=R("compare/capture_checks.csv"),
         metrics=report(
             R("compare/metrics.csv"),
             caption="../report/compare_metrics.rst",
@@ -180,7 +261,7 @@ rule compare_tables:
         generators=CMP_RUN,
         left_out=CMP_LEFT_OUT,
         cfg={k: CMP_ORDER if k == "generators" else CMP[k]
-             for k in ("generators", "seeds", "fps", "context", "length", "verdicts", "claims", "seed")},
+             for k in ("generators", "seeds", "fps", "context", "length", "verdicts", "claims", "seed", "genmm")},
         source=SOURCE,
         sweep={"default": CMP["transitions_per_s"], "budgets": [float(b) for b in CMP_SWEEP], "generators": CMP_GRAPHS},
     threads: 1
@@ -197,71 +278,10 @@ rule compare_tables:
         "../scripts/compare_tables.py"
 
 
-if CMP_FM:
-
-    rule compare_run_fairmotion:
-        input:
-            CMP_CLIPS,
-        output:
-            **{f"{k}_{g}": (CMP_OUT[k].format(cmpgen=g) if k in CMP_OUT else R(f"compare/bvh/{g}.bvh"))
-               for g in CMP_FM for k in ("metrics", "timing", "shown", "bvh")},
-            **{f"sweep{i}{k}": R(f"compare/sweep/{g}_{b}{k}.csv") for i, (g, b) in enumerate(CMP_FM_SWEEP)
-               for k in ("", "_timing")},
-        params:
-            # each row's and budget's config as compare_run's and compare_sweep_run's (compare_job_cfg,
-            # compare_sweep_cfg): a changed block reruns this job only if one of them reads it
-            rows=[(g, job_cfg(config, g)) for g in CMP_FM],
-            sweep=[(g, b, job_cfg(config, g, budget=b)) for g, b in CMP_FM_SWEEP],
-            seed=config["seed"],
-            roles={},  # as compare_run's
-            sweep_roles=config["joint_roles"],  # as compare_sweep_run's
-            showcase=CMP_SHOWCASE,
-        # the comparison's longest job (438 s of CPU on the paper run): started early, so it does not run alone at the end
-        priority: 10
-        threads: 1
-        resources:
-            mem_mb=2500,
-            runtime=60,
-        log:
-            L("compare/run/fairmotion_rows_and_sweep.log"),
-        benchmark:
-            B("compare/run/fairmotion_rows_and_sweep.tsv")
-        conda:
-            "../envs/animsynth.yaml"
-        script:
-            "../scripts/compare_run_fairmotion.py"
-
-
-rule compare_sweep_run:
-    wildcard_constraints:
-        cmpgraph="|".join(dict.fromkeys(g for g, _b in CMP_OWN_SWEEP)) or "none",
-    input:
-        CMP_CLIPS,
-    output:
-        metrics=R("compare/sweep/{cmpgraph}_{budget}.csv"),
-        timing=R("compare/sweep/{cmpgraph}_{budget}_timing.csv"),
-    params:
-        cfg=compare_sweep_cfg,
-        seed=config["seed"],
-        roles=config["joint_roles"],
-    threads: 1
-    resources:
-        mem_mb=2000,
-        runtime=30,
-    log:
-        L("compare/sweep/{cmpgraph}_{budget}.log"),
-    benchmark:
-        B("compare/sweep/{cmpgraph}_{budget}.tsv")
-    conda:
-        "../envs/animsynth.yaml"
-    script:
-        "../scripts/compare_sweep_run.py"
-
-
 rule compare_sweep:
     input:
-        default=expand(CMP_OUT["metrics"], cmpgen=CMP_GRAPHS),
-        sweep=[R(f"compare/sweep/{g}_{b}.csv") for b in CMP_SWEEP for g in CMP_GRAPHS],
+        default=[CMP_OUT["metrics"].format(cmpsubj=s, cmpgen=g) for s in CMP_SUBJECTS for g in CMP_GRAPHS],
+        sweep=CMP_SWEEP_FILES,
     output:
         table=report(
             R("compare/budget_sweep.csv"),
@@ -296,7 +316,8 @@ rule compare_sweep:
 rule compare_figures:
     input:
         metrics=R("compare/metrics.csv"),
-        shown=expand(CMP_OUT["shown"], cmpgen=CMP_RUN),
+        # the showcase subject's (compare.showcase) motion of every generator
+        shown=[CMP_OUT["shown"].format(cmpsubj=CMP_SHOWCASE_SUBJECT, cmpgen=g) for g in CMP_RUN],
     output:
         metrics=report(
             R("compare/metrics.png"),
@@ -308,9 +329,10 @@ rule compare_figures:
             caption="../report/compare_strips.rst",
             category="The generators side by side",
         ),
+        # the showcase as BVH files, start frames included (animsynth score reads them back)
+        bvh=expand(R("compare/bvh/{cmpgen}.bvh"), cmpgen=CMP_RUN),
     params:
         generators=CMP_RUN,
-        showcase=CMP_SHOWCASE,
         source=SOURCE,
     threads: 1
     resources:
@@ -358,7 +380,9 @@ COMPARE_SUMMARY = [
         "title": "Held-out clips",
         "csv": R("compare/clips.csv"),
         "group": "The generators side by side",
-        "note": "Leave one out within each Gauch & Peters subset; temporal split of each re-sequencing clip.",
+        "note": "Held-out windows of every subject: leave one out within each Gauch & Peters subset and subject set "
+        "of 2 or more trials; a temporal split in blocks of each re-sequencing clip and one-trial subject set; "
+        "windows of context + length frames, at most compare.max_clips_per_subject per subject.",
     },
 ]
 COMPARE_VERDICTS = [R("compare/verdicts.csv"), R("compare/sanity_checks.csv")]

@@ -1,8 +1,13 @@
-"""One generator fitted on every clip's database, every seed generated from the clip's start and scored."""
+"""One generator job of one subject: every row it runs (a generator; fairmotion's two rows; a graph generator's
+further budgets of the sweep) fitted once per database of the subject's clips, every seed of every window generated
+from its start and scored, in one process (so fairmotion's loading of every trial and its graph construction run
+once per database for all its rows and budgets)."""
 from animsynth.compare.jobs import run_job
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)
-p = snakemake.params
-run_job(snakemake.input[0], snakemake.wildcards.cmpgen, dict(p.cfg), int(p.seed), dict(p.roles),
-        tuple(p.showcase), dict(snakemake.output))
+p, o = snakemake.params, snakemake.output
+for name, cfg, roles, prefix, show in p.rows:
+    keys = ("metrics", "timing", "shown") if show is not None else ("metrics", "timing")
+    run_job(snakemake.input[0], name, dict(cfg), int(p.seed), dict(roles), None if show is None else tuple(show),
+            {k: getattr(o, f"{prefix}{k}") for k in keys})

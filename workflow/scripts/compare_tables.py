@@ -1,9 +1,11 @@
-"""metrics.csv, summary.csv, winners.csv, cost_timing.csv, verdicts.csv and summary.md of the comparison."""
+"""clips.csv, metrics.csv, summary.csv, winners.csv, cost_timing.csv, verdicts.csv and summary.md of the comparison,
+gathered from every subject's jobs."""
 from animsynth.compare.jobs import tables_job
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)
 p = snakemake.params
 inp = snakemake.input
-tables_job({"clips": inp.clips, "metrics": list(inp.metrics), "timing": list(inp.timing), "sweep": list(inp.sweep)},
+tables_job({"clips": list(inp.clips), "clip_files": list(inp.clip_files), "captures": list(inp.captures),
+            "metrics": list(inp.metrics), "timing": list(inp.timing), "sweep": list(inp.sweep)},
            dict(snakemake.output), list(p.generators), dict(p.left_out), dict(p.cfg), p.source, dict(p.sweep))

@@ -39,7 +39,7 @@ def independent_groups(clips: pd.DataFrame, by: str = "subject") -> dict:
     rows = list(clips.itertuples(index=False))
     trials, base = {}, {}
     for r in rows:
-        own = str(r.clip).split("/", 1)[-1]
+        own = str(r.clip).split("/", 1)[-1].split("@", 1)[0]  # the held-out trial (a clip id may add @<frame>)
         text = f"{own} {r.held_out} {r.database}"
         ts = set(_TRIAL.findall(text))
         if not ts:  # not CMU ids: the clip's trial and the database's names (without a temporal split's range)

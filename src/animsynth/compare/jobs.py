@@ -1,14 +1,16 @@
 """Workflow steps of the compare family (the scripts in workflow/scripts only call these): one function per step,
 reading its inputs and writing its outputs; the work is done by the modules it calls.
 
-* :func:`clips_job`: every held-out clip of the protocol (:mod:`animsynth.compare.protocol`) ->
-  ``compare/clips.npz`` and its table;
-* :func:`run_job`: one generator over every clip and seed, scored (:mod:`animsynth.compare.runner`,
-  :mod:`animsynth.compare.scoring`) -> ``compare/runs/<generator>.csv``, ``<generator>_timing.csv``, the showcase;
-* :func:`tables_job`: the family's tables and summary page (:mod:`animsynth.compare.tables`,
-  :mod:`animsynth.compare.verdicts`);
+* :func:`clips_job`: one subject's held-out clips (:mod:`animsynth.compare.protocol`) ->
+  ``compare/clips/<subject>.npz`` and its table;
+* :func:`run_job`: one generator over one subject's clips and seeds, fitted once per database, scored
+  (:mod:`animsynth.compare.runner`, :mod:`animsynth.compare.scoring`) -> ``compare/runs/<subject>/<generator>.csv``,
+  ``<generator>_timing.csv``, the subject's showcase;
+* :func:`tables_job`: the family's tables and summary page, every subject's files gathered
+  (:mod:`animsynth.compare.tables`, :mod:`animsynth.compare.verdicts`), the clips table (:func:`gather_clips`);
 * :func:`sweep_job`: the transition budget sweep's table and figure;
-* :func:`figures_job`: ``metrics.png`` and ``strips.png`` (:mod:`animsynth.compare.plots`).
+* :func:`figures_job`: ``metrics.png``, ``strips.png`` (:mod:`animsynth.compare.plots`) and the showcase's BVH
+  files.
 """
 
 from __future__ import annotations
@@ -17,24 +19,35 @@ import logging
 
 log = logging.getLogger("animsynth.compare.jobs")
 
-__all__ = ["clips_job", "run_job", "tables_job", "sweep_job", "figures_job"]
+__all__ = ["clips_job", "run_job", "tables_job", "sweep_job", "figures_job", "gather_clips"]
 
 
-def clips_job(trials: dict, subsets: dict, resequencing: dict, cfg: dict, out: dict) -> list:
-    """Every held-out clip (:func:`animsynth.compare.protocol.prepare_clips`; ``trials``: {trial id: Motion}) into
-    ``out``: ``clips`` (the ``.npz``), ``table`` (+ ``table_md``: the clips table). Returns the clips."""
+def clips_job(trials: dict, subsets: dict, resequencing: dict, cfg: dict, out: dict, subjects: dict | None = None,
+              first_frames: dict | None = None) -> list:
+    """One subject's held-out clips into ``out``: ``clips`` (the ``.npz``), ``table`` (its rows of the clips table)
+    and ``captures`` (its rows of ``capture_checks.csv``). Returns the clips.
+
+    Every trial (``trials``: {trial id: Motion at its own rate}) is checked first
+    (:func:`animsynth.capture_check.check_capture` with ``cfg["capture_check"]``; ``first_frames``: {trial id: the
+    record's ``first_frame``}, for the notes), and its flagged frames stay out of held-out windows and databases
+    (:func:`animsynth.compare.protocol.prepare_clips`; ``subjects``: {trial id: subject})."""
+    from ..capture_check import check_capture, checks_table
     from ..tables import write_table
     from .protocol import clips_table, prepare_clips, save_clips
 
-    clips = prepare_clips(trials, subsets, resequencing, cfg)
+    checks = [check_capture(m, t, cfg["capture_check"], (first_frames or {}).get(t, 0)) for t, m in trials.items()]
+    usable = {c.trial: c.usable for c in checks}
+    clips = prepare_clips(trials, subsets, resequencing, cfg, subjects, usable)
     save_clips(out["clips"], clips)
-    write_table(clips_table(clips), out["table"], md=out["table_md"])
+    write_table(clips_table(clips, int(cfg.get("min_clips_per_subject") or 0)), out["table"], md=False)
+    write_table(checks_table(checks), out["captures"], md=False)
     return clips
 
 
 def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase, out: dict) -> None:
-    """One generator over every clip and seed (one workflow job): ``out`` names ``metrics``, ``timing``,
-    ``shown`` and ``bvh`` (the showcase as BVH, start frames included; both optional, together)."""
+    """One generator over one subject's clips and seeds (one row of a workflow job): ``out`` names ``metrics``,
+    ``timing``, and optionally ``shown`` (with ``showcase``: (clip spec, seed[, required]),
+    :func:`animsynth.compare.runner.showcase_clip`) and ``bvh`` (the showcase as BVH, start frames included)."""
     from ..io.bvh import write_bvh
     from ..tables import write_table
     from .protocol import load_clips
@@ -46,8 +59,9 @@ def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict
         raise ValueError(f"config key 'compare.showcase': clip {showcase[0]!r} seed {showcase[1]} was not run")
     write_table(metrics, out["metrics"], md=False)
     write_table(timing, out["timing"], md=False)
-    if "shown" in out:  # the budget sweep's jobs write metrics and timing only
+    if "shown" in out:  # the budget sweep's rows write metrics and timing only
         save_shown(out["shown"], shown)
+    if "bvh" in out:
         write_bvh(out["bvh"], shown)
 
 
@@ -64,17 +78,52 @@ def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, 
     sweep_figure(table, out["figure"], float(default_budget))
 
 
+def gather_clips(paths, cfg: dict, clip_files=()):
+    """The clips table of the run from every subject's rows (``paths``, in subject order), with ``figure``: ``own``,
+    or ``generic`` for a subject whose skeleton another subject's trials share (a generic figure, not the subject's
+    own bones: :func:`animsynth.skeleton.shared_figures` on the held-out trials' skeletons of ``clip_files``, the
+    subjects' ``.npz``; without them every subject is ``own``), and each clip's note completed: where GenMM runs
+    (``cfg["generators"]``) and a clip's database is too short for its pyramid floor
+    (:func:`animsynth.compare.generators.genmm.pyramid_note`, on the ``database_longest`` column), the note says
+    so."""
+    import pandas as pd
+
+    from ..skeleton import figure_kinds, shared_figures
+    from .generators.genmm import pyramid_note
+    from .protocol import load_skeletons
+
+    clips = pd.concat([pd.read_csv(p, dtype={"held_out": str, "subject": str}, keep_default_na=False)
+                       for p in paths], ignore_index=True)
+    skeletons = {t: sk for f in clip_files for t, sk in load_skeletons(f).items()}
+    trial_subject = {t: s for t, s in zip(clips["held_out"].str.split(" ").str[0], clips["subject"])}
+    kinds = figure_kinds(shared_figures(skeletons, {t: trial_subject[t] for t in skeletons})) if skeletons else {}
+    clips.insert(clips.columns.get_loc("subject") + 1, "figure", [kinds.get(s, "own") for s in clips["subject"]])
+    if "genmm" in cfg.get("generators", ()) and "genmm" in cfg:
+        gm = cfg["genmm"]
+        notes = [pyramid_note(n, gm["patch_size"], gm["min_coarse_patches"], gm["min_levels"])
+                 for n in clips["database_longest"]]
+        clips["note"] = ["; ".join(x for x in (str(a), b) if x) for a, b in zip(clips["note"], notes)]
+    return clips
+
+
 def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, source: str, sweep: dict | None = None) -> None:
-    """The family's tables (:func:`animsynth.compare.tables.family_tables`, from ``inp``: ``clips``, ``metrics``,
-    ``timing`` lists; optional ``sweep``: the budget sweep's metrics files) into ``out``: ``metrics``,
+    """The clips table (:func:`gather_clips` of ``inp["clips"]``, the subjects' rows) into ``out["clips"]`` (+
+    ``clips_md``) and the family's tables (:func:`animsynth.compare.tables.family_tables`, from ``inp``: the clips
+    table, ``metrics``, ``timing`` lists; optional ``sweep``: the budget sweep's metrics files) into ``out``: ``metrics``,
     ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``), ``cost`` (+ ``cost_md``), ``verdicts``
     (+ ``verdicts_md``), ``claims_stats``, ``exploratory`` (+ ``exploratory_md``), ``sanity`` (+ ``sanity_md``),
     ``sensitivity`` (+ ``sensitivity_md``), ``summary_md`` (the family's page)."""
+    import pandas as pd
+
     from ..atomic import atomic_write_text
     from ..tables import write_table
     from .tables import family_tables
 
-    t = family_tables(inp, generators, left_out, cfg, source, sweep)
+    write_table(gather_clips(inp["clips"], cfg, inp.get("clip_files", ())), out["clips"], md=out["clips_md"])
+    if "captures" in inp:  # every subject's capture checks, gathered
+        write_table(pd.concat([pd.read_csv(p, keep_default_na=False) for p in inp["captures"]], ignore_index=True),
+                    out["captures"], md=False)
+    t = family_tables(dict(inp, clips=out["clips"]), generators, left_out, cfg, source, sweep)
     write_table(t["metrics"], out["metrics"], md=False)
     write_table(t["metrics_timing"], out["metrics_timing"], md=False)
     write_table(t["summary"], out["summary"], md=False)  # compare/summary.md is the family's page below
@@ -88,12 +137,14 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     atomic_write_text(out["summary_md"], t["summary_md"])
 
 
-def figures_job(metrics_path, shown_paths, generators, showcase, source: str, out: dict) -> None:
-    """``out["metrics"]`` (every metric of the figure per generator, :func:`animsynth.compare.plots.metrics_figure`)
-    and ``out["strips"]`` (one skeleton strip per generator from the showcase start, ``shown_paths`` in the order
-    of ``generators``)."""
+def figures_job(metrics_path, shown_paths, generators, source: str, out: dict) -> None:
+    """``out["metrics"]`` (every metric of the figure per generator, :func:`animsynth.compare.plots.metrics_figure`),
+    ``out["strips"]`` (one skeleton strip per generator from the showcase start, ``shown_paths`` in the order of
+    ``generators``) and ``out["bvh"]`` (optional: one BVH file per generator, the showcase's start and generated
+    frames, in the same order)."""
     import pandas as pd
 
+    from ..io.bvh import write_bvh
     from .plots import metrics_figure, strips_figure
     from .runner import load_shown
 
@@ -102,6 +153,10 @@ def figures_job(metrics_path, shown_paths, generators, showcase, source: str, ou
     metrics_figure(out["metrics"], metrics, list(generators), f"Generators side by side ({data}): values over "
                    "held-out clips x seeds (box: IQR, whiskers: 5-95 %; grey: the realism bounds)")
     shown = {g: load_shown(f) for g, f in zip(generators, shown_paths)}
-    strips_figure(out["strips"], shown, title=f"From the same start: clip {showcase[0]}, seed {showcase[1]} ({data}); "
+    names = [m.name.split(" ", 1)[-1] for m in shown.values()]
+    clip = max(names, key=len)  # "<clip> seed <i>" where a generator ran
+    strips_figure(out["strips"], shown, title=f"From the same start: clip {clip} ({data}); "
                   "grey: last start frame, red: frames at a seam")
+    for path, m in zip(out.get("bvh") or [], shown.values()):
+        write_bvh(path, m)
     log.info("metrics.png: %d rows; strips.png: %s", len(metrics), ", ".join(shown))

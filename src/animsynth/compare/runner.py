@@ -1,9 +1,16 @@
-"""One generator over every clip of the protocol: fitted on each clip's database, every seed generated from the
-clip's start and scored (:func:`run_generator`), its cost measured; a generator that fails is kept as empty rows.
+"""One generator over the clips of one subject: fitted once on each database the clips share (:func:`by_database`),
+every seed of every window of that database generated from the window's start and scored (:func:`run_generator`),
+its cost measured; a generator that fails is kept as empty rows.
 
-Files of one generator job: per generator ``compare/runs/<generator>.csv`` (metrics, one row per clip x seed),
-``<generator>_timing.csv`` (build and generation cost, one row per clip, :data:`TIMING_COLUMNS`) and
-``<generator>_showcase.npz`` (the showcase clip's start and generated frames: :func:`save_shown` / :func:`load_shown`).
+The runner reads of a generator only what :class:`animsynth.generator.Generator` declares (``query``,
+``native_fps``, ``entry_seam``, :meth:`~animsynth.generator.Generator.run_notes`,
+:meth:`~animsynth.generator.Generator.outside_cost`, :meth:`~animsynth.generator.Generator.set_label`); no
+generator is special-cased by name.
+
+Files of one generator job: per subject and generator ``compare/runs/<subject>/<generator>.csv`` (metrics, one row
+per clip x seed), ``<generator>_timing.csv`` (build and generation cost, one row per database,
+:data:`TIMING_COLUMNS`) and ``<generator>_showcase.npz`` (the subject's showcase clip's start and generated frames:
+:func:`save_shown` / :func:`load_shown`).
 """
 
 from __future__ import annotations
@@ -22,16 +29,16 @@ from ..skeleton import Skeleton
 from .generators.registry import make_generator
 from .measures.metric_table import KEY_COLUMNS, METRIC_NAMES
 from .protocol import Clip, clip_seeds
-from .scoring import DatabaseKinematics, joint_count, reference, run_stats_by_skeleton, run_values, score
+from .scoring import DatabaseKinematics, reference, run_values, score
 
 __all__ = ["TIMING_COLUMNS", "cpu_seconds", "peak_rss_mb", "run_generator", "run_isolated", "failed_run",
-           "generation_query", "native_inputs", "save_shown", "load_shown"]
+           "generation_query", "native_inputs", "by_database", "showcase_clip", "save_shown", "load_shown"]
 
 log = logging.getLogger("animsynth.compare.runner")
 
 #: the columns of ``<generator>_timing.csv``
-TIMING_COLUMNS = ["generator", "clip", "database_frames", "build_cpu_s", "build_wall_s", "generate_cpu_s",
-                  "generate_wall_s", "frames_generated", "peak_rss_mb"]
+TIMING_COLUMNS = ["generator", "database", "clips", "database_frames", "build_cpu_s", "build_wall_s",
+                  "generate_cpu_s", "generate_wall_s", "frames_generated", "peak_rss_mb"]
 
 
 def cpu_seconds() -> float:
@@ -55,7 +62,8 @@ def peak_rss_mb() -> float:
 
 def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int, roles: dict | None = None,
                   showcase: tuple[str, int] | None = None):
-    """Fit ``generator`` on every clip's database, generate every seed from the clip's start, score.
+    """Fit ``generator`` once on every database the clips share, generate every seed of every clip from the
+    clip's start, score.
 
     Parameters
     ----------
@@ -64,16 +72,17 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     cfg : the ``compare`` block (with the re-sequencing study's ``stisomap`` block added)
     master_seed : the config's ``seed``
     roles : joint-role overrides (config ``joint_roles``)
-    showcase : (clip id, seed index) whose motion is returned
+    showcase : (clip spec, seed index[, required]) whose motion is returned (:func:`showcase_clip`; ``required``,
+        default true: a build that stops on the showcase clip stops the job)
 
     Returns
     -------
     metrics : DataFrame, one row per clip x seed (:data:`KEY_COLUMNS` + :data:`METRIC_NAMES` + ``note``):
         a clip whose database the generator cannot be built on (its ``fit`` raises ValueError, e.g. a
         motion graph without transitions) keeps its rows with no values and ``note`` = "not built: <why>"
-    timing : DataFrame, one row per clip (:data:`TIMING_COLUMNS`): CPU (:func:`cpu_seconds`, child
-        processes included) and wall seconds of the build and of the generation, the job's peak resident
-        memory so far (:func:`peak_rss_mb`)
+    timing : DataFrame, one row per database (:data:`TIMING_COLUMNS`): its clips, CPU (:func:`cpu_seconds`, child
+        processes included, and the generator's :meth:`~animsynth.generator.Generator.outside_cost`) and wall
+        seconds of the build and of the generation, the job's peak resident memory so far (:func:`peak_rss_mb`)
     shown : Motion or None, the showcase clip's start and generated frames joined
         (``meta["context"]``: start frames)
 
@@ -90,7 +99,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
         close_processes()  # a user generator's child process ends with its job
 
 
-def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase: tuple[str, int] | None = None):
+def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase: tuple | None = None):
     """The files of a generator that could not run at all: ``why`` logged as one error line (and printed to
     stderr, the run's console), every clip x seed row with no values and ``note`` = "failed: <why>", every timing
     row empty, and as the showcase the showcase clip's start alone (no generated frame; ``meta["note"]``)."""
@@ -98,12 +107,12 @@ def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase:
     log.error("%s", line)
     print(f"animsynth: ERROR: {line}", file=sys.stderr)
     rows, trows, shown = [], [], None
-    for clip in clips:
-        r, t = _empty_rows(clip, generator, int(cfg["seeds"]), f"failed: {line}")
+    shown_id = None if showcase is None else showcase_clip(clips, showcase[0])
+    for key, cs in by_database(clips).items():
+        r, sh = _not_run(cs, generator, int(cfg["seeds"]), f"failed: {line}", shown_id)
         rows += r
-        trows.append(t)
-        if showcase is not None and clip.clip == showcase[0]:
-            shown = _start_only(clip, generator, f"failed: {line}")
+        shown = shown or sh
+        trows.append(_timing_row(generator, key, cs))
     return (pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"]), pd.DataFrame(trows, columns=TIMING_COLUMNS),
             shown)
 
@@ -115,116 +124,173 @@ def _start_only(clip: Clip, generator: str, note: str) -> Motion:
                   {"context": clip.context, "seams": np.zeros(0, np.int64), "note": note})
 
 
-def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> tuple[list, dict]:
-    """The metric rows (one per seed, no values, ``note``) and the timing row (no times) of a clip a generator
-    has no motion for."""
+def _empty_rows(clip: Clip, generator: str, n_seeds: int, note: str) -> list:
+    """The metric rows (one per seed, no values, ``note``) of a clip a generator has no motion for."""
     key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
-    rows = [{**key, "seed": i, **{m: np.nan for m in METRIC_NAMES}, "note": note} for i in range(n_seeds)]
-    timing = {"generator": generator, "clip": clip.clip, "database_frames": int(sum(d.n_frames for d in clip.database)),
-              "build_cpu_s": np.nan, "build_wall_s": np.nan, "generate_cpu_s": np.nan, "generate_wall_s": np.nan,
-              "frames_generated": 0, "peak_rss_mb": peak_rss_mb()}
-    return rows, timing
+    return [{**key, "seed": i, **{m: np.nan for m in METRIC_NAMES}, "note": note} for i in range(n_seeds)]
 
 
 def generation_query(gen, clip: Clip) -> dict:
-    """What ``gen.generate`` is given besides the start, length and seed, by its ``query``
+    """What ``gen.generate`` is given besides the start, length and seed, by its declared ``query``
     (:class:`animsynth.generator.Generator`): nothing for ``"start"``; ``trajectory`` = the clip's held-out frames
     after the start (:attr:`Clip.future`) for ``"future_trajectory"``."""
     from ..generator import QUERY_FUTURE_TRAJECTORY, QUERY_START
 
-    query = getattr(gen, "query", QUERY_START)
-    if query == QUERY_START:
+    if gen.query == QUERY_START:
         return {}
-    if query == QUERY_FUTURE_TRAJECTORY:
+    if gen.query == QUERY_FUTURE_TRAJECTORY:
         return {"trajectory": clip.future}
-    raise ValueError(f"generator {getattr(gen, 'name', gen)!r}: unknown query {query!r} (one of "
+    raise ValueError(f"generator {gen.name!r}: unknown query {gen.query!r} (one of "
                      f"{[QUERY_START, QUERY_FUTURE_TRAJECTORY]})")
 
 
 def native_inputs(gen, clip: Clip) -> tuple[dict, dict]:
-    """What ``gen.fit`` and ``gen.generate`` are given at the generator's native rate: for a generator with
-    ``input_rate = "native"`` (fairmotion's peer) whose ``native_fps`` the clip carries from the source
-    (:class:`NativeRate`), ``({"native_clips": database}, {"native_start": start})``; else ``({}, {})`` (the generator
-    upsamples the working-rate clips itself)."""
-    if getattr(gen, "input_rate", "working") != "native" or getattr(gen, "native_fps", None) is None:
-        return {}, {}
-    nat = clip.at_rate(float(gen.native_fps))
+    """What ``gen.fit`` and ``gen.generate`` are given at the generator's declared native rate ``native_fps``
+    (:class:`animsynth.generator.Generator`): ``({"native_clips": database}, {"native_start": start})`` from the
+    clip at that rate (:class:`NativeRate`), ``None`` for both when the generator has no native rate or the clip
+    does not carry it (then the generator works from the working-rate clips)."""
+    nat = None if gen.native_fps is None else clip.at_rate(float(gen.native_fps))
     if nat is None or not nat.database:
-        return {}, {}
+        return {"native_clips": None}, {"native_start": None}
     return {"native_clips": nat.database}, {"native_start": nat.start}
 
 
-def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
+def by_database(clips: list[Clip]) -> dict[str, list[Clip]]:
+    """The clips grouped by the database they share (``database_id``; a clip without one is its own), in order."""
+    out: dict[str, list[Clip]] = {}
+    for c in clips:
+        out.setdefault(c.database_id or c.clip, []).append(c)
+    return out
+
+
+def _timing_row(generator: str, key: str, cs: list[Clip], **cost) -> dict:
+    """One build's timing row (:data:`TIMING_COLUMNS`); the costs not given are empty."""
+    row = {"generator": generator, "database": key, "clips": len(cs),
+           "database_frames": int(sum(d.n_frames for d in cs[0].database)), "build_cpu_s": np.nan,
+           "build_wall_s": np.nan, "generate_cpu_s": np.nan, "generate_wall_s": np.nan, "frames_generated": 0,
+           "peak_rss_mb": peak_rss_mb()}
+    row.update(cost)
+    return row
+
+
+def _not_run(cs, generator, n_seeds, note, shown_id):
+    """The rows of every clip of one database a generator has no motion for (and its showcase: the start alone)."""
+    rows = [r for c in cs for r in _empty_rows(c, generator, n_seeds, note)]
+    shown = next((_start_only(c, generator, note) for c in cs if c.clip == shown_id), None)
+    return rows, shown
+
+
+def _fit(generator, cs, cfg, key, shown):
+    """A fitted generator for the database of ``cs`` with its build cost, or ``(None, why)`` when the cost guard
+    refuses it or its build stops with a reason (``shown``: (showcase clip id, required))."""
     from .cost import guard as cost_guard
 
+    c0 = cs[0]
+    db_frames = int(sum(d.n_frames for d in c0.database))
+    length = max(c.length for c in cs)
+    level, line = cost_guard(generator, key, db_frames, cfg, length, len(cs) * int(cfg["seeds"]))
+    if level == "refuse":
+        log.error("%s", line)
+        print(f"animsynth: compare: {line}", file=sys.stderr)
+        return None, f"not run: {line}"
+    if level == "warn":
+        log.warning("%s", line)
+    gen = make_generator(generator, cfg)
+    gen.set_label(key)
+    fit_native, _ = native_inputs(gen, c0)
+    c0_cpu, w0 = cpu_seconds(), time.perf_counter()
+    try:
+        gen.fit(c0.database, **fit_native)
+    except ValueError as exc:  # e.g. a motion graph without transitions on a short database
+        if shown[1] and any(c.clip == shown[0] for c in cs):
+            raise ValueError(f"{generator} cannot be built on the showcase clip {shown[0]} ({exc}); choose "
+                             "another with config key 'compare.showcase.clip'") from exc
+        log.warning("%s cannot be built on %s: %s", generator, key, exc)
+        return None, f"not built: {exc}"
+    # work outside this process (a user generator's child) is not among its finished children until it ends
+    cost = {"build_cpu_s": cpu_seconds() - c0_cpu + gen.outside_cost()["cpu_s"],
+            "build_wall_s": time.perf_counter() - w0}
+    return gen, cost
+
+
+def _run_windows(gen, generator, cs, cfg, master_seed, roles, kin, shown_id):
+    """Every seed of every window ``cs`` of one database from the fitted ``gen``, scored: (rows, showcase motion or
+    None, generation CPU and wall seconds, frames generated, the largest outside memory)."""
     mcfg = cfg["metrics"]
-    rows, trows, shown = [], [], None
-    kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
-    std = run_stats_by_skeleton(clips, mcfg, roles, kin)
-    for clip in clips:
+    rows, shown, gen_cpu, gen_wall, frames, rss = [], None, 0.0, 0.0, 0, 0.0
+    for clip in cs:
+        gen.set_label(clip.clip)
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
-        db_frames = int(sum(d.n_frames for d in clip.database))
-        # the cost guard (compare.cost_guard; animsynth.compare.cost): an estimate before the build
-        level, line = cost_guard(generator, clip.clip, db_frames, cfg, clip.length, len(seeds))
-        if level == "refuse":
-            log.error("%s", line)
-            print(f"animsynth: compare: {line}", file=sys.stderr)
-            r, t = _empty_rows(clip, generator, len(seeds), f"not run: {line}")
-            rows += r
-            trows.append(t)
-            if showcase is not None and clip.clip == showcase[0]:
-                shown = _start_only(clip, generator, f"not run: {line}")
-            continue
-        if level == "warn":
-            log.warning("%s", line)
-        gen = make_generator(generator, cfg, held_out=clip.held_out)
-        fit_native, generate_native = native_inputs(gen, clip)
-        if hasattr(gen, "child_cpu_s_"):  # a user generator: its log lines name the clip
-            gen.clip = clip.clip
-        c0, w0 = cpu_seconds(), time.perf_counter()
-        try:
-            gen.fit(clip.database, **fit_native)
-        except ValueError as exc:  # e.g. a motion graph without transitions on a short database
-            if showcase is not None and clip.clip == showcase[0]:
-                raise ValueError(f"{generator} cannot be built on the showcase clip {clip.clip} ({exc}); choose "
-                                 "another with config key 'compare.showcase.clip'") from exc
-            log.warning("%s cannot be built on %s: %s", generator, clip.clip, exc)
-            r, t = _empty_rows(clip, generator, len(seeds), f"not built: {exc}")
-            rows += r
-            trows.append(t)
-            continue
-        build_cpu, build_wall = cpu_seconds() - c0, time.perf_counter() - w0
-        # a user generator's child process: its CPU is not among the job's finished children until it ends
-        build_cpu += float(getattr(gen, "child_cpu_s_", 0.0))
-        start = clip.start
-        ref = reference(clip, mcfg, roles, std[joint_count(clip)], kin)
-        gen_cpu = gen_wall = 0.0
-        feats = []
-        query = {**generation_query(gen, clip), **generate_native}
+        ref = reference(clip, mcfg, roles, None, kin)  # L2P normalised by this clip's own database
+        query = {**generation_query(gen, clip), **native_inputs(gen, clip)[1]}
+        start, feats = clip.start, []
         for i, s in enumerate(seeds):
             c0, w0 = cpu_seconds(), time.perf_counter()
             m = gen.generate(start, clip.length, s, **query)
-            gen_cpu += cpu_seconds() - c0 + float(getattr(gen, "child_cpu_s_", 0.0))
+            outside = gen.outside_cost()
+            gen_cpu += cpu_seconds() - c0 + outside["cpu_s"]
             gen_wall += time.perf_counter() - w0
-            row, f = score(clip, ref, m, generator, mcfg, roles)
+            rss = max(rss, outside["rss_mb"])
+            row, f = score(clip, ref, m, generator, mcfg, roles, entry_seam=gen.entry_seam)
             feats.append(f)
             rows.append({**key, "seed": i, **row, "note": ""})
-            if showcase is not None and (clip.clip, i) == tuple(showcase):
-                seams = np.asarray(m.meta["seams"], np.int64)
-                if generator != "replay":  # the entry is a seam, as scored
-                    seams = np.union1d(seams, [0])
-                shown = Motion(np.vstack([start.values, m.values]), m.skeleton, m.fps, f"{generator} {clip.clip}",
-                               {"context": clip.context, "seams": seams + clip.context})
+            if (clip.clip, i) == shown_id:
+                shown = _shown(clip, m, f"{generator} {clip.clip} seed {i}", gen.entry_seam)
         per_run = run_values(gen, feats)  # the generator's own count, the spread over seeds: one value per clip
         for r in rows[-len(seeds):]:
             r.update(per_run)
-        trows.append({"generator": generator, "clip": clip.clip, "database_frames": db_frames,
-                      "build_cpu_s": build_cpu, "build_wall_s": build_wall, "generate_cpu_s": gen_cpu,
-                      "generate_wall_s": gen_wall, "frames_generated": clip.length * len(seeds),
-                      "peak_rss_mb": max(peak_rss_mb(), float(getattr(gen, "child_rss_mb_", 0.0)))})
-        log.info("%s on %s: build %.3f s CPU, %d seeds x %d frames in %.3f s CPU", generator, clip.clip, build_cpu,
-                 len(seeds), clip.length, gen_cpu)
+        frames += clip.length * len(seeds)
+    return rows, shown, gen_cpu, gen_wall, frames, rss
+
+
+def _shown(clip: Clip, m: Motion, name: str, entry_seam: bool) -> Motion:
+    """The start and the generated motion joined (``name``: generator, clip and seed), its seams (the entry one too
+    where it is a seam, as scored)."""
+    seams = np.asarray(m.meta["seams"], np.int64)
+    if entry_seam:
+        seams = np.union1d(seams, [0])
+    return Motion(np.vstack([clip.start.values, m.values]), m.skeleton, m.fps, name,
+                  {"context": clip.context, "seams": seams + clip.context})
+
+
+def showcase_clip(clips: list[Clip], spec: str | None) -> str | None:
+    """The id of the clip a showcase ``spec`` names among ``clips``: the clip itself (``<group>/<trial>@<frame>``),
+    the first clip of a held-out trial (``<group>/<trial>``), or with ``None`` the first clip; ``None`` when the
+    spec names none of them."""
+    if not clips:
+        return None
+    if spec is None:
+        return clips[0].clip
+    for c in clips:
+        if c.clip == spec or c.clip.split("@", 1)[0] == spec:
+            return c.clip
+    return None
+
+
+def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
+    """:func:`run_generator`: one build per database (:func:`by_database`), every window and seed of it from that
+    build."""
+    rows, trows, shown = [], [], None
+    kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
+    shown_id = (None, 0) if showcase is None else (showcase_clip(clips, showcase[0]), int(showcase[1]))
+    required = showcase is not None and (len(showcase) < 3 or bool(showcase[2]))
+    for key, cs in by_database(clips).items():
+        gen, cost = _fit(generator, cs, cfg, key, (shown_id[0], required))
+        if gen is None:
+            r, sh = _not_run(cs, generator, int(cfg["seeds"]), cost, shown_id[0])
+            rows += r
+            shown = shown or sh
+            trows.append(_timing_row(generator, key, cs))
+            continue
+        r, sh, g_cpu, g_wall, frames, rss = _run_windows(gen, generator, cs, cfg, master_seed, roles, kin, shown_id)
+        rows += r
+        shown = shown or sh
+        trows.append(_timing_row(generator, key, cs, **cost, generate_cpu_s=g_cpu, generate_wall_s=g_wall,
+                                 frames_generated=frames, peak_rss_mb=max(peak_rss_mb(), rss,
+                                                                          gen.outside_cost()["rss_mb"])))
+        log.info("%s on %s: build %.3f s CPU, %d windows x %d seeds: %d frames in %.3f s CPU", generator, key,
+                 cost["build_cpu_s"], len(cs), int(cfg["seeds"]), frames, g_cpu)
     metrics = pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"])
     return metrics, pd.DataFrame(trows, columns=TIMING_COLUMNS), shown
 

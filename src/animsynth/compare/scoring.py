@@ -1,7 +1,8 @@
 """Scoring: every metric of one generated motion against the held-out clip it continues.
 
 The comparison scores each generator's motion with :func:`score` (its clip's database side computed once,
-:func:`reference`; L2P normalised by the whole run's database, :func:`run_stats`). ``animsynth score`` scores motions
+:func:`reference`; L2P normalised by the clip's own database, so a clip's scores do not depend on what else the
+run holds). ``animsynth score`` scores motions
 made anywhere (a BVH file from any tool) the same way (:func:`score_motions`): a generated motion is scored against
 the held-out capture it should continue, as a generator's motion is scored in the comparison: its first ``context``
 frames are the start (the frames the generator was given, as in the protocol: the same frames as the
@@ -19,8 +20,8 @@ What a scored file cannot give is left empty, by what each metric needs (:attr:`
 seeds. The metrics that read the database (:data:`DATABASE_METRICS`: L2P's normalisation, coverage, novelty) and
 foot skating (:data:`SKATING_METRICS`: the floor from the database's feet) are left empty without one; foot skating
 is scored without a database when the floor height is given (``compare.metrics.floor_m``). With the database and
-the settings of a compare run, a motion of that run's BVH folder scores as in its ``metrics.csv`` (L2P: when the
-run's database is this clip's, as in a run of one clip; the comparison normalises L2P by the whole run's database).
+the settings of a compare run, a motion of that run's BVH folder scores as in its ``metrics.csv`` (given the clip's
+whole database: the comparison normalises L2P by the clip's own database).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from .protocol import Clip
 
 log = logging.getLogger("animsynth.compare.scoring")
 
-__all__ = ["Reference", "DatabaseKinematics", "run_stats", "run_stats_by_skeleton", "joint_count", "reference",
+__all__ = ["Reference", "DatabaseKinematics", "run_stats", "reference",
            "score", "run_values", "SKATING_METRICS", "DATABASE_METRICS", "UNSCORED", "score_motions", "on_skeleton"]
 
 #: foot skating: needs the floor (the database's foot heights, or compare.metrics.floor_m)
@@ -61,7 +62,7 @@ class Reference:
     foot_idx : int array, the foot joints
     floor : float, the floor height (m)
     jumps : metrics.JumpReference, the database's own frame-to-frame jumps
-    std : ndarray (J, 3), LAFAN1 position statistics of the whole run's database windows (:func:`run_stats`)
+    std : ndarray (J, 3), LAFAN1 position statistics of the clip's database windows (the comparison's; or given)
     capture_max : (float, float), the held-out capture's largest velocity and acceleration jump
     features : list of ndarray, the database clips' pose features
     truth_pos, truth_q : the ground truth's positions (m) and global quaternions
@@ -123,8 +124,8 @@ class DatabaseKinematics:
 
 def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None,
               kin: DatabaseKinematics | None = None) -> np.ndarray:
-    """LAFAN1's position statistics (std, (J, 3)) over the whole run's database: every distinct database clip
-    of every held-out clip (by name), as LAFAN1 normalises by its whole training set. Windows of
+    """LAFAN1's position statistics (std, (J, 3)) over the databases of ``clips``: every distinct database clip
+    (by name), as LAFAN1 normalises by its whole training set (the comparison passes one clip: its own database). Windows of
     ``context + length`` frames (the longest of the run's clips; shorter if a database clip is shorter),
     every ``compare.metrics.l2p_stride`` frames, aligned at the last context frame (``kin``: the job's
     :class:`DatabaseKinematics`, made here if not given)."""
@@ -145,27 +146,6 @@ def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None,
     context = min(min(c.context for c in clips), window)
     pos, fwd = zip(*(kin(d) for d in db))
     return M.position_stats(pos, fwd, window, int(mcfg["l2p_stride"]), context)[1]
-
-
-def joint_count(clip: Clip) -> int:
-    """The joints of the clip's skeleton: the key of :func:`run_stats_by_skeleton`."""
-    return len(clip.held_out.skeleton.joints)
-
-
-def run_stats_by_skeleton(clips: list[Clip], mcfg: dict, roles: dict | None = None,
-                          kin: DatabaseKinematics | None = None) -> dict:
-    """:func:`run_stats` per skeleton: {joint count: std (J, 3)}. A run of one skeleton (CMU, the demo) has one
-    entry, the whole run's database; a run mixing skeletons (a user's BVH files of several sources) normalises
-    each clip's L2P by the database clips of its own skeleton, logged (positions of different joint sets have no
-    common statistics)."""
-    groups: dict[int, list[Clip]] = {}
-    for c in clips:
-        groups.setdefault(joint_count(c), []).append(c)
-    if len(groups) > 1:
-        log.warning("the run mixes skeletons of %s joints: each clip's L2P is normalised by the database clips of "
-                    "its own skeleton", sorted(groups))
-    kin = kin or DatabaseKinematics(roles)
-    return {n: run_stats(cs, mcfg, roles, kin) for n, cs in groups.items()}
 
 
 def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray | None = None,
@@ -200,7 +180,7 @@ def reference(clip: Clip, mcfg: dict, roles: dict | None = None, std: np.ndarray
 
 
 def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict, roles: dict | None = None,
-          track: str = "short", needs=None) -> tuple[dict, np.ndarray]:
+          track: str = "short", needs=None, entry_seam: bool = True) -> tuple[dict, np.ndarray]:
     """Every metric of ``track`` that one generated motion gives; returns the row and its pose features.
 
     Parameters
@@ -208,7 +188,7 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     clip : Clip, the held-out clip the motion continues
     ref : Reference, the clip's database side (:func:`reference`)
     motion : Motion, the generated frames (without the start)
-    generator : str, its name (the entry, generated frame 0, is a seam for every generator but ``replay``)
+    generator : str, its name
     mcfg : the ``compare.metrics`` block
     roles : joint-role overrides
     track : ``"short"`` (the columns of ``metrics.csv``) or ``"long"``: the records computed on it
@@ -216,6 +196,8 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     needs : the needs available (keys of :data:`~animsynth.compare.measures.metric_table.NEEDS`; ``None``: every
         need of one motion, :data:`~animsynth.compare.measures.metric_table.MOTION_NEEDS`): a record whose need is
         not among them is NaN, its computation not called
+    entry_seam : whether the entry (generated frame 0) is a seam: the generator's declared
+        :attr:`animsynth.generator.Generator.entry_seam` (every generator but the replay of the capture)
 
     Returns
     -------
@@ -230,7 +212,7 @@ def score(clip: Clip, ref: Reference, motion: Motion, generator: str, mcfg: dict
     """
     from .measures.scored import ScoredMotion
 
-    s = ScoredMotion(clip, ref, motion, generator, mcfg, roles)
+    s = ScoredMotion(clip, ref, motion, generator, mcfg, roles, entry_seam)
     have = MOTION_NEEDS if needs is None else tuple(needs)
     row: dict = {}
     for need in MOTION_NEEDS:

@@ -12,7 +12,8 @@ from ..config import ConfigError
 
 log = logging.getLogger("animsynth.compare")
 
-__all__ = ["check", "groups", "clip_ids", "subject_sets", "showcase", "run_generators", "clips_cfg", "native_rates",
+__all__ = ["check", "groups", "held_out_trials", "trial_subjects", "first_frames", "subject_groups", "subject_showcase",
+           "subject_sets", "showcase", "run_generators", "clips_cfg", "native_rates",
            "job_cfg", "unavailable", "user_generators", "generator_order", "user_job_cfg", "left_out", "trial_rate",
            "check_subject_sets", "check_trial_rates", "common_rates", "CLIP_KEYS", "RUN_KEYS", "GENERATOR_BLOCKS"]
 
@@ -60,17 +61,58 @@ def groups(config: dict, missing=()) -> tuple[dict, dict]:
             {g: t for g, t in split.items() if t not in gone})
 
 
-def clip_ids(config: dict, missing=()) -> list[str]:
-    """Every held-out clip of the protocol: ``<group>/<trial>`` of the leave-one-out groups, then of the
-    temporal splits (:func:`groups`; ``missing``: trial ids left out of this run)."""
+def held_out_trials(config: dict, missing=()) -> list[str]:
+    """Every held-out part's trial of the protocol: ``<group>/<trial>`` of the leave-one-out groups, then of the
+    temporal splits (:func:`groups`; ``missing``: trial ids left out of this run). A clip's id adds the window's
+    first frame, ``<group>/<trial>@<frame>``, known once the trials are read (the clips job)."""
     subsets, reseq = groups(config, missing)
     return [f"{s}/{t}" for s, ids in subsets.items() for t in ids] + [f"{d}/{t}" for d, t in reseq.items()]
 
 
-def showcase(config: dict) -> tuple[str, int]:
-    """The clip and seed index of the strips figure and the BVH files (default: the first clip, seed 0)."""
+def trial_subjects(config: dict) -> dict:
+    """``{trial id: subject}`` from the trial records (their ``subject``)."""
+    return {str(t["id"]): str(t["subject"]) for t in config["trials"]}
+
+
+def subject_groups(config: dict, missing=()) -> dict:
+    """``{subject: (leave-one-out groups, temporal splits)}``: :func:`groups` split by subject, the comparison's unit
+    of work (one clips job and one job per generator per subject). A group's subject is its trials' ``subject``
+    (:func:`animsynth.compare.protocol.group_subject`: joined by ``+`` when they differ); subjects in the order of
+    their first group."""
+    from .protocol import group_subject
+
+    subsets, reseq = groups(config, missing)
+    subj = trial_subjects(config)
+    out: dict = {}
+    for g, ids in subsets.items():
+        out.setdefault(group_subject(ids, subj, g), ({}, {}))[0][g] = ids
+    for g, t in reseq.items():
+        out.setdefault(group_subject([t], subj, g), ({}, {}))[1][g] = t
+    return out
+
+
+def showcase(config: dict, missing=()) -> tuple[str | None, int, str]:
+    """The strips figure's and the BVH files' clip, seed index and subject: ``compare.showcase.clip`` (a held-out
+    trial ``<group>/<trial>``: its first clip; or a clip ``<group>/<trial>@<frame>``) or, when null, the first
+    clip of the first subject (``None``)."""
     sc = config["compare"]["showcase"]
-    return (sc["clip"] or clip_ids(config)[0], int(sc["seed"]))
+    spec = sc["clip"]
+    by_subject = subject_groups(config, missing)
+    subject = next(iter(by_subject), "")
+    if spec is not None:
+        trial = spec.split("@", 1)[0]
+        for s, (loo, split) in by_subject.items():
+            if trial in [f"{g}/{t}" for g, ids in loo.items() for t in ids] + [f"{g}/{t}" for g, t in split.items()]:
+                subject = s
+    return spec, int(sc["seed"]), subject
+
+
+def subject_showcase(config: dict, subject: str, missing=()) -> list:
+    """What one subject's generator jobs show (:func:`animsynth.compare.runner.showcase_clip`): ``[clip spec, seed,
+    required]``: the run's showcase clip where it is this subject's (required: a generator that cannot be built on it
+    stops the run), else the subject's first clip (not required: its start alone then)."""
+    spec, seed, owner = showcase(config, missing)
+    return [spec if owner == subject else None, seed, owner == subject]
 
 
 def unavailable(name: str) -> str:
@@ -126,8 +168,10 @@ def user_job_cfg(config: dict, name: str) -> dict:
             "user_timeout_s": cmp.get("user_timeout_s"), "user_process": cmp.get("user_process", True)}
 
 
-#: the ``compare`` keys the clips job reads (the protocol: rate, start, lengths, temporal split)
-CLIP_KEYS = ("fps", "context", "length", "min_length", "holdout_fraction")
+#: the ``compare`` keys the clips job reads (the protocol: rate, start, lengths, temporal split, clips per subject,
+#: database size)
+CLIP_KEYS = ("fps", "context", "length", "min_length", "split_blocks", "max_clips_per_subject",
+             "min_clips_per_subject", "max_database_s")
 #: the ``compare`` keys every generator job reads
 RUN_KEYS = ("seed", "seeds", "fps", "metrics", "transitions_per_s", "cost_guard")
 #: each generator's own ``compare`` block (a changed block reruns only the jobs of the generators that read it)
@@ -151,9 +195,16 @@ def native_rates(config: dict) -> list[float]:
 
 
 def clips_cfg(config: dict) -> dict:
-    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block) and, as ``native_fps``, the
-    native rates its clips also carry (:func:`native_rates`)."""
-    return {**{k: config["compare"][k] for k in CLIP_KEYS}, "native_fps": native_rates(config)}
+    """The config the clips job reads (:data:`CLIP_KEYS` of the ``compare`` block), as ``native_fps`` the native
+    rates its clips also carry (:func:`native_rates`), and the ``capture_check`` block (every trial is checked
+    before clips are cut: :func:`animsynth.capture_check.check_capture`)."""
+    return {**{k: config["compare"][k] for k in CLIP_KEYS}, "native_fps": native_rates(config),
+            "capture_check": dict(config["capture_check"])}
+
+
+def first_frames(config: dict) -> dict:
+    """``{trial id: first_frame}`` of the trial records (the frames a file has before the parsed motion)."""
+    return {str(t["id"]): int(t.get("first_frame", 0) or 0) for t in config["trials"]}
 
 
 def job_cfg(config: dict, generator: str | None = None, budget: float | None = None) -> dict:
@@ -232,6 +283,10 @@ def check(config: dict) -> None:
         if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
             raise ConfigError(f"config key 'compare.fps': {cmp['fps']} must be the trials' rate (fps: "
                               f"{config['fps']}) divided by a whole number")
+    cap = cmp.get("max_clips_per_subject")
+    if cap is not None and cmp["min_clips_per_subject"] > cap:
+        raise ConfigError(f"config key 'compare.min_clips_per_subject': {cmp['min_clips_per_subject']} exceeds "
+                          f"compare.max_clips_per_subject ({cap}): no subject could enter the declared tests")
     if cmp["min_length"] > cmp["length"]:
         raise ConfigError(f"config key 'compare.min_length': {cmp['min_length']} exceeds compare.length "
                           f"({cmp['length']})")
@@ -267,9 +322,9 @@ def check(config: dict) -> None:
                           f"compare.context + compare.min_length ({cmp['context']} + {cmp['min_length']}): a short "
                           "clip's start and continuation would hold no patch")
     sc = cmp["showcase"]
-    if sc["clip"] is not None and sc["clip"] not in clip_ids(config):
-        raise ConfigError(f"config key 'compare.showcase.clip': {sc['clip']!r} is not a clip of this run "
-                          f"({clip_ids(config)})")
+    if sc["clip"] is not None and sc["clip"].split("@", 1)[0] not in held_out_trials(config):
+        raise ConfigError(f"config key 'compare.showcase.clip': {sc['clip']!r} is not a held-out trial of this run "
+                          f"(one of {held_out_trials(config)}, optionally with @<frame> of one of its clips)")
     if sc["seed"] >= cmp["seeds"]:
         raise ConfigError(f"config key 'compare.showcase.seed': seed index {sc['seed']} but compare.seeds is "
                           f"{cmp['seeds']}")

@@ -38,17 +38,17 @@ def read_metrics(paths) -> pd.DataFrame:
 
 def sweep_runs(default: pd.DataFrame, paths, default_budget: float, budgets, generators) -> dict:
     """``{budget: metrics of the graph generators}``: the default run's rows of ``generators`` at
-    ``default_budget`` and one metrics file per further budget and generator (``paths``, in the order of
-    ``budgets`` x ``generators``)."""
+    ``default_budget`` and the metrics files of every further budget (``paths``, budget by budget: each budget's
+    files for every generator and subject, the same number per budget)."""
     runs = {float(default_budget): default[default["generator"].isin(generators)]}
-    paths = list(paths)
-    if len(paths) != len(list(budgets)) * len(list(generators)):
-        raise ValueError(f"budget sweep: {len(paths)} metrics files for {len(list(budgets))} budgets x "
-                         f"{len(list(generators))} generators")
-    k = 0
-    for b in budgets:
-        runs[float(b)] = read_metrics(paths[k:k + len(generators)])
-        k += len(generators)
+    paths, budgets = list(paths), list(budgets)
+    per = len(paths) // len(budgets) if budgets else 0
+    if not budgets or per * len(budgets) != len(paths) or per % max(1, len(list(generators))):
+        if budgets or paths:
+            raise ValueError(f"budget sweep: {len(paths)} metrics files for {len(budgets)} budgets x "
+                             f"{len(list(generators))} generators")
+    for i, b in enumerate(budgets):
+        runs[float(b)] = read_metrics(paths[i * per:(i + 1) * per])
     return runs
 
 
@@ -155,7 +155,8 @@ def winners_table(metrics: pd.DataFrame, summary: pd.DataFrame, order) -> pd.Dat
 
 
 def cost_table(timing: pd.DataFrame, order) -> pd.DataFrame:
-    """Per generator: builds (clips it was built on), median and total build CPU and wall seconds, generation
+    """Per generator: builds (databases it was built on, each serving its clips), median and total build CPU and
+    wall seconds, generation
     frames per CPU and wall second, the generator job's peak resident memory (MB: the whole job, Python and
     scoring included; a child process, such as a pool a user generator starts, by its largest). Machine-dependent
     (a timing table)."""
@@ -287,7 +288,8 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
         out += ["## Sanity checks", "", "Claims true by construction, decided the same way; not findings.", "",
                 to_markdown(sanity[["claim", "ours", "verdict", "evidence"]]), ""]
     out += [
-            "## Clips", "", to_markdown(clips), "",
+            "## Clips", "", to_markdown(clips[[c for c in ("clip", "subject", "group", "protocol", "held_out", "database",
+                                                          "length", "note") if c in clips]]), "",
             "Per clip x seed values: `metrics.csv`; medians and spreads: `summary.csv`; build time, generation "
             "speed and memory: `cost_timing.csv` (machine-dependent, not shown here).", ""]
     return "\n".join(out)

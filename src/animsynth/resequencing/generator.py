@@ -154,8 +154,9 @@ class Resequencer(Generator):
                              "not both")
         return st_parameters(self.stisomap, fps) if self.stisomap else dict(self.st or {})
 
-    def fit(self, database) -> "Resequencer":
-        """Build the neighbourhood graph of the database's frames (list of Motion)."""
+    def fit(self, database, native_clips=None) -> "Resequencer":
+        """Build the neighbourhood graph of the database's frames (list of Motion; ``native_clips``: ignored, it runs
+        at the working rate)."""
         from scipy.spatial import cKDTree
 
         from .features import motion_features
@@ -236,9 +237,10 @@ class Resequencer(Generator):
         path, cost = shortest_path_frames(self.graph_, start, end)
         return (path, cost) if return_cost else path
 
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, native_start: Motion | None = None) -> Motion:
         """Paths from the database frame nearest the start's last frame to seeded random targets, chained until
-        ``length`` frames, played with the root integrated (:meth:`animsynth.generator.Database.play`)."""
+        ``length`` frames, played with the root integrated (:meth:`animsynth.generator.Database.play`;
+        ``native_start``: ignored, it runs at the working rate)."""
         from .features import motion_features
 
         self._check_start(start, length)

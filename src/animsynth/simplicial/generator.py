@@ -161,8 +161,9 @@ class FieldFollower(Generator):
         return follow_field(self.field_, x0, steps)
 
     # ------------------------------------------------------------------ the generator interface
-    def fit(self, database) -> "FieldFollower":
-        """Fit on a database of motions (list of Motion): the joint angles of every clip, root removed, each clip
+    def fit(self, database, native_clips=None) -> "FieldFollower":
+        """Fit on a database of motions (list of Motion; ``native_clips``: ignored, it runs at the working rate,
+        :class:`animsynth.generator.Generator`): the joint angles of every clip, root removed, each clip
         on the angle branch of the first clip's (:func:`animsynth.retarget.align_angle_branches`; the
         comparison's clips already are, and stay as they are). The clips are expected continuous along time
         (:func:`animsynth.retarget.unwrap_angles`, which :func:`animsynth.data.load_trial` and the
@@ -180,7 +181,7 @@ class FieldFollower(Generator):
         self.steps_per_frame_ = 2 if self.derivative == "half" else 1
         return self
 
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, native_start: Motion | None = None) -> Motion:
         """Follow the field from the start's last pose and decode the path to poses.
 
         Parameters
@@ -190,6 +191,7 @@ class FieldFollower(Generator):
             ``jitter``
         length : int, output frames; the path takes ``length * steps_per_frame_`` Euler steps
         seed : int, the jitter's random direction
+        native_start : ignored (it runs at the working rate)
 
         Returns
         -------

@@ -47,8 +47,8 @@ fairmotion's walk assumes 60 fps (its output motion is built at its default 60 f
 The peer is therefore fed its native rate, ``native_fps`` = 60 (default; a whole multiple ``k`` of the working
 rate). In the comparison the clips carry the database and the start at that rate taken by frame step from the
 source trials (CMU's 120 fps: every second frame; :class:`animsynth.compare.protocol.NativeRate`), and the runner
-passes them (``fit(database, native_clips=...)``, ``generate(..., native_start=...)``; the class attribute
-``input_rate = "native"`` says the peer takes them): fairmotion builds its graph and walks on the captured 60 fps
+passes them (``fit(database, native_clips=...)``, ``generate(..., native_start=...)``; its ``native_fps``, the
+interface's declared native rate, says at which rate it reads them): fairmotion builds its graph and walks on the captured 60 fps
 frames, and the start node is chosen by the 60 fps start. Without them (a source rate that is not a whole multiple
 of 60, or a caller that has only the working-rate clips) every database clip is upsampled from the working rate by
 ``k`` before it is written to BVH (:func:`.fairmotion_load.upsample`: joint rotations slerped, the root translation interpolated
@@ -145,8 +145,9 @@ def _fairmotion():
 class FairmotionGraph(Generator):
     """fairmotion 0.0.4's motion graph behind the compare generator interface (see the module docstring).
 
-    ``input_rate = "native"``: :meth:`fit` and :meth:`generate` also take the database and the start at
-    ``native_fps`` (``native_clips``, ``native_start``), which the compare runner passes when the clips carry them.
+    ``native_fps`` (the interface's declared native rate, :class:`animsynth.generator.Generator`): :meth:`fit` and
+    :meth:`generate` read the database and the start at that rate (``native_clips``, ``native_start``), which the
+    compare runner passes when the clips carry them (``None``: the working-rate clips upsampled).
 
     Lengths are in frames at the database's rate (converted to fairmotion's seconds). Defaults: nodes of
     ``base`` = 15 frames (0.5 s at 30 fps; fairmotion's own 1.5 s leaves a few nodes on clips of seconds),
@@ -213,7 +214,6 @@ class FairmotionGraph(Generator):
     """
 
     name = "fairmotion"
-    input_rate = "native"
 
     def __init__(self, base: int = 15, stride: int | None = None, blend: int = 10, compare: int = 10,
                  threshold: float | None = None, threshold_quantile: float = 0.5, w_joint_pos: float = 8.0,

@@ -22,12 +22,18 @@ Synthesis (the paper's, with the reference's defaults):
   (5 patches, the reference's ``5x_patchsize``), each finer level by 1 / ``pyramid_factor`` (0.75) more,
   the last at full rate; clips and motion are resampled linearly; a clip shorter than a patch at a level
   gives no patch there;
-* at least ``min_levels`` (7) levels where the database allows (:func:`level_scales`): when that rule gives
-  fewer (a longest clip under 232 frames at the defaults, as :func:`level_scales` counts; under 55 frames the
-  rule alone gives the full rate only, as the reference's own ``_get_pyramid_lengths`` does), the coarsest
-  scale is lowered to ``pyramid_factor ** (min_levels - 1)``,
-  but never below ``min_coarse_patches * patch_size / longest clip`` (3 patches, 33 frames: every level
-  at least three patches long); the finer levels follow by the same factor. Why 3 and not 1: with the
+* at least ``min_levels`` (7) levels, the coarsest at least ``min_coarse_patches`` (3) patches of the longest
+  clip, on every database whose longest clip is longer than those 3 patches (:func:`level_scales`): when the rule
+  gives fewer levels (a longest clip under 232 frames at the defaults, as :func:`level_scales` counts; under 55
+  frames the rule alone gives the full rate only, as the reference's own ``_get_pyramid_lengths`` does), the
+  coarsest scale is lowered to ``pyramid_factor ** (min_levels - 1)``, and the finer levels follow by the same
+  factor; where that would go below the floor (a longest clip under 185 frames), the coarsest level is the floor
+  (33 frames) and the 7 levels between it and the full rate are spaced by a larger factor (0.83 on a 100-frame
+  clip, 0.96 on a 42-frame one). A longest clip of at most 33 frames keeps one level, the full rate
+  (:func:`pyramid_note`; the comparison's clips table says so). The floor binding is why, before this rule
+  spaced the levels, the paper run's clips of short databases (r1, r2, subject 09, the run) had 1 to 3 levels
+  despite ``min_levels``: a fixed factor of 0.75 from a 33-frame floor reaches the full rate in fewer steps.
+  Why 3 and not 1: with the
   coarsest level one patch long, the synthesised motion's coarsest level is one patch choosing among one
   patch per clip, and the seed no longer matters (measured on three 60-frame synthetic walks, 40 frames from
   an 8-frame start, 12 seeds: 1 distinct motion at a 1-patch floor; 10 (local root) and 8 (world) at 2; 12 and
@@ -62,7 +68,8 @@ from ...motion import Motion
 from ...generator import Database, Generator
 from .poses import decode, encode, rotating_joints
 
-__all__ = ["GenMM", "make_genmm", "extract_patches", "match_patches", "vote", "resample_rows", "level_scales"]
+__all__ = ["GenMM", "make_genmm", "extract_patches", "match_patches", "vote", "resample_rows", "level_scales",
+           "pyramid_note"]
 
 
 def extract_patches(x: np.ndarray, size: int) -> np.ndarray:
@@ -146,10 +153,13 @@ def level_scales(longest: int, patch_size: int, coarse_patches: float, factor: f
         ``pyramid_factor``: the scale of a level over the next finer one's, in (0, 1).
     min_levels : int
         When the rule above gives fewer levels, the coarsest scale is lowered to ``factor ** (min_levels - 1)``
-        (``min_levels`` levels), but not below ``min_coarse_patches * patch_size / longest`` (then fewer levels).
+        (``min_levels`` levels); where that would go below the floor (``min_coarse_patches``), the coarsest level
+        is the floor and the levels between it and the full rate are spaced by the larger factor
+        ``floor ** (1 / (min_levels - 1))``, so that ``min_levels`` levels remain.
     min_coarse_patches : float
-        The floor of that lowering: the longest clip's length at the coarsest level, in patches (at least 1, so
-        the longest clip keeps a patch at every level).
+        The floor: the longest clip's length at the coarsest level, in patches (at least 1, so the longest clip
+        keeps a patch at every level). A longest clip not longer than the floor holds no pyramid above it: one
+        level, the full rate (:func:`pyramid_note` says so).
 
     Returns
     -------
@@ -161,13 +171,27 @@ def level_scales(longest: int, patch_size: int, coarse_patches: float, factor: f
         n += 1  # the rule's level count
     if n < int(min_levels):
         floor = max(1.0, float(min_coarse_patches)) * patch_size / float(longest)
-        s = min(1.0, max(float(factor) ** (int(min_levels) - 1), floor))
+        if floor >= 1.0 - 1e-9:
+            return [1.0]
+        s = float(factor) ** (int(min_levels) - 1)
+        if s < floor:  # the floor binds: min_levels levels from the floor to the full rate, closer together
+            return [float(floor ** (1.0 - i / (int(min_levels) - 1))) for i in range(int(min_levels) - 1)] + [1.0]
     out = []
     while s < 1.0 - 1e-9:
         out.append(s)
         s /= float(factor)
     out.append(1.0)
     return out
+
+
+def pyramid_note(longest: int, patch_size: int, min_coarse_patches: float, min_levels: int = 2) -> str:
+    """Why a database gets no pyramid of ``min_levels`` GenMM levels ('' when it does): its longest clip is not
+    longer than the floor of ``min_coarse_patches`` patches, so :func:`level_scales` gives the full rate alone."""
+    floor = max(1.0, float(min_coarse_patches)) * int(patch_size)
+    if int(min_levels) <= 1 or int(longest) > floor + 1e-9:
+        return ""
+    return (f"GenMM: the longest database clip has {int(longest)} frames, not above the pyramid floor of {floor:g} "
+            f"(compare.genmm.min_coarse_patches x patch_size): one level")
 
 
 class GenMM(Generator):
@@ -252,7 +276,8 @@ class GenMM(Generator):
 
     # -- estimator ------------------------------------------------------------------------------------
 
-    def fit(self, database) -> "GenMM":
+    def fit(self, database, native_clips=None) -> "GenMM":
+        """The database's patches at every pyramid level (``native_clips``: ignored, it runs at the working rate)."""
         if self.root not in ("local", "world"):
             raise ValueError(f"genmm: root must be 'local' or 'world', got {self.root!r}")
         P = int(self.patch_size)
@@ -285,7 +310,8 @@ class GenMM(Generator):
             self.key_norms_.append(np.einsum("ij,ij->i", self.keys_[-1], self.keys_[-1]))
         return self
 
-    def generate(self, start: Motion, length: int, seed: int, initial: Motion | None = None) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, initial: Motion | None = None,
+                 native_start: Motion | None = None) -> Motion:
         """``length`` frames after ``start`` (``seed`` draws the initial noise).
 
         Parameters
@@ -295,6 +321,7 @@ class GenMM(Generator):
         seed : int
         initial : Motion, optional, ``start frames + length`` frames: the initial guess instead of the
             coarsest database (the noise is added to it)
+        native_start : ignored (it runs at the working rate)
 
         ``meta``: ``seams`` empty and ``source_frames`` -1 (every frame is a mean of patches),
         ``match_distance`` (mean distance of the last step's matches), ``levels`` (frames per level).

@@ -195,8 +195,9 @@ class MotionGraph(Generator):
             raise ValueError(f"threshold_quantile must be in (0, 1], got {self.threshold_quantile!r}")
         return int(k), int(b), int(r)
 
-    def fit(self, database) -> "MotionGraph":
-        """Build the graph on ``database`` (list of Motion: one DOF layout, one frame rate).
+    def fit(self, database, native_clips=None) -> "MotionGraph":
+        """Build the graph on ``database`` (list of Motion: one DOF layout, one frame rate; ``native_clips``: ignored,
+        it runs at the working rate).
 
         Every clip needs at least ``window + 2`` frames. Clips on skeletons with other bone lengths are
         compared through their own forward kinematics; the output is on the first clip's skeleton: frames of
@@ -438,11 +439,11 @@ class MotionGraph(Generator):
                 g = int(self._land_[t])
         return steps, n_out
 
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, native_start: Motion | None = None) -> Motion:
         """A seeded random walk of ``length`` frames from the node nearest the end of ``start``.
 
         At every node the walk picks uniformly among its out-edges (play on, or one of the transitions that
-        leave there).
+        leave there). ``native_start``: ignored (it runs at the working rate).
 
         Returns
         -------

@@ -246,7 +246,8 @@ class MotionMatching(Generator):
                 d[s] = d[s + 1]
         return d
 
-    def fit(self, database) -> "MotionMatching":
+    def fit(self, database, native_clips=None) -> "MotionMatching":
+        """Build the feature database (``native_clips``: ignored, it runs at the working rate)."""
         self.db_ = db = Database(database)
         sk, fps = db.skeleton, db.fps
         if len(tuple(self.weights)) != 5:
@@ -338,7 +339,8 @@ class MotionMatching(Generator):
 
     # -- generation -----------------------------------------------------------------------------------
 
-    def generate(self, start: Motion, length: int, seed: int, trajectory: Motion | None = None) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, trajectory: Motion | None = None,
+                 native_start: Motion | None = None) -> Motion:
         """``length`` frames after ``start``; ``seed`` is not used (deterministic).
 
         Parameters
@@ -348,6 +350,7 @@ class MotionMatching(Generator):
         seed : int, ignored (kept for the common interface)
         trajectory : Motion, optional; the true future (frame 0 follows the start's last) whose root
             positions and facings replace the gamepad query (clamped to its last frame)
+        native_start : ignored (it runs at the working rate)
 
         ``meta``: ``seams``, ``source_frames`` (the database frame each output frame plays, before the
         offsets), ``costs`` (cost of the frame chosen at each search), ``search_frames`` (output frames
@@ -536,7 +539,8 @@ class MotionMatchingTrajectory(MotionMatching):
     name = "motion_matching_traj"
     query = "future_trajectory"
 
-    def generate(self, start: Motion, length: int, seed: int, trajectory: Motion | None = None) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, trajectory: Motion | None = None,
+                 native_start: Motion | None = None) -> Motion:
         if trajectory is None:
             raise ValueError(f"{self.name}: its query is the future trajectory: pass trajectory= (the held-out "
                              "frames after the start)")

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...generator import Database, Generator
+from ...generator import QUERY_FUTURE_TRAJECTORY, Database, Generator
 from ...kinematics import root_rotation, root_translation, set_root
 from ...motion import Motion
 
@@ -16,30 +16,37 @@ __all__ = ["Concat", "Replay"]
 class Replay(Generator):
     """The held-out capture itself: the frames that follow the start (the same for every seed).
 
-    Parameters
-    ----------
-    held_out : Motion, the held-out clip whose first frames are the start
+    Its query is the held-out future (``query = "future_trajectory"``: the caller passes the held-out frames after
+    the start as ``trajectory``) and it plays their first ``length``; the step into them is the capture's own, so
+    the entry is no seam (``entry_seam = False``). Fitted once per database like every generator, it serves every
+    held-out window of that database.
     """
 
-    def __init__(self, held_out: Motion | None = None):
-        self.held_out = held_out
-        self.name = "replay"
+    name = "replay"
+    query = QUERY_FUTURE_TRAJECTORY
+    entry_seam = False
 
-    def fit(self, database) -> "Replay":
-        if self.held_out is None:
-            raise ValueError("replay needs the held-out clip (Replay(held_out=...))")
+    def __init__(self):
+        """No parameters: what it plays is the held-out future it is given."""
+
+    def fit(self, database, native_clips=None) -> "Replay":
+        """Keep the database (``native_clips``: ignored): the replay reads only the held-out frames it is given."""
         self.db_ = Database(database)
         return self
 
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, trajectory: Motion | None = None,
+                 native_start: Motion | None = None) -> Motion:
+        """The first ``length`` frames of ``trajectory`` (the held-out frames after ``start``)."""
         self._check_start(start, length)
-        h = np.asarray(self.held_out.values, float)
-        c, length = start.n_frames, int(length)
-        if not np.array_equal(h[:c], np.asarray(start.values, float)):
-            raise ValueError("replay: the start is not the held-out clip's first frames")
-        if c + length > h.shape[0]:
-            raise ValueError(f"replay: the held-out clip has {h.shape[0]} frames, {c} + {length} asked for")
-        return self._motion(h[c:c + length], length, [], np.full((length, 2), -1))
+        length = int(length)
+        if trajectory is None:
+            raise ValueError("replay: its query is the held-out future: pass trajectory= (the held-out frames "
+                             "after the start)")
+        if trajectory.columns != start.columns:
+            raise ValueError("replay: the held-out frames are on other DOF columns than the start")
+        if trajectory.n_frames < length:
+            raise ValueError(f"replay: {trajectory.n_frames} held-out frames after the start, {length} asked for")
+        return self._motion(np.asarray(trajectory.values[:length], float), length, [], np.full((length, 2), -1))
 
 
 class Concat(Generator):
@@ -60,14 +67,14 @@ class Concat(Generator):
         self.max_segment_s = max_segment_s
         self.name = "concat"
 
-    def fit(self, database) -> "Concat":
+    def fit(self, database, native_clips=None) -> "Concat":
         if not 0 < float(self.min_segment_s) <= float(self.max_segment_s):
             raise ValueError(f"concat segments: need 0 < min_segment_s <= max_segment_s, got "
                              f"{self.min_segment_s}, {self.max_segment_s}")
         self.db_ = Database(database)
         return self
 
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, native_start: Motion | None = None) -> Motion:
         self._check_start(start, length)
         db, length = self.db_, int(length)
         sk = db.skeleton

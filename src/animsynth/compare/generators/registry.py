@@ -14,8 +14,8 @@ is the frame after the start's last one. ``meta["seams"]`` holds the frame indic
 frame ``t`` does not follow frame ``t - 1`` in the source (a transition or a blend start; empty
 for a generator without seams), ``meta["source_frames"]`` the ``(clip, frame)`` of the database frame
 each output frame plays (``-1`` where the frame is synthesised). The entry from the start into the
-generated frames is scored as a seam by the family for every generator but ``replay``
-(:func:`animsynth.compare.scoring.score`), whatever a generator records.
+generated frames is scored as a seam for every generator that declares ``entry_seam`` (all but ``replay``:
+:class:`animsynth.generator.Generator`), whatever a generator records.
 
 Generators (``GENERATORS``):
 
@@ -56,12 +56,13 @@ The graph generators (motion_graph, fairmotion, fairmotion_fixed) keep the same 
     is a different protocol (following a known path), not a better generator.
 
 Every generator's ``query`` (:class:`animsynth.generator.Generator`) says what it is given: ``"start"`` (the
-start alone; all but ``motion_matching_traj``) or ``"future_trajectory"``.
+start alone; all but ``motion_matching_traj`` and the bound ``replay``) or ``"future_trajectory"``.
 ``genmm``
     generative motion matching (Li et al. 2023; :mod:`animsynth.compare.generators.genmm`) in keyframe mode from the
     start; seeds differ by the initial noise.
 ``replay``
-    the held-out capture itself (upper bound for realism; the same for every seed; :mod:`.references`).
+    the held-out capture itself (upper bound for realism; the same for every seed; :mod:`.references`): its query
+    is the held-out future, which it plays.
 ``concat``
     random database segments appended (lower bound; :mod:`.references`): root position made continuous, no blending,
     no alignment of heading.
@@ -72,7 +73,6 @@ from __future__ import annotations
 import logging
 
 from ...generator import Generator
-from ...motion import Motion
 from ...resequencing.generator import Resequencer
 from ...simplicial.generator import FieldFollower
 from .names import FAIRMOTION_ROWS, GENERATORS
@@ -85,7 +85,7 @@ __all__ = ["make_generator"]
 # ----------------------------------------------------------------------------- the factory
 
 
-def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Generator:
+def make_generator(name: str, cfg: dict) -> Generator:
     """An unfitted generator from the ``compare`` config block (``cfg``).
 
     Parameters
@@ -95,7 +95,6 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
         false, with the time limit ``cfg["user_timeout_s"]`` per call and the folders ``cfg["user_guard"]``
         guarded)
     cfg : dict, the ``compare`` block with ``stisomap`` (the re-sequencing study's block) added
-    held_out : Motion, the held-out clip (``replay`` only)
     """
     if name in ("delaunay", "knn"):
         return FieldFollower(method=name, **cfg["field"])
@@ -125,7 +124,7 @@ def make_generator(name: str, cfg: dict, held_out: Motion | None = None) -> Gene
             gm["alpha"] = float("inf")
         return make_genmm(gm, name=name)
     if name == "replay":
-        return Replay(held_out)
+        return Replay()
     if name == "concat":
         return Concat(**cfg["concat"])
     user = cfg.get("user_generators") or {}

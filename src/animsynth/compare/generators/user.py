@@ -419,11 +419,11 @@ class UserGenerator(Generator):
 
     Attributes
     ----------
-    clip : str, the clip being fitted (set by the job; named in the log lines)
+    clip : str, what the job is fitting or generating for (:meth:`set_label`; named in the log lines)
     db_ : Database, the clips the class was fitted on (copies: the class cannot change the family's data)
     model_ : the user's fitted instance (in-process route only)
     child_cpu_s_, child_rss_mb_ : the CPU seconds of the last call in the child process and its peak resident
-        memory (0 in-process: the job's own counters hold them)
+        memory (0 in-process: the job's own counters hold them); read through :meth:`outside_cost`
     """
 
     def __init__(self, name: str, spec: str, timeout_s: float | None = None, process: bool = False, guard=()):
@@ -439,7 +439,17 @@ class UserGenerator(Generator):
     def _head(self) -> str:
         return _head(self.name, self.spec)
 
-    def fit(self, database) -> "UserGenerator":
+    def set_label(self, label: str) -> None:
+        """The clip (or database) the next calls are for, named in the log lines."""
+        self.clip = str(label)
+
+    def outside_cost(self) -> dict:
+        """The last call's CPU seconds in the child process and its peak resident memory (0 in-process)."""
+        return {"cpu_s": float(self.child_cpu_s_), "rss_mb": float(self.child_rss_mb_)}
+
+    def fit(self, database, native_clips=None) -> "UserGenerator":
+        """Fit the user's class on copies of ``database`` (``native_clips``: ignored; a user's class runs at the
+        working rate)."""
         import time
 
         clips = [_copy(c) for c in database]
@@ -458,7 +468,7 @@ class UserGenerator(Generator):
                  time.perf_counter() - t0)
         return self
 
-    def generate(self, start: Motion, length: int, seed: int) -> Motion:
+    def generate(self, start: Motion, length: int, seed: int, native_start: Motion | None = None) -> Motion:
         import time
 
         self._check_start(start, length)

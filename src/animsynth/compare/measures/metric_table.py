@@ -188,7 +188,7 @@ METRICS = (
     Metric("ldlj", "log dimensionless jerk", "higher", "", "LDLJ",
            "smoothness: log dimensionless jerk (higher smoother)", compute="smoothness:score_ldlj"),
     Metric("sparc", "spectral arc length", "higher", "", compute="smoothness:score_sparc"),
-    Metric("l2p", "LAFAN1 L2P (run statistics)", "lower", "database", "L2P", "L2P vs held-out continuation",
+    Metric("l2p", "LAFAN1 L2P (clip database statistics)", "lower", "database", "L2P", "L2P vs held-out continuation",
            exploratory=True, margin=0.25,
            margin_why="a quarter of the database's own per-joint position standard deviation (the unit L2P is "
                       "normalised by): a smaller gap to the capture is not a different continuation",

@@ -30,11 +30,14 @@ class ScoredMotion:
     motion : Motion
         The generated frames (without the start), at the clip's rate.
     generator : str
-        The generator's name (the entry frame is a seam for every generator but ``replay``).
+        The generator's name.
     mcfg : dict
         The ``compare.metrics`` block.
     roles : dict, optional
         Joint-role overrides (config ``joint_roles``).
+    entry_seam : bool
+        Whether the entry (generated frame 0) is a seam: the generator's declared
+        :attr:`animsynth.generator.Generator.entry_seam` (every generator but the replay of the capture).
 
     Attributes
     ----------
@@ -43,8 +46,10 @@ class ScoredMotion:
     n_frames : int, the generated frames
     """
 
-    def __init__(self, clip, ref, motion, generator: str, mcfg: dict, roles: dict | None = None):
+    def __init__(self, clip, ref, motion, generator: str, mcfg: dict, roles: dict | None = None,
+                 entry_seam: bool = True):
         self.clip, self.ref, self.motion, self.generator = clip, ref, motion, generator
+        self.entry_seam = bool(entry_seam)
         self.mcfg, self.roles = mcfg, roles
         self.fps = float(motion.fps)
         self.context = int(clip.context)
@@ -87,10 +92,10 @@ class ScoredMotion:
 
     @cached_property
     def seams(self) -> np.ndarray:
-        """The seams (generated-frame indices) the generator reports; the entry (0) is one for every generator but
-        ``replay``."""
+        """The seams (generated-frame indices) the generator reports, with the entry (0) when it is one
+        (:attr:`entry_seam`)."""
         s = np.asarray(self.motion.meta.get("seams", []), np.int64)
-        return s if self.generator == "replay" else np.union1d(s, [0])
+        return np.union1d(s, [0]) if self.entry_seam else s
 
     @cached_property
     def facing(self) -> np.ndarray:
