@@ -191,9 +191,10 @@ def test_adding_a_subject_as_docs_data_md_walks_through_it(tmp_path):
     assert "--configfile config/cmu.yaml config/samba.yaml config/paper.yaml mine.yaml" in out
     for k in (1, 2, 3):
         assert f"trial=143_0{k}" in out
-    clips_job = out[out.index("rule compare_clips:"):]
-    clips_job = clips_job[:clips_job.index("\n\n")]
-    assert "results/paper/data/trials/143_03.npz" in clips_job
+    jobs = [j[:j.index("\n\n")] for j in out.split("rule compare_clips:")[1:]]
+    clips_job = [j for j in jobs if "cmpsubj=143" in j]
+    assert len(clips_job) == 1, jobs  # the new subject's own clips job, which reads its three trials
+    assert all(f"results/paper/data/trials/143_0{k}.npz" in clips_job[0] for k in (1, 2, 3))
     assert not (wd / "results/paper/report.html").exists()
     # the subject is one more group of the comparison
     cfg = _merged(yaml.safe_load((wd / "mine.yaml").read_text()))
