@@ -193,7 +193,7 @@ def test_without_a_database_no_foot_roles_are_needed(run, tmp_path, capsys):
 
 
 def test_a_file_with_an_extra_end_joint_is_read_joint_by_joint(run, tmp_path, capsys):
-    """docs/compare.md: files are read onto the reference's skeleton joint by joint; a joint the reference
+    """docs/compare/own_generator.md: files are read onto the reference's skeleton joint by joint; a joint the reference
     does not have (here a hat on the head) is left out and the scores are the file's without it."""
     import copy
 

@@ -71,10 +71,10 @@ def test_compare_outputs(tiny_workflow):
 
 
 def _docs_toy() -> str:
-    """The toy generator shown in docs/compare.md (run here as a user would copy it)."""
+    """The toy generator shown in docs/compare/own_generator.md (run here as a user would copy it)."""
     from conftest import REPO
 
-    text = (REPO / "docs" / "compare.md").read_text()
+    text = (REPO / "docs" / "compare" / "own_generator.md").read_text()
     start = text.index("```python\n# mine/toy.py") + len("```python\n")
     return text[start:text.index("```", start)]
 

@@ -363,7 +363,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("score", help="score BVH files from any tool with the compare family's metrics",
                        description="Score generated BVH files against the held-out capture they continue, with the "
-                       "metrics of compare/metrics.csv (docs/compare.md, Score motions made anywhere). The first "
+                       "metrics of compare/metrics.csv (docs/compare/own_generator.md, Score motions made anywhere). The first "
                        "--context frames of every file are the start; the frames after it are scored against the "
                        "reference's. The generator's seams, transitions and seed spread are not in a BVH file: "
                        "those columns stay empty, as do the metrics that read the database without --database.")

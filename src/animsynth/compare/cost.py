@@ -19,7 +19,7 @@ generator                                growth                  why
 ``replay``, ``concat``                   ``c * n``               a copy of the clips
 =======================================  ======================  ======================================================
 
-The constants (:data:`COST_MODELS`, :data:`FAIRMOTION_CPU_S`; CPU seconds; docs/compare.md, "What a build costs")
+The constants (:data:`COST_MODELS`, :data:`FAIRMOTION_CPU_S`; CPU seconds; docs/compare/generators.md, "What a build costs")
 were measured on the shared 2-core Intel Xeon machine of the project: fairmotion's per operation, from builds and
 walks on synthetic databases with the operations counted (the comparisons fairmotion made, the frames loaded and
 generated), the others as twice the median ratio of the paper run's ``metrics_timing.csv`` (19 clips, the clips of at
@@ -50,7 +50,7 @@ class CostModel:
     growth: str = ""
 
 
-#: each generator's growth and constants (CPU seconds; module docstring and docs/compare.md say how measured)
+#: each generator's growth and constants (CPU seconds; module docstring and docs/compare/generators.md say how measured)
 COST_MODELS = {
     # fairmotion's constants are per operation (FAIRMOTION_CPU_S, fairmotion_ops): build is unused
     "fairmotion": CostModel(2, 0.0, growth="O(nodes^2 x comparisons): every pair of nodes compared"),
@@ -80,7 +80,7 @@ def model_frames(generator: str, frames: int, cfg: dict) -> int:
 
 
 #: fairmotion's CPU seconds per operation (:func:`fairmotion_ops`), measured on synthetic databases of the
-#: CMU-like skeleton (31 joints) at its native 60 fps (docs/compare.md, "What a build costs": every measured build
+#: CMU-like skeleton (31 joints) at its native 60 fps (docs/compare/generators.md, "What a build costs": every measured build
 #: and walk is within 25 % of the estimate): loading a frame (its BVH round trip and velocities), one comparison of
 #: two nodes at one of their compared frames (``construct``'s pose, root / end-effector and trajectory
 #: similarity), and generating a frame (the walk and its blends)

@@ -1,6 +1,6 @@
 """The comparison's protocol: the held-out clips (windows), their databases, starts and seeds, and the clips file.
 
-Protocol (docs/compare.md, "Protocol"):
+Protocol (docs/compare/protocol.md):
 
 * Every trial is resampled to the working rate ``compare.fps`` by keeping every n-th frame
   (n = trial fps / working fps, an integer); frames a capture check flags (``usable``) stay out of held-out

@@ -119,7 +119,7 @@ def unavailable(name: str) -> str:
     """Why generator ``name`` cannot run here ('' when it can).
 
     Only fairmotion can be missing: its package is installed apart from the stack (``python3 run.py``
-    installs it with ``--no-deps``; docs/compare.md). Checked without importing it (the workflow parses
+    installs it with ``--no-deps``; docs/compare/generators.md). Checked without importing it (the workflow parses
     this in every job): a package that is installed but whose motion graph cannot be imported stops
     the fairmotion job with :class:`animsynth.compare.generators.fairmotion_peer.FairmotionUnavailable`.
     """
@@ -145,7 +145,7 @@ def generator_order(config: dict) -> list[str]:
 def run_generators(config: dict) -> tuple[list[str], dict]:
     """``(generators that run, {generator left out: reason})``: fairmotion is left out when its package is
     not installed here (:func:`unavailable`); the user generators run after the family's own (a user
-    generator that cannot run is found out by its job, which still writes its files: docs/compare.md)."""
+    generator that cannot run is found out by its job, which still writes its files: docs/compare/own_generator.md)."""
     run, left = [], {}
     for g in config["compare"]["generators"]:
         why = unavailable(g)

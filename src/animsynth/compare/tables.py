@@ -249,7 +249,7 @@ def summary_markdown(clips: pd.DataFrame, winners: pd.DataFrame, verdicts: pd.Da
     if "motion_matching_traj" in generators:
         out += ["Query protocol: **motion_matching_traj** is given the held-out future as its query trajectory "
                 "(where the capture went next), information no other generator sees; its scores against the ground "
-                "truth are not comparable with those of the rows that see the start alone (docs/compare.md, "
+                "truth are not comparable with those of the rows that see the start alone (docs/compare/generators.md, "
                 "Motion matching).", ""]
     if did_not_run:
         out += ["Did not run (no value on any clip, so in no ranking; their claims read \"did not run\"): "
@@ -302,7 +302,7 @@ def _num(x) -> str:
 
 
 def results_markdown(compare_dir) -> str:
-    """The results section of docs/compare.md, generated from a run's tables (``compare_dir``: e.g.
+    """The results page docs/compare/results.md, generated from a run's tables (``compare_dir``: e.g.
     ``results/paper/compare``): medians (IQR) per generator, the findings, the sanity checks, the skating
     sensitivity and, when present, the budget sweep. Every number comes from those files."""
     from pathlib import Path

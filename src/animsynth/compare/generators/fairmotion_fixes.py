@@ -29,7 +29,7 @@ undone afterwards:
     from the same clip (and of any later visit), which then jumps back where its own frames were not moved
     (the paper run of 2026-12-05, this fix and the 60 fps source together, on the 19 clips of the run before:
     the fixed row's median 95th percentile of the per-frame velocity jump 1.69 -> 1.22 m/s, the largest jump
-    over every clip and seed 96.7 -> 25.3 m/s; docs/compare.md, "Results on CMU"). Patch: ``cut`` returns the
+    over every clip and seed 96.7 -> 25.3 m/s; docs/compare/results.md). Patch: ``cut`` returns the
     poses of its own deep copy (``cut_motion.poses[start:end]``, and its velocities cut alike), as upstream's
     fix in the same commit as the three above does; the loaded clips are then never moved by a walk.
 

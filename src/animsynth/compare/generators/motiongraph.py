@@ -88,7 +88,7 @@ def budget_count(transitions_per_s: float, database_seconds: float) -> int:
     fairmotion rows): each keeps the same number of its best candidate transitions per second of database.
     A quantile of candidate distances would not be equally strict: our candidates are the local minima of a
     frame-by-frame distance matrix, fairmotion's every pair of its nodes, so the same quantile keeps very
-    different numbers of transitions (docs/compare.md, "Equal strictness").
+    different numbers of transitions (docs/compare/generators.md, "Equal strictness").
     """
     if not (np.isfinite(transitions_per_s) and transitions_per_s > 0):
         raise ValueError(f"transitions_per_s must be a positive number, got {transitions_per_s!r}")

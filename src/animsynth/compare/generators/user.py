@@ -2,7 +2,7 @@
 
 ``compare.user_generators`` maps a row name to ``"path/to/file.py:ClassName"`` (the path absolute or relative
 to the working directory of the run: the project folder under ``python3 run.py``). The class is built with no
-arguments and has the interface of the family's generators (docs/compare.md, "Your own generator")::
+arguments and has the interface of the family's generators (docs/compare/own_generator.md)::
 
     gen = ClassName()
     gen.fit(database)                       # database.clips: list of Motion; .skeleton, .fps

@@ -9,7 +9,7 @@ the guarded folders (the project and the job's results folder) made through Pyth
 writing, ``os.open`` also with ``dir_fd``, rename / replace, remove / unlink, rmdir, mkdir, mkfifo, mknod, hard and
 symbolic links, chmod, chown, utime, truncate, ``shutil`` copy / move / rmtree; a path relative to a ``dir_fd`` is
 read through ``/proc/self/fd``). A hard link whose source lies in a guarded folder is refused too (it would give a
-writable name to a guarded file). Not guarded, and said so in docs/compare.md: writes by code that Python does not
+writable name to a guarded file). Not guarded, and said so in docs/compare/own_generator.md: writes by code that Python does not
 audit (a C extension's own ``fopen``, ``ctypes``), by programs the class starts, and through a file descriptor the
 class holds already (a descriptor is only obtained by a checked ``open``, except those the job passed on: the
 standard streams).

@@ -20,7 +20,7 @@ Tracks
 Selections
     :data:`SWEEP_METRICS` (the budget sweep table's columns), :data:`SWEEP_PANELS` (its figure's panels),
     :data:`FIGURE_METRICS` (the panels of ``metrics.png``), :data:`RESULT_METRICS` (the columns of the results
-    section of docs/compare.md): tuples of names in the order of their table or figure, each name checked against
+    page docs/compare/results.md): tuples of names in the order of their table or figure, each name checked against
     :data:`METRICS` on import. :data:`EXPLORATORY_METRICS` (the exploratory table's metrics) and
     :data:`SKATING_CLAIM_METRICS` (a claim on one of them compares generators whose feet touch the floor), in the
     table's order: flags of the records. :data:`SENSITIVITY_METRICS`: the skating metrics whose
@@ -69,7 +69,7 @@ class Metric:
     unit : str, its unit (the ``unit`` column of ``summary.csv`` and ``winners.csv``, the verdicts' evidence)
     better : str, which way is better: ``"lower"``, ``"higher"`` or ``""`` (a descriptive number)
     needs : str, a key of :data:`NEEDS`: what it needs besides the generated motion and its start
-    label : str, its heading in a table (the results section of docs/compare.md); "" where none shows it
+    label : str, its heading in a table (the results page docs/compare/results.md); "" where none shows it
     title : str, its panel title in a figure (``metrics.png``, ``budget_sweep.png``); "" where none shows it
     exploratory : bool, a metric of the exploratory table (:data:`EXPLORATORY_METRICS`)
     skating_claim : bool, a skating metric of the claims (:data:`SKATING_CLAIM_METRICS`): a claim on it compares
@@ -255,7 +255,7 @@ SWEEP_PANELS = ("transitions_kept", "transition_skate_share", "skate_share", "ve
 #: the panels of metrics.png
 FIGURE_METRICS = ("skate_share", "transition_skate_share", "velocity_jump_p95", "velocity_jump_over_capture",
                   "skating_ratio_gmd", "ldlj", "l2p", "npss", "coverage", "novelty_median_m", "seed_diversity_m")
-#: the columns of the results section of docs/compare.md
+#: the columns of the results page docs/compare/results.md
 RESULT_METRICS = ("skate_share", "skating_ratio_gmd", "transition_skate_share", "velocity_jump", "velocity_jump_p95",
                   "velocity_jump_over_capture", "ldlj", "l2p", "l2p_m", "coverage", "novelty_median_m")
 #: the metrics of the exploratory table (with every declared claim's metric)
