@@ -167,8 +167,7 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     ends = forward_kinematics(skeleton, values, ends=True)
     pos = np.concatenate([starts, ends], axis=1)
     ext = np.median(pos.max(axis=1) - pos.min(axis=1), axis=0)
-    tall = int(np.argmax(ext))
-    ratio = float(np.sort(ext)[-2] / max(ext[tall], 1e-300))
+    ratio = float(np.sort(ext)[-2] / max(ext[int(np.argmax(ext))], 1e-300))
     info = {"extent": ext, "ratio": ratio, "biped": False, "legs": 0, "ambiguous": False, "why": "",
             "leg_counts": {}}
     head = role_indices(skeleton, ("head",), overrides)
@@ -181,32 +180,52 @@ def detect_up_axis(skeleton: Skeleton, values, overrides: dict | None = None) ->
     most = max((n for ax, n in counts.items()
                 if feet is None or any(f in c for c in chains[ax] for f in feet)), default=0)
     if head is not None and feet is not None and most <= MAX_BIPED_LEGS:
-        per_frame = starts[:, head[0]] - 0.5 * (starts[:, feet[0]] + starts[:, feet[1]])
-        d = np.median(per_frame, axis=0)
-        a = int(np.argmax(np.abs(d)))
-        axis = ("+" if d[a] >= 0 else "-") + "xyz"[a]
-        info.update(biped=True, legs=counts[axis], sign_from="roles")
-        why = []
-        second = float(np.sort(np.abs(d))[-2] / max(abs(d[a]), 1e-300))
-        decided = _roles_decide(per_frame, axis, counts)
-        if second > AMBIGUOUS_RATIO and not decided:
-            why.append(f"the head-to-feet vector {_fmt_vec(d)} lies between two axes")
-        hips = role_indices(skeleton, ("left_hip", "right_hip"), overrides)
-        if hips is not None:
-            u = axis_vector(axis)
-            hh = float(np.median(0.5 * (starts[:, hips[0]] + starts[:, hips[1]]) @ u))
-            hd = float(np.median(starts[:, head[0]] @ u))
-            hf = float(np.median(0.5 * (starts[:, feet[0]] + starts[:, feet[1]]) @ u))
-            if not hf <= hh <= hd:
-                why.append("the hips are not between the head and the feet")
-        if tall != a and ratio < AMBIGUOUS_RATIO and not decided:
-            why.append(f"the body is tallest along {'xyz'[tall]} (lying down?)")
-        info.update(ambiguous=bool(why), why="; ".join(why) or "head above feet")
-        return axis, info
+        return _biped_up(skeleton, starts, head[0], feet, info, overrides)
     if head is not None and feet is not None:
         info["why"] = f"head and feet found by role, but {most} leg-like chains"
     else:
         info["why"] = "no head or feet by joint role"
+    return _up_from_legs(info)
+
+
+def _biped_up(skeleton: Skeleton, starts: np.ndarray, head: int, feet: list[int], info: dict,
+              overrides: dict | None) -> tuple[str, dict]:
+    """A biped's up axis (:func:`detect_up_axis`): the signed axis nearest to its head minus the mid-point of its
+    feet, and ``info`` updated with whether (and why) that is ambiguous.
+
+    ``starts`` (frames, joints, 3) are the joint starts; ``head`` and ``feet`` joint indices by role; ``info``
+    holds the extents and leg counts already found."""
+    counts = info["leg_counts"]
+    per_frame = starts[:, head] - 0.5 * (starts[:, feet[0]] + starts[:, feet[1]])
+    d = np.median(per_frame, axis=0)
+    a = int(np.argmax(np.abs(d)))
+    axis = ("+" if d[a] >= 0 else "-") + "xyz"[a]
+    info.update(biped=True, legs=counts[axis], sign_from="roles")
+    why = []
+    second = float(np.sort(np.abs(d))[-2] / max(abs(d[a]), 1e-300))
+    decided = _roles_decide(per_frame, axis, counts)
+    if second > AMBIGUOUS_RATIO and not decided:
+        why.append(f"the head-to-feet vector {_fmt_vec(d)} lies between two axes")
+    hips = role_indices(skeleton, ("left_hip", "right_hip"), overrides)
+    if hips is not None:
+        u = axis_vector(axis)
+        hh = float(np.median(0.5 * (starts[:, hips[0]] + starts[:, hips[1]]) @ u))
+        hd = float(np.median(starts[:, head] @ u))
+        hf = float(np.median(0.5 * (starts[:, feet[0]] + starts[:, feet[1]]) @ u))
+        if not hf <= hh <= hd:
+            why.append("the hips are not between the head and the feet")
+    tall = int(np.argmax(info["extent"]))
+    if tall != a and info["ratio"] < AMBIGUOUS_RATIO and not decided:
+        why.append(f"the body is tallest along {'xyz'[tall]} (lying down?)")
+    info.update(ambiguous=bool(why), why="; ".join(why) or "head above feet")
+    return axis, info
+
+
+def _up_from_legs(info: dict) -> tuple[str, dict]:
+    """The up axis of a body that is not a biped (:func:`detect_up_axis`): the signed axis along which the most
+    leg-like chains (``info["leg_counts"]``) stand, or the file's own +y when that is ambiguous; ``info``
+    updated (its ``why`` extended)."""
+    counts = info["leg_counts"]
     best = max(AXES, key=lambda ax: (counts[ax], ax == CANONICAL_UP))
     second = max(c for ax, c in counts.items() if ax != best)
     info["legs"] = counts[best]

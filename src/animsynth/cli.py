@@ -305,9 +305,22 @@ def _write_motion(path: str, motion) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``animsynth`` command line: a subcommand per task, each with its own options; every one
+    that reads BVH takes the BVH input options, and every one the memory budget."""
     p = _Parser(prog="animsynth", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
+    for add in (_add_amc2bvh, _add_preview, _add_generate, _add_resequence, _add_face, _add_score):
+        add(sub)
+    for name in ("preview", "generate", "resequence", "score"):
+        _add_bvh_input_options(sub.choices[name])
+    for s in sub.choices.values():
+        s.add_argument("--memory-budget-gib", type=positive_float, default=DEFAULT_MEMORY_BUDGET_GIB,
+                       help=f"refuse requests whose arrays exceed this many GiB (default {DEFAULT_MEMORY_BUDGET_GIB:g})")
+    return p
 
+
+def _add_amc2bvh(sub) -> None:
+    """The ``amc2bvh`` command: an ASF/AMC trial written as BVH."""
     s = sub.add_parser("amc2bvh", help="convert an ASF/AMC trial to BVH (opens in Blender)")
     s.add_argument("asf", type=_existing_file), s.add_argument("amc", type=_existing_file)
     s.add_argument("out", type=_out_with((".bvh",)), help="output .bvh")
@@ -315,11 +328,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--metres", action="store_true", help="write lengths in metres instead of ASF units")
     s.set_defaults(func=cmd_amc2bvh)
 
+
+def _add_preview(sub) -> None:
+    """The ``preview`` command: an animated GIF of a trial's skeleton."""
     s = sub.add_parser("preview", help="animated GIF of a trial's skeleton (BVH, or ASF + AMC)")
     s.add_argument("files", nargs="+", metavar="FILE", help="MOTION.bvh, or SKEL.asf MOTION.amc; then OUT.gif")
     s.add_argument("--fps", type=fps_float, default=120.0, help="frame rate of the AMC motion (default 120)")
     s.set_defaults(func=cmd_preview)
 
+
+def _add_generate(sub) -> None:
+    """The ``generate`` command: a motion from Gauch & Peters' vector field (Delaunay or k-NN)."""
     s = sub.add_parser("generate", help="generate a motion with the Delaunay or k-NN vector field (Gauch & Peters)")
     s.add_argument("train", nargs="+", metavar="FILE",
                    help="training .bvh files, or .amc files with --asf (same skeleton); then OUT (or --out)")
@@ -339,6 +358,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", default=None, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_generate)
 
+
+def _add_resequence(sub) -> None:
+    """The ``resequence`` command: a trial's frames re-sequenced between two frames (Isomap, ST-Isomap)."""
     s = sub.add_parser("resequence", help="re-sequence a trial between two frames (Isomap / ST-Isomap + Dijkstra)")
     s.add_argument("files", nargs="+", metavar="FILE",
                    help="MOTION.bvh, or SKEL.asf MOTION.amc; then OUT (or --out)")
@@ -353,6 +375,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", default=None, type=_out_with(MOTION_OUTPUTS), help="output .bvh, .amc or .gif")
     s.set_defaults(func=cmd_resequence)
 
+
+def _add_face(sub) -> None:
+    """The ``face`` command: a face animation (68 landmarks) from expression labels."""
     s = sub.add_parser("face", help="synthesise a face animation (68 landmarks) from expression labels")
     s.add_argument("--labels", required=True, type=_labels, help="comma-separated, e.g. fear,surprise,happy")
     s.add_argument("--ckplus", default=None, type=_existing_dir,
@@ -361,6 +386,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("out", type=_out_with((".gif", ".csv")), help="output .gif (or .csv of landmarks)")
     s.set_defaults(func=cmd_face)
 
+
+def _add_score(sub) -> None:
+    """The ``score`` command: BVH files from any tool scored with the compare family's metrics."""
     s = sub.add_parser("score", help="score BVH files from any tool with the compare family's metrics",
                        description="Score generated BVH files against the held-out capture they continue, with the "
                        "metrics of compare/metrics.csv (docs/compare/own_generator.md, Score motions made anywhere). The first "
@@ -381,26 +409,24 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--floor-m", type=_finite, default=None,
                    help="floor height in metres (default: compare.metrics.floor_m, else from the database's feet)")
     s.set_defaults(func=cmd_score)
-    for name in ("preview", "generate", "resequence", "score"):
-        s = sub.choices[name]
-        s.add_argument("--length-to-m", action="append", metavar="[FILE=]M",
-                       help="metres per length unit of BVH input (default 1; 0.01 centimetres, 0.05644 cgspeed's CMU "
-                            "conversions); FILE=M for one file; repeatable")
-        s.add_argument("--role", action="append", metavar="[FILE:]ROLE=JOINT",
-                       help="joint role of BVH input (e.g. left_hip=Bip01_L_Thigh); repeatable")
-        s.add_argument("--up-axis", action="append", metavar="[FILE=]AXIS",
-                       help="up axis of BVH input (+x -x +y -y +z -z; default: detected); a negative axis works "
-                            "either way: --up-axis -z or --up-axis=-z")
-        s.add_argument("--forward-axis", action="append", metavar="[FILE=]AXIS",
-                       help="forward axis of BVH input (default: the smallest turn taking up to +y); a negative "
-                            "axis works either way: --forward-axis -y or --forward-axis=-y")
-        s.add_argument("--root", action="append", metavar="[FILE=]NAME",
-                       help="the skeleton to read from a BVH file that holds several (two characters, a "
-                            "character and a prop): the name of its root joint")
-    for s in sub.choices.values():
-        s.add_argument("--memory-budget-gib", type=positive_float, default=DEFAULT_MEMORY_BUDGET_GIB,
-                       help=f"refuse requests whose arrays exceed this many GiB (default {DEFAULT_MEMORY_BUDGET_GIB:g})")
-    return p
+
+
+def _add_bvh_input_options(s) -> None:
+    """The options of a command that reads BVH input: per-file length unit, joint roles, axes and root."""
+    s.add_argument("--length-to-m", action="append", metavar="[FILE=]M",
+                   help="metres per length unit of BVH input (default 1; 0.01 centimetres, 0.05644 cgspeed's CMU "
+                        "conversions); FILE=M for one file; repeatable")
+    s.add_argument("--role", action="append", metavar="[FILE:]ROLE=JOINT",
+                   help="joint role of BVH input (e.g. left_hip=Bip01_L_Thigh); repeatable")
+    s.add_argument("--up-axis", action="append", metavar="[FILE=]AXIS",
+                   help="up axis of BVH input (+x -x +y -y +z -z; default: detected); a negative axis works "
+                        "either way: --up-axis -z or --up-axis=-z")
+    s.add_argument("--forward-axis", action="append", metavar="[FILE=]AXIS",
+                   help="forward axis of BVH input (default: the smallest turn taking up to +y); a negative "
+                        "axis works either way: --forward-axis -y or --forward-axis=-y")
+    s.add_argument("--root", action="append", metavar="[FILE=]NAME",
+                   help="the skeleton to read from a BVH file that holds several (two characters, a "
+                        "character and a prop): the name of its root joint")
 
 
 #: The option whose size a command's arrays grow with (named when memory runs out anyway).

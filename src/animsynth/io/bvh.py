@@ -279,128 +279,161 @@ def read_bvh(path, fps: float | None = None, root: str | None = None) -> Motion:
         channels. A leading UTF-8 byte-order mark is ignored.
     """
     raw = read_text_lines(path)
+    toks, motion_line = _hierarchy_tokens(path, raw)
+    joints = _HierarchyReader(path, toks, motion_line).read()
+    ft_s, ftime, data = _read_motion(path, raw, motion_line, sum(len(r["channels"]) for r in joints))
+    joints, data = _pick_skeleton(path, joints, data, root)
+    joints, data = _drop_dummy_root(path, joints, data)
+    joints, data = _merge_dummy_root(path, joints, data)
+    data = _constant_child_positions(path, joints, data)
+    sk, cols = _generic_skeleton(path, joints)
+    values = _positions_as_translations(sk, data[:, cols] if cols else np.zeros((data.shape[0], 0)))
+    return Motion(values, sk, float(fps) if fps is not None else _frame_rate(ft_s, ftime), sk.name)
+
+
+def _hierarchy_tokens(path, raw: list[str]) -> tuple[list[tuple[str, int]], int]:
+    """The tokens ``(text, line)`` of the lines before the ``MOTION`` line, and that line's number."""
     toks: list[tuple[str, int]] = []
-    motion_line = None
     for ln, line in enumerate(raw, start=1):
         if line.strip().upper() == "MOTION":
-            motion_line = ln
-            break
+            return toks, ln
         toks += [(t, ln) for t in line.split()]
-    if motion_line is None:
-        raise MotionFormatError(path, len(raw), "no MOTION section")
-    pos = 0
+    raise MotionFormatError(path, len(raw), "no MOTION section")
 
-    def nxt():
-        nonlocal pos
-        if pos >= len(toks):
-            raise MotionFormatError(path, motion_line, "hierarchy ends early (a joint is not closed)")
-        pos += 1
-        return toks[pos - 1]
 
-    t, ln = nxt()
-    if t != "HIERARCHY":
-        raise MotionFormatError(path, ln, f"expected HIERARCHY, got {t!r}")
-    joints: list[dict] = []
-    seen: dict[str, int] = {}
+class _HierarchyReader:
+    """The ``HIERARCHY`` section read token by token into joint records, in file order (a parent before its
+    children): dicts of ``name``, ``parent`` (index, -1 for a root), ``offset``, ``channels`` (BVH channel names),
+    ``end`` (the End Site's offset or None), ``line`` (of its ``ROOT``/``JOINT``) and ``chan_line``.
 
-    def axes_of(chans, suffix, lnc, name):
-        ax = [c[0] for c in chans if c.endswith(suffix)]
-        if len(set(ax)) != len(ax):
-            raise MotionFormatError(path, lnc, f"joint {name!r}: {suffix} channels repeat an axis "
-                                               f"({' '.join(c for c in chans if c.endswith(suffix))}); "
-                                               "each axis may appear once")
-        return ax
+    Hand-written recursive descent rather than a parser library: the grammar is a handful of keywords, and
+    every error has to name the file and line of the token at fault.
+    """
 
-    def parse_joint(parent: int, kw: str, ln0: int, depth: int = 1):
-        if depth > MAX_JOINT_DEPTH:
-            raise MotionFormatError(path, ln0, f"joints nested more than {MAX_JOINT_DEPTH} deep (a skeleton "
-                                               "chain this long is a broken or hostile file)")
-        name, lnn = nxt()
-        if name in ("{", "}"):
-            raise MotionFormatError(path, lnn, f"{kw} without a name")
-        if name in seen:
-            raise MotionFormatError(path, lnn, f"duplicate joint name {name!r} (first on line {seen[name]})")
-        seen[name] = lnn
-        b, lnb = nxt()
-        if b != "{":
-            raise MotionFormatError(path, lnb, f"expected '{{' after {kw} {name}")
-        rec = {"name": name, "parent": parent, "offset": None, "channels": None, "end": None, "line": ln0,
-               "chan_line": ln0}
-        idx = len(joints)
-        joints.append(rec)
+    def __init__(self, path, toks: list[tuple[str, int]], motion_line: int):
+        self.path, self.toks, self.motion_line = path, toks, motion_line
+        self.pos = 0
+        self.joints: list[dict] = []
+        self.seen: dict[str, int] = {}
+
+    def next(self) -> tuple[str, int]:
+        """The next token and its line; the hierarchy may not end before every joint is closed."""
+        if self.pos >= len(self.toks):
+            raise MotionFormatError(self.path, self.motion_line, "hierarchy ends early (a joint is not closed)")
+        self.pos += 1
+        return self.toks[self.pos - 1]
+
+    def read(self) -> list[dict]:
+        """``HIERARCHY``, then one ``ROOT`` block or several (characters, props), and nothing after them."""
+        t, ln = self.next()
+        if t != "HIERARCHY":
+            raise MotionFormatError(self.path, ln, f"expected HIERARCHY, got {t!r}")
+        kw, ln = self.next()
+        if kw != "ROOT":
+            raise MotionFormatError(self.path, ln, f"expected ROOT, got {kw!r}")
+        self.joint(-1, kw, ln)
+        while self.pos < len(self.toks) and self.toks[self.pos][0] == "ROOT":  # another character (or prop)
+            kw, ln = self.next()
+            self.joint(-1, kw, ln)
+        if self.pos < len(self.toks):
+            t, ln = self.toks[self.pos]
+            raise MotionFormatError(self.path, ln, f"{t!r} after the root joint's closing brace")
+        return self.joints
+
+    def joint(self, parent: int, kw: str, ln0: int, depth: int = 1) -> int:
+        """One ``ROOT`` or ``JOINT`` block (keyword ``kw`` on line ``ln0``) with its children; returns its index."""
+        rec = self._open(parent, kw, ln0, depth)
+        idx, name = len(self.joints) - 1, rec["name"]
         while True:
-            t, ln = nxt()
+            t, ln = self.next()
             if t == "OFFSET":
                 if rec["offset"] is not None:
-                    raise MotionFormatError(path, ln, f"joint {name!r} has a second OFFSET")
-                rec["offset"] = np.array([parse_float(nxt()[0], path, ln, "offset") for _ in range(3)])
+                    raise MotionFormatError(self.path, ln, f"joint {name!r} has a second OFFSET")
+                rec["offset"] = self._xyz(ln)
             elif t == "CHANNELS":
                 if rec["channels"] is not None:
-                    raise MotionFormatError(path, ln, f"joint {name!r} has a second CHANNELS line")
-                c, lnc = nxt()
-                try:
-                    k = int(c)
-                except ValueError:
-                    raise MotionFormatError(path, lnc, f"bad channel count {c!r}") from None
-                if not 0 <= k <= 6:
-                    raise MotionFormatError(path, lnc, f"channel count must be 0 to 6, got {c!r}")
-                chans = [nxt() for _ in range(k)]
-                bad = [c for c, _ in chans if c not in _CH]
-                if bad:
-                    raise MotionFormatError(path, chans[[c for c, _ in chans].index(bad[0])][1],
-                                            f"unknown channel {bad[0]!r} (expected {', '.join(_CH)})")
-                chans = [c for c, _ in chans]
-                axes_of(chans, "rotation", lnc, name)
-                axes_of(chans, "position", lnc, name)
-                rec["channels"] = chans
-                rec["chan_line"] = lnc
+                    raise MotionFormatError(self.path, ln, f"joint {name!r} has a second CHANNELS line")
+                rec["channels"], rec["chan_line"] = self._channels(name)
             elif t == "JOINT":
-                parse_joint(idx, t, ln, depth + 1)
+                self.joint(idx, t, ln, depth + 1)
             elif t == "End":
-                s, lns = nxt()
-                b2, _ = nxt()
-                o, lno = nxt()
-                if s != "Site" or b2 != "{" or o != "OFFSET":
-                    raise MotionFormatError(path, lns, "malformed End Site")
-                rec["end"] = np.array([parse_float(nxt()[0], path, lno, "offset") for _ in range(3)])
-                e, lne = nxt()
-                if e != "}":
-                    raise MotionFormatError(path, lne, "End Site block not closed")
+                rec["end"] = self._end_site()
             elif t == "}":
                 break
             else:
-                raise MotionFormatError(path, ln, f"unexpected token {t!r} in joint {name!r}")
+                raise MotionFormatError(self.path, ln, f"unexpected token {t!r} in joint {name!r}")
         if rec["offset"] is None:
-            raise MotionFormatError(path, ln0, f"joint {name!r} has no OFFSET")
+            raise MotionFormatError(self.path, ln0, f"joint {name!r} has no OFFSET")
         if rec["channels"] is None:
             rec["channels"] = []
         return idx
 
-    kw, ln = nxt()
-    if kw != "ROOT":
-        raise MotionFormatError(path, ln, f"expected ROOT, got {kw!r}")
-    parse_joint(-1, kw, ln)
-    while pos < len(toks) and toks[pos][0] == "ROOT":  # another character (or prop) in the same file
-        kw, ln = nxt()
-        parse_joint(-1, kw, ln)
-    if pos < len(toks):
-        t, ln = toks[pos]
-        raise MotionFormatError(path, ln, f"{t!r} after the root joint's closing brace")
-    # motion header
-    i = motion_line
+    def _open(self, parent: int, kw: str, ln0: int, depth: int) -> dict:
+        """A joint's head, ``NAME {`` after its keyword: checked (depth, a unique name) and its record appended."""
+        if depth > MAX_JOINT_DEPTH:
+            raise MotionFormatError(self.path, ln0, f"joints nested more than {MAX_JOINT_DEPTH} deep (a skeleton "
+                                                    "chain this long is a broken or hostile file)")
+        name, lnn = self.next()
+        if name in ("{", "}"):
+            raise MotionFormatError(self.path, lnn, f"{kw} without a name")
+        if name in self.seen:
+            raise MotionFormatError(self.path, lnn, f"duplicate joint name {name!r} (first on line {self.seen[name]})")
+        self.seen[name] = lnn
+        b, lnb = self.next()
+        if b != "{":
+            raise MotionFormatError(self.path, lnb, f"expected '{{' after {kw} {name}")
+        rec = {"name": name, "parent": parent, "offset": None, "channels": None, "end": None, "line": ln0,
+               "chan_line": ln0}
+        self.joints.append(rec)
+        return rec
 
-    def header(prefix):
-        nonlocal i
-        while i < len(raw) and not raw[i].strip():
-            i += 1
-        if i >= len(raw) or not raw[i].strip().startswith(prefix):
-            raise MotionFormatError(path, i + 1, f"expected '{prefix}'")
-        val = raw[i].split(":", 1)[1].strip()
-        i += 1
-        return val, i
+    def _xyz(self, line: int) -> np.ndarray:
+        """The three numbers of an ``OFFSET`` on ``line``."""
+        return np.array([parse_float(self.next()[0], self.path, line, "offset") for _ in range(3)])
 
-    nf_s, lnf = header("Frames:")
-    ft_s, lnt = header("Frame Time:")
+    def _channels(self, name: str) -> tuple[list[str], int]:
+        """A ``CHANNELS`` line's names after its keyword, checked (count 0 to 6, known names, each axis once per
+        kind), and the line of its count."""
+        c, lnc = self.next()
+        try:
+            k = int(c)
+        except ValueError:
+            raise MotionFormatError(self.path, lnc, f"bad channel count {c!r}") from None
+        if not 0 <= k <= 6:
+            raise MotionFormatError(self.path, lnc, f"channel count must be 0 to 6, got {c!r}")
+        chans = [self.next() for _ in range(k)]
+        bad = [c for c, _ in chans if c not in _CH]
+        if bad:
+            raise MotionFormatError(self.path, chans[[c for c, _ in chans].index(bad[0])][1],
+                                    f"unknown channel {bad[0]!r} (expected {', '.join(_CH)})")
+        names = [c for c, _ in chans]
+        for suffix in ("rotation", "position"):
+            axes = [c[0] for c in names if c.endswith(suffix)]
+            if len(set(axes)) != len(axes):
+                raise MotionFormatError(self.path, lnc, f"joint {name!r}: {suffix} channels repeat an axis "
+                                                        f"({' '.join(c for c in names if c.endswith(suffix))}); "
+                                                        "each axis may appear once")
+        return names, lnc
+
+    def _end_site(self) -> np.ndarray:
+        """An ``End Site { OFFSET x y z }`` block after its ``End``: the offset."""
+        s, lns = self.next()
+        b2, _ = self.next()
+        o, lno = self.next()
+        if s != "Site" or b2 != "{" or o != "OFFSET":
+            raise MotionFormatError(self.path, lns, "malformed End Site")
+        end = self._xyz(lno)
+        e, lne = self.next()
+        if e != "}":
+            raise MotionFormatError(self.path, lne, "End Site block not closed")
+        return end
+
+
+def _read_motion(path, raw: list[str], motion_line: int, ncols: int) -> tuple[str, float, np.ndarray]:
+    """The ``MOTION`` section after line ``motion_line``: the frame time as printed and as a number, and the
+    frame rows (frames, ncols), as many as ``Frames:`` declares."""
+    nf_s, lnf = _header_value(path, raw, motion_line, "Frames:")
+    ft_s, lnt = _header_value(path, raw, lnf, "Frame Time:")
     try:
         nframes = int(nf_s)
     except ValueError:
@@ -408,9 +441,8 @@ def read_bvh(path, fps: float | None = None, root: str | None = None) -> Motion:
     if nframes < 1:
         raise MotionFormatError(path, lnf, f"frame count must be at least 1, got {nframes}")
     ftime = _parse_frame_time(ft_s, path, lnt)
-    ncols = sum(len(r["channels"]) for r in joints)
     rows = []
-    for k in range(i, len(raw)):
+    for k in range(lnt, len(raw)):
         if not raw[k].strip():
             continue
         parts = raw[k].split()
@@ -421,13 +453,23 @@ def read_bvh(path, fps: float | None = None, root: str | None = None) -> Motion:
         rows.append([parse_float(p, path, k + 1) for p in parts])
     if len(rows) != nframes:
         raise MotionFormatError(path, len(raw), f"header says {nframes} frames, file has {len(rows)} (truncated?)")
-    data = np.array(rows, float).reshape(nframes, ncols)
-    joints, data = _pick_skeleton(path, joints, data, root)
-    joints, data = _drop_dummy_root(path, joints, data)
-    joints, data = _merge_dummy_root(path, joints, data)
-    data = _constant_child_positions(path, joints, data)
-    # the generic skeleton: DOF = position channels, then rotation channels
-    # reversed (intrinsic channel order -> extrinsic DOF order)
+    return ft_s, ftime, np.array(rows, float).reshape(nframes, ncols)
+
+
+def _header_value(path, raw: list[str], i: int, prefix: str) -> tuple[str, int]:
+    """The value after ``prefix:`` on the first non-blank line from index ``i``, and that line's number (the
+    index of the line after it)."""
+    while i < len(raw) and not raw[i].strip():
+        i += 1
+    if i >= len(raw) or not raw[i].strip().startswith(prefix):
+        raise MotionFormatError(path, i + 1, f"expected '{prefix}'")
+    return raw[i].split(":", 1)[1].strip(), i + 1
+
+
+def _generic_skeleton(path, joints: list[dict]) -> tuple[Skeleton, list[int]]:
+    """The skeleton of the joint records, named after the file, and the data column of each of its DOF: a joint's
+    DOF are its position channels, then its rotation channels reversed (intrinsic channel order -> extrinsic DOF
+    order)."""
     sk_joints, cols, col = [], [], 0
     for idx, rec in enumerate(joints):
         chans = rec["channels"]
@@ -440,16 +482,18 @@ def read_bvh(path, fps: float | None = None, root: str | None = None) -> Motion:
         sk_joints.append(Joint(rec["name"], rec["parent"], np.asarray(rec["offset"], float),
                                np.asarray(tail, float), [_CH[c] for c in trans + rots]))
         cols += [order[c] for c in trans + rots]
-    values = data[:, cols] if cols else np.zeros((nframes, 0))
-    sk = Skeleton(sk_joints, name=os.path.splitext(os.path.basename(os.fspath(path)))[0])
-    # position channels (root: absolute; other joints: the translation from the parent) replace the OFFSET;
-    # our translation DOF are added to it
+    return Skeleton(sk_joints, name=os.path.splitext(os.path.basename(os.fspath(path)))[0]), cols
+
+
+def _positions_as_translations(sk: Skeleton, values: np.ndarray) -> np.ndarray:
+    """``values`` with each position channel (root: absolute; other joints: from the parent), which replaces the
+    joint's OFFSET, made our translation DOF, which add to it: the channel minus the OFFSET (in place)."""
     slices = sk.dof_slices()
     for j in sk.joints:
         for k, d in enumerate(j.dofs):
             if d in TRANS_DOFS:
                 values[:, slices[j.name].start + k] -= j.offset[TRANS_DOFS.index(d)]
-    return Motion(values, sk, float(fps) if fps is not None else _frame_rate(ft_s, ftime), sk.name)
+    return values
 
 
 def _pick_skeleton(path, joints: list[dict], data: np.ndarray, root: str | None):
