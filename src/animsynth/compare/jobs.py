@@ -135,6 +135,10 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
         write_table(pd.concat([pd.read_csv(p, keep_default_na=False) for p in inp["captures"]], ignore_index=True),
                     out["captures"], md=False)
     t = family_tables(dict(inp, clips=out["clips"]), generators, left_out, cfg, source, sweep)
+    if inp.get("long_metrics"):  # the long track: its rows, its claims after the 2-s ones, its own section
+        from .long_tables import with_long_track
+
+        t = with_long_track(t, inp, left_out, cfg, out["clips"])
     write_table(t["metrics"], out["metrics"], md=False)
     write_table(t["metrics_timing"], out["metrics_timing"], md=False)
     write_table(t["summary"], out["summary"], md=False)  # compare/summary.md is the family's page below

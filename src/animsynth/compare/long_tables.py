@@ -23,7 +23,7 @@ from .measures.metric_table import on_track
 
 log = logging.getLogger("animsynth.compare.long_tables")
 
-__all__ = ["LONG_ONLY", "long_tables", "long_markdown"]
+__all__ = ["LONG_ONLY", "long_tables", "long_markdown", "with_long_track"]
 
 #: the records computed on the long track alone (the columns of the summary's long section)
 LONG_ONLY = tuple(m.name for m in on_track("long") if m.tracks == ("long",))
@@ -100,3 +100,13 @@ def long_markdown(metrics: pd.DataFrame, medians: pd.DataFrame, verdicts: pd.Dat
             "by the same rule and words as the 2-s claims, Holm over the long track's claims alone.", ""]
     out += [to_markdown(verdicts[["claim", "ours", "verdict", "evidence"]]) if len(verdicts) else "(no long claim)", ""]
     return "\n".join(out)
+
+
+def with_long_track(t: dict, inp: dict, left_out: dict, cfg: dict, clips_path) -> dict:
+    """The family's tables ``t`` (:func:`animsynth.compare.tables.family_tables`) with the long track's
+    (:func:`long_tables` of ``inp``; ``clips_path``: the gathered clips table): ``long`` added, the long claims'
+    rows after the 2-s ones in ``verdicts`` and ``claims_stats``, its section at the end of ``summary_md``."""
+    long = long_tables(inp, left_out, cfg, pd.read_csv(clips_path, dtype=str), t["data"])
+    return dict(t, long=long, verdicts=pd.concat([t["verdicts"], long["verdicts"]], ignore_index=True),
+                claims_stats=pd.concat([t["claims_stats"], long["claims_stats"]], ignore_index=True),
+                summary_md=t["summary_md"].rstrip("\n") + "\n\n" + long["markdown"])

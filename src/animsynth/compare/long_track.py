@@ -4,8 +4,9 @@ track's records (:func:`animsynth.compare.measures.metric_table.on_track` ``"lon
 
 * :func:`long_settings` -- the long track's settings of one generator row (``None``: the track is off);
 * :func:`long_contexts` -- the windows a subject continues for the long track: spread evenly over its databases;
-* :func:`run_long` -- every long seed of the chosen windows of one database from the fitted generator, scored;
-* :func:`not_run_rows` -- the rows of windows a generator has no long motion for (``note`` says why).
+* :func:`generate_long` -- one long motion, or why a generator has none;
+* :func:`not_run_rows` -- the rows of windows a generator has no long motion for (``note`` says why);
+* the run itself, from the 2-s track's build of each database: :func:`animsynth.compare.runner.run_tracks`.
 
 The contexts and seeds are the short track's (the first ``seeds`` of each window's short-track seeds,
 :func:`animsynth.compare.protocol.clip_seeds`), so both tracks start from the same frames. A generator whose
@@ -23,15 +24,14 @@ job's CPU splits by track) and ``<generator>_long_showcase.npz`` (the first long
 from __future__ import annotations
 
 import logging
-import time
 
 import numpy as np
 
 from .measures.metric_table import KEY_COLUMNS, track_names
-from .protocol import Clip, clip_seeds
+from .protocol import Clip
 
-__all__ = ["LONG_NAMES", "LONG_COLUMNS", "LONG_TIMING_COLUMNS", "long_settings", "long_contexts", "run_long",
-           "not_run_rows"]
+__all__ = ["LONG_NAMES", "LONG_COLUMNS", "LONG_TIMING_COLUMNS", "long_settings", "long_contexts", "not_run_rows",
+           "generate_long", "say_once"]
 
 log = logging.getLogger("animsynth.compare.long_track")
 
@@ -79,7 +79,7 @@ def not_run_rows(clips: list[Clip], generator: str, n_seeds: int, note: str) -> 
             for c in clips for i in range(n_seeds)]
 
 
-def _generate(gen, clip: Clip, n: int, seed: int, query: dict):
+def generate_long(gen, clip: Clip, n: int, seed: int, query: dict):
     """``gen``'s ``n`` frames from the clip's start, or ``(None, why)`` when it raises or returns another number
     of frames (a user generator's own failure, :class:`UserGeneratorError`, stops the job as on the short track)."""
     from ..generator import QUERY_FUTURE_TRAJECTORY
@@ -99,69 +99,7 @@ def _generate(gen, clip: Clip, n: int, seed: int, query: dict):
     return m, ""
 
 
-def run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, master_seed: int, roles, kin,
-             said: set) -> tuple[list[dict], object, dict]:
-    """Every long seed of the windows ``cs`` (one database's chosen long contexts) from the fitted ``gen``.
-
-    Parameters
-    ----------
-    gen : the fitted generator (the short track's build of this database)
-    generator : its row name
-    cs : list of Clip, the database's long contexts (:func:`long_contexts`)
-    settings : :func:`long_settings` of the row
-    cfg : the job's ``compare`` config (``fps``, ``seed``, ``seeds``, ``metrics``)
-    master_seed : the config's ``seed``
-    roles : joint-role overrides
-    kin : the job's :class:`~animsynth.compare.scoring.DatabaseKinematics`
-    said : the "did not run" reasons already logged by this job (a reason is logged once)
-
-    Returns
-    -------
-    rows : list of dict, one per window x seed (:data:`LONG_COLUMNS`)
-    shown : Motion or None, the first window's start and seed 0's frames joined
-    cost : dict, this database's row of :data:`LONG_TIMING_COLUMNS`
-    """
-    from .runner import _shown, cpu_seconds, generation_query, native_inputs
-    from .scoring import reference, run_values, score
-
-    n = int(round(settings["seconds"] * float(cfg["fps"])))
-    n_seeds, mcfg = settings["seeds"], cfg["metrics"]
-    rows, shown = [], None
-    cost = {"generator": generator, "contexts": len(cs), "seeds": n_seeds, "frames_generated": 0,
-            "generate_cpu_s": 0.0, "generate_wall_s": 0.0, "score_cpu_s": 0.0}
-    for clip in cs:
-        gen.set_label(f"{clip.clip} long")
-        seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, max(n_seeds, int(cfg["seeds"])))[:n_seeds]
-        query = {**generation_query(gen, clip), **native_inputs(gen, clip)[1]}
-        ref, feats, these = None, [], []
-        for i, s in enumerate(seeds):
-            c0, w0 = cpu_seconds(), time.perf_counter()
-            m, why = _generate(gen, clip, n, s, query)
-            cost["generate_cpu_s"] += cpu_seconds() - c0 + gen.outside_cost()["cpu_s"]
-            cost["generate_wall_s"] += time.perf_counter() - w0
-            if m is None:
-                _say(generator, clip, why, said)
-                these += not_run_rows([clip], generator, 1, f"did not run: {why}")
-                these[-1]["seed"] = i
-                continue
-            c0 = cpu_seconds()
-            ref = ref or reference(clip, mcfg, roles, None, kin)
-            row, f = score(clip, ref, m, generator, mcfg, roles, track="long", entry_seam=gen.entry_seam)
-            cost["score_cpu_s"] += cpu_seconds() - c0
-            cost["frames_generated"] += n
-            feats.append(f)
-            these.append({**_key(clip, generator), "seed": i, **row, "note": ""})
-            if i == 0 and shown is None:
-                shown = _shown(clip, m, f"{generator} {clip.clip} seed 0, {settings['seconds']:g} s", gen.entry_seam)
-        if feats and len(feats) == len(seeds):  # the spread over seeds and the generator's own counts
-            per_run = run_values(gen, feats, track="long")
-            for r in these:
-                r.update(per_run)
-        rows += these
-    return rows, shown, cost
-
-
-def _say(generator: str, clip: Clip, why: str, said: set) -> None:
+def say_once(generator: str, clip: Clip, why: str, said: set) -> None:
     """Log a generator's reason for not running the long track, once per job."""
     if why in said:
         return

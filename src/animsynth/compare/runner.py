@@ -297,7 +297,7 @@ def showcase_clip(clips: list[Clip], spec: str | None) -> str | None:
 def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
     """:func:`run_tracks`: one build per database (:func:`by_database`), every window and seed of it from that
     build, then the database's long contexts from the same build."""
-    from .long_track import long_contexts, long_settings, not_run_rows, run_long
+    from .long_track import long_contexts, long_settings, not_run_rows
 
     rows, trows, shown = [], [], None
     kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
@@ -328,7 +328,7 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         log.info("%s on %s: build %.3f s CPU, %d windows x %d seeds: %d frames in %.3f s CPU", generator, key,
                  cost["build_cpu_s"], len(cs), int(cfg["seeds"]), frames, g_cpu)
         if lcs:  # the long track from the same build
-            r, sh, lcost = run_long(gen, generator, lcs, ls, cfg, master_seed, roles, kin, long["said"])
+            r, sh, lcost = _run_long(gen, generator, lcs, ls, cfg, master_seed, roles, kin, long["said"])
             long["rows"] += r
             long["shown"] = long["shown"] or sh or _start_only(lcs[0], generator, r[0]["note"])
             long["timing"].append({**lcost, "database": key})
@@ -337,6 +337,69 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
                      lcost["generate_cpu_s"], lcost["score_cpu_s"])
     metrics = pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"])
     return metrics, pd.DataFrame(trows, columns=TIMING_COLUMNS), shown, _long_frames(long)
+
+
+def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, master_seed: int, roles, kin,
+             said: set) -> tuple[list[dict], object, dict]:
+    """Every long seed of the windows ``cs`` (one database's chosen long contexts) from the fitted ``gen``
+    (:mod:`animsynth.compare.long_track`).
+
+    Parameters
+    ----------
+    gen : the fitted generator (the short track's build of this database)
+    generator : its row name
+    cs : list of Clip, the database's long contexts (:func:`~.long_track.long_contexts`)
+    settings : :func:`~.long_track.long_settings` of the row
+    cfg : the job's ``compare`` config (``fps``, ``seed``, ``seeds``, ``metrics``)
+    master_seed : the config's ``seed``
+    roles : joint-role overrides
+    kin : the job's :class:`~animsynth.compare.scoring.DatabaseKinematics`
+    said : the "did not run" reasons already logged by this job (a reason is logged once)
+
+    Returns
+    -------
+    rows : list of dict, one per window x seed (:data:`~.long_track.LONG_COLUMNS`)
+    shown : Motion or None, the first window's start and seed 0's frames joined
+    cost : dict, this database's row of :data:`~.long_track.LONG_TIMING_COLUMNS`
+    """
+    from .long_track import generate_long, not_run_rows, say_once
+
+    n = int(round(settings["seconds"] * float(cfg["fps"])))
+    n_seeds, mcfg = settings["seeds"], cfg["metrics"]
+    rows, shown = [], None
+    cost = {"generator": generator, "contexts": len(cs), "seeds": n_seeds, "frames_generated": 0,
+            "generate_cpu_s": 0.0, "generate_wall_s": 0.0, "score_cpu_s": 0.0}
+    for clip in cs:
+        gen.set_label(f"{clip.clip} long")
+        seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, max(n_seeds, int(cfg["seeds"])))[:n_seeds]
+        query = {**generation_query(gen, clip), **native_inputs(gen, clip)[1]}
+        ref, feats, these = None, [], []
+        for i, s in enumerate(seeds):
+            c0, w0 = cpu_seconds(), time.perf_counter()
+            m, why = generate_long(gen, clip, n, s, query)
+            cost["generate_cpu_s"] += cpu_seconds() - c0 + gen.outside_cost()["cpu_s"]
+            cost["generate_wall_s"] += time.perf_counter() - w0
+            if m is None:
+                say_once(generator, clip, why, said)
+                these += not_run_rows([clip], generator, 1, f"did not run: {why}")
+                these[-1]["seed"] = i
+                continue
+            c0 = cpu_seconds()
+            ref = reference(clip, mcfg, roles, None, kin) if ref is None else ref
+            row, f = score(clip, ref, m, generator, mcfg, roles, track="long", entry_seam=gen.entry_seam)
+            cost["score_cpu_s"] += cpu_seconds() - c0
+            cost["frames_generated"] += n
+            feats.append(f)
+            these.append({"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator,
+                          "seed": i, **row, "note": ""})
+            if i == 0 and shown is None:
+                shown = _shown(clip, m, f"{generator} {clip.clip} seed 0, {settings['seconds']:g} s", gen.entry_seam)
+        if feats and len(feats) == len(seeds):  # the spread over seeds and the generator's own counts
+            per_run = run_values(gen, feats, track="long")
+            for r in these:
+                r.update(per_run)
+        rows += these
+    return rows, shown, cost
 
 
 def _long_frames(long: dict | None) -> dict | None:

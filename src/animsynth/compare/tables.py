@@ -60,9 +60,8 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
     Returns ``{name: DataFrame}``: ``metrics`` (every row, in the clips' and the config's generator order),
     ``metrics_timing``, ``summary``, ``winners``, ``cost``, ``verdicts`` (the declared claims, ``cfg["claims"]``),
     ``claims_stats`` (their numbers), ``exploratory`` (every other pair, no verdict), ``sanity``, ``sensitivity``;
-    and ``summary_md``: the family's page (text). With the long track's files (``inp["long_metrics"]``,
-    ``inp["long_timing"]``), ``long`` (:func:`animsynth.compare.long_tables.long_tables`) and its claims' rows after
-    the 2-s ones in ``verdicts`` and ``claims_stats``, its section at the end of ``summary_md``.
+    and ``summary_md``: the family's page (text); ``data``: what the run is on (the verdicts' ``data``). The claims
+    decided are the 2-s track's (the long track's: :func:`animsynth.compare.long_tables.with_long_track`).
 
     ``sweep``: ``{"default": transitions_per_s, "budgets": [...], "generators": [...]}`` describing
     ``inp["sweep"]`` (:func:`sweep_runs`); the claims against the peer quote the sweep as evidence."""
@@ -106,14 +105,7 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
            "exploratory": exploratory, "sanity": sanity, "sensitivity": sensitivity_table(metrics, order),
            "summary_md": summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg, not_built,
                                           sanity, {g: w for g, w in empty.items() if w})}
-    if inp.get("long_metrics"):  # the long track: its rows, its claims after the 2-s ones, its own section
-        from .long_tables import long_tables
-
-        long = long_tables(inp, left_out, cfg, clips_full, data)
-        out["long"] = long
-        out["verdicts"] = pd.concat([verdicts, long["verdicts"]], ignore_index=True)
-        out["claims_stats"] = pd.concat([claims_stats, long["claims_stats"]], ignore_index=True)
-        out["summary_md"] = out["summary_md"].rstrip("\n") + "\n\n" + long["markdown"]
+    out["data"] = data  # what the run is on: the long track's tables say it too
     return out
 
 
