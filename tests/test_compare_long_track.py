@@ -189,7 +189,8 @@ def test_a_long_claim_is_decided_by_the_same_rule_and_words(tmp_path):
         t = long_tables({"long_metrics": [tmp_path / f"{name}.csv"], "long_timing": [tmp_path / f"{name}_t.csv"]},
                         {}, cmp, clips, "constructed")
         v = t["verdicts"].set_index("claim")
-        claim = next(c["claim"] for c in cmp["claims"] if c["id"] == "long_genmm_vs_graph_repetition")
+        claim = next(c["claim"] for c in cmp["claims"] if c.get("track") == "long" and c["metric"] ==
+                     "repetition_share" and (c["a"], c["b"]) == ("genmm", "motion_graph"))
         decided[name] = v.loc[claim, "verdict"]
         assert (t["verdicts"]["source"] == "compare/metrics_long.csv").all()
         # the other long claims' rows did not run here: Holm runs over the long claims alone
