@@ -17,6 +17,7 @@ from animsynth.compare import settings
 from animsynth.compare import claim_stats as CS
 from animsynth.compare import groups as GR
 from animsynth.compare import verdicts as CV
+from animsynth.compare.claims import track_claims
 from animsynth.config import ConfigError
 from animsynth.generator import Database, align_root
 from animsynth.retarget import unwrap_angles
@@ -266,8 +267,8 @@ def _metrics(values: dict) -> pd.DataFrame:
 VC = {"alpha": 0.05, "min_groups": 3, "novelty_copy_m": 0.01,
       "min_effect": {"skate_share": 0.02, "transition_skate_share": 0.02, "velocity_jump_p95": 0.1, "l2p": 0.25,
                      "novelty_median_m": 0.005, "coverage": 0.02}}
-#: the declared claims of the shipped config
-CLAIMS = _config()["compare"]["claims"]
+#: the declared 2-s claims of the shipped config (the long track's: tests/test_compare_long_track.py)
+CLAIMS = track_claims(_config()["compare"]["claims"], "short")
 
 
 def _claim(a: str, b: str, metric: str) -> str:
@@ -617,10 +618,11 @@ def test_a_subset_the_run_lacks_is_left_out_with_a_warning(caplog):
 def test_the_job_config_holds_the_generators_block_and_nothing_of_the_others():
     config = _config()
     mg = settings.job_cfg(config, "motion_graph")
-    assert list(mg) == [*settings.RUN_KEYS, "motion_graph"] and mg["motion_graph"] == config["compare"]["motion_graph"]
+    assert list(mg) == [*settings.RUN_KEYS, "motion_graph", "long_track"]
+    assert mg["motion_graph"] == config["compare"]["motion_graph"]
     st = settings.job_cfg(config, "stisomap")
     assert st["stisomap"] == config["resequencing"]["stisomap"] and "resequencing_graph" in st and "field" not in st
-    assert list(settings.job_cfg(config, "replay")) == list(settings.RUN_KEYS)  # no block of its own
+    assert list(settings.job_cfg(config, "replay")) == [*settings.RUN_KEYS, "long_track"]  # no block of its own
     every = settings.job_cfg(config)
     assert {*settings.GENERATOR_BLOCKS.values(), "stisomap"} <= set(every)
     sweep = settings.job_cfg(dict(config, compare=dict(config["compare"], seeds=5, budget_sweep_seeds=2)),

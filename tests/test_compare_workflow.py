@@ -68,6 +68,34 @@ def test_compare_outputs(tiny_workflow):
     assert len(ours) == len(v) + len(sanity)  # the findings, then the sanity checks marked as such
     assert ours["sanity_check"].astype(bool).sum() == len(sanity)
     assert "The generators side by side" in (tiny_workflow / "results" / "claims.rst").read_text()
+    _long_track_outputs(r, clips, gens, v, stats)
+
+
+def _long_track_outputs(r, clips, gens, v, stats):
+    """The long track of the tiny run (compare.long_track of config/test.yaml): every generator's rows on each
+    subject's long context, replay's "did not run", its claims after the 2-s ones, its preview."""
+    from animsynth.compare.long_track import LONG_COLUMNS
+
+    lm = pd.read_csv(r / "metrics_long.csv")
+    lm["note"] = lm["note"].fillna("")
+    assert list(lm.columns) == LONG_COLUMNS
+    per = lm.merge(clips[["clip", "subject"]], on="clip").groupby("subject")["generator"].agg(set)
+    assert len(per) == clips["subject"].nunique() and all(set(gens) == g for g in per)  # every row, every subject
+    assert (lm["generator"] != "replay").sum() and (lm.loc[lm["generator"] == "replay", "note"].str.startswith(
+        "did not run: its query is the held-out future")).all()
+    assert lm.groupby("generator")["seed"].nunique().to_dict()["fairmotion"] == 1  # compare.long_track.seeds_by_generator
+    ran = lm[lm["note"] == ""]
+    assert ran["repetition_share"].between(0, 1).all() and ran["coverage_after_5s"].notna().any()
+    long_claims = [c for c in default_config()["compare"]["claims"] if c.get("track") == "long"]
+    assert list(v["claim"].tail(len(long_claims))) == [c["claim"] for c in long_claims]
+    assert set(v["source"].tail(len(long_claims))) == {"compare/metrics_long.csv"}
+    assert set(v["source"].head(len(v) - len(long_claims))) == {"compare/metrics.csv"}
+    assert list(stats["claim_id"].tail(len(long_claims))) == [c["id"] for c in long_claims]
+    t = pd.read_csv(r / "metrics_long_timing.csv")
+    assert set(t["generator"]) == set(gens) and (t.loc[t["generator"].isin(ran["generator"]), "frames_generated"]
+                                                 .groupby(t["generator"]).sum() > 0).all()
+    assert "## The 5-second track" in (r / "summary.md").read_text()
+    assert (r / "long_strips.png").stat().st_size > 0 and (r / "metrics_long.md").stat().st_size > 0
 
 
 def _docs_toy() -> str:

@@ -518,6 +518,7 @@ def compare_benchmarks():
         + job_benchmarks("compare_tables")
         + job_benchmarks("compare_figures")
         + (job_benchmarks("compare_sweep") if CMP_SWEEP and CMP_GRAPHS else [])
+        + (job_benchmarks("compare_long_strips") if CMP_LONG_ON else [])
     )
 
 

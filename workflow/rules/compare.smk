@@ -9,6 +9,7 @@
 # tables and docs say why. Every job gets only the config keys it uses. Resources: measured on CMU (the paper run)
 # with headroom.
 from animsynth.compare.generators.names import FAIRMOTION_ROWS
+from animsynth.compare.long_track import long_settings
 from animsynth.compare.settings import (clips_cfg, first_frames, generator_order, groups, run_generators, showcase,
                                         subject_groups, trial_subjects, user_generators)
 
@@ -41,6 +42,14 @@ CMP_OUT = {
     "shown": R("compare/runs/{cmpsubj}/{cmpgen}_showcase.npz"),
 }
 CMP_SWEEP_OUT = R("compare/sweep/{cmpsubj}/{cmpgen}_{budget}.csv")
+# the long track (compare.long_track, docs/compare/long_track.md): each default-budget row's job continues its
+# subject's long contexts from the same builds and writes these beside its 2-s files
+CMP_LONG_ON = long_settings(CMP.get("long_track"), "") is not None
+CMP_LONG_OUT = {
+    "long_metrics": R("compare/runs/{cmpsubj}/{cmpgen}_long.csv"),
+    "long_timing": R("compare/runs/{cmpsubj}/{cmpgen}_long_timing.csv"),
+    "long_shown": R("compare/runs/{cmpsubj}/{cmpgen}_long_showcase.npz"),
+} if CMP_LONG_ON else {}
 # fairmotion's rows and its budget sweep run in one job per subject (compare_run_fairmotion): they build the same
 # graphs, so fairmotion's loading of every trial and its graph construction run once per database; each row and
 # budget keeps its own threshold and walks (animsynth.compare.generators.fairmotion_peer)
@@ -95,6 +104,7 @@ rule compare_run:
         metrics=CMP_OUT["metrics"],
         timing=CMP_OUT["timing"],
         shown=CMP_OUT["shown"],
+        **CMP_LONG_OUT,
     params:
         rows=lambda w: compare_rows(w, [(w.cmpgen, None, "")]),
         seed=config["seed"],
@@ -123,6 +133,7 @@ if CMP_SWEEP_GRAPH:
             metrics=CMP_OUT["metrics"],
             timing=CMP_OUT["timing"],
             shown=CMP_OUT["shown"],
+            **CMP_LONG_OUT,
             **{f"sweep{i}_{k}": R(f"compare/sweep/{{cmpsubj}}/{{cmpgen}}_{b}{ext}")
                for i, b in enumerate(CMP_SWEEP) for k, ext in (("metrics", ".csv"), ("timing", "_timing.csv"))},
         params:
@@ -151,6 +162,7 @@ if CMP_FM:
             CMP_CLIPS,
         output:
             **{f"{g}_{k}": CMP_OUT[k].replace("{cmpgen}", g) for g in CMP_FM for k in ("metrics", "timing", "shown")},
+            **{f"{g}_{k}": v.replace("{cmpgen}", g) for g in CMP_FM for k, v in CMP_LONG_OUT.items()},
             **{f"sweep{i}_{k}": R(f"compare/sweep/{{cmpsubj}}/{g}_{b}{ext}") for i, (g, b) in enumerate(CMP_FM_SWEEP)
                for k, ext in (("metrics", ".csv"), ("timing", "_timing.csv"))},
         params:
@@ -177,6 +189,8 @@ if CMP_FM:
 
 CMP_METRICS = [CMP_OUT["metrics"].format(cmpsubj=s, cmpgen=g) for s in CMP_SUBJECTS for g in CMP_RUN]
 CMP_TIMING = [CMP_OUT["timing"].format(cmpsubj=s, cmpgen=g) for s in CMP_SUBJECTS for g in CMP_RUN]
+CMP_LONG_FILES = {k: [v.format(cmpsubj=s, cmpgen=g) for s in CMP_SUBJECTS for g in CMP_RUN]
+                  for k, v in CMP_LONG_OUT.items()}
 # the budget sweep's files: budget by budget, then graph generator, then subject (compare.tables.sweep_runs)
 CMP_SWEEP_FILES = [CMP_SWEEP_OUT.format(cmpsubj=s, cmpgen=g, budget=b) for b in CMP_SWEEP for g in CMP_GRAPHS
                    for s in CMP_SUBJECTS]
@@ -192,6 +206,9 @@ rule compare_tables:
         timing=CMP_TIMING,
         # the budget sweep's runs: quoted as evidence in the claims against the peer
         sweep=CMP_SWEEP_FILES,
+        # the long track's rows and costs (none when compare.long_track is off)
+        long_metrics=CMP_LONG_FILES.get("long_metrics", []),
+        long_timing=CMP_LONG_FILES.get("long_timing", []),
     output:
         clips=report(
             R("compare/clips.csv"),
@@ -206,6 +223,10 @@ rule compare_tables:
             category="The generators side by side",
         ),
         metrics_timing=R("compare/metrics_timing.csv"),
+        **({"metrics_long": report(R("compare/metrics_long.csv"), caption="../report/compare_metrics_long.rst",
+                                   category="The generators side by side"),
+            "metrics_long_md": R("compare/metrics_long.md"),
+            "metrics_long_timing": R("compare/metrics_long_timing.csv")} if CMP_LONG_ON else {}),
         summary=report(
             R("compare/summary.csv"),
             caption="../report/compare_summary.rst",
@@ -261,7 +282,8 @@ rule compare_tables:
         generators=CMP_RUN,
         left_out=CMP_LEFT_OUT,
         cfg={k: CMP_ORDER if k == "generators" else CMP[k]
-             for k in ("generators", "seeds", "fps", "context", "length", "verdicts", "claims", "seed", "genmm")},
+             for k in ("generators", "seeds", "fps", "context", "length", "verdicts", "claims", "seed", "genmm",
+                       "long_track")},
         source=SOURCE,
         sweep={"default": CMP["transitions_per_s"], "budgets": [float(b) for b in CMP_SWEEP], "generators": CMP_GRAPHS},
     threads: 1
@@ -348,6 +370,36 @@ rule compare_figures:
         "../scripts/compare_figures.py"
 
 
+if CMP_LONG_ON:
+
+    rule compare_long_strips:
+        input:
+            # the showcase subject's (compare.showcase) first long context, seed 0, of every generator
+            shown=[CMP_LONG_OUT["long_shown"].format(cmpsubj=CMP_SHOWCASE_SUBJECT, cmpgen=g) for g in CMP_RUN],
+        output:
+            strips=report(
+                R("compare/long_strips.png"),
+                caption="../report/compare_long_strips.rst",
+                category="The generators side by side",
+            ),
+        params:
+            generators=CMP_RUN,
+            source=SOURCE,
+            seconds=CMP["long_track"]["seconds"],
+        threads: 1
+        resources:
+            mem_mb=1000,
+            runtime=10,
+        log:
+            L("compare/long_strips.log"),
+        benchmark:
+            B("compare/long_strips.tsv")
+        conda:
+            "../envs/animsynth.yaml"
+        script:
+            "../scripts/compare_long_strips.py"
+
+
 COMPARE_TARGETS = [
     R("compare/clips.csv"),
     R("compare/metrics.csv"),
@@ -365,6 +417,8 @@ COMPARE_TARGETS = [
 ] + expand(R("compare/bvh/{cmpgen}.bvh"), cmpgen=CMP_RUN)
 if CMP_SWEEP and CMP_GRAPHS:
     COMPARE_TARGETS += [R("compare/budget_sweep.csv"), R("compare/budget_sweep.png")]
+if CMP_LONG_ON:
+    COMPARE_TARGETS += [R("compare/metrics_long.csv"), R("compare/long_strips.png")]
 
 # Tables for results/summary.md (its section "The generators side by side") and the verdict file.
 COMPARE_SUMMARY = [
@@ -400,3 +454,9 @@ COMPARE_FIGURES = [
         "breaks the motion, and whether its poses stay plausible.",
     },
 ]
+if CMP_LONG_ON:
+    COMPARE_FIGURES.append({
+        "png": R("compare/long_strips.png"),
+        "caption": f"The long track: {CMP['long_track']['seconds']:g} s of every generator from the same start, its "
+        "root path from above beside its poses every 2 s: loops and freezes the long track's measures count.",
+    })

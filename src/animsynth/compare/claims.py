@@ -20,8 +20,8 @@ import re
 from ..config import ConfigError
 from .measures.metric_table import KEY_COLUMNS, metric_or_blank
 
-__all__ = ["EVERY", "declared_claims", "margin", "check_claims", "claims_markdown", "margins_markdown",
-           "update_page", "page_parts"]
+__all__ = ["EVERY", "claim_track", "track_claims", "declared_claims", "margin", "check_claims", "claims_markdown",
+           "margins_markdown", "update_page", "page_parts"]
 
 #: ``b`` of a claim against every generator of the run but the references (one intersection-union finding)
 EVERY = "*"
@@ -51,6 +51,17 @@ def margin(metric: str, vc: dict | None = None, spec: dict | None = None) -> flo
     return None if m is None else float(m)
 
 
+def claim_track(spec: dict) -> str:
+    """The track a declared claim is decided on: its ``track`` key, ``"short"`` (the 2-s continuations) when it
+    gives none."""
+    return spec.get("track") or "short"
+
+
+def track_claims(claims, track: str) -> list[dict]:
+    """The declared claims (``compare.claims``) decided on ``track``, in order: one family of Holm's correction."""
+    return [c for c in claims or [] if claim_track(c) == track]
+
+
 def declared_claims(cmp: dict) -> list[dict]:
     """The declared claims of a ``compare`` block (``compare.claims``), in order, each a copy with ``direction``
     (the metric's when the claim gives none), ``margin`` (:func:`margin`), ``paper_value`` and ``note`` filled in."""
@@ -68,7 +79,9 @@ def declared_claims(cmp: dict) -> list[dict]:
 def check_claims(config: dict) -> None:
     """Refuse at config time what the schema cannot see in ``compare.claims``, one line naming the key.
 
-    An unknown metric, a text column (clip, seed, group, note, ...), an unknown generator (neither one of the
+    An unknown track (:data:`~animsynth.compare.measures.metric_table.TRACKS`), a metric not on the claim's track,
+    a long-track claim while ``compare.long_track`` is off, an unknown metric, a text column (clip, seed, group,
+    note, ...), an unknown generator (neither one of the
     family's rows, :data:`animsynth.compare.generators.names.GENERATORS`, nor in ``compare.user_generators``: a typo),
     ``a == b``, ``'*'`` anywhere but ``b``, a duplicate id, a metric with neither a margin nor ``min_effect``, and a
     descriptive metric (no direction in the metric table) without ``direction``.
@@ -81,20 +94,25 @@ def check_claims(config: dict) -> None:
     ------
     ConfigError
     """
-    from .measures.metric_table import METRIC_NAMES
-
     from .generators.names import GENERATORS
+    from .measures.metric_table import TRACKS, track_names
 
     cmp = config["compare"]
     known = set(GENERATORS) | set(cmp["generators"]) | set(cmp.get("user_generators") or {})
     seen: dict = {}
     for i, c in enumerate(cmp.get("claims") or []):
         key = f"config key 'compare.claims[{i}]"
-        metric = c["metric"]
-        if metric in _TEXT_COLUMNS or metric not in METRIC_NAMES:
-            what = "a text column of metrics.csv" if metric in _TEXT_COLUMNS else "not a metric"
-            raise ConfigError(f"{key}.metric': {metric!r} is {what} (one of the metric table's columns: "
-                              "compare/measures/metric_table.py)")
+        metric, track = c["metric"], claim_track(c)
+        if track not in TRACKS:
+            raise ConfigError(f"{key}.track': {track!r} is not a track (one of {', '.join(TRACKS)})")
+        if track == "long" and not _long_on(cmp):
+            raise ConfigError(f"{key}.track': a long-track claim while config key 'compare.long_track' is off")
+        if metric in _TEXT_COLUMNS or metric not in track_names(track):
+            what = ("a text column of metrics.csv" if metric in _TEXT_COLUMNS else
+                    f"not a metric of the {track} track" if metric in track_names("long") + track_names("short")
+                    else "not a metric")
+            raise ConfigError(f"{key}.metric': {metric!r} is {what} (one of the {track} track's columns of the "
+                              "metric table: compare/measures/metric_table.py)")
         for side in ("a", "b"):
             g = c[side]
             if g == EVERY and side == "a":
@@ -115,6 +133,12 @@ def check_claims(config: dict) -> None:
                               "metric table); say which value of a the claim expects (lower or higher)")
 
 
+def _long_on(cmp: dict) -> bool:
+    """Whether the ``compare`` block runs the long track (``long_track`` set and not ``enabled: false``)."""
+    block = cmp.get("long_track")
+    return bool(block) and bool(block.get("enabled", True))
+
+
 def _md(rows: list[list[str]], head: list[str]) -> str:
     esc = lambda x: str(x).replace("|", "\\|")  # noqa: E731
     return "\n".join(["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -122,8 +146,8 @@ def _md(rows: list[list[str]], head: list[str]) -> str:
 
 
 def claims_markdown(cmp: dict) -> str:
-    """The declared claims of a ``compare`` block as a Markdown table: id, claim, a, b, metric, direction, margin
-    (and where it comes from), what a paper says, the note."""
+    """The declared claims of a ``compare`` block as a Markdown table: id, track (:func:`claim_track`), claim, a, b,
+    metric, direction, margin (and where it comes from), what a paper says, the note."""
     rows = []
     over = ((cmp.get("verdicts") or {}).get("min_effect") or {})
     for raw, s in zip(cmp.get("claims") or [], declared_claims(cmp)):
@@ -131,9 +155,9 @@ def claims_markdown(cmp: dict) -> str:
         src = ("the claim's min_effect" if raw.get("min_effect") is not None else
                "compare.verdicts.min_effect" if s["metric"] in over else "the metric's margin")
         b = "every generator but the references (`*`)" if s["b"] == EVERY else s["b"]
-        rows.append([f"`{s['id']}`", s["claim"], s["a"], b, f"`{s['metric']}`", s["direction"],
+        rows.append([f"`{s['id']}`", claim_track(s), s["claim"], s["a"], b, f"`{s['metric']}`", s["direction"],
                      f"{s['margin']:g} {unit} ({src})", s["paper_value"], s["note"]])
-    return _md(rows, ["id", "claim", "a", "b", "metric", "direction", "margin", "paper", "note"])
+    return _md(rows, ["id", "track", "claim", "a", "b", "metric", "direction", "margin", "paper", "note"])
 
 
 def margins_markdown(cmp: dict) -> str:

@@ -10,7 +10,8 @@ reading its inputs and writing its outputs; the work is done by the modules it c
   (:mod:`animsynth.compare.tables`, :mod:`animsynth.compare.verdicts`), the clips table (:func:`gather_clips`);
 * :func:`sweep_job`: the transition budget sweep's table and figure;
 * :func:`figures_job`: ``metrics.png``, ``strips.png`` (:mod:`animsynth.compare.plots`) and the showcase's BVH
-  files.
+  files;
+* :func:`long_strips_job`: ``long_strips.png``, the long track's preview.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import logging
 
 log = logging.getLogger("animsynth.compare.jobs")
 
-__all__ = ["clips_job", "run_job", "tables_job", "sweep_job", "figures_job", "gather_clips"]
+__all__ = ["clips_job", "run_job", "tables_job", "sweep_job", "figures_job", "long_strips_job", "gather_clips"]
 
 
 def clips_job(trials: dict, subsets: dict, resequencing: dict, cfg: dict, out: dict, subjects: dict | None = None,
@@ -47,14 +48,22 @@ def clips_job(trials: dict, subsets: dict, resequencing: dict, cfg: dict, out: d
 def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase, out: dict) -> None:
     """One generator over one subject's clips and seeds (one row of a workflow job): ``out`` names ``metrics``,
     ``timing``, and optionally ``shown`` (with ``showcase``: (clip spec, seed[, required]),
-    :func:`animsynth.compare.runner.showcase_clip`) and ``bvh`` (the showcase as BVH, start frames included)."""
+    :func:`animsynth.compare.runner.showcase_clip`) and ``bvh`` (the showcase as BVH, start frames included); with
+    the long track on (``cfg["long_track"]``), ``long_metrics``, ``long_timing`` and ``long_shown`` (its files,
+    :mod:`animsynth.compare.long_track`, from the same builds)."""
     from ..io.bvh import write_bvh
     from ..tables import write_table
     from .protocol import load_clips
     from .runner import run_isolated, save_shown
 
     clips = load_clips(clips_path)
-    metrics, timing, shown = run_isolated(clips, generator, cfg, master_seed, roles, showcase, out.values())
+    metrics, timing, shown, long = run_isolated(clips, generator, cfg, master_seed, roles, showcase, out.values())
+    if "long_metrics" in out:
+        if long is None or long["shown"] is None:
+            raise ValueError(f"{generator}: the long track ran no context (config key 'compare.long_track')")
+        write_table(long["metrics"], out["long_metrics"], md=False)
+        write_table(long["timing"], out["long_timing"], md=False)
+        save_shown(out["long_shown"], long["shown"])
     if "shown" in out and shown is None:
         raise ValueError(f"config key 'compare.showcase': clip {showcase[0]!r} seed {showcase[1]} was not run")
     write_table(metrics, out["metrics"], md=False)
@@ -112,11 +121,13 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     table, ``metrics``, ``timing`` lists; optional ``sweep``: the budget sweep's metrics files) into ``out``: ``metrics``,
     ``metrics_timing``, ``summary``, ``winners`` (+ ``winners_md``), ``cost`` (+ ``cost_md``), ``verdicts``
     (+ ``verdicts_md``), ``claims_stats``, ``exploratory`` (+ ``exploratory_md``), ``sanity`` (+ ``sanity_md``),
-    ``sensitivity`` (+ ``sensitivity_md``), ``summary_md`` (the family's page)."""
+    ``sensitivity`` (+ ``sensitivity_md``), ``summary_md`` (the family's page); with the long track's files
+    (``inp["long_metrics"]``, ``inp["long_timing"]``), ``metrics_long`` (+ ``metrics_long_md``: its medians) and
+    ``metrics_long_timing``."""
     import pandas as pd
 
     from ..atomic import atomic_write_text
-    from ..tables import write_table
+    from ..tables import to_markdown, write_table
     from .tables import family_tables
 
     write_table(gather_clips(inp["clips"], cfg, inp.get("clip_files", ())), out["clips"], md=out["clips_md"])
@@ -124,6 +135,10 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
         write_table(pd.concat([pd.read_csv(p, keep_default_na=False) for p in inp["captures"]], ignore_index=True),
                     out["captures"], md=False)
     t = family_tables(dict(inp, clips=out["clips"]), generators, left_out, cfg, source, sweep)
+    if inp.get("long_metrics"):  # the long track: its rows, its claims after the 2-s ones, its own section
+        from .long_tables import with_long_track
+
+        t = with_long_track(t, inp, left_out, cfg, out["clips"])
     write_table(t["metrics"], out["metrics"], md=False)
     write_table(t["metrics_timing"], out["metrics_timing"], md=False)
     write_table(t["summary"], out["summary"], md=False)  # compare/summary.md is the family's page below
@@ -134,7 +149,28 @@ def tables_job(inp: dict, out: dict, generators, left_out: dict, cfg: dict, sour
     write_table(t["exploratory"], out["exploratory"], md=out["exploratory_md"])
     write_table(t["sanity"], out["sanity"], md=out["sanity_md"])
     write_table(t["sensitivity"], out["sensitivity"], md=out["sensitivity_md"])
+    if "long" in t:  # the long track's rows, medians (the .md) and cost
+        write_table(t["long"]["metrics"], out["metrics_long"], md=False)
+        atomic_write_text(out["metrics_long_md"], to_markdown(
+            t["long"]["medians"], "The long track: median and spread per generator and measure",
+            "Over long contexts x seeds (rows: metrics_long.csv; docs/compare/long_track.md)."))
+        write_table(t["long"]["timing"], out["metrics_long_timing"], md=False)
     atomic_write_text(out["summary_md"], t["summary_md"])
+
+
+def long_strips_job(shown_paths, generators, source: str, seconds: float, path) -> None:
+    """``compare/long_strips.png``: the showcase subject's first long context, seed 0, one row per generator
+    (``shown_paths``: its ``<generator>_long_showcase.npz`` in the order of ``generators``;
+    :func:`animsynth.compare.plots.long_strips_figure`)."""
+    from .plots import long_strips_figure
+    from .runner import load_shown
+
+    data = "synthetic mocap" if source == "synthetic" else f"{source} mocap"
+    shown = {g: load_shown(f) for g, f in zip(generators, shown_paths)}
+    clip = next((m.name.split(" ", 1)[-1] for m in shown.values() if not m.meta.get("note")), "")
+    long_strips_figure(path, shown, title=f"{seconds:g} s from the same start ({data}): {clip}\nleft: root path "
+                       "from above (dots every 2 s); right: poses every 2 s (grey: last start frame, red: at a seam)")
+    log.info("long_strips.png: %s", ", ".join(shown))
 
 
 def figures_job(metrics_path, shown_paths, generators, source: str, out: dict) -> None:

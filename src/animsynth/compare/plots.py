@@ -113,6 +113,57 @@ def strips_figure(path, shown: dict, n_panels: int = 8, title: str = "") -> None
     _save(fig, path, title)
 
 
+def long_strips_figure(path, shown: dict, every_s: float = 2.0, title: str = "") -> None:
+    """The long track's preview: one row per generator from the same start, its root path seen from above (start
+    grey, generated blue, a dot every ``every_s`` seconds) beside its poses every ``every_s`` seconds (side view,
+    each centred on its root; seam frames red), so a loop (a path over itself, poses that repeat) or a freeze (dots
+    on one spot, one pose) can be seen.
+
+    Parameters
+    ----------
+    shown : {generator: Motion}, the start and the long run's frames joined (``meta["context"]``: start frames,
+        ``meta["seams"]``, ``meta["note"]``: why a generator with no long motion shows its start alone)
+    """
+    import matplotlib.pyplot as plt
+
+    from .measures import positions
+
+    names = list(shown)
+    longest = max(m.n_frames - int(m.meta["context"]) for m in shown.values())
+    step = max(1, int(round(every_s * next(iter(shown.values())).fps)))
+    n_poses = longest // step + 2
+    fig, axes = plt.subplots(len(names), 2, figsize=(2.2 + 0.9 * n_poses, 1.7 * len(names)), dpi=100,
+                             squeeze=False, gridspec_kw={"width_ratios": [1.6, 0.9 * n_poses]})
+    for (path_ax, ax), g in zip(axes, names):
+        m = shown[g]
+        pos, c = positions(m), int(m.meta["context"])
+        height = float(np.ptp(pos[:, :, 1])) or 1.0
+        idx = np.concatenate([[c - 1], np.arange(c + step - 1, pos.shape[0], step)])
+        path_ax.plot(pos[:c, 0, 0], pos[:c, 0, 2], "-", color="0.6", lw=1.5)
+        path_ax.plot(pos[c - 1:, 0, 0], pos[c - 1:, 0, 2], "-", color="tab:blue", lw=0.8)
+        path_ax.plot(pos[idx[1:], 0, 0], pos[idx[1:], 0, 2], ".", color="tab:blue", ms=4)
+        path_ax.set_aspect("equal", adjustable="datalim")
+        path_ax.tick_params(labelsize=6)
+        seams = {int(x) for x in np.asarray(m.meta.get("seams", []))}
+        parents = m.skeleton.parents()
+        for k, f in enumerate(idx):
+            q = pos[f] - pos[f, :1] * np.array([1.0, 0.0, 1.0])
+            x = q[:, 0] + k * height * 0.9
+            colour = "0.6" if f < c else ("tab:red" if any(abs(f - s) <= 1 for s in seams) else "tab:blue")
+            for j, p in enumerate(parents):
+                if p >= 0:
+                    ax.plot([x[p], x[j]], [q[p, 1], q[j, 1]], "-", color=colour, lw=1.1)
+            ax.text(k * height * 0.9, pos[:, :, 1].min() - 0.1 * height, f"{(f - c + 1) / m.fps:.0f} s", ha="center",
+                    fontsize=6)
+        ax.set_xlim(-0.6 * height, (n_poses - 0.4) * height * 0.9)
+        ax.set_aspect("equal")
+        ax.axis("off")
+        note = str(m.meta.get("note") or "")
+        note = f" -- no long motion: {note if len(note) <= 110 else note[:107] + '...'}" if note else ""
+        ax.set_title(g + note, fontsize=8.5, loc="left")
+    _save(fig, path, title)
+
+
 def sweep_figure(table: pd.DataFrame, path, default_budget: float) -> None:
     """The transition budget sweep (:func:`animsynth.compare.tables.sweep_table`): one panel per metric, one line
     per graph generator against the budget (transitions per second of database, log scale), one panel per metric of

@@ -10,7 +10,8 @@ generator is special-cased by name.
 Files of one generator job: per subject and generator ``compare/runs/<subject>/<generator>.csv`` (metrics, one row
 per clip x seed), ``<generator>_timing.csv`` (build and generation cost, one row per database,
 :data:`TIMING_COLUMNS`) and ``<generator>_showcase.npz`` (the subject's showcase clip's start and generated frames:
-:func:`save_shown` / :func:`load_shown`).
+:func:`save_shown` / :func:`load_shown`); with ``compare.long_track`` on, the long track's files from the same
+builds (:func:`run_tracks`, :mod:`animsynth.compare.long_track`).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from .measures.metric_table import KEY_COLUMNS, METRIC_NAMES
 from .protocol import Clip, clip_seeds
 from .scoring import DatabaseKinematics, reference, run_values, score
 
-__all__ = ["TIMING_COLUMNS", "cpu_seconds", "peak_rss_mb", "run_generator", "run_isolated", "failed_run",
+__all__ = ["TIMING_COLUMNS", "cpu_seconds", "peak_rss_mb", "run_generator", "run_tracks", "run_isolated", "failed_run",
            "generation_query", "native_inputs", "by_database", "showcase_clip", "save_shown", "load_shown"]
 
 log = logging.getLogger("animsynth.compare.runner")
@@ -89,6 +90,21 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
     A user generator (``compare.user_generators``) that fails in any way (:class:`UserGeneratorError`) stops at
     its first failure: one error line, and every row of it empty (:func:`failed_run`).
     """
+    return run_tracks(clips, generator, dict(cfg, long_track=None), master_seed, roles, showcase)[:3]
+
+
+def run_tracks(clips: list[Clip], generator: str, cfg: dict, master_seed: int, roles: dict | None = None,
+               showcase: tuple[str, int] | None = None):
+    """:func:`run_generator` and, from the same build of each database, the long track
+    (:mod:`animsynth.compare.long_track`, ``cfg["long_track"]``: :func:`~.long_track.long_settings` of the row).
+
+    Returns
+    -------
+    metrics, timing, shown : as :func:`run_generator`
+    long : dict or None (the track off): ``metrics`` (one row per long context x seed,
+        :data:`~.long_track.LONG_COLUMNS`), ``timing`` (one row per database with a long context,
+        :data:`~.long_track.LONG_TIMING_COLUMNS`), ``shown`` (the first long context's start and seed 0's frames)
+    """
     from .generators.user import UserGeneratorError, close_processes
 
     try:
@@ -106,15 +122,25 @@ def failed_run(clips: list[Clip], generator: str, cfg: dict, why: str, showcase:
     line = " ".join(why.split())
     log.error("%s", line)
     print(f"animsynth: ERROR: {line}", file=sys.stderr)
+    from .long_track import long_contexts, long_settings, not_run_rows
+
     rows, trows, shown = [], [], None
     shown_id = None if showcase is None else showcase_clip(clips, showcase[0])
-    for key, cs in by_database(clips).items():
+    grouped = by_database(clips)
+    for key, cs in grouped.items():
         r, sh = _not_run(cs, generator, int(cfg["seeds"]), f"failed: {line}", shown_id)
         rows += r
         shown = shown or sh
         trows.append(_timing_row(generator, key, cs))
+    long = None
+    ls = long_settings(cfg.get("long_track"), generator)
+    if ls:
+        ids = long_contexts(grouped, ls["contexts_per_subject"])
+        lcs = [c for c in clips if c.clip in ids]
+        long = {"rows": not_run_rows(lcs, generator, ls["seeds"], f"did not run: failed: {line}"), "timing": [],
+                "shown": _start_only(lcs[0], generator, f"failed: {line}") if lcs else None}
     return (pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"]), pd.DataFrame(trows, columns=TIMING_COLUMNS),
-            shown)
+            shown, _long_frames(long))
 
 
 def _start_only(clip: Clip, generator: str, note: str) -> Motion:
@@ -269,19 +295,29 @@ def showcase_clip(clips: list[Clip], spec: str | None) -> str | None:
 
 
 def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
-    """:func:`run_generator`: one build per database (:func:`by_database`), every window and seed of it from that
-    build."""
+    """:func:`run_tracks`: one build per database (:func:`by_database`), every window and seed of it from that
+    build, then the database's long contexts from the same build."""
+    from .long_track import long_contexts, long_settings, not_run_rows
+
     rows, trows, shown = [], [], None
     kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
     shown_id = (None, 0) if showcase is None else (showcase_clip(clips, showcase[0]), int(showcase[1]))
     required = showcase is not None and (len(showcase) < 3 or bool(showcase[2]))
-    for key, cs in by_database(clips).items():
+    grouped = by_database(clips)
+    ls = long_settings(cfg.get("long_track"), generator)
+    long_ids = set(long_contexts(grouped, ls["contexts_per_subject"])) if ls else set()
+    long = {"rows": [], "timing": [], "shown": None, "said": set()} if ls else None
+    for key, cs in grouped.items():
         gen, cost = _fit(generator, cs, cfg, key, (shown_id[0], required))
+        lcs = [c for c in cs if c.clip in long_ids]
         if gen is None:
             r, sh = _not_run(cs, generator, int(cfg["seeds"]), cost, shown_id[0])
             rows += r
             shown = shown or sh
             trows.append(_timing_row(generator, key, cs))
+            if lcs:
+                long["rows"] += not_run_rows(lcs, generator, ls["seeds"], f"did not run: {cost}")
+                long["shown"] = long["shown"] or _start_only(lcs[0], generator, cost)
             continue
         r, sh, g_cpu, g_wall, frames, rss = _run_windows(gen, generator, cs, cfg, master_seed, roles, kin, shown_id)
         rows += r
@@ -291,8 +327,90 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
                                                                           gen.outside_cost()["rss_mb"])))
         log.info("%s on %s: build %.3f s CPU, %d windows x %d seeds: %d frames in %.3f s CPU", generator, key,
                  cost["build_cpu_s"], len(cs), int(cfg["seeds"]), frames, g_cpu)
+        if lcs:  # the long track from the same build
+            r, sh, lcost = _run_long(gen, generator, lcs, ls, cfg, master_seed, roles, kin, long["said"])
+            long["rows"] += r
+            long["shown"] = long["shown"] or sh or _start_only(lcs[0], generator, r[0]["note"])
+            long["timing"].append({**lcost, "database": key})
+            log.info("%s on %s, long track: %d contexts x %d seeds: %d frames, %.3f s CPU generating, %.3f s CPU "
+                     "scoring", generator, key, len(lcs), ls["seeds"], lcost["frames_generated"],
+                     lcost["generate_cpu_s"], lcost["score_cpu_s"])
     metrics = pd.DataFrame(rows, columns=KEY_COLUMNS + METRIC_NAMES + ["note"])
-    return metrics, pd.DataFrame(trows, columns=TIMING_COLUMNS), shown
+    return metrics, pd.DataFrame(trows, columns=TIMING_COLUMNS), shown, _long_frames(long)
+
+
+def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, master_seed: int, roles, kin,
+             said: set) -> tuple[list[dict], object, dict]:
+    """Every long seed of the windows ``cs`` (one database's chosen long contexts) from the fitted ``gen``
+    (:mod:`animsynth.compare.long_track`).
+
+    Parameters
+    ----------
+    gen : the fitted generator (the short track's build of this database)
+    generator : its row name
+    cs : list of Clip, the database's long contexts (:func:`~.long_track.long_contexts`)
+    settings : :func:`~.long_track.long_settings` of the row
+    cfg : the job's ``compare`` config (``fps``, ``seed``, ``seeds``, ``metrics``)
+    master_seed : the config's ``seed``
+    roles : joint-role overrides
+    kin : the job's :class:`~animsynth.compare.scoring.DatabaseKinematics`
+    said : the "did not run" reasons already logged by this job (a reason is logged once)
+
+    Returns
+    -------
+    rows : list of dict, one per window x seed (:data:`~.long_track.LONG_COLUMNS`)
+    shown : Motion or None, the first window's start and seed 0's frames joined
+    cost : dict, this database's row of :data:`~.long_track.LONG_TIMING_COLUMNS`
+    """
+    from .long_track import generate_long, not_run_rows, say_once
+
+    n = int(round(settings["seconds"] * float(cfg["fps"])))
+    n_seeds, mcfg = settings["seeds"], cfg["metrics"]
+    rows, shown = [], None
+    cost = {"generator": generator, "contexts": len(cs), "seeds": n_seeds, "frames_generated": 0,
+            "generate_cpu_s": 0.0, "generate_wall_s": 0.0, "score_cpu_s": 0.0}
+    for clip in cs:
+        gen.set_label(f"{clip.clip} long")
+        seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, max(n_seeds, int(cfg["seeds"])))[:n_seeds]
+        query = {**generation_query(gen, clip), **native_inputs(gen, clip)[1]}
+        ref, feats, these = None, [], []
+        for i, s in enumerate(seeds):
+            c0, w0 = cpu_seconds(), time.perf_counter()
+            m, why = generate_long(gen, clip, n, s, query)
+            cost["generate_cpu_s"] += cpu_seconds() - c0 + gen.outside_cost()["cpu_s"]
+            cost["generate_wall_s"] += time.perf_counter() - w0
+            if m is None:
+                say_once(generator, clip, why, said)
+                these += not_run_rows([clip], generator, 1, f"did not run: {why}")
+                these[-1]["seed"] = i
+                continue
+            c0 = cpu_seconds()
+            ref = reference(clip, mcfg, roles, None, kin) if ref is None else ref
+            row, f = score(clip, ref, m, generator, mcfg, roles, track="long", entry_seam=gen.entry_seam)
+            cost["score_cpu_s"] += cpu_seconds() - c0
+            cost["frames_generated"] += n
+            feats.append(f)
+            these.append({"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator,
+                          "seed": i, **row, "note": ""})
+            if i == 0 and shown is None:
+                shown = _shown(clip, m, f"{generator} {clip.clip} seed 0, {settings['seconds']:g} s", gen.entry_seam)
+        if feats and len(feats) == len(seeds):  # the spread over seeds and the generator's own counts
+            per_run = run_values(gen, feats, track="long")
+            for r in these:
+                r.update(per_run)
+        rows += these
+    return rows, shown, cost
+
+
+def _long_frames(long: dict | None) -> dict | None:
+    """The long track's results as frames: ``metrics`` (:data:`~.long_track.LONG_COLUMNS`), ``timing``
+    (:data:`~.long_track.LONG_TIMING_COLUMNS`) and ``shown``; ``None`` when the track is off."""
+    from .long_track import LONG_COLUMNS, LONG_TIMING_COLUMNS
+
+    if long is None:
+        return None
+    return {"metrics": pd.DataFrame(long["rows"], columns=LONG_COLUMNS),
+            "timing": pd.DataFrame(long["timing"], columns=LONG_TIMING_COLUMNS), "shown": long["shown"]}
 
 
 
@@ -324,7 +442,7 @@ def load_shown(path) -> Motion:
 
 def run_isolated(clips: list[Clip], generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase,
                  outputs) -> tuple:
-    """:func:`run_generator` as one workflow job runs it: with one BLAS thread (the job's threads: 1; the simplex
+    """:func:`run_tracks` as one workflow job runs it: with one BLAS thread (the job's threads: 1; the simplex
     searches make many small LAPACK calls) and, for a user generator (``compare.user_generators``), a guard on the
     project (the working directory) and the folder of the job's ``outputs`` (paths), which it may not change."""
     from threadpoolctl import threadpool_limits
@@ -333,4 +451,4 @@ def run_isolated(clips: list[Clip], generator: str, cfg: dict, master_seed: int,
         outs = [os.path.dirname(os.path.abspath(p)) for p in outputs]
         cfg = dict(cfg, user_guard=list(dict.fromkeys([os.getcwd(), os.path.commonpath(outs)])))
     with threadpool_limits(1, user_api="blas"):
-        return run_generator(clips, generator, cfg, master_seed, roles, showcase)
+        return run_tracks(clips, generator, cfg, master_seed, roles, showcase)

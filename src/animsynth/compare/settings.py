@@ -218,7 +218,8 @@ def job_cfg(config: dict, generator: str | None = None, budget: float | None = N
         family runs that study's method); ``None``: the config of every generator at once (each block and
         ``stisomap``), for a caller that fits several generators from one config
     budget : a transition budget of the budget sweep (``compare.budget_sweep``): ``transitions_per_s`` set to it
-        and ``compare.budget_sweep_seeds`` seeds (at most ``compare.seeds``)
+        and ``compare.budget_sweep_seeds`` seeds (at most ``compare.seeds``); without one, a generator's config has
+        ``long_track``: its long-track settings (:func:`animsynth.compare.long_track.long_settings`, ``None``: off)
 
     Returns
     -------
@@ -238,6 +239,11 @@ def job_cfg(config: dict, generator: str | None = None, budget: float | None = N
     if budget is not None:
         cfg["transitions_per_s"] = float(budget)
         cfg["seeds"] = min(int(cmp["seeds"]), int(cmp["budget_sweep_seeds"]))
+    elif generator is not None:
+        from .long_track import long_settings
+
+        # the row's own long-track settings (its seeds resolved): another row's seeds rerun nothing here
+        cfg["long_track"] = long_settings(cmp.get("long_track"), generator)
     return cfg
 
 

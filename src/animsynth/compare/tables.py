@@ -13,6 +13,7 @@ from .generators.names import GENERATORS, REFERENCES
 from .measures.metric_table import (METRIC_NAMES, RESULT_METRICS, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, SWEEP_METRICS,
                            at_speed, metric)
 from .claim_stats import pair_outcomes
+from .claims import track_claims
 
 log = logging.getLogger("animsynth.compare.tables")
 
@@ -59,7 +60,8 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
     Returns ``{name: DataFrame}``: ``metrics`` (every row, in the clips' and the config's generator order),
     ``metrics_timing``, ``summary``, ``winners``, ``cost``, ``verdicts`` (the declared claims, ``cfg["claims"]``),
     ``claims_stats`` (their numbers), ``exploratory`` (every other pair, no verdict), ``sanity``, ``sensitivity``;
-    and ``summary_md``: the family's page (text).
+    and ``summary_md``: the family's page (text); ``data``: what the run is on (the verdicts' ``data``). The claims
+    decided are the 2-s track's (the long track's: :func:`animsynth.compare.long_tables.with_long_track`).
 
     ``sweep``: ``{"default": transitions_per_s, "budgets": [...], "generators": [...]}`` describing
     ``inp["sweep"]`` (:func:`sweep_runs`); the claims against the peer quote the sweep as evidence."""
@@ -86,7 +88,7 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
         sweep_tab = sweep_table(sweep_runs(metrics, inp["sweep"], sweep["default"], sweep["budgets"],
                                            sweep["generators"]), order)
     seed = int(cfg.get("seed", 0))
-    declared = cfg.get("claims") or []
+    declared = track_claims(cfg.get("claims"), "short")  # the long track's claims: their own Holm family
     verdicts, claims_stats = decide_claims(own, cfg["verdicts"], data, left_out, clips_full, sweep=sweep_tab,
                                            claims=declared, seed=seed)
     exploratory = exploratory_table(own, cfg["verdicts"], clips_full, claims=declared, order=order, seed=seed,
@@ -98,11 +100,13 @@ def family_tables(inp: dict, generators, left_out: dict, cfg: dict, source: str,
     log.info("%d rows (%d clips x %d generators x %d seeds), %d not built, %d verdicts: %s", len(metrics),
              metrics["clip"].nunique(), metrics["generator"].nunique(), int(cfg["seeds"]), len(not_built),
              len(verdicts), ", ".join(verdicts["verdict"]))
-    return {"metrics": metrics, "metrics_timing": timing, "summary": summary, "winners": winners,
-            "cost": cost_table(timing, order), "verdicts": verdicts, "claims_stats": claims_stats,
-            "exploratory": exploratory, "sanity": sanity, "sensitivity": sensitivity_table(metrics, order),
-            "summary_md": summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg, not_built,
-                                           sanity, {g: w for g, w in empty.items() if w})}
+    out = {"metrics": metrics, "metrics_timing": timing, "summary": summary, "winners": winners,
+           "cost": cost_table(timing, order), "verdicts": verdicts, "claims_stats": claims_stats,
+           "exploratory": exploratory, "sanity": sanity, "sensitivity": sensitivity_table(metrics, order),
+           "summary_md": summary_markdown(clips, winners, verdicts, generators, left_out, data, cfg, not_built,
+                                          sanity, {g: w for g, w in empty.items() if w})}
+    out["data"] = data  # what the run is on: the long track's tables say it too
+    return out
 
 
 def order_generators(names, order) -> list[str]:
@@ -110,12 +114,13 @@ def order_generators(names, order) -> list[str]:
     return [g for g in order if g in set(names)]
 
 
-def summary_table(metrics: pd.DataFrame, order) -> pd.DataFrame:
-    """Per generator and metric: n (clip x seed rows with a value), median, IQR and 5-95 % range."""
+def summary_table(metrics: pd.DataFrame, order, names=METRIC_NAMES) -> pd.DataFrame:
+    """Per generator and metric (``names``: the track's columns, the short track's by default): n (clip x seed rows
+    with a value), median, IQR and 5-95 % range."""
     out = []
     for g in order_generators(metrics["generator"].unique(), order):
         sub = metrics[metrics["generator"] == g]
-        for m in METRIC_NAMES:
+        for m in names:
             x = pd.to_numeric(sub[m], errors="coerce").to_numpy(float)
             x = x[np.isfinite(x)]
             q = np.percentile(x, [5, 25, 50, 75, 95]) if x.size else np.full(5, np.nan)

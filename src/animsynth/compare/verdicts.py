@@ -146,8 +146,9 @@ class _Claim:
     """One declared claim: its statistics (or why it has none) and how to write its row once Holm has run."""
 
     def __init__(self, spec: dict, metrics: pd.DataFrame, groups: dict, vc: dict, data: str, left_out: dict,
-                 seed: int, sweep=None, generic=frozenset()):
+                 seed: int, sweep=None, generic=frozenset(), source: str = "compare/metrics.csv"):
         self.spec, self.data, self.vc, self.groups, self.seed = spec, data, vc, groups, seed
+        self.source = source
         self.a, self.b, self.metric = spec["a"], spec["b"], spec["metric"]
         if spec["margin"] is None or not spec["direction"]:
             raise ValueError(f"claim {spec['id']!r}: metric {self.metric!r} needs a margin (min_effect) and a direction "
@@ -299,7 +300,7 @@ class _Claim:
         if self.st is None:
             return V.row(spec["claim"], word, f"{lead}{word} because {why}", paper_value=spec.get("paper_value", ""),
                          ours=f"{word} (0 {_units(vc)})" if word == "undecided" else word, data=self.data,
-                         source="compare/metrics.csv")
+                         source=self.source)
         st = self.st
         unit = metric_or_blank(self.metric).unit
         grouping = GROUPINGS[vc.get("grouping", "subject")]
@@ -351,12 +352,12 @@ class _Claim:
             elif ev := _sweep_evidence(self.sweep, self.a, self.b, self.metric):
                 text += "; " + ev
         return V.row(spec["claim"], word, text, paper_value=spec.get("paper_value", ""),
-                     ours=self._ours(word, p_holm), data=self.data, source="compare/metrics.csv")
+                     ours=self._ours(word, p_holm), data=self.data, source=self.source)
 
 
 def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | None = None,
                   clips: pd.DataFrame | None = None, sweep: pd.DataFrame | None = None, *, claims,
-                  seed: int = 0) -> tuple[pd.DataFrame, pd.DataFrame]:
+                  seed: int = 0, source: str = "compare/metrics.csv") -> tuple[pd.DataFrame, pd.DataFrame]:
     """The declared claims decided: the verdict table and ``claims_stats.csv`` (:data:`STATS_COLUMNS`).
 
     Parameters
@@ -370,13 +371,15 @@ def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
         column; ``None``: each subset one group, every subject on its own skeleton)
     sweep : DataFrame or None, the budget sweep table (:func:`animsynth.compare.tables.sweep_table`): quoted as
         evidence in the claims against the peer (decided at the default budget)
-    claims : the declared claims (``compare.claims`` of the config); every one gets a row
+    claims : the declared claims (``compare.claims`` of the config); every one gets a row, and Holm's correction
+        runs over them (one track's claims: :func:`animsynth.compare.claims.track_claims`)
     seed : the seed of the random sign flips (more than :data:`EXACT_MAX` groups; ``compare.seed``)
+    source : the table the claims read (``compare/metrics_long.csv`` for the long track), the rows' ``source``
     """
     groups = clip_groups(metrics, clips, vc)
     specs = declared_claims({"claims": claims, "verdicts": vc})
     generic = generic_clips(clips)
-    cs = [_Claim(s, metrics, groups, vc, data, left_out or {}, seed, sweep, generic) for s in specs]
+    cs = [_Claim(s, metrics, groups, vc, data, left_out or {}, seed, sweep, generic, source) for s in specs]
     ps = [c.p for c in cs]
     adj = V.holm(ps)
     m = int(np.sum(np.isfinite(ps)))
