@@ -13,12 +13,15 @@ from pathlib import Path
 
 import pytest
 
-from conftest import REPO, SAFETY_TIMEOUT, copy_workflow, place_papers
+from conftest import REPO, SAFETY_TIMEOUT, copy_finished_run, place_papers
 
 pytestmark = pytest.mark.workflow
 
-#: a small part of the tiny run: 12 synthetic trials made and parsed, then Table I's lengths (25 jobs)
+#: a small part of the tiny run: Table I's lengths, rebuilt in a copy of the finished tiny run whose 12 parsed trials
+#: and Table I are removed (13 jobs; the synthetic trials the parse jobs read are kept, so none of the 12
+#: synth_trial jobs runs again)
 TARGET = "results/data/datasets.csv"
+REMOVED = ("results/data/trials/*.npz", TARGET, "results/data/datasets.md")
 
 
 def _run_py(wd: Path, **kw) -> subprocess.Popen:
@@ -31,7 +34,11 @@ def _run_py(wd: Path, **kw) -> subprocess.Popen:
 
 
 def test_ctrl_c_leaves_no_lock_and_the_same_command_resumes(tiny_workflow, tmp_path):
-    wd = copy_workflow(tmp_path / "run")
+    wd = copy_finished_run(tiny_workflow, tmp_path / "run")
+    for pattern in REMOVED:
+        for p in wd.glob(pattern):
+            p.unlink()
+    assert not list((wd / "results/data/trials").glob("*.npz"))
     for name in ("run.py", "pyproject.toml"):  # run.py checks the venv against pyproject.toml
         shutil.copy2(REPO / name, wd / name)
     place_papers(wd)

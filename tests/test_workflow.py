@@ -67,6 +67,15 @@ def _run_jobs(wd: Path) -> list[dict]:
     return jobs
 
 
+@pytest.fixture(scope="module")
+def tiny_summary(tiny_workflow) -> str:
+    """``snakemake --detailed-summary`` of the finished tiny run (one call, read by the two tests below that need
+    every output with its rule and log)."""
+    res = run_snakemake(tiny_workflow, "--configfile", "config/test.yaml", "--detailed-summary")
+    assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
+    return res.stdout
+
+
 def test_every_job_of_the_tiny_run_kept_a_log_and_a_benchmark_file(tiny_workflow):
     jobs = [j for j in _run_jobs(tiny_workflow) if "output" in j]  # the target rule `all` makes nothing
     rules = {j["rule"] for j in jobs}
@@ -86,7 +95,7 @@ def test_every_job_of_the_tiny_run_kept_a_log_and_a_benchmark_file(tiny_workflow
     assert not problems, "\n".join(problems[:40])
 
 
-def test_every_file_the_tiny_run_wrote_is_a_declared_output(tiny_workflow):
+def test_every_file_the_tiny_run_wrote_is_a_declared_output(tiny_workflow, tiny_summary):
     """No rule writes a file it does not declare (snakemake --list-untracked lists none under results/).
 
     The one exception is the benchmark file of the job that aggregates the benchmark files (it is written
@@ -96,9 +105,7 @@ def test_every_file_the_tiny_run_wrote_is_a_declared_output(tiny_workflow):
     res = run_snakemake(tiny_workflow, "--configfile", "config/test.yaml", "--list-untracked")
     assert res.returncode == 0, res.stderr[-2000:]
     listed = [ln.strip() for ln in (res.stdout + res.stderr).splitlines() if ln.strip().startswith("results")]
-    summary = run_snakemake(tiny_workflow, "--configfile", "config/test.yaml", "--detailed-summary")
-    assert summary.returncode == 0, summary.stderr[-2000:]
-    outputs = [ln.split("\t")[0] for ln in summary.stdout.splitlines()[1:] if ln.strip()]
+    outputs = [ln.split("\t")[0] for ln in tiny_summary.splitlines()[1:] if ln.strip()]
     folders = [o.rstrip("/") + "/" for o in outputs if (tiny_workflow / o).is_dir()]
     assert any("meshdetail/character/main" in f for f in folders), folders  # the directory outputs are seen
     own = "results/benchmarks/rules/report/rule_benchmarks.tsv"
@@ -130,13 +137,11 @@ def test_not_compared_is_only_timing_tables():
                        "rule_benchmarks.csv", "rule_benchmarks_per_rule.md"]
 
 
-def _jobs_by_rule(wd: Path) -> dict[str, list[tuple[str, ...]]]:
-    """Every job of the finished run in ``wd``, as its output files, per rule (``--detailed-summary``:
-    outputs of one job share its log)."""
-    res = run_snakemake(wd, "--configfile", "config/test.yaml", "--detailed-summary")
-    assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
-    lines = res.stdout.splitlines()
-    assert lines and lines[0].startswith("output_file\tdate\trule\tlog-file(s)"), res.stdout[:2000]
+def _jobs_by_rule(summary: str) -> dict[str, list[tuple[str, ...]]]:
+    """Every job of a finished run, as its output files, per rule, from the run's ``--detailed-summary``
+    (outputs of one job share its log)."""
+    lines = summary.splitlines()
+    assert lines and lines[0].startswith("output_file\tdate\trule\tlog-file(s)"), summary[:2000]
     jobs: dict[tuple[str, str], list[str]] = {}
     for line in lines[1:]:
         out, date, rule, log = line.split("\t")[:4]
@@ -177,7 +182,7 @@ def _same_content(a: Path, root_a: Path, b: Path, root_b: Path) -> bool:
     return _comparable(a, root_a.resolve()) == _comparable(b, root_b.resolve())
 
 
-def test_same_config_gives_identical_outputs(tiny_workflow, tmp_path):
+def test_same_config_gives_identical_outputs(tiny_workflow, tiny_summary, tmp_path):
     """Determinism without a second whole run: in a copy of the finished tiny run, one job of every rule
     loses its outputs, and one snakemake call rebuilds exactly those (plus whatever lies between them);
     every rule's computation thus runs a second time (except rules that write only timing tables). Each
@@ -186,7 +191,7 @@ def test_same_config_gives_identical_outputs(tiny_workflow, tmp_path):
     ones, byte for byte."""
     wd = copy_finished_run(tiny_workflow, tmp_path / "again" / "run")
     place_papers(wd)
-    by_rule = _jobs_by_rule(wd)
+    by_rule = _jobs_by_rule(tiny_summary)  # the copy holds the tiny run's outputs, under the same relative paths
     assert len(by_rule) > 20, sorted(by_rule)
     # one job per rule; a rule that writes only timing tables (compared nowhere) is not re-run
     chosen = {rule: jobs[0] for rule, jobs in by_rule.items()
