@@ -386,3 +386,36 @@ def test_only_short_lines_between_provenance_and_scoreboard_and_every_timing_tab
     paths, real, data, prov = _run(tmp_path)
     plain = build_summary([], paths, SOURCE_NOTE, prov, data, real, False)
     assert "Timing tables" not in plain and "timing" not in plain.lower()
+
+
+def test_the_long_track_claims_are_a_scoreboard_row_of_their_own(tmp_path):
+    """The comparison's claims decided on the long track's table (their ``source``, report.ROW_PARTS) keep their
+    family and ids but carry a paper label of their own, and the scoreboard draws and counts them as a row of
+    their own after the 2-s claims' row."""
+    from animsynth.report import ROW_PARTS
+
+    paths, real, data, _ = _run(tmp_path)
+    comp = pd.read_csv(paths[-1], dtype=str, keep_default_na=False)
+    long_source = next(iter(ROW_PARTS))
+    extra = [{**comp.iloc[0].to_dict(), "claim": f"long claim {i}", "verdict": v, "source": long_source}
+             for i, v in enumerate(["undecided", "reproduced", "contradicted"])]
+    pd.concat([comp, pd.DataFrame(extra)], ignore_index=True).to_csv(paths[-1], index=False)
+    claims = claims_table(paths, data, real)
+    is_long = claims["source"] == long_source
+    assert list(claims.loc[claims["family"] == "compare", "id"]) == ["C1", "C2", "C3", "C4", "C5"]
+    assert claims.loc[is_long, "paper"].str.endswith(": " + ROW_PARTS[long_source]).all()
+    assert claims.loc[(claims["family"] == "compare") & ~is_long, "paper"].nunique() == 1
+    counts = scoreboard_counts(claims)
+    comp_rows = counts[counts["family"] == "compare"]
+    assert list(comp_rows["claims"]) == [2, 3]
+    assert comp_rows.iloc[1][["reproduced", "contradicted"]].tolist() == [1, 1]
+    assert comp_rows.iloc[1]["paper"].endswith(ROW_PARTS[long_source])
+    fig, drawn = draw_scoreboard(claims)
+    try:
+        assert list(drawn["paper"]) == list(counts["paper"])
+        names = {t.get_text() for t in fig.axes[0].texts}
+        assert set(counts["paper"]) <= names  # one row heading per row, the long track's included
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)

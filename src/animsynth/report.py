@@ -18,6 +18,9 @@ log = logging.getLogger("animsynth.report")
 FAMILY_PAPERS = {f.name: f.paper for f in families.report_order()}
 #: the section of summary.md and of the report's home page that puts the generators side by side
 SIDE_BY_SIDE = families.get("compare").section
+#: ``{verdict source: label}``: a family's claims decided on that table form a scoreboard row of their own, its
+#: ``paper`` the family's with the label added (the comparison's long-track claims beside its 2-s claims)
+ROW_PARTS = {"compare/metrics_long.csv": "the long track"}
 
 
 PAPER_RUN_COMMAND = ("python3 run.py paper --config cmu_mirror=../shared/data/cmu_mocap "
@@ -144,6 +147,8 @@ def claims_table(paths, family_data: dict[str, str] | None = None,
         df.loc[df["data"].str.strip() == "", "data"] = family_data.get(fam, "")
         df.insert(0, "family", fam)
         df.insert(0, "paper", FAMILY_PAPERS.get(fam, fam))
+        for source, part in ROW_PARTS.items():  # claims drawn as a scoreboard row of their own
+            df.loc[df["source"].astype(str) == source, "paper"] = f"{FAMILY_PAPERS.get(fam, fam)}: {part}"
         df["real"] = bool(family_real[fam])
         # a family's sanity_checks.csv (claims true by construction, same format) is shown apart, not counted
         df["sanity_check"] = Path(p).name == SANITY_FILE

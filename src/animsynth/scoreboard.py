@@ -96,6 +96,18 @@ def scoreboard_rows(claims: pd.DataFrame) -> list[str]:
     return [f for f in ROW_ORDER if f in fams] + [f for f in fams if f not in ROW_ORDER]
 
 
+def _row_parts(claims: pd.DataFrame) -> list[tuple[str, str, pd.DataFrame]]:
+    """``(family, paper, rows)`` of every scoreboard row: the families in :func:`scoreboard_rows` order, a family's
+    rows split by their ``paper`` label in table order (a family's claims of another kind, such as the comparison's
+    long track, carry a label of their own and form a row of their own)."""
+    out = []
+    for fam in scoreboard_rows(claims):
+        part = claims[claims["family"].astype(str) == fam]
+        for paper in dict.fromkeys(part["paper"].astype(str)):
+            out.append((fam, paper, part[part["paper"].astype(str) == paper]))
+    return out
+
+
 def _verdict_words(claims: pd.DataFrame) -> list[str]:
     """The verdict columns of the counts: the vocabulary from best to worst (:data:`VERDICT_COLOURS`' order),
     then any other word of the findings (sorted)."""
@@ -122,13 +134,12 @@ def scoreboard_counts(claims: pd.DataFrame) -> pd.DataFrame:
     words = _verdict_words(claims)
     sanity = sanity_checks(claims)
     rows = []
-    for fam in scoreboard_rows(claims):
-        part = claims[claims["family"].astype(str) == fam]
+    for fam, paper, part in _row_parts(claims):
         real = part["real"].map(_real)
         data = "real data" if real.all() else "synthetic data" if not real.any() else "real and synthetic data"
         findings = part[~sanity.loc[part.index]]
         counts = findings["verdict"].astype(str).value_counts()
-        rows.append({"family": fam, "paper": str(part["paper"].iloc[0]), "data": data, "claims": len(findings),
+        rows.append({"family": fam, "paper": paper, "data": data, "claims": len(findings),
                      **{w: int(counts.get(w, 0)) for w in words},
                      "sanity_checks": int(sanity.loc[part.index].sum())})
     return pd.DataFrame(rows, columns=["family", "paper", "data", "claims", *words, "sanity_checks"])
@@ -205,14 +216,14 @@ class _Layout:
         cell, gap, left = self.cell, self.gap, self.left
         self.per_line = per_line
         self.any_sanity = bool(sanity.any())
-        n_sanity_cols = max([int(sanity[claims["family"] == f].sum()) for f in counts["family"]] or [0])
+        parts = _row_parts(claims)
+        n_sanity_cols = max([int(sanity.loc[part.index].sum()) for _f, _p, part in parts] or [0])
         self.n_sanity_cols = min(n_sanity_cols, 6)
         sanity_w = (0.35 + self.n_sanity_cols * (cell + gap) + 0.1) if self.any_sanity else 0.0
         self.width = max(left + per_line * (cell + gap) + sanity_w + 0.25, 8.0)
         self.blocks = []
         y = 0.85 if title != "-" else 0.25
-        for fam in counts["family"]:
-            part = claims[claims["family"].astype(str) == fam]
+        for fam, _paper, part in parts:
             find = part[~sanity.loc[part.index]]
             san = part[sanity.loc[part.index]]
             lines = max(1, int(np.ceil(len(find) / per_line)), int(np.ceil(len(san) / max(self.n_sanity_cols, 1))))

@@ -23,8 +23,10 @@ from .measures.metric_table import on_track
 
 log = logging.getLogger("animsynth.compare.long_tables")
 
-__all__ = ["LONG_ONLY", "long_tables", "long_markdown", "with_long_track"]
+__all__ = ["LONG_ONLY", "LONG_SOURCE", "long_tables", "long_markdown", "with_long_track"]
 
+#: the ``source`` of a long claim's verdict row: the report draws these claims as a scoreboard row of their own
+LONG_SOURCE = "compare/metrics_long.csv"
 #: the records computed on the long track alone (the columns of the summary's long section)
 LONG_ONLY = tuple(m.name for m in on_track("long") if m.tracks == ("long",))
 
@@ -62,7 +64,7 @@ def long_tables(inp: dict, left_out: dict, cfg: dict, clips_full: pd.DataFrame, 
     own = metrics[metrics["generator"].isin(GENERATORS)]
     verdicts, stats = decide_claims(own, cfg["verdicts"], label, left_out, clips_full,
                                     claims=track_claims(cfg.get("claims"), "long"), seed=int(cfg.get("seed", 0)),
-                                    source="compare/metrics_long.csv")
+                                    source=LONG_SOURCE)
     medians = summary_table(metrics, order, LONG_NAMES)
     log.info("long track: %d rows (%d contexts x %d generators), %d verdicts: %s", len(metrics),
              metrics["clip"].nunique(), metrics["generator"].nunique(), len(verdicts), ", ".join(verdicts["verdict"]))
