@@ -90,33 +90,27 @@ def aggregate_rule_benchmarks(paths, root: str = "benchmarks/rules") -> pd.DataF
     return pd.DataFrame(rows, columns=cols)
 
 
+def _per_group(df: pd.DataFrame, key: str, columns: dict) -> pd.DataFrame:
+    """Per value of ``key``: its job count and each ``{output column: (input column, "sum"|"max", decimals)}``."""
+    cols = [key, "jobs", *columns]
+    if df.empty:
+        return pd.DataFrame(columns=cols)
+    g = df.groupby(key, sort=True)
+    out = {key: list(g.groups), "jobs": g.size().values}
+    out.update({name: getattr(g[col], how)().round(nd).values for name, (col, how, nd) in columns.items()})
+    return pd.DataFrame(out)[cols]
+
+
 def rule_benchmark_summary(df: pd.DataFrame) -> pd.DataFrame:
     """Per rule: jobs, total and max runtime, peak memory."""
-    if df.empty:
-        return pd.DataFrame(columns=["rule", "jobs", "total_seconds", "max_seconds", "peak_rss_mb"])
-    g = df.groupby("rule", sort=True)
-    return pd.DataFrame({
-        "rule": list(g.groups),
-        "jobs": g.size().values,
-        "total_seconds": g["seconds"].sum().round(2).values,
-        "max_seconds": g["seconds"].max().round(2).values,
-        "peak_rss_mb": g["max_rss_mb"].max().round(1).values,
-    })
+    return _per_group(df, "rule", {"total_seconds": ("seconds", "sum", 2), "max_seconds": ("seconds", "max", 2),
+                                   "peak_rss_mb": ("max_rss_mb", "max", 1)})
 
 
 def family_benchmark_summary(df: pd.DataFrame) -> pd.DataFrame:
     """Per family (data, simplicial, ...): jobs, summed wall and CPU seconds, peak memory of one job."""
-    cols = ["family", "jobs", "wall_s", "cpu_s", "peak_rss_mb"]
-    if df.empty:
-        return pd.DataFrame(columns=cols)
-    g = df.groupby("family", sort=True)
-    return pd.DataFrame({
-        "family": list(g.groups),
-        "jobs": g.size().values,
-        "wall_s": g["seconds"].sum().round(1).values,
-        "cpu_s": g["cpu_time_s"].sum().round(1).values,
-        "peak_rss_mb": g["max_rss_mb"].max().round(1).values,
-    })[cols]
+    return _per_group(df, "family", {"wall_s": ("seconds", "sum", 1), "cpu_s": ("cpu_time_s", "sum", 1),
+                                     "peak_rss_mb": ("max_rss_mb", "max", 1)})
 
 
 def machine_label() -> str:
