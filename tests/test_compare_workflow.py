@@ -96,6 +96,11 @@ def _long_track_outputs(r, clips, gens, v, stats):
                                                  .groupby(t["generator"]).sum() > 0).all()
     assert "## The 5-second track" in (r / "summary.md").read_text()
     assert (r / "long_strips.png").stat().st_size > 0 and (r / "metrics_long.md").stat().st_size > 0
+    # the results page (docs/compare/results.md) carries the long track's medians as its tables job wrote them
+    from animsynth.compare.tables import results_markdown
+
+    page = results_markdown(r)
+    assert "**The long track**" in page and (r / "metrics_long.md").read_text().strip() in page
 
 
 def _docs_toy() -> str:

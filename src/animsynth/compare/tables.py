@@ -309,7 +309,8 @@ def _num(x) -> str:
 def results_markdown(compare_dir) -> str:
     """The results page docs/compare/results.md, generated from a run's tables (``compare_dir``: e.g.
     ``results/paper/compare``): medians (IQR) per generator, the findings, the sanity checks, the skating
-    sensitivity and, when present, the budget sweep. Every number comes from those files."""
+    sensitivity and, when present, the budget sweep and the long track's medians. Every number comes from those
+    files."""
     from pathlib import Path
 
     from ..tables import to_markdown
@@ -343,4 +344,8 @@ def results_markdown(compare_dir) -> str:
     if (d / "budget_sweep.csv").exists():
         out += ["**Transition budget sweep** (`budget_sweep.csv`, figure `budget_sweep.png`):", "",
                 to_markdown(pd.read_csv(d / "budget_sweep.csv")), ""]
+    if (d / "metrics_long.md").exists():  # the long track's medians, as its tables job rendered them
+        out += ["**The long track** (`metrics_long.csv`; medians and spread per generator, `metrics_long.md`; its "
+                "claims are the findings above whose source is `compare/metrics_long.csv`; preview "
+                "`long_strips.png`):", "", (d / "metrics_long.md").read_text().strip(), ""]
     return "\n".join(out)
