@@ -651,6 +651,15 @@ def test_the_jobs_shared_kinematics_give_the_references_of_separate_computations
     assert not pos.flags.writeable and not fwd.flags.writeable  # shared by every clip: read-only
     other = Motion(clips[0].database[0].values[::-1].copy(), walks[0].skeleton, 15.0, clips[0].database[0].name)
     assert np.array_equal(kin(other)[0], M.positions(other))  # same name, other values: computed apart
+    import copy
+
+    db0 = clips[0].database[0]
+    longer = copy.deepcopy(db0.skeleton)
+    for j in longer.joints[1:]:
+        j.offset = j.offset * 1.25  # the same values on longer bones (a trial read onto another's rest pose)
+    moved = Motion(db0.values, longer, db0.fps, db0.name)
+    assert np.array_equal(kin(moved)[0], M.positions(moved))  # same name and values, other bones: computed apart
+    assert not np.array_equal(kin(moved)[0], kin(db0)[0])
 
 
 def test_budget_sweep_compares_the_graphs_on_the_clips_both_were_built_on():

@@ -196,6 +196,24 @@ def test_subjects_on_a_generic_figure_leave_the_test_and_show_as_a_sensitivity_l
     assert without["verdict"] == decide(effects, figure={})[0]["verdict"] and "sensitivity" not in without["evidence"]
 
 
+def test_a_subject_with_fewer_clips_than_the_minimum_is_no_unit_of_the_tests():
+    """clips.csv's enough_clips (compare.min_clips_per_subject): a subject below the minimum leaves the claims,
+    the sanity checks and the exploratory table, and the data column names it."""
+    effects = [0.08] * 10 + [-0.5, -0.5]
+    metrics, clips = build(effects)
+    clips["subject"] = clips["held_out"].str.split("_").str[0]
+    clips["enough_clips"] = ~clips["group"].isin(["s10", "s11"])  # the two opposite subjects: too few clips
+    v, stats = CV.decide_claims(metrics, VC, "test data", {}, clips, claims=[SKATE])
+    assert stats.set_index("claim_id").loc["t_skate", "n_groups"] == 10
+    assert v.iloc[0]["verdict"] == "reproduced"
+    assert "fewer clips than compare.min_clips_per_subject: subject 20 (3 clips), subject 21 (3 clips)" in \
+        v.iloc[0]["data"]
+    both, _ = CV.decide_claims(metrics, VC, "test data", {}, clips.assign(enough_clips=True), claims=[SKATE])
+    assert "fewer clips" not in both.iloc[0]["data"]
+    ex = CV.exploratory_table(metrics, VC, clips, claims=[], order=["motion_graph", "stisomap"])
+    assert set(ex.loc[ex["label"] == "exploratory", "n_groups"]) == {10}
+
+
 # ------------------------------------------------------------------------------------------- the capture claim
 def test_one_significant_opposite_part_contradicts_the_capture_claim():
     """The capture skates less than motion_graph in no subject and more in all 12, while against stisomap it is

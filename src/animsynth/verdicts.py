@@ -63,8 +63,8 @@ __all__ = ["COLUMNS", "WORDS", "VOCABULARY", "OUTCOMES", "OUTCOME_WORDS", "Verdi
 COLUMNS = ("claim", "paper_value", "ours", "data", "verdict", "evidence", "source")
 #: every verdict word -> the one sentence of what it means (docs/compare/verdicts.md renders this table)
 WORDS = {
-    "reproduced": "the claim holds: significant in the claimed direction with the effect at least its margin (a "
-                  "declared comparison), or it holds on every nudge or case tested",
+    "reproduced": "the claim holds: significant in the claimed direction with the mean effect at least its margin "
+                  "(a declared comparison), or it holds on every nudge or case tested",
     "partly": "it holds for some of the cases or units the claim covers and not for others, each side significantly "
               "or stably (a significant split, or a significant lead whose share of units falls short)",
     "no material difference": "equivalence shown: the 90 % interval of the effect lies inside plus or minus the "

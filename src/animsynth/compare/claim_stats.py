@@ -24,7 +24,7 @@ import pandas as pd
 from .. import verdicts as V
 
 __all__ = ["pair_outcomes", "metric_wide", "pair_from_wide", "per_clip", "group_outcomes", "subject_tests",
-           "sign_flip_p", "Stats", "EXACT_MAX", "touching", "contact_by_clip", "no_values", "generic_clips",
+           "sign_flip_p", "Stats", "EXACT_MAX", "touching", "contact_by_clip", "no_values", "generic_clips", "few_clips",
            "metric_median", "spread"]
 
 
@@ -295,7 +295,8 @@ def no_values(metrics: pd.DataFrame, g: str, left_out: dict | None = None, metri
         return ""
     if not len(rows):
         return f"{g} did not run: not in this run"
-    notes = sorted({str(x) for x in rows.get("note", pd.Series(dtype=str)).fillna("") if str(x)})
+    notes = sorted({str(x).removeprefix("did not run: ") for x in rows.get("note", pd.Series(dtype=str)).fillna("")
+                    if str(x)})
     return f"{g} did not run: " + ("; ".join(notes) if notes else f"no values{' of ' + metric if metric else ''}")
 
 
@@ -306,3 +307,22 @@ def generic_clips(clips: pd.DataFrame | None) -> set:
     if clips is None or "figure" not in clips:
         return set()
     return set(clips.loc[clips["figure"].astype(str).str.strip() == "generic", "clip"])
+
+
+def few_clips(clips: pd.DataFrame | None) -> tuple[set, dict]:
+    """The clips of subjects with fewer clips than ``compare.min_clips_per_subject`` (``enough_clips`` false in
+    ``compare/clips.csv``), and ``{subject: its clips}`` of those subjects: they leave the declared tests, the
+    sanity checks and the exploratory table; none when the table has no ``enough_clips`` column."""
+    if clips is None or "enough_clips" not in clips or "subject" not in clips:
+        return set(), {}
+    few = ~clips["enough_clips"].astype(str).str.strip().str.lower().isin(("true", "1", "yes"))
+    part = clips[few]
+    return set(part["clip"]), {str(k): int(v) for k, v in part.groupby("subject")["clip"].nunique().items()}
+
+
+def few_clips_text(subjects: dict) -> str:
+    """The line naming the subjects :func:`few_clips` leaves out ("" when none)."""
+    if not subjects:
+        return ""
+    return ("; left out of the tests, fewer clips than compare.min_clips_per_subject: "
+            + ", ".join(f"subject {s} ({n} clip{'s' if n != 1 else ''})" for s, n in sorted(subjects.items())))

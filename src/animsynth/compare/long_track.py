@@ -10,11 +10,13 @@ track's records (:func:`animsynth.compare.measures.metric_table.on_track` ``"lon
 
 The contexts and seeds are the short track's (the first ``seeds`` of each window's short-track seeds,
 :func:`animsynth.compare.protocol.clip_seeds`), so both tracks start from the same frames. A generator whose
-``generate`` raises, or returns another number of frames than asked, gets rows with no values and ``note`` =
-"did not run: <why>" (logged once per job): never a silently shorter motion. So does a generator whose declared
-query is the held-out future (:data:`animsynth.generator.QUERY_FUTURE_TRAJECTORY`: the replay of the capture,
-motion matching queried with the capture's path) when that future is shorter than the long run: the held-out
-capture is only ``context + length`` frames, and a query that stops there would be another method.
+``generate`` says it cannot continue this long (ValueError, NotImplementedError), or returns another number of
+frames than asked, gets rows with no values and ``note`` = "did not run: <why>" (logged once per job): never a
+silently shorter motion; any other exception stops the job. So does a generator whose declared query is the held-out
+future (:data:`animsynth.generator.QUERY_FUTURE_TRAJECTORY`: the replay of the capture, motion matching queried with
+the capture's path) when that future, the frames of the held-out stretch after the start, is shorter than the long
+run, since a query that stops there would be another method; where the held-out stretch does last that long after
+the start (a long trial held out whole), these rows run and hold values.
 
 Files of one generator job: ``compare/runs/<subject>/<generator>_long.csv`` (:data:`LONG_COLUMNS`),
 ``<generator>_long_timing.csv`` (:data:`LONG_TIMING_COLUMNS`: the long track's generation and scoring CPU, so a
@@ -80,8 +82,10 @@ def not_run_rows(clips: list[Clip], generator: str, n_seeds: int, note: str) -> 
 
 
 def generate_long(gen, clip: Clip, n: int, seed: int, query: dict):
-    """``gen``'s ``n`` frames from the clip's start, or ``(None, why)`` when it raises or returns another number
-    of frames (a user generator's own failure, :class:`UserGeneratorError`, stops the job as on the short track)."""
+    """``gen``'s ``n`` frames from the clip's start, or ``(None, why)`` when it says it cannot continue this long
+    (a ValueError, as fairmotion's walk into a dead end, or NotImplementedError) or returns another number of
+    frames. Any other exception is a bug, not a limit: it stops the job as on the short track (so does a user
+    generator's own failure, :class:`UserGeneratorError`)."""
     from ..generator import QUERY_FUTURE_TRAJECTORY
     from .generators.user import UserGeneratorError
 
@@ -92,7 +96,7 @@ def generate_long(gen, clip: Clip, n: int, seed: int, query: dict):
         m = gen.generate(clip.start, n, seed, **query)
     except UserGeneratorError:
         raise
-    except Exception as exc:  # any generator that cannot continue this long says why in one line
+    except (ValueError, NotImplementedError) as exc:  # a generator that cannot continue this long says why
         return None, " ".join(f"{type(exc).__name__}: {exc}".split())
     if m.n_frames != n:
         return None, f"returned {m.n_frames} frames, {n} asked for"

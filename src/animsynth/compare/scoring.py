@@ -100,8 +100,8 @@ class DatabaseKinematics:
 
     A database clip is shared by several held-out clips (leave one out) and read by the run's L2P statistics and
     by each clip's reference: calling an instance with a motion returns its ``(positions, facing)``, computed on
-    the first call (keyed by the motion's name, checked by its values: two motions of one name and other values
-    are computed apart). The arrays are read-only (a metric that wrote into them would change the others').
+    the first call (keyed by the motion's name, checked by its values and its skeleton: two motions of one name and
+    other values or bones are computed apart). The arrays are read-only (a metric that wrote into them would change the others').
     """
 
     def __init__(self, roles: dict | None = None):
@@ -112,14 +112,27 @@ class DatabaseKinematics:
         from . import measures as M
 
         hit = self._memo.get(motion.name)
-        if hit is not None and (hit[0] is motion.values or np.array_equal(hit[0], motion.values)):
+        if (hit is not None and (hit[0] is motion.values or np.array_equal(hit[0], motion.values))
+                and _same_skeleton(hit[3], motion.skeleton)):
             return hit[1], hit[2]
         pos, fwd = M.positions(motion), M.facing(motion, self.roles)
         pos.setflags(write=False)
         fwd.setflags(write=False)
         if hit is None:
-            self._memo[motion.name] = (motion.values, pos, fwd)
+            self._memo[motion.name] = (motion.values, pos, fwd, motion.skeleton)
         return pos, fwd
+
+
+def _same_skeleton(a, b) -> bool:
+    """Whether two skeletons pose alike: the same object, or the same joints with the same offsets, tails, axes and
+    unit (a database trial read onto another held-out trial's rest pose keeps its values but not its bones)."""
+    if a is b:
+        return True
+    if len(a.joints) != len(b.joints) or a.length_to_m != b.length_to_m:
+        return False
+    return all(ja.name == jb.name and ja.parent == jb.parent and np.array_equal(ja.offset, jb.offset)
+               and np.array_equal(ja.tail, jb.tail) and np.array_equal(ja.axis, jb.axis)
+               for ja, jb in zip(a.joints, b.joints))
 
 
 def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None,

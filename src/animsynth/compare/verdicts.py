@@ -39,8 +39,8 @@ import numpy as np
 import pandas as pd
 
 from .. import verdicts as V
-from .claim_stats import EXACT_MAX, Stats, generic_clips, metric_median, metric_wide, no_values, pair_from_wide, \
-    pair_outcomes, per_clip, spread, touching
+from .claim_stats import (EXACT_MAX, Stats, few_clips, few_clips_text, generic_clips, metric_median, metric_wide,
+                          no_values, pair_from_wide, pair_outcomes, per_clip, spread, touching)
 from .claims import EVERY, declared_claims, margin
 from .groups import GROUPINGS, clip_groups
 from .generators.names import REFERENCES
@@ -115,7 +115,8 @@ def decide(st: Stats, p_holm: float, margin: float, vc: dict, ci90: tuple | None
     if word == "undecided" and st.n:
         floor = 2.0 / 2 ** st.n if st.n <= EXACT_MAX else 1.0 / (1 + int(vc.get("permutations", 100000)))
         why += (f" (with {st.n} {_units(vc, st.n)} the smallest possible p is {V.fmt(floor, 3)}; 80 % power at the "
-                f"observed effect would need {st.power or 'an estimate from at least 2'} {_units(vc)})")
+                f"observed effect would need {st.power or 'an estimate from at least 2'} {_units(vc)}, before Holm's "
+                "correction: a lower bound)")
     return word, why
 
 
@@ -251,7 +252,8 @@ class _Claim:
                 f"{V.fmt(st.mean)} {unit} (95 % t interval over {_units(vc)} {V.fmt(st.lo)} to {V.fmt(st.hi)}), "
                 f"sign-flip p = {V.fmt(self.p, 3)}, Holm p = {V.fmt(p_holm, 3)}")
         if word == "undecided":
-            text += f", {_units(vc)} for 80 % power at this effect: {st.power or 'no estimate'}"
+            text += (f", {_units(vc)} for 80 % power at this effect (t test at alpha, before Holm: a lower bound): "
+                     f"{st.power or 'no estimate'}")
         if self.b == EVERY:
             med = {g: metric_median(self.metrics, g, self.metric) for g, _s in self.parts}
             text += f"; {self.metric} median {self.a} {spread(self.metrics, self.a, self.metric)}"
@@ -339,7 +341,7 @@ class _Claim:
                              for g, r in st.subjects.iterrows())
             text += (f"{st.n} independent {_units(vc, st.n)}: {st.numbers(unit)}, Holm-adjusted p = "
                      f"{V.fmt(p_holm, 3)}, 90 % t interval {V.fmt(st.lo90)} to {V.fmt(st.hi90)}, {_units(vc)} for "
-                     f"80 % power at this effect: {st.power or 'no estimate'}; {test}; holds in {st.holding}, "
+                     f"80 % power at this effect (before Holm): {st.power or 'no estimate'}; {test}; holds in {st.holding}, "
                      f"opposite in {st.opposite}, neither in {st.n - st.holding - st.opposite}; per group (clips "
                      f"holding / untied clips, median effect): {groups}; per-subject sign tests (clips for / untied "
                      f"clips): {subj}; counted by clips instead: {ch} of {ch + cf} untied clips")
@@ -376,6 +378,9 @@ def decide_claims(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
     seed : the seed of the random sign flips (more than :data:`EXACT_MAX` groups; ``compare.seed``)
     source : the table the claims read (``compare/metrics_long.csv`` for the long track), the rows' ``source``
     """
+    few, few_subjects = few_clips(clips)
+    metrics = metrics[~metrics["clip"].isin(few)]  # subjects below the minimum of clips are no unit of the tests
+    data = data + few_clips_text(few_subjects)
     groups = clip_groups(metrics, clips, vc)
     specs = declared_claims({"claims": claims, "verdicts": vc})
     generic = generic_clips(clips)
@@ -425,7 +430,7 @@ def exploratory_table(metrics: pd.DataFrame, vc: dict, clips: pd.DataFrame | Non
     verdict.
     """
     groups = clip_groups(metrics, clips, vc)
-    main = metrics[~metrics["clip"].isin(generic_clips(clips))]
+    main = metrics[~metrics["clip"].isin(generic_clips(clips) | few_clips(clips)[0])]
     specs = declared_claims({"claims": claims, "verdicts": vc})
     present = list(dict.fromkeys(metrics["generator"]))
     ran = [g for g in (order or present) if g in set(present)]
@@ -525,7 +530,7 @@ def sanity_checks(metrics: pd.DataFrame, vc: dict, data: str, left_out: dict | N
     out): not findings. A check whose generators are not configured has no row; one whose generators did not run
     is ``did not run``."""
     groups = clip_groups(metrics, clips, vc)
-    main = metrics[~metrics["clip"].isin(generic_clips(clips))]
+    main = metrics[~metrics["clip"].isin(generic_clips(clips) | few_clips(clips)[0])]
     configured = set(metrics["generator"]) | set(left_out or {})
     tests = []
     for claim, gens, need_all, test in _SANITY:
