@@ -429,6 +429,13 @@ def test_clips_sharing_a_trial_or_a_subject_in_a_subset_are_one_group():
     # a clip without a subject id keeps its subset as its group
     other = pd.concat([clips, pd.DataFrame([{"clip": "x/walkA", "group": "x", "held_out": "walkA", "database": "walkB"}])])
     assert GR.independent_groups(other)["x/walkA"] == "x"
+    # the declared subject (clips.csv's column, the trial records') joins two sets of one person with other ids
+    mine = pd.DataFrame([{"clip": "a/walkA", "group": "a", "held_out": "walkA", "database": "walkB", "subject": "ann"},
+                         {"clip": "b/runA", "group": "b", "held_out": "runA", "database": "runB", "subject": "ann"},
+                         {"clip": "c/jogA", "group": "c", "held_out": "jogA", "database": "jogB", "subject": "bob"}])
+    g = GR.independent_groups(mine)
+    assert g["a/walkA"] == g["b/runA"] != g["c/jogA"] and len(set(g.values())) == 2
+    assert len(set(GR.independent_groups(mine.drop(columns="subject")).values())) == 3  # without it: by subset
     with pytest.raises(ValueError, match="compare.verdicts.grouping"):
         GR.independent_groups(clips, "trial")
 

@@ -24,12 +24,14 @@ GROUPINGS = {
 
 
 def independent_groups(clips: pd.DataFrame, by: str = "subject") -> dict:
-    """``{clip: group label}`` from the clips table (``clip``, ``group``, ``held_out``, ``database``).
+    """``{clip: group label}`` from the clips table (``clip``, ``group``, ``held_out``, ``database``, optionally
+    ``subject``).
 
     A clip's trials are its held-out trial and its database trials (CMU ids ``<subject>_<trial>`` found in the
     clip id and the ``held_out`` and ``database`` columns; other names: the clip's trial and the database's
-    names); its subject is the held-out trial's subject (the text before ``_``; none for other names, so the
-    subset alone makes the group). ``by="subject"``: the clips of one subject form a group (a clip without a
+    names); its subject is the ``subject`` column (the trial record's ``subject``, as the protocol counts clips per
+    subject), else the held-out trial's CMU subject (the text before ``_``; none for other names, so the subset
+    alone makes the group). ``by="subject"``: the clips of one subject form a group (a clip without a
     subject: its subset); ``by="subset_subject"``: the clips of one subset and subject. Groups sharing a trial
     are joined. The label names the subsets / datasets joined (``r1 + run``) and, when one subset holds several
     groups, the subject; by subject, ``subject 35 (w1, r1, run, walk)``.
@@ -45,8 +47,10 @@ def independent_groups(clips: pd.DataFrame, by: str = "subject") -> dict:
         if not ts:  # not CMU ids: the clip's trial and the database's names (without a temporal split's range)
             ts = {own} | {t for t in str(r.database).split() if t != "frames" and not re.fullmatch(r"\d+-\d+", t)}
         trials[r.clip] = ts
+        declared = str(getattr(r, "subject", "") or "").strip()
         held = _TRIAL.findall(own) or _TRIAL.findall(str(r.held_out))
-        subject = held[0].split("_")[0] if held else ""  # no subject id: the subset is the group
+        # the trial record's subject (clips.csv's column) first; else a CMU id's; none: the subset is the group
+        subject = declared if declared and declared != "nan" else held[0].split("_")[0] if held else ""
         base[r.clip] = ("", subject) if by == "subject" and subject else (str(r.group), subject)
     parent = {k: k for k in set(base.values())}
 
