@@ -151,6 +151,11 @@ def test_long_claims_pass_and_bad_ones_are_refused_naming_the_key():
                              ({"track": None}, "metric", "not a metric of the short track")):
         with pytest.raises(ConfigError, match=rf"compare\.claims\[{n}\]\.{key}'.*{words}"):
             settings.check(_with_claim(**over))
+    short_run = _with_claim(metric="coverage_after_20s")
+    settings.check(short_run)  # 20 s runs: coverage after 20 s is there
+    short_run["compare"]["long_track"] = dict(short_run["compare"]["long_track"], seconds=10)
+    with pytest.raises(ConfigError, match=rf"compare\.claims\[{n}\]\.metric'.*needs a run of at least 20 s"):
+        settings.check(short_run)
     off = _with_claim()
     off["compare"]["long_track"] = None
     first = next(i for i, c in enumerate(off["compare"]["claims"]) if c.get("track") == "long")

@@ -80,7 +80,8 @@ def check_claims(config: dict) -> None:
     """Refuse at config time what the schema cannot see in ``compare.claims``, one line naming the key.
 
     An unknown track (:data:`~animsynth.compare.measures.metric_table.TRACKS`), a metric not on the claim's track,
-    a long-track claim while ``compare.long_track`` is off, an unknown metric, a text column (clip, seed, group,
+    a long-track claim while ``compare.long_track`` is off, a long-track metric that needs a longer run than
+    ``compare.long_track.seconds`` (its record's ``min_seconds``), an unknown metric, a text column (clip, seed, group,
     note, ...), an unknown generator (neither one of the
     family's rows, :data:`animsynth.compare.generators.names.GENERATORS`, nor in ``compare.user_generators``: a typo),
     ``a == b``, ``'*'`` anywhere but ``b``, a duplicate id, a metric with neither a margin nor ``min_effect``, and a
@@ -120,6 +121,10 @@ def check_claims(config: dict) -> None:
             if g != EVERY and g not in known:
                 raise ConfigError(f"{key}.{side}': {g!r} is not a generator (one of the family's rows, "
                                   "animsynth.compare.generators.names.GENERATORS, or of compare.user_generators)")
+        need = metric_or_blank(metric).min_seconds
+        if track == "long" and need > float(cmp["long_track"].get("seconds") or 0):
+            raise ConfigError(f"{key}.metric': {metric!r} needs a run of at least {need:g} s; config key "
+                              f"'compare.long_track.seconds' is {cmp['long_track'].get('seconds')}")
         if c["a"] == c["b"]:
             raise ConfigError(f"{key}.b': {c['b']!r} is also a; a claim compares two generators")
         if c["id"] in seen:

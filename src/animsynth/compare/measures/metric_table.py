@@ -85,6 +85,8 @@ class Metric:
         :data:`RUN_NEEDS`: with a :class:`~.scored.RunOutputs`) and returns ``{column: value}`` for at least every
         record that names it (one computation may fill several records: foot skating gives three)
     tracks : tuple of str, the :data:`TRACKS` it is computed on
+    min_seconds : float, the shortest run (s) the value needs (coverage after 20 s: 20; the first against the last
+        2 s: 4); a shorter run gives NaN, and a claim on it with a shorter ``compare.long_track.seconds`` is refused
     """
 
     name: str
@@ -99,6 +101,7 @@ class Metric:
     margin_why: str = ""
     compute: str = ""
     tracks: tuple = TRACKS
+    min_seconds: float = 0.0
 
 
 #: the skating threshold sensitivity speeds (m/s) of the ``*_at_<speed>`` columns
@@ -220,13 +223,16 @@ METRICS = (
            "capture's range", margin=0.05, margin_why="1 s of a 20-s run with the body sunk, floating or keeled over "
            "beyond anything the capture does", compute="root:score_drift", tracks=_LONG),
     *(Metric(after_time("coverage", t), "share of database windows", "higher", "database",
-             margin=0.05, margin_why=_COVERAGE_WHY, compute="over_time:score_coverage_over_time", tracks=_LONG)
+             margin=0.05, margin_why=_COVERAGE_WHY, compute="over_time:score_coverage_over_time", tracks=_LONG,
+             min_seconds=float(t))
       for t in COVERAGE_TIMES_S),
     *(Metric(at_edge("skate_share", w), "share of contact joint-frames" + (", last minus first" if w == "change" else ""),
              "lower", "floor", skating_claim=True, margin=0.05, margin_why=_SKATE_WHY,
-             compute="over_time:score_skating_first_last", tracks=_LONG) for w in ("first", "last", "change")),
+             compute="over_time:score_skating_first_last", tracks=_LONG, min_seconds=2 * EDGE_S)
+      for w in ("first", "last", "change")),
     *(Metric(at_edge("velocity_jump_p95", w), "m/s" + (", last minus first" if w == "change" else ""), "lower", "",
-             margin=0.2, margin_why=_JUMP_WHY, compute="over_time:score_jumps_first_last", tracks=_LONG)
+             margin=0.2, margin_why=_JUMP_WHY, compute="over_time:score_jumps_first_last", tracks=_LONG,
+             min_seconds=2 * EDGE_S)
       for w in ("first", "last", "change")),
 )
 _BY_NAME = {m.name: m for m in METRICS}
