@@ -176,8 +176,8 @@ def _levels(clip: protocol.Clip, gm: dict) -> int:
 
 def test_genmm_has_its_levels_on_every_clip_of_constructed_short_databases():
     """Databases of 35 to 120 frames (runs, short splits): every clip's GenMM has min_levels levels, its coarsest at
-    least min_coarse_patches patches; a database piece at or under the floor (a 21-frame split) has one level and
-    its note says so."""
+    least min_coarse_patches patches; a database at or under the floor (a 21-frame split) is refused (GenMM never
+    runs below its level; with min_levels 1 it would run on one level) and its note says so."""
     sk = cmu_like_skeleton("cmp", 3)
     gm = default_config()["compare"]["genmm"]
     floor = gm["min_coarse_patches"] * gm["patch_size"]
@@ -187,13 +187,16 @@ def test_genmm_has_its_levels_on_every_clip_of_constructed_short_databases():
     clips = protocol.prepare_clips(trials, {"runs": ["r0", "r1", "r2", "r3"]}, {"run": "short"}, cfg)
     for c in clips:
         longest = max(d.n_frames for d in c.database)
-        g = make_genmm(gm).fit(c.database)
         if longest > floor:
+            g = make_genmm(gm).fit(c.database)
             assert len(g.scales_) >= gm["min_levels"] and g.scales_[0] * longest >= floor - 1e-6, (c.clip, longest)
             assert pyramid_note(longest, gm["patch_size"], gm["min_coarse_patches"], gm["min_levels"]) == ""
         else:
-            assert g.scales_ == [1.0] and "pyramid floor" in pyramid_note(longest, gm["patch_size"],
-                                                                          gm["min_coarse_patches"], gm["min_levels"])
+            assert "pyramid floor" in pyramid_note(longest, gm["patch_size"], gm["min_coarse_patches"],
+                                                   gm["min_levels"])
+            with pytest.raises(ValueError, match="not run below its level"):
+                make_genmm(gm).fit(c.database)
+            assert make_genmm(dict(gm, min_levels=1)).fit(c.database).scales_ == [1.0]  # asked for: one level
     assert {max(d.n_frames for d in c.database) for c in clips if c.group == "run"} == {21}
 
 

@@ -29,8 +29,10 @@ Synthesis (the paper's, with the reference's defaults):
   coarsest scale is lowered to ``pyramid_factor ** (min_levels - 1)``, and the finer levels follow by the same
   factor; where that would go below the floor (a longest clip under 185 frames), the coarsest level is the floor
   (33 frames) and the 7 levels between it and the full rate are spaced by a larger factor (0.83 on a 100-frame
-  clip, 0.96 on a 42-frame one). A longest clip of at most 33 frames keeps one level, the full rate
-  (:func:`pyramid_note`; the comparison's clips table says so). The floor binding is why, before this rule
+  clip, 0.96 on a 42-frame one). A database whose longest clip has at most 33 frames would keep one level, the
+  full rate (:func:`pyramid_note`; the comparison's clips table says so): with ``min_levels`` above 1, ``fit``
+  refuses it (ValueError: the comparison's rows read "not built", GenMM never runs below its level; on the paper
+  run the run clip 35_17's temporal blocks, databases of 21 frames). The floor binding is why, before this rule
   spaced the levels, the paper run's clips of short databases (r1, r2, subject 09, the run) had 1 to 3 levels
   despite ``min_levels``: a fixed factor of 0.75 from a 33-frame floor reaches the full rate in fewer steps.
   Why 3 and not 1: with the
@@ -298,6 +300,10 @@ class GenMM(Generator):
             raise ValueError(f"genmm: min_levels must be a whole number >= 1, got {self.min_levels!r}")
         if not float(self.min_coarse_patches) >= 1.0:
             raise ValueError(f"genmm: min_coarse_patches must be >= 1, got {self.min_coarse_patches!r}")
+        below = pyramid_note(longest, P, float(self.min_coarse_patches), int(self.min_levels))
+        if below:  # GenMM is never run below its level: a database too short for the floor is no GenMM database
+            raise ValueError(f"{below}, below min_levels {int(self.min_levels)}: not run below its level (set "
+                             "compare.genmm.min_levels: 1 to run it on one level)")
         self.scales_ = level_scales(longest, P, float(self.coarse_patches), float(self.pyramid_factor),
                                     int(self.min_levels), float(self.min_coarse_patches))
         self.level_frames_ = []
