@@ -87,6 +87,26 @@ def test_both_tracks_share_one_build_per_database(monkeypatch, clips, cfg):
     pd.testing.assert_frame_equal(metrics, alone)
 
 
+def test_the_cost_guard_counts_the_long_tracks_frames(monkeypatch, clips, cfg):
+    """The estimate before a build counts every frame the build serves: each window's seeds and, for the databases
+    with a long context, the long track's seeds x seconds x fps."""
+    from animsynth.compare import cost
+
+    asked = {}
+    real = cost.guard
+
+    def recording(generator, key, frames, c, length=0, seeds=0):
+        asked[key] = int(length) * int(seeds)
+        return real(generator, key, frames, c, length, seeds)
+
+    monkeypatch.setattr(cost, "guard", recording)
+    runner.run_tracks(clips, "concat", dict(cfg, long_track=LONG), 7)
+    n = int(round(LONG["seconds"] * cfg["fps"]))
+    for key, cs in runner.by_database(clips).items():
+        short = sum(c.length for c in cs) * int(cfg["seeds"])
+        assert asked[key] == short + (2 * n if key in ("w1/t0", "w1/t2") else 0), key  # two long seeds there
+
+
 def test_replay_cannot_run_longer_than_the_held_out_capture(clips, cfg, caplog):
     _m, _t, _s, long = runner.run_tracks(clips, "replay", dict(cfg, long_track=dict(LONG, contexts_per_subject=1)), 7)
     m = long["metrics"]

@@ -206,15 +206,16 @@ def _not_run(cs, generator, n_seeds, note, shown_id):
     return rows, shown
 
 
-def _fit(generator, cs, cfg, key, shown):
+def _fit(generator, cs, cfg, key, shown, long_frames: int = 0):
     """A fitted generator for the database of ``cs`` with its build cost, or ``(None, why)`` when the cost guard
-    refuses it or its build stops with a reason (``shown``: (showcase clip id, required))."""
+    refuses it or its build stops with a reason (``shown``: (showcase clip id, required)). The guard's estimate
+    counts every frame the build will serve: each window's seeds and ``long_frames``, the long track's."""
     from .cost import guard as cost_guard
 
     c0 = cs[0]
     db_frames = int(sum(d.n_frames for d in c0.database))
-    length = max(c.length for c in cs)
-    level, line = cost_guard(generator, key, db_frames, cfg, length, len(cs) * int(cfg["seeds"]))
+    generated = sum(c.length for c in cs) * int(cfg["seeds"]) + int(long_frames)
+    level, line = cost_guard(generator, key, db_frames, cfg, generated, 1)
     if level == "refuse":
         log.error("%s", line)
         print(f"animsynth: compare: {line}", file=sys.stderr)
@@ -308,8 +309,9 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
     long_ids = set(long_contexts(grouped, ls["contexts_per_subject"])) if ls else set()
     long = {"rows": [], "timing": [], "shown": None, "said": set()} if ls else None
     for key, cs in grouped.items():
-        gen, cost = _fit(generator, cs, cfg, key, (shown_id[0], required))
         lcs = [c for c in cs if c.clip in long_ids]
+        long_frames = len(lcs) * ls["seeds"] * int(round(ls["seconds"] * float(cfg["fps"]))) if lcs else 0
+        gen, cost = _fit(generator, cs, cfg, key, (shown_id[0], required), long_frames)
         if gen is None:
             r, sh = _not_run(cs, generator, int(cfg["seeds"]), cost, shown_id[0])
             rows += r
