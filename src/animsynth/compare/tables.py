@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 
 from .generators.names import GENERATORS, REFERENCES
-from .measures.metric_table import (METRIC_NAMES, RESULT_METRICS, SENSITIVITY_METRICS, SENSITIVITY_SPEEDS, SWEEP_METRICS,
-                           at_speed, metric)
+from .measures.metric_table import (LONG_RESULT_METRICS, METRIC_NAMES, RESULT_METRICS, SENSITIVITY_METRICS,
+                                    SENSITIVITY_SPEEDS, SWEEP_METRICS, at_speed, metric)
 from .claim_stats import pair_outcomes
 from .claims import track_claims
 
@@ -314,22 +314,11 @@ def results_markdown(compare_dir) -> str:
     from pathlib import Path
 
     from ..tables import to_markdown
-    from ..verdicts import fmt
 
     d = Path(compare_dir)
     summary = pd.read_csv(d / "summary.csv")
-    gens = list(dict.fromkeys(summary["generator"]))
-    rows = []
-    for g in gens:
-        row = {"generator": g + (" (bound)" if g in REFERENCES else "")}
-        for m in RESULT_METRICS:
-            head = metric(m).label
-            r = summary[(summary["generator"] == g) & (summary["metric"] == m)]
-            row[head] = (f"{fmt(r['median'].iloc[0])} ({fmt(r['q25'].iloc[0])}-{fmt(r['q75'].iloc[0])})"
-                         if len(r) and r["n"].iloc[0] > 0 else "-")
-        rows.append(row)
     out = ["Medians over clips x seeds, interquartile range in brackets (`summary.csv`):", "",
-           to_markdown(pd.DataFrame(rows)), ""]
+           to_markdown(_medians_table(summary, RESULT_METRICS, lambda m: metric(m).label)), ""]
     v = pd.read_csv(d / "verdicts.csv", keep_default_na=False)
     out += ["**Findings** (`verdicts.csv`):", "", to_markdown(v[["claim", "verdict", "ours", "evidence"]]), ""]
     if (d / "claims_stats.csv").exists():
@@ -344,8 +333,29 @@ def results_markdown(compare_dir) -> str:
     if (d / "budget_sweep.csv").exists():
         out += ["**Transition budget sweep** (`budget_sweep.csv`, figure `budget_sweep.png`):", "",
                 to_markdown(pd.read_csv(d / "budget_sweep.csv")), ""]
-    if (d / "metrics_long.md").exists():  # the long track's medians, as its tables job rendered them
-        out += ["**The long track** (`metrics_long.csv`; medians and spread per generator, `metrics_long.md`; its "
-                "claims are the findings above whose source is `compare/metrics_long.csv`; preview "
-                "`long_strips.png`):", "", (d / "metrics_long.md").read_text().strip(), ""]
+    if (d / "metrics_long.csv").exists():  # the long track's medians, from its rows
+        long = pd.read_csv(d / "metrics_long.csv")
+        order = list(dict.fromkeys(summary["generator"])) + [g for g in dict.fromkeys(long["generator"])
+                                                              if g not in set(summary["generator"])]
+        table = summary_table(long, order, list(LONG_RESULT_METRICS))
+        out += ["**The long track** (`metrics_long.csv`: medians over its contexts x seeds, interquartile range in "
+                "brackets, \"-\" where a generator did not run (its rows' note says why); every measure in "
+                "`metrics_long.md`; its claims are the findings above whose source is `compare/metrics_long.csv`; "
+                "preview `long_strips.png`):", "", to_markdown(_medians_table(table, LONG_RESULT_METRICS, str)), ""]
     return "\n".join(out)
+
+
+def _medians_table(summary: pd.DataFrame, metrics, heading) -> pd.DataFrame:
+    """One row per generator of ``summary`` (:func:`summary_table`'s long form): ``median (q25-q75)`` of each of
+    ``metrics`` under ``heading(metric)``, "-" without a value."""
+    from ..verdicts import fmt
+
+    rows = []
+    for g in dict.fromkeys(summary["generator"]):
+        row = {"generator": g + (" (bound)" if g in REFERENCES else "")}
+        for m in metrics:
+            r = summary[(summary["generator"] == g) & (summary["metric"] == m)]
+            row[heading(m) or m] = (f"{fmt(r['median'].iloc[0])} ({fmt(r['q25'].iloc[0])}-{fmt(r['q75'].iloc[0])})"
+                                    if len(r) and r["n"].iloc[0] > 0 else "-")
+        rows.append(row)
+    return pd.DataFrame(rows)

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 __all__ = ["Metric", "METRICS", "METRIC_NAMES", "KEY_COLUMNS", "TRACKS", "SENSITIVITY_SPEEDS", "SENSITIVITY_METRICS",
            "COVERAGE_TIMES_S", "EDGE_S", "at_speed", "after_time", "at_edge", "NEEDS", "PER_RUN", "MOTION_NEEDS",
            "RUN_NEEDS", "metric", "metric_or_blank", "names_needing", "on_track", "track_names", "computation",
-           "by_computation", "SWEEP_METRICS", "SWEEP_PANELS", "FIGURE_METRICS", "RESULT_METRICS",
+           "by_computation", "SWEEP_METRICS", "SWEEP_PANELS", "FIGURE_METRICS", "RESULT_METRICS", "LONG_RESULT_METRICS",
            "EXPLORATORY_METRICS", "SKATING_CLAIM_METRICS"]
 
 #: what a metric needs besides the generated motion and its start (:attr:`Metric.needs`)
@@ -264,6 +264,9 @@ FIGURE_METRICS = ("skate_share", "transition_skate_share", "velocity_jump_p95", 
 #: the columns of the results page docs/compare/results.md
 RESULT_METRICS = ("skate_share", "skating_ratio_gmd", "transition_skate_share", "velocity_jump", "velocity_jump_p95",
                   "velocity_jump_over_capture", "ldlj", "l2p", "l2p_m", "coverage", "novelty_median_m")
+#: the long track's columns of the results page (the long-only measures beside skating and jumps over 20 s)
+LONG_RESULT_METRICS = ("repetition_share", "freezing_share", "drift_share", "coverage_after_5s", "coverage_after_20s",
+                       "skate_share", "skate_share_change", "velocity_jump_p95", "velocity_jump_p95_change")
 #: the metrics of the exploratory table (with every declared claim's metric)
 EXPLORATORY_METRICS = tuple(m.name for m in METRICS if m.exploratory)
 #: the skating metrics of the claims: a claim on one of them compares generators whose feet touch the floor
