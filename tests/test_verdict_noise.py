@@ -195,20 +195,30 @@ def test_resequencing_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_wor
 @pytest.mark.workflow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_compare_verdicts_of_the_tiny_run_survive_last_digit_noise(tiny_workflow, seed):
+    """Each track's declared claims, rebuilt from its own table (the 2-s claims from metrics.csv, the long track's
+    from metrics_long.csv), give the words verdicts.csv holds, and the same words under last-digit noise."""
+    from animsynth.compare.claims import track_claims
+    from animsynth.compare.long_tables import LONG_SOURCE
     from animsynth.compare.tables import data_label
     from animsynth.compare.verdicts import build_verdicts
 
     out = tiny_workflow / "results" / "compare"
     cmp = _tiny_config(tiny_workflow)["compare"]
-    metrics = pd.read_csv(out / "metrics.csv")
-    clips = pd.read_csv(out / "clips.csv")
-    data = data_label("synthetic", clips, cmp["seeds"])
-    left_out = {g: "left out" for g in cmp["generators"] if g not in set(metrics["generator"])}
-    want = build_verdicts(metrics, cmp["verdicts"], data, left_out, clips, claims=cmp["claims"])
+    clips = pd.read_csv(out / "clips.csv", dtype=str)
     written = pd.read_csv(out / "verdicts.csv")
-    assert want[["claim", "verdict"]].equals(written[["claim", "verdict"]])  # the rule's inputs, rebuilt
-    got = build_verdicts(perturbed(metrics, seed), cmp["verdicts"], data, left_out, clips, claims=cmp["claims"])
-    assert len(want) >= 5
-    assert got["verdict"].tolist() == want["verdict"].tolist(), pd.concat(
-        [want[["claim", "verdict"]], got["verdict"].rename("noisy")], axis=1).to_string()
+    n = 0
+    for track, table, source in (("short", "metrics.csv", "compare/metrics.csv"), ("long", "metrics_long.csv",
+                                                                                    LONG_SOURCE)):
+        metrics = pd.read_csv(out / table)
+        data = data_label("synthetic", clips, cmp["seeds"])
+        left_out = {g: "left out" for g in cmp["generators"] if g not in set(metrics["generator"])}
+        claims = track_claims(cmp["claims"], track)
+        want = build_verdicts(metrics, cmp["verdicts"], data, left_out, clips, claims=claims)
+        mine = written[written["source"] == source].reset_index(drop=True)
+        assert want[["claim", "verdict"]].equals(mine[["claim", "verdict"]]), track  # the rule's inputs, rebuilt
+        got = build_verdicts(perturbed(metrics, seed), cmp["verdicts"], data, left_out, clips, claims=claims)
+        assert got["verdict"].tolist() == want["verdict"].tolist(), pd.concat(
+            [want[["claim", "verdict"]], got["verdict"].rename("noisy")], axis=1).to_string()
+        n += len(want)
+    assert n == len(written) and n >= 8
 
