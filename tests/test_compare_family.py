@@ -307,8 +307,6 @@ def _grouped(group_effects: list[list[float]], seeds: int = 2, pair=("motion_gra
 
 
 def test_counting_clips_says_reproduced_where_counting_groups_cannot_decide():
-    from scipy.stats import binomtest
-
     # 19 clips in 7 independent groups: 5 groups of 3 clips all hold clearly; in 2 groups of 2 clips one clip
     # holds and one the opposite (the group votes neither way)
     effects = [[0.05, 0.06, 0.05]] * 5 + [[0.05, -0.05]] * 2
@@ -317,7 +315,8 @@ def test_counting_clips_says_reproduced_where_counting_groups_cannot_decide():
     j = CS.pair_outcomes(metrics, "motion_graph", "stisomap", "skate_share")
     c = CS.per_clip(j)
     h, f = int((c["outcome"] > 0).sum()), int((c["outcome"] < 0).sum())
-    assert (h, f) == (17, 2) and h / (h + f) >= 0.75 and binomtest(h, h + f).pvalue < 0.05  # by clips: reproduced
+    # by clips it would read reproduced: 17 of 19 untied clips hold (89 %), a sign test p of 0.0007
+    assert (h, f) == (17, 2)
     groups = GR.independent_groups(clips)
     assert len(set(groups.values())) == 7
     v = CV.build_verdicts(metrics, VC, "test data", {}, clips, claims=CLAIMS).set_index("claim")
