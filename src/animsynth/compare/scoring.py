@@ -124,15 +124,10 @@ class DatabaseKinematics:
 
 
 def _same_skeleton(a, b) -> bool:
-    """Whether two skeletons pose alike: the same object, or the same joints with the same offsets, tails, axes and
-    unit (a database trial read onto another held-out trial's rest pose keeps its values but not its bones)."""
-    if a is b:
-        return True
-    if len(a.joints) != len(b.joints) or a.length_to_m != b.length_to_m:
-        return False
-    return all(ja.name == jb.name and ja.parent == jb.parent and np.array_equal(ja.offset, jb.offset)
-               and np.array_equal(ja.tail, jb.tail) and np.array_equal(ja.axis, jb.axis)
-               for ja, jb in zip(a.joints, b.joints))
+    """Whether two skeletons pose alike: the same object, or the same serialised skeleton (every joint's offset,
+    tail, axis and DOFs and the unit: :meth:`animsynth.skeleton.Skeleton.to_json`). A database trial read onto
+    another held-out trial's rest pose keeps its values but not its bones."""
+    return a is b or a.to_json() == b.to_json()
 
 
 def run_stats(clips: list[Clip], mcfg: dict, roles: dict | None = None,
