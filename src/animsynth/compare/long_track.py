@@ -32,7 +32,7 @@ import numpy as np
 from .measures.metric_table import KEY_COLUMNS, track_names
 from .protocol import Clip
 
-__all__ = ["LONG_NAMES", "LONG_COLUMNS", "LONG_TIMING_COLUMNS", "long_settings", "long_contexts", "not_run_rows",
+__all__ = ["LONG_NAMES", "LONG_COLUMNS", "LONG_TIMING_COLUMNS", "long_settings", "long_frames", "long_contexts", "not_run_rows",
            "generate_long", "say_once"]
 
 log = logging.getLogger("animsynth.compare.long_track")
@@ -44,6 +44,11 @@ LONG_COLUMNS = KEY_COLUMNS + LONG_NAMES + ["note"]
 #: the columns of ``<generator>_long_timing.csv``: one row per database with a long context
 LONG_TIMING_COLUMNS = ["generator", "database", "contexts", "seeds", "frames_generated", "generate_cpu_s",
                        "generate_wall_s", "score_cpu_s"]
+
+
+def long_frames(settings: dict, fps: float) -> int:
+    """The frames one long run generates: ``settings["seconds"]`` (:func:`long_settings`) at the working rate."""
+    return int(round(float(settings["seconds"]) * float(fps)))
 
 
 def long_settings(block: dict | None, generator: str) -> dict | None:

@@ -298,7 +298,7 @@ def showcase_clip(clips: list[Clip], spec: str | None) -> str | None:
 def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
     """:func:`run_tracks`: one build per database (:func:`by_database`), every window and seed of it from that
     build, then the database's long contexts from the same build."""
-    from .long_track import long_contexts, long_settings, not_run_rows
+    from .long_track import long_contexts, long_frames, long_settings, not_run_rows
 
     rows, trows, shown = [], [], None
     kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
@@ -310,8 +310,8 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
     long = {"rows": [], "timing": [], "shown": None, "said": set()} if ls else None
     for key, cs in grouped.items():
         lcs = [c for c in cs if c.clip in long_ids]
-        long_frames = len(lcs) * ls["seeds"] * int(round(ls["seconds"] * float(cfg["fps"]))) if lcs else 0
-        gen, cost = _fit(generator, cs, cfg, key, (shown_id[0], required), long_frames)
+        n_long = len(lcs) * ls["seeds"] * long_frames(ls, cfg["fps"]) if lcs else 0
+        gen, cost = _fit(generator, cs, cfg, key, (shown_id[0], required), n_long)
         if gen is None:
             r, sh = _not_run(cs, generator, int(cfg["seeds"]), cost, shown_id[0])
             rows += r
@@ -364,9 +364,9 @@ def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, ma
     shown : Motion or None, the first window's start and seed 0's frames joined
     cost : dict, this database's row of :data:`~.long_track.LONG_TIMING_COLUMNS`
     """
-    from .long_track import generate_long, not_run_rows, say_once
+    from .long_track import generate_long, long_frames, not_run_rows, say_once
 
-    n = int(round(settings["seconds"] * float(cfg["fps"])))
+    n = long_frames(settings, cfg["fps"])
     n_seeds, mcfg = settings["seeds"], cfg["metrics"]
     rows, shown = [], None
     cost = {"generator": generator, "contexts": len(cs), "seeds": n_seeds, "frames_generated": 0,
