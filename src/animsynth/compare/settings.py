@@ -248,10 +248,26 @@ def job_cfg(config: dict, generator: str | None = None, budget: float | None = N
 
 
 def check(config: dict) -> None:
-    """Raise :class:`ConfigError` naming the key for values the schema cannot check."""
+    """Raise :class:`ConfigError` naming the key for values the schema cannot check (each step below names what it
+    checks)."""
     cmp = config["compare"]
-    # a subset or clip the run does not have is left out with a warning (the demo default names r1; a user's
-    # config with other subsets must still run every family), never an error that stops the other families
+    _warn_unknown_clip_sources(config)
+    _check_user_generator_names(config)
+    check_subject_sets(config)
+    _check_clip_sources(config)
+    check_trial_rates(config)  # a user's trials: each at its own rate (a BVH file's Frame Time)
+    _check_clip_sizes(cmp)
+    _check_generator_blocks(cmp)
+    _check_showcase_and_window(config)
+    from .claims import check_claims
+
+    check_claims(config)  # the declared claims against the metric table and the configured rows
+
+
+def _warn_unknown_clip_sources(config: dict) -> None:
+    """A subset or re-sequencing key the run does not have is left out with a warning (the demo default names r1; a
+    user's config with other subsets must still run every family), never an error that stops the other families."""
+    cmp = config["compare"]
     have = {k for k, v in config["subsets"].items() if v}
     for s in cmp["subsets"] or []:
         if s not in have:
@@ -261,6 +277,10 @@ def check(config: dict) -> None:
         if d not in config["resequencing_trials"]:
             log.warning("config key 'compare.resequencing': %r is not a key of resequencing_trials (%s): left out "
                         "of the comparison", d, sorted(config["resequencing_trials"]))
+
+
+def _check_user_generator_names(config: dict) -> None:
+    """A user generator's name is none of the family's and no other file's; its spec parses."""
     from .generators.names import GENERATORS
     from .generators.user import parse_spec
 
@@ -275,7 +295,11 @@ def check(config: dict) -> None:
             parse_spec(spec)
         except ValueError as exc:
             raise ConfigError(f"config key 'compare.user_generators.{name}': {exc}") from None
-    check_subject_sets(config)
+
+
+def _check_clip_sources(config: dict) -> None:
+    """There are clips to compare, every subset can leave one out, and AMC trials' rate divides into compare.fps."""
+    cmp = config["compare"]
     subsets, reseq = groups(config)
     if not subsets and not reseq:
         raise ConfigError("config keys 'compare.subsets' and 'compare.resequencing': no clip to compare")
@@ -283,12 +307,15 @@ def check(config: dict) -> None:
         if len(ids) < 2:
             raise ConfigError(f"config key 'compare.subsets': subset {s!r} has {len(ids)} trial; leave one out "
                               "needs at least 2")
-    check_trial_rates(config)  # a user's trials: each at its own rate (a BVH file's Frame Time)
     if config["mocap_source"] != "user":  # AMC trials run at the config's fps (BVH files carry their own)
         ratio = float(config["fps"]) / float(cmp["fps"])
         if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
             raise ConfigError(f"config key 'compare.fps': {cmp['fps']} must be the trials' rate (fps: "
                               f"{config['fps']}) divided by a whole number")
+
+
+def _check_clip_sizes(cmp: dict) -> None:
+    """The clip counts and lengths are consistent: a subject can enter the tests, a clip is at least its minimum."""
     cap = cmp.get("max_clips_per_subject")
     if cap is not None and cmp["min_clips_per_subject"] > cap:
         raise ConfigError(f"config key 'compare.min_clips_per_subject': {cmp['min_clips_per_subject']} exceeds "
@@ -296,6 +323,10 @@ def check(config: dict) -> None:
     if cmp["min_length"] > cmp["length"]:
         raise ConfigError(f"config key 'compare.min_length': {cmp['min_length']} exceeds compare.length "
                           f"({cmp['length']})")
+
+
+def _check_generator_blocks(cmp: dict) -> None:
+    """Each generator block's values fit together (segments, blends, strides, future times, weights, patches)."""
     c = cmp["concat"]
     if c["min_segment_s"] > c["max_segment_s"]:
         raise ConfigError(f"config key 'compare.concat.min_segment_s': {c['min_segment_s']} exceeds "
@@ -304,14 +335,7 @@ def check(config: dict) -> None:
     if mg["blend"] is not None and mg["blend"] > mg["window"]:
         raise ConfigError(f"config key 'compare.motion_graph.blend': {mg['blend']} exceeds the window "
                           f"({mg['window']} frames)")
-    fm = cmp["fairmotion"]
-    if not fm["blend"] < fm["base"]:
-        raise ConfigError(f"config key 'compare.fairmotion.blend': {fm['blend']} must be below base ({fm['base']})")
-    if fm["compare"] < fm["blend"]:
-        raise ConfigError(f"config key 'compare.fairmotion.compare': {fm['compare']} must be at least blend "
-                          f"({fm['blend']})")
-    if fm["stride"] is not None and fm["stride"] > fm["base"]:
-        raise ConfigError(f"config key 'compare.fairmotion.stride': {fm['stride']} exceeds base ({fm['base']})")
+    _check_fairmotion_block(cmp["fairmotion"])
     mm = cmp["motion_matching"]
     fut = [float(x) for x in mm["future_s"]]
     if any(b <= a for a, b in zip(fut, fut[1:])):
@@ -327,6 +351,22 @@ def check(config: dict) -> None:
         raise ConfigError(f"config key 'compare.genmm.patch_size': {gm['patch_size']} frames exceed "
                           f"compare.context + compare.min_length ({cmp['context']} + {cmp['min_length']}): a short "
                           "clip's start and continuation would hold no patch")
+
+
+def _check_fairmotion_block(fm: dict) -> None:
+    """fairmotion's blend is below its base, its comparison window at least the blend, its stride at most the base."""
+    if not fm["blend"] < fm["base"]:
+        raise ConfigError(f"config key 'compare.fairmotion.blend': {fm['blend']} must be below base ({fm['base']})")
+    if fm["compare"] < fm["blend"]:
+        raise ConfigError(f"config key 'compare.fairmotion.compare': {fm['compare']} must be at least blend "
+                          f"({fm['blend']})")
+    if fm["stride"] is not None and fm["stride"] > fm["base"]:
+        raise ConfigError(f"config key 'compare.fairmotion.stride': {fm['stride']} exceeds base ({fm['base']})")
+
+
+def _check_showcase_and_window(config: dict) -> None:
+    """The showcase clip is a held-out trial and its seed one of the run's; the metrics' window fits a short clip."""
+    cmp = config["compare"]
     sc = cmp["showcase"]
     if sc["clip"] is not None and sc["clip"].split("@", 1)[0] not in held_out_trials(config):
         raise ConfigError(f"config key 'compare.showcase.clip': {sc['clip']!r} is not a held-out trial of this run "
@@ -337,9 +377,6 @@ def check(config: dict) -> None:
     if cmp["metrics"]["window"] > cmp["min_length"]:
         raise ConfigError(f"config key 'compare.metrics.window': {cmp['metrics']['window']} frames exceed "
                           f"compare.min_length ({cmp['min_length']}): a short clip would have no window")
-    from .claims import check_claims
-
-    check_claims(config)  # the declared claims against the metric table and the configured rows
 
 
 def check_subject_sets(config: dict) -> None:
