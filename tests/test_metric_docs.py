@@ -1,8 +1,10 @@
-"""The docs' metric table is generated from the metric table's records and kept up to date; every record names a
+"""The metric table collects the records each measure module declares (those listed in their order, then any other
+module by name); the docs' metric table is generated from them and kept up to date; every record names a
 computation that exists."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pytest
@@ -40,3 +42,50 @@ def test_render_keeps_the_page_around_the_markers_and_refuses_a_page_without_the
 def test_every_record_names_a_computation_that_exists():
     for path in metric_table.by_computation(metric_table.METRICS):
         assert callable(metric_table.computation(path)), path
+
+
+def _package(root: Path, name: str, modules: dict[str, str]) -> str:
+    """A package ``name`` under ``root`` with one module per entry: its ``RECORDS`` (Python text) or None."""
+    (root / name).mkdir()
+    (root / name / "__init__.py").write_text("")
+    for module, records in modules.items():
+        body = "def score(s):\n    return {}\n"
+        if records is not None:
+            body = f"from animsynth.compare.measures.metric_record import Metric\n{body}RECORDS = {records}\n"
+        (root / name / f"{module}.py").write_text(body)
+    return name
+
+
+@pytest.fixture
+def packages(tmp_path, monkeypatch):
+    monkeypatch.syspath_prepend(str(tmp_path))
+    made = []
+
+    def make(name, modules):
+        made.append(_package(tmp_path, name, modules))
+        return name
+
+    yield make
+    for key in [k for k in sys.modules if k.split(".")[0] in made]:
+        del sys.modules[key]
+
+
+def _rec(module: str, name: str) -> str:
+    return f'Metric("{name}", "m", "", "", compute="{module}:score"),'
+
+
+def test_the_table_takes_the_listed_modules_in_order_then_every_other_module_with_records_by_name(packages):
+    pkg = packages("measures_fake_a", {"zeta": f"({_rec('zeta', 'z1')} {_rec('zeta', 'z2')})",
+                                       "alpha": f"({_rec('alpha', 'a1')})", "new_b": f"({_rec('new_b', 'b1')})",
+                                       "new_a": f"({_rec('new_a', 'n1')})", "helper": None,
+                                       "docs": "1 / 0"})  # skipped: never imported
+    names = [m.name for m in metric_table.records_of(pkg, ("zeta", "alpha"), ("docs",))]
+    assert names == ["z1", "z2", "a1", "n1", "b1"]
+
+
+def test_a_record_outside_its_module_or_a_listed_module_without_records_is_refused(packages):
+    pkg = packages("measures_fake_b", {"mine": f"({_rec('other', 'x')})", "bare": None})
+    with pytest.raises(ValueError, match=r"measures_fake_b\.mine: the record 'x' names the computation 'other:score'"):
+        metric_table.records_of(pkg)
+    with pytest.raises(ValueError, match=r"measures_fake_b\.bare: RECORDS must be"):
+        metric_table.records_of(pkg, ("bare",), ("mine",))

@@ -3,9 +3,10 @@
 Pure numpy functions (scipy where it helps). Every length is in metres, every speed in m/s, every acceleration
 in m/s^2; the vertical axis is y (:data:`UP`), as in CMU ASF/AMC and BVH. ``docs/compare/metrics.md`` defines each
 metric, names its source and says where ours differs from it. This package gathers them; each concern is a module of
-its own, imported on first use of one of its names (the metric table, :mod:`.metric_table`, imports none of them:
-the tables, verdicts and figures read it without the metrics' code). The columns of ``metrics.csv`` (unit,
-direction, what each needs, the computation that gives it, its tracks) are the metric table.
+its own, imported on first use of one of its names. Each measure module declares the records of its columns (unit,
+direction, what each needs, the computation that gives it, its tracks: :class:`~.metric_record.Metric`) beside
+their computations, in a tuple ``RECORDS``; the metric table (:mod:`.metric_table`) collects them into the columns
+of ``metrics.csv``, and a new module that declares ``RECORDS`` joins it without an edit elsewhere.
 
 Positions and features (:mod:`.pose`)
     :func:`positions` (forward kinematics in metres), :func:`positions_and_quaternions` (and the world rotations,

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .metric_record import Metric
 from .pose import HORIZONTAL, align_quaternions, rotate_to
 
-__all__ = ["position_stats", "l2p", "l2q", "npss", "score_l2p", "score_l2p_m", "score_l2q", "score_npss"]
+__all__ = ["position_stats", "l2p", "l2q", "npss", "score_l2p", "score_l2p_m", "score_l2q", "score_npss", "RECORDS"]
 
 _NAN = float("nan")
 
@@ -176,3 +177,18 @@ def score_l2q(s) -> dict:
 def score_npss(s) -> dict:
     """``npss`` of the world rotations (``compare.metrics.npss_spectrum``)."""
     return {"npss": npss(s.quaternions, s.ref.truth_q, spectrum=s.mcfg["npss_spectrum"], quaternions=True)}
+
+
+#: this module's columns, in their order in ``metrics.csv``: against a ground truth of the same length, on the
+#: short track only
+RECORDS = (
+    Metric("l2p", "LAFAN1 L2P (clip database statistics)", "lower", "database", "L2P", "L2P vs held-out continuation",
+           exploratory=True, margin=0.25,
+           margin_why="a quarter of the database's own per-joint position standard deviation (the unit L2P is "
+                      "normalised by): a smaller gap to the capture is not a different continuation",
+           compute="ground_truth:score_l2p", tracks=("short",)),
+    Metric("l2p_m", "m", "lower", "reference", "L2P (m)", compute="ground_truth:score_l2p_m", tracks=("short",)),
+    Metric("l2q", "LAFAN1 L2Q", "lower", "reference", compute="ground_truth:score_l2q", tracks=("short",)),
+    Metric("npss", "NPSS", "lower", "reference", title="NPSS vs held-out continuation",
+           compute="ground_truth:score_npss", tracks=("short",)),
+)

@@ -7,8 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .metric_record import Metric
+
 __all__ = ["JumpReference", "jump_reference", "seam_jumps", "frame_jumps", "capture_max_jumps", "score_frame_jumps",
-           "score_jumps_over_capture"]
+           "score_jumps_over_capture", "VELOCITY_JUMP_P95", "RECORDS"]
 
 _NAN = float("nan")
 
@@ -171,3 +173,23 @@ def score_frame_jumps(s) -> dict:
 def score_jumps_over_capture(s) -> dict:
     """The share of the generated frames of ``s`` jumping more than the held-out capture's largest jump."""
     return _frame_jumps(s)
+
+
+# ----------------------------------------------------------------------------- the records
+VELOCITY_JUMP_P95 = Metric(
+    "velocity_jump_p95", "m/s", "lower", "", "per-frame velocity jump p95 (m/s)",
+    "per-frame velocity jump: 95th percentile (m/s)", exploratory=True, margin=0.2,
+    margin_why="a change of joint velocity of 0.2 m/s within one frame (7 mm of position at 30 fps), about half of a "
+               "capture's own 95th percentile: smaller pops hide in the capture's own noise",
+    compute="jumps:score_frame_jumps")
+#: this module's columns, in their order in ``metrics.csv``
+RECORDS = (
+    VELOCITY_JUMP_P95,
+    Metric("velocity_jump_max", "m/s", "lower", "", compute="jumps:score_frame_jumps"),
+    Metric("velocity_jump_over_capture", "share of frames", "lower", "reference",
+           "frames above the capture's largest jump", "share of frames jumping more than the capture's largest",
+           compute="jumps:score_jumps_over_capture"),
+    Metric("accel_jump_p95", "m/s^2", "lower", "", compute="jumps:score_frame_jumps"),
+    Metric("accel_jump_max", "m/s^2", "lower", "", compute="jumps:score_frame_jumps"),
+    Metric("accel_jump_over_capture", "share of frames", "lower", "reference", compute="jumps:score_jumps_over_capture"),
+)

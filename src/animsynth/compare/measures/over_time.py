@@ -19,9 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .metric_table import COVERAGE_TIMES_S, EDGE_S, after_time, at_edge
+from .jumps import VELOCITY_JUMP_P95, frame_jumps
+from .metric_record import COVERAGE_TIMES_S, EDGE_S, Metric, after_time, at_edge
+from .skating import SKATE_SHARE, foot_skating
+from .windows import COVERAGE, coverage
 
-__all__ = ["coverage_after", "score_coverage_over_time", "score_skating_first_last", "score_jumps_first_last"]
+__all__ = ["coverage_after", "score_coverage_over_time", "score_skating_first_last", "score_jumps_first_last",
+           "RECORDS"]
 
 _NAN = float("nan")
 
@@ -46,8 +50,6 @@ def coverage_after(features, db_features, fps: float, window: int, threshold_m: 
     dict
         ``{t: coverage}`` per time (NaN where the motion is shorter than ``t``).
     """
-    from .windows import coverage
-
     F = np.asarray(features, float)
     out = {}
     for t in times_s:
@@ -57,7 +59,7 @@ def coverage_after(features, db_features, fps: float, window: int, threshold_m: 
 
 
 def score_coverage_over_time(s) -> dict:
-    """``coverage_after_<t>s`` for every :data:`~.metric_table.COVERAGE_TIMES_S` of ``s``
+    """``coverage_after_<t>s`` for every :data:`~.metric_record.COVERAGE_TIMES_S` of ``s``
     (:class:`~.scored.ScoredMotion`)."""
     cov = coverage_after(s.features, s.ref.features, s.fps, int(s.mcfg["window"]), s.setting("coverage_threshold_m"),
                          COVERAGE_TIMES_S)
@@ -75,9 +77,7 @@ def _with_change(name: str, first: float, last: float) -> dict:
 
 
 def score_skating_first_last(s) -> dict:
-    """``skate_share`` over the first and the last :data:`~.metric_table.EDGE_S` seconds, and their change."""
-    from .skating import foot_skating
-
+    """``skate_share`` over the first and the last :data:`~.metric_record.EDGE_S` seconds, and their change."""
     edges = _edges(s)
     if edges is None:
         return _with_change("skate_share", _NAN, _NAN)
@@ -90,9 +90,7 @@ def score_skating_first_last(s) -> dict:
 
 
 def score_jumps_first_last(s) -> dict:
-    """``velocity_jump_p95`` over the first and the last :data:`~.metric_table.EDGE_S` seconds, and their change."""
-    from .jumps import frame_jumps
-
+    """``velocity_jump_p95`` over the first and the last :data:`~.metric_record.EDGE_S` seconds, and their change."""
     edges = _edges(s)
     if edges is None:
         return _with_change("velocity_jump_p95", _NAN, _NAN)
@@ -101,3 +99,28 @@ def score_jumps_first_last(s) -> dict:
     first_p95 = frame_jumps(pos[:c + n], s.fps, c, none)["velocity_jump_p95"]
     last_p95 = frame_jumps(pos, s.fps, c + last, none)["velocity_jump_p95"]
     return _with_change("velocity_jump_p95", first_p95, last_p95)
+
+
+# ----------------------------------------------------------------------------- the records
+def _edge_records(of: Metric, compute: str, why: str) -> tuple[Metric, ...]:
+    """The records of ``of`` over the first and the last :data:`~.metric_record.EDGE_S` seconds and their change,
+    with its unit, direction, needs and margin."""
+    return tuple(Metric(at_edge(of.name, w), of.unit + (", last minus first" if w == "change" else ""), of.better,
+                        of.needs, skating_claim=of.skating_claim, margin=of.margin, margin_why=why, compute=compute,
+                        tracks=("long",), min_seconds=2 * EDGE_S)
+                 for w in ("first", "last", "change"))
+
+
+#: this module's columns of the long track's table, in their order: coverage after each time (the unit, direction
+#: and margin of ``coverage``), then the skate share and the velocity jump's 95th percentile over the first and the
+#: last seconds (those of the whole run's)
+RECORDS = (
+    *(Metric(after_time(COVERAGE.name, t), COVERAGE.unit, COVERAGE.better, COVERAGE.needs, margin=COVERAGE.margin,
+             margin_why=COVERAGE.margin_why, compute="over_time:score_coverage_over_time", tracks=("long",),
+             min_seconds=float(t))
+      for t in COVERAGE_TIMES_S),
+    *_edge_records(SKATE_SHARE, "over_time:score_skating_first_last",
+                   "5 percentage points of contact joint-frames, as for the skate share over the whole run"),
+    *_edge_records(VELOCITY_JUMP_P95, "over_time:score_jumps_first_last",
+                   "0.2 m/s within one frame, as for the per-frame velocity jump over the whole run"),
+)

@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["earliest_repeat_distance", "repetition_share", "score_repetition"]
+from .metric_record import Metric
+
+__all__ = ["earliest_repeat_distance", "repetition_share", "score_repetition", "RECORDS"]
 
 
 def earliest_repeat_distance(features, window: int) -> np.ndarray:
@@ -93,3 +95,12 @@ def score_repetition(s) -> dict:
     ``compare.metrics.repetition_window_s`` seconds, tolerance ``repetition_tolerance_m``."""
     window = max(int(round(s.setting("repetition_window_s") * s.fps)), 1)
     return {"repetition_share": repetition_share(s.features, window, s.setting("repetition_tolerance_m"))}
+
+
+#: this module's column of the long track's table
+RECORDS = (
+    Metric("repetition_share", "share of frames", "lower", "", "repetition", "repetition: share of frames in a "
+           "repeated window", margin=0.1, margin_why="a tenth of the run (2 s of 20 s) inside windows that replay an "
+           "earlier second: one more pass of a 2-s loop, about the least a viewer notices as a loop",
+           compute="repetition:score_repetition", tracks=("long",)),
+)

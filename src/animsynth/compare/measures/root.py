@@ -27,10 +27,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .metric_record import Metric
 from .pose import HORIZONTAL, UP
 
 __all__ = ["root_speed", "pose_speed", "still_frames", "root_tilt_deg", "drift_share", "score_still",
-           "score_freezing", "score_drift"]
+           "score_freezing", "score_drift", "RECORDS"]
 
 _NAN = float("nan")
 
@@ -156,3 +157,16 @@ def score_drift(s) -> dict:
     tilt = root_tilt_deg(s.motion.skeleton, s.motion.values)
     return {"drift_share": drift_share(s.generated_pos[:, 0, UP], tilt, height_range, tilt_range,
                                        s.setting("drift_height_tolerance_m"), s.setting("drift_tilt_tolerance_deg"))}
+
+
+#: this module's columns of the long track's table, in their order
+RECORDS = (
+    Metric("still_share", "share of frames", "", "", compute="root:score_still", tracks=("long",)),
+    Metric("freezing_share", "share of frames beyond the capture's", "lower", "reference", "freezing",
+           "freezing: still beyond the capture", margin=0.05, margin_why="1 s of a 20-s run standing still where the "
+           "person moved: a stop a user sees as the character getting stuck", compute="root:score_freezing",
+           tracks=("long",)),
+    Metric("drift_share", "share of frames", "lower", "database", "drift", "drift: root height or tilt outside the "
+           "capture's range", margin=0.05, margin_why="1 s of a 20-s run with the body sunk, floating or keeled over "
+           "beyond anything the capture does", compute="root:score_drift", tracks=("long",)),
+)

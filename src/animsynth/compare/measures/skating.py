@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .metric_table import SENSITIVITY_SPEEDS, at_speed
+from .metric_record import SENSITIVITY_SPEEDS, Metric, at_speed
 from .pose import HORIZONTAL, UP
 
 __all__ = ["floor_height", "foot_skating", "skating_ratio", "score_foot_skating", "score_skating_ratio_gmd",
-           "score_skating_sensitivity", "score_transition_skating"]
+           "score_skating_sensitivity", "score_transition_skating", "SKATE_SHARE", "SKATING_RATIO_GMD",
+           "SENSITIVITY_METRICS", "RECORDS"]
 
 _NAN = float("nan")
 
@@ -167,7 +168,7 @@ def score_skating_ratio_gmd(s) -> dict:
 
 def score_skating_sensitivity(s) -> dict:
     """The skate share and the GMD-style ratio of ``s`` at every speed threshold of
-    :data:`~.metric_table.SENSITIVITY_SPEEDS` (``<name>_at_<speed>``)."""
+    :data:`~.metric_record.SENSITIVITY_SPEEDS` (``<name>_at_<speed>``)."""
     height, pos, out = s.setting("contact_height_m"), s.pos[s.context - 1:], {}
     for v in SENSITIVITY_SPEEDS:
         out[at_speed("skate_share", v)] = foot_skating(pos, s.fps, s.ref.foot_idx, height, v, s.ref.floor)["skate_share"]
@@ -188,3 +189,32 @@ def score_transition_skating(s) -> dict:
         n_contact += nc
         n_skate += (part["skate_share"] * nc) if nc else 0.0
     return {"transition_skate_share": n_skate / n_contact if n_contact else _NAN}
+
+
+# ----------------------------------------------------------------------------- the records
+SKATE_SHARE = Metric("skate_share", "share of contact joint-frames", "lower", "floor", "skate share",
+                     "foot skating: share of contact frames", exploratory=True, skating_claim=True,
+                     margin=0.05, margin_why="5 percentage points of contact joint-frames: in a 2-s walk (about four "
+                     "stances of 15 frames) some 3 more sliding frames per foot joint, about the smallest slide an "
+                     "animator would go in to fix", compute="skating:score_foot_skating")
+SKATING_RATIO_GMD = Metric("skating_ratio_gmd", "share of frame steps (GMD)", "lower", "floor", "GMD skating ratio",
+                           "skating ratio (GMD-style)", margin=0.05,
+                           margin_why="5 percentage points of frame steps, as for the skate share",
+                           compute="skating:score_skating_ratio_gmd")
+_SENSITIVITY = (SKATE_SHARE, SKATING_RATIO_GMD)
+#: the skating metrics measured again at each of :data:`~.metric_record.SENSITIVITY_SPEEDS` (the
+#: ``<name>_at_<speed>`` columns, :func:`~.metric_record.at_speed`: no direction, the unit of the metric at that speed)
+SENSITIVITY_METRICS = tuple(m.name for m in _SENSITIVITY)
+#: this module's columns, in their order in ``metrics.csv``
+RECORDS = (
+    Metric("contact_share", "share of foot joint-frames", "", "floor", compute="skating:score_foot_skating"),
+    SKATE_SHARE,
+    Metric("skate_m_per_contact_frame", "m", "lower", "floor", compute="skating:score_foot_skating"),
+    Metric("transition_skate_share", "share of contact joint-frames near seams", "lower", "seams",
+           "skate share near seams", "skating near seams: share", exploratory=True, skating_claim=True, margin=0.05,
+           margin_why="5 percentage points of the contact joint-frames near seams, as for the skate share",
+           compute="skating:score_transition_skating"),
+    SKATING_RATIO_GMD,
+    *(Metric(at_speed(m.name, v), f"{m.unit}, {v:g} m/s", "", m.needs, compute="skating:score_skating_sensitivity")
+      for m in _SENSITIVITY for v in SENSITIVITY_SPEEDS),
+)

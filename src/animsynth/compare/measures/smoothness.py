@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["speed_profile", "ldlj", "sparc", "score_ldlj", "score_sparc"]
+from .metric_record import Metric
+
+__all__ = ["speed_profile", "ldlj", "sparc", "score_ldlj", "score_sparc", "RECORDS"]
 
 _NAN = float("nan")
 
@@ -119,3 +121,11 @@ def score_ldlj(s) -> dict:
 def score_sparc(s) -> dict:
     """``sparc`` of the generated frames of ``s``."""
     return {"sparc": sparc(s.generated_pos, s.fps)}
+
+
+#: this module's columns, in their order in ``metrics.csv``
+RECORDS = (
+    Metric("ldlj", "log dimensionless jerk", "higher", "", "LDLJ",
+           "smoothness: log dimensionless jerk (higher smoother)", compute="smoothness:score_ldlj"),
+    Metric("sparc", "spectral arc length", "higher", "", compute="smoothness:score_sparc"),
+)

@@ -10,8 +10,9 @@ records trust what the generator reports: the per-frame jumps (:func:`~.jumps.fr
 from __future__ import annotations
 
 from .jumps import seam_jumps
+from .metric_record import Metric
 
-__all__ = ["score_seam_count", "score_seam_jumps", "run_transitions_kept"]
+__all__ = ["score_seam_count", "score_seam_jumps", "run_transitions_kept", "RECORDS"]
 
 _SEAM_JUMPS = ("velocity_jump", "velocity_jump_ratio", "velocity_jump_pct", "accel_jump", "accel_jump_ratio",
                "accel_jump_pct")
@@ -33,3 +34,20 @@ def run_transitions_kept(run) -> dict:
     """``transitions_kept``: the candidate transitions the generator of ``run`` (a :class:`~.scored.RunOutputs`)
     keeps before pruning, from its ``run_notes()``; NaN where it gives none (a generator without transitions)."""
     return {"transitions_kept": float(run.generator.run_notes().get("transitions_kept", float("nan")))}
+
+
+#: this module's columns, in their order in ``metrics.csv``; the jumps at the seams a generator reports are
+#: secondary: they trust the generator's own seams
+RECORDS = (
+    Metric("n_seams", "seams", "", "seams", compute="transitions:score_seam_count"),
+    Metric("seams_per_s", "1/s", "", "seams", compute="transitions:score_seam_count"),
+    Metric("transitions_kept", "transitions before pruning", "", "generator", title="transitions kept (before pruning)",
+           compute="transitions:run_transitions_kept"),
+    Metric("velocity_jump", "m/s", "", "seams", "seam velocity jump (m/s)", "velocity jump at reported seams (m/s)",
+           compute="transitions:score_seam_jumps"),
+    Metric("velocity_jump_ratio", "x capture median", "", "seams", compute="transitions:score_seam_jumps"),
+    Metric("velocity_jump_pct", "percentile in capture", "", "seams", compute="transitions:score_seam_jumps"),
+    Metric("accel_jump", "m/s^2", "", "seams", compute="transitions:score_seam_jumps"),
+    Metric("accel_jump_ratio", "x capture median", "", "seams", compute="transitions:score_seam_jumps"),
+    Metric("accel_jump_pct", "percentile in capture", "", "seams", compute="transitions:score_seam_jumps"),
+)

@@ -7,8 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .metric_record import Metric
+
 __all__ = ["window_nearest", "window_scores", "coverage", "local_diversity", "seed_diversity", "novelty", "score_windows",
-           "score_novelty", "run_seed_diversity"]
+           "score_novelty", "run_seed_diversity", "COVERAGE", "RECORDS"]
 
 _NAN = float("nan")
 
@@ -204,3 +206,21 @@ def score_novelty(s) -> dict:
 def run_seed_diversity(run) -> dict:
     """``seed_diversity_m`` over every seed of one generator's run on a clip (a :class:`~.scored.RunOutputs`)."""
     return {"seed_diversity_m": seed_diversity(run.features)}
+
+
+# ----------------------------------------------------------------------------- the records
+COVERAGE = Metric("coverage", "share of database windows", "higher", "database", "coverage",
+                  "coverage of database windows", exploratory=True, margin=0.05,
+                  margin_why="5 % of the database's windows: about one second of a 20-s database reached or missed",
+                  compute="windows:score_windows")
+#: this module's columns, in their order in ``metrics.csv``
+RECORDS = (
+    COVERAGE,
+    Metric("local_diversity_m", "m", "", "database", compute="windows:score_windows"),
+    Metric("seed_diversity_m", "m", "higher", "seeds", title="diversity across seeds (m)",
+           compute="windows:run_seed_diversity"),
+    Metric("novelty_median_m", "m", "", "database", "novelty (m)", "novelty: distance to nearest database frame (m)",
+           margin=0.01, margin_why="1 cm median distance to the nearest database pose: closer, a pose is a copy with "
+                                   "capture noise", compute="windows:score_novelty"),
+    Metric("copy_share", "share of frames", "", "database", compute="windows:score_novelty"),
+)
