@@ -28,6 +28,7 @@ import pandas as pd
 import pytest
 
 from conftest import REPO, SAFETY_TIMEOUT, SNAKEMAKE, copy_workflow, place_papers, run_snakemake
+from run_outputs import WHOLE_RUN_COMPARED, outputs_that_differ
 
 pytestmark = [pytest.mark.slurm, pytest.mark.workflow]
 
@@ -275,3 +276,9 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
     assert len(slurm_logs) == n_jobs, len(slurm_logs)
 
     _assert_same_tables(local_reference, remote)
+    # every output, not only the tables: the SLURM run is a whole second run of the config, so this is the
+    # determinism check of every job (tests/test_workflow.py then leaves its partial second run out)
+    differ = outputs_that_differ(local_reference, remote)
+    assert not differ, f"{len(differ)} outputs differ between the local and the SLURM run: {differ[:20]}"
+    if not os.environ.get("ANIMSYNTH_SLURM_LOCAL_REFERENCE"):  # the session's own tiny run, compared whole
+        WHOLE_RUN_COMPARED["tiny"] = True

@@ -1,14 +1,12 @@
-"""Studies on a BVH skeleton that is not CMU's: ``ROOT Hips``, Mixamo-style
-names, no hip joints, fingers or thumbs, ``Zrotation Xrotation Yrotation``
-everywhere, centimetres. Body parts are found by joint role
-(animsynth.joints), through the workflow's own-data route."""
+"""The library on a BVH skeleton that is not CMU's: ``ROOT Hips``, Mixamo-style names, no hip joints, fingers or
+thumbs, ``Zrotation Xrotation Yrotation`` everywhere, centimetres; body parts found by joint role
+(animsynth.joints). The workflow's own-data route on Hips-named skeletons (simplicial, re-sequencing and compare,
+each class of BVH file found in the wild) is tests/test_user_bvh_classes.py."""
 
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 import pytest
-import yaml
 
 from animsynth.io.bvh import read_bvh, write_bvh
 from animsynth.joints import JointRoleError, resolve_role
@@ -19,7 +17,6 @@ from animsynth.resequencing.features import motion_features
 from animsynth.resequencing.metrics import foot_ground
 from animsynth.skeleton import Joint, Skeleton
 from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
-from conftest import REPO, copy_workflow, run_snakemake
 
 NAMES = {"root": "Hips", "lowerback": "Spine", "upperback": "Spine1", "thorax": "Spine2", "lowerneck": "Neck",
          "upperneck": "Neck1", "head": "Head", "lclavicle": "LeftShoulder", "lhumerus": "LeftArm",
@@ -94,34 +91,3 @@ def test_unresolvable_role_names_the_role_and_the_joints(tmp_path):
     b.skeleton.roles = {"left_knee": "Knee_L_custom"}
     assert resolve_role(b.skeleton, "left_knee") == "Knee_L_custom"
     assert joint_weights(motion_features(b).joint_names, PAPER_WEIGHTS, b.skeleton.roles).sum() > 0
-
-
-TRIALS = [("w1", "walk_straight", 0), ("w2", "walk_straight", 1), ("w3", "walk_straight", 2),
-          ("r1", "run_straight", 3), ("r2", "run_straight", 4), ("r3", "run_straight", 5),
-          ("d1", "dance", 6)]
-
-
-@pytest.mark.workflow
-def test_simplicial_and_resequencing_run_on_a_hips_bvh_through_the_own_data_route(tmp_path):
-    data = tmp_path / "my_bvh"
-    data.mkdir()
-    sk = cmu_like_skeleton("me", 2)
-    for tid, kind, seed in TRIALS:
-        to_hips_bvh(generate_motion(kind, 90 if kind != "dance" else 120, seed, sk), data / f"{tid}.bvh")
-    test_cfg = yaml.safe_load((REPO / "config" / "test.yaml").read_text())
-    cfg = {"mocap_source": "user", "data_dir": str(data), "bvh_length_to_m": 0.01,
-           "trials": [{"id": tid, "subject": "me", "kind": kind, "bvh": f"{tid}.bvh"} for tid, kind, _ in TRIALS],
-           "subsets": {"w1": ["w1", "w2", "w3"], "r1": ["r1", "r2", "r3"], "w2": None, "r2": None},
-           "resequencing_trials": {"walk": "w1", "run": "r1", "dance": "d1"},
-           "simplicial": test_cfg["simplicial"], "resequencing": test_cfg["resequencing"]}
-    wd = copy_workflow(tmp_path / "wf")
-    (wd / "config" / "mybvh.yaml").write_text(yaml.safe_dump(cfg))
-    targets = ["results/simplicial/table2.csv", "results/resequencing/smoothness.csv"]
-    res = run_snakemake(wd, *targets, "--configfile", "config/mybvh.yaml")
-    assert res.returncode == 0, (res.stdout + res.stderr)[-6000:]
-    t2 = pd.read_csv(wd / "results/simplicial/table2.csv")
-    assert np.isfinite(t2["all"].to_numpy(float)).all()
-    # the user's own walk, run and dance are not the paper's CMU clips: its min k is not shown beside them
-    k = pd.read_csv(wd / "results/resequencing/table2_min_k.csv")
-    assert len(k) and k["min_k_paper"].isna().all() and k["min_k"].notna().all()
-    assert "not the paper's CMU trial" in (wd / "results/resequencing/table2_min_k.md").read_text()

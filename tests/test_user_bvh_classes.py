@@ -1,7 +1,15 @@
 """The own-data route on BVH files of every class found in the wild (tests/bvh_classes.py): one config mixes
 a centimetre Bandai-style skeleton, a CMU-unit (cgspeed) one, a Bip01 skeleton with 6 channels on every joint
 (its roles named on its trials), mixed rotation orders, a rest pose along X and a Z-up file in metres, each
-trial with its own unit; simplicial, re-sequencing (walk and run only: dance is null) and compare run on it."""
+trial with its own unit; simplicial, re-sequencing (walk and run only: dance is null) and compare run on it.
+
+The comparison runs the generators whose code reads the skeleton in its own way (:data:`COMPARE_GENERATORS`): our
+motion graph (feet and floor from the joint roles), fairmotion (the skeleton written to BVH and read by fairmotion's
+loader), motion matching (foot locking on the roles), GenMM, ST-Isomap (the re-sequencing features: joint
+quaternions) and the replay bound. The others read the skeleton only through what these already exercise (isomap:
+ST-Isomap's features; Delaunay and k-NN: the DOF values of the simplicial study, which this run fits on every
+class; the motion-matching variants: motion matching's code with other weights; concat: clips cut as replay's), and
+each job costs its start-up, so they run on the tiny run's synthetic skeleton only."""
 
 from __future__ import annotations
 
@@ -16,6 +24,8 @@ from conftest import REPO, copy_workflow, run_snakemake
 
 pytestmark = pytest.mark.workflow
 
+#: the comparison's generators here (module docstring: the ones that read the skeleton in a way of their own)
+COMPARE_GENERATORS = ["stisomap", "motion_graph", "fairmotion", "fairmotion_fixed", "motion_matching", "genmm", "replay"]
 # (trial id, class, kind, frames, subject seed)
 TRIALS = [("ban1", "bandai", "walk_straight", 90), ("ban2", "bandai", "walk_straight", 80),
           ("ban3", "bandai", "walk_straight", 96),
@@ -43,7 +53,8 @@ def _config(data):
                         "r2": ["mix1", "mix2", "mix3"]},
             "resequencing_trials": {"walk": "lafan", "run": "blend", "dance": None},
             "simplicial": test_cfg["simplicial"], "resequencing": test_cfg["resequencing"],
-            "compare": {**test_cfg["compare"], "subsets": ["w1", "r1"], "resequencing": None}}
+            "compare": {**test_cfg["compare"], "subsets": ["w1", "r1"], "resequencing": None,
+                        "generators": COMPARE_GENERATORS}}
 
 
 def test_every_class_through_simplicial_resequencing_and_compare(tmp_path):
@@ -52,7 +63,8 @@ def test_every_class_through_simplicial_resequencing_and_compare(tmp_path):
     cfg = _config(data)
     wd = copy_workflow(tmp_path / "wf")
     (wd / "config" / "wild.yaml").write_text(yaml.safe_dump(cfg))
-    targets = ["results/simplicial/table2.csv", "results/resequencing/smoothness.csv", "results/compare/metrics.csv"]
+    targets = ["results/simplicial/table2.csv", "results/resequencing/smoothness.csv",
+               "results/resequencing/table2_min_k.csv", "results/compare/metrics.csv"]
     res = run_snakemake(wd, *targets, "--configfile", "config/wild.yaml")
     assert res.returncode == 0, (res.stdout + res.stderr)[-6000:]
     logs = {p.stem: p.read_text() for p in (wd / "logs" / "data" / "parse_trial").glob("*.log")}
@@ -65,9 +77,16 @@ def test_every_class_through_simplicial_resequencing_and_compare(tmp_path):
     assert np.isfinite(t2[["w1", "w2", "r1", "r2", "all"]].to_numpy(float)).all()
     sm = pd.read_csv(wd / "results/resequencing/smoothness.csv")
     assert set(sm["dataset"]) == {"walk", "run"}
+    # the user's own walk and run are not the paper's CMU clips: its min k is not shown beside them
+    k = pd.read_csv(wd / "results/resequencing/table2_min_k.csv")
+    assert len(k) and k["min_k_paper"].isna().all() and k["min_k"].notna().all()
+    assert "not the paper's CMU trial" in (wd / "results/resequencing/table2_min_k.md").read_text()
     m = pd.read_csv(wd / "results/compare/metrics.csv")
     held_out = {c.split("@", 1)[0] for c in m["clip"]}  # a clip is a window <group>/<trial>@<first frame>
     assert {"w1/ban1", "r1/cmu1", "walk/lafan", "run/blend"} <= held_out
+    assert set(m["generator"]) == set(COMPARE_GENERATORS)
+    ran = m.groupby("generator")["velocity_jump_p95"].apply(lambda v: np.isfinite(v.to_numpy(float)).any())
+    assert ran.all(), ran[~ran]  # every generator made motions on these skeletons
     rep = m[m["generator"] == "replay"]
     assert (rep["l2p"] == 0).all()
     assert np.isfinite(m.loc[m["generator"] != "replay", "l2p"].to_numpy(float)).any()

@@ -1,15 +1,14 @@
 """The workflow itself: lint, a dry run of every config, the tiny run, determinism."""
 
-import json
 import re
 import shutil
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 import pytest
 
 from conftest import REPO, copy_finished_run, copy_workflow, place_papers, run_snakemake
+from run_outputs import NOT_COMPARED, WHOLE_RUN_COMPARED, same_content, tables
 
 CONFIGS = sorted(p.name for p in (REPO / "config").glob("*.yaml") if p.name != "schema.yaml")
 
@@ -116,19 +115,6 @@ def test_every_file_the_tiny_run_wrote_is_a_declared_output(tiny_workflow, tiny_
 #: Machine- and load-dependent outputs, the only ones allowed to differ between runs.
 # facegraph/table1.md is the rendered view that joins Table 1 with its timing table (as the paper's Table 1 does);
 # table1.csv itself is compared.
-NOT_COMPARED = re.compile(r"((^|_)timing\.(csv|md)|^benchmarks\.(csv|md)|^rule_benchmarks.*\.(csv|md)|^table1\.md)$")
-
-
-def _tables(root: Path) -> dict[str, bytes]:
-    """Every table under results/ (CSV, and its Markdown rendering), as bytes."""
-    out = {}
-    for p in sorted((root / "results").rglob("*")):
-        if p.suffix not in (".csv", ".md") or NOT_COMPARED.search(p.name):
-            continue
-        out[str(p.relative_to(root))] = p.read_bytes()
-    return out
-
-
 def test_not_compared_is_only_timing_tables():
     names = ["meshdetail/timing.csv", "facegraph/table1_timing.csv", "benchmarks.csv", "rule_benchmarks.csv",
              "rule_benchmarks_per_rule.md", "facegraph/table1.csv", "summary.md", "simplicial/benchmarks_paper.csv"]
@@ -154,41 +140,18 @@ def _jobs_by_rule(summary: str) -> dict[str, list[tuple[str, ...]]]:
     return by_rule
 
 
-#: Timing fields inside otherwise deterministic JSON outputs (e.g. a facegraph configuration's run record).
-JSON_TIMING = re.compile(r"_(cpu|wall)_s$|_ms(_sd)?$")
-
-
-def _comparable(path: Path, root: Path):
-    """What must be equal in an output of the run in ``root``: its bytes with ``root`` written as ``<wd>``
-    (a few outputs record where their inputs were); JSON without timing fields; ``.npz`` array by array
-    (the zip container stores write times); a folder, file by file."""
-    if path.is_dir():
-        return {str(p.relative_to(path)): _comparable(p, root) for p in sorted(path.rglob("*")) if p.is_file()}
-    if path.suffix == ".npz":
-        with np.load(path) as z:
-            return {k: ("U", z[k].shape, str(z[k].tolist()).replace(str(root), "<wd>")) if z[k].dtype.kind == "U"
-                    else (z[k].dtype.str, z[k].shape, z[k].tobytes()) for k in z.files}
-    data = path.read_bytes().replace(str(root).encode(), b"<wd>")
-    if path.suffix == ".json":
-        def drop(x):
-            if isinstance(x, dict):
-                return {k: drop(v) for k, v in x.items() if not JSON_TIMING.search(str(k))}
-            return [drop(v) for v in x] if isinstance(x, list) else x
-        return drop(json.loads(data))
-    return data
-
-
-def _same_content(a: Path, root_a: Path, b: Path, root_b: Path) -> bool:
-    return _comparable(a, root_a.resolve()) == _comparable(b, root_b.resolve())
-
-
 def test_same_config_gives_identical_outputs(tiny_workflow, tiny_summary, tmp_path):
     """Determinism without a second whole run: in a copy of the finished tiny run, one job of every rule
     loses its outputs, and one snakemake call rebuilds exactly those (plus whatever lies between them);
     every rule's computation thus runs a second time (except rules that write only timing tables). Each
-    rebuilt output must equal the first run's (:func:`_comparable`: bytes, up to the working directory's
+    rebuilt output must equal the first run's (:func:`run_outputs.comparable`: bytes, up to the working directory's
     path, timing fields of JSON records aside), and so must every table under results/ except the timing
-    ones, byte for byte."""
+    ones, byte for byte. When the SLURM test of this session (tests/test_slurm.py, which runs first) has run the
+    whole tiny config again and found every output equal to this run's, every job has already run twice and been
+    compared: this test would repeat a part of that run, and says so instead."""
+    if WHOLE_RUN_COMPARED.get("tiny"):
+        pytest.skip("the SLURM test ran every job of the tiny config a second time and found every output under "
+                    "results/ equal to this run's (run_outputs.outputs_that_differ): nothing left to rebuild here")
     wd = copy_finished_run(tiny_workflow, tmp_path / "again" / "run")
     place_papers(wd)
     by_rule = _jobs_by_rule(tiny_summary)  # the copy holds the tiny run's outputs, under the same relative paths
@@ -206,9 +169,9 @@ def test_same_config_gives_identical_outputs(tiny_workflow, tiny_summary, tmp_pa
     ran = set(re.findall(r"^(?:local)?rule (\w+):$", out, re.M))
     assert set(chosen) <= ran, f"rules not re-executed: {sorted(set(chosen) - ran)}"
     timing = [t for t in targets if NOT_COMPARED.search(Path(t).name)]
-    differ = [t for t in targets if t not in timing and not _same_content(tiny_workflow / t, tiny_workflow, wd / t, wd)]
+    differ = [t for t in targets if t not in timing and not same_content(tiny_workflow / t, tiny_workflow, wd / t, wd)]
     assert not differ, f"{len(differ)} of {len(targets)} rebuilt outputs differ from the first run: {differ}"
-    a, b = _tables(tiny_workflow), _tables(wd)
+    a, b = tables(tiny_workflow), tables(wd)
     assert a.keys() == b.keys() and len(a) > 20
     differ = sorted(k for k in a if a[k] != b[k])
     assert not differ, f"{len(differ)} of {len(a)} tables differ between two runs of one config: {differ}"
