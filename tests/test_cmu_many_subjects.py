@@ -4,21 +4,17 @@ skeletons checked against the mirror's trials.csv, the capture check's flags and
 Skipped with the reason when ../shared/data (or ANIMSYNTH_SHARED_DATA) is absent."""
 
 import csv
-import logging
 
 import numpy as np
 import pytest
-import yaml
-
-from animsynth.config import trial_records
 
 from animsynth.axes import standing_height
 from animsynth.capture_check import check_capture
-from animsynth.data import load_trial
 from animsynth.joints import ROLES, resolve_roles
 from animsynth.kinematics import forward_kinematics
 from animsynth.skeleton import figure_kinds, shared_figures
-from conftest import CMU, CMU_MANY, REPO, default_config, need
+from cmu_yaml_trials import cmu_yaml_trials, paper_config, read_trial
+from conftest import CMU, CMU_MANY, need
 
 pytestmark = pytest.mark.realdata
 
@@ -35,42 +31,19 @@ EXPECTED_FLAGS = {
 }
 
 
-def _records():
-    return trial_records(yaml.safe_load((REPO / "config" / "cmu.yaml").read_text())["trials"])
-
-
-def _load(t, first_frame=None):
-    root = (CMU_MANY if t.get("mirror") == "many" else CMU)
-    ff = t.get("first_frame", 0) if first_frame is None else first_frame
-    if "bvh" in t:
-        return load_trial(bvh=root / t["bvh"], bvh_length_to_m=t["bvh_length_to_m"], first_frame=ff,
-                          joint_roles=t.get("joint_roles"), name=t["id"])
-    return load_trial(amc=root / t["amc"], asf=root / t["asf"], joint_roles=t.get("joint_roles"), name=t["id"])
-
-
-class _Warnings(logging.Handler):
-    def __init__(self):
-        super().__init__(logging.WARNING)
-        self.lines: list[str] = []
-
-    def emit(self, record):
-        self.lines.append(record.getMessage())
+@pytest.fixture(scope="module")
+def trials():
+    """{trial id: (record, Motion, [warnings logged while loading it])} of every trial of config/cmu.yaml, read as
+    the parse job reads them (tests/cmu_yaml_trials.py: parsed once per process, this module's own copy)."""
+    need(CMU / "subjects")
+    need(CMU_MANY / "subjects")
+    return cmu_yaml_trials()
 
 
 @pytest.fixture(scope="module")
-def trials():
-    """{trial id: (record, Motion, [warnings logged while loading it])} of every trial of config/cmu.yaml."""
-    need(CMU / "subjects")
-    need(CMU_MANY / "subjects")
-    out, root = {}, logging.getLogger()
-    for t in _records():
-        handler = _Warnings()
-        root.addHandler(handler)
-        try:
-            out[t["id"]] = (t, _load(t), handler.lines)
-        finally:
-            root.removeHandler(handler)
-    return out
+def paper():
+    """The paper run's config (config/config.yaml with config/cmu.yaml over it, validated)."""
+    return paper_config()
 
 
 def test_the_six_subjects_parse_as_their_files_say(trials):
@@ -95,8 +68,8 @@ def test_the_six_subjects_parse_as_their_files_say(trials):
         assert len(resolve_roles(m.skeleton, list(ROLES))) == len(ROLES)
 
 
-def test_the_capture_check_flags_these_frames_and_no_others(trials):
-    cfg = default_config()["capture_check"]
+def test_the_capture_check_flags_these_frames_and_no_others(trials, paper):
+    cfg = paper["capture_check"]
     found = {}
     for tid, (t, m, _) in trials.items():
         c = check_capture(m, tid, cfg, first_frame=t.get("first_frame", 0))
@@ -106,12 +79,12 @@ def test_the_capture_check_flags_these_frames_and_no_others(trials):
     assert found == EXPECTED_FLAGS
 
 
-def test_the_motionbuilder_files_frame_0_is_a_t_pose(trials):
+def test_the_motionbuilder_files_frame_0_is_a_t_pose(trials, paper):
     """Read with frame 0 (first_frame 0), 26_01, 27_01, 32_01 and 32_02 start in a T-pose that jumps into the
     capture: frames 0 and 1 flagged; with the record's first_frame 1 nothing is."""
-    cfg = default_config()["capture_check"]
+    cfg = paper["capture_check"]
     for tid in ("26_01", "27_01", "32_01", "32_02"):
-        c = check_capture(_load(trials[tid][0], first_frame=0), tid, cfg)
+        c = check_capture(read_trial(paper, trials[tid][0], first_frame=0), tid, cfg)
         assert [(f.kind, f.first, f.last) for f in c.flags] == [("tpose_settling", 0, 1)], tid
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import functools
 
 import numpy as np
 import pytest
@@ -272,7 +273,10 @@ def test_the_motion_graph_is_a_generator_of_the_interface(sk):
 
 
 # ---------------------------------------------------------------- the fairmotion peer
+@functools.cache
 def _fairmotion_reason() -> str:
+    """Why fairmotion cannot run here ('' when it can): asked once per process (every skip condition below reads
+    it at collection; its package-metadata look-up is not free)."""
     from animsynth.compare.generators.fairmotion_peer import FairmotionUnavailable, _fairmotion
 
     try:
@@ -301,8 +305,10 @@ def test_missing_fairmotion_is_reported_with_the_install_command(sk, monkeypatch
 def test_fairmotion_peer_walks_its_graph_on_our_clips(sk):
     from animsynth.compare.generators.fairmotion_peer import FairmotionGraph
 
-    a = generate_motion("walk_straight", 60, 1, sk, fps=FPS)
-    b = generate_motion("walk_straight", 60, 8, sk, fps=FPS)
+    # the clips of _fm below: fairmotion's loading and construction of them are built once in this process (the
+    # peer's memos; this graph keeps its own threshold)
+    a = generate_motion("walk_straight", 48, 1, sk, fps=FPS)
+    b = generate_motion("walk_straight", 48, 8, sk, fps=FPS)
     g = FairmotionGraph(base=8, blend=4, compare=4).fit([a, b])
     assert g.fairmotion_version_ == "0.0.4" and g.n_nodes_ >= 2 and len(g.transitions_) > 0
     start = Motion(a.values[:10], sk, FPS, "start")
@@ -391,6 +397,8 @@ def test_fairmotion_rigid_turn_fix_turns_the_path_with_the_piece(sk):
                     ref = _positions(clips[src[t[0], 0]])[src[t, 1]]
                     residuals.append(floor_alignment(pos[t].reshape(-1, 3), ref.reshape(-1, 3))[3])
                     break
+            if "rigid_turn" not in fixes and residuals and max(residuals) > 1e-4:
+                break  # released, one walk whose path does not turn is the defect: more walks cannot undo it
         assert residuals, "no walk turned into the other clip"
         worst[fixes] = max(residuals)
     assert worst[base_fixes + ("rigid_turn",)] < 1e-8
@@ -428,6 +436,8 @@ def test_fairmotion_cut_copy_fix_keeps_the_walks_clips_in_place(sk, monkeypatch)
             view = seen[-1]
             assert view._copies
             n_moved += sum(not np.array_equal(poses(m), poses(g._loaded_[i])) for i, m in view._copies.items())
+            if fixes != FIXES and n_moved > 0 and max(ratios) > 5.0:
+                break  # the rows without cut_copy need one walk that shows the defect: more walks cannot undo it
         worst[fixes], moved[fixes] = max(ratios), n_moved
     assert moved[FIXES] == 0 and worst[FIXES] < 1.5
     assert moved[FIXES[:3]] > 0 and worst[FIXES[:3]] > 5.0  # the other three fixes alone
@@ -492,7 +502,9 @@ def test_fairmotion_loads_a_shared_trial_once_and_builds_what_a_fresh_load_build
     walks on the first graph, which move poses in place) and equals a build from a cold start."""
     from animsynth.compare.generators import fairmotion_peer as fp
 
-    a, b, c = (generate_motion("walk_straight", 48, s, sk, fps=FPS) for s in (1, 8, 5))
+    # 24 frames (47 at fairmotion's 60 fps): two 16-frame nodes per clip, enough for transitions between the
+    # clips and walks through them; the loading memo's work is the same at any length, its cost is not
+    a, b, c = (generate_motion("walk_straight", 24, s, sk, fps=FPS) for s in (1, 8, 5))
     start = Motion(c.values[:10], sk, FPS, "start")
 
     def build(db):
@@ -556,7 +568,9 @@ def test_fairmotion_construct_in_process_equals_its_pool(sk):
     in the same order; and the walks on both are equal."""
     from animsynth.compare.generators import fairmotion_peer as fp
 
-    a, b, c = (generate_motion(kind, 48, s, sk, fps=FPS) for kind, s in
+    # 24 frames (47 at 60 fps): six nodes and 36 edges, every pair of nodes compared in both mappings, as on
+    # longer clips (construct's cost grows with the square of the nodes, its comparisons do not change kind)
+    a, b, c = (generate_motion(kind, 24, s, sk, fps=FPS) for kind, s in
                (("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5)))
     start = Motion(a.values[:10], sk, FPS, "start")
     graphs = {}
@@ -585,7 +599,9 @@ def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
     copied once) and walks exactly as on a deep copy of every clip; the loaded clips stay untouched."""
     from animsynth.compare.generators import fairmotion_peer as fp
 
-    clips = [generate_motion(kind, 48, s, sk, fps=FPS) for kind, s in
+    # 24 frames (47 at 60 fps): eight nodes on four clips; the walks of seeds 1 and 2 read three and two of the
+    # four clips (what the lazy copy is about) and the size of a clip does not change what its copy is
+    clips = [generate_motion(kind, 24, s, sk, fps=FPS) for kind, s in
              (("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5), ("walk_turn", 3))]
     start = Motion(clips[0].values[:10], sk, FPS, "start")
     g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
@@ -620,10 +636,10 @@ def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
 
 
 # ---------------------------------------------------------------- the native-rate clips (fed from the source)
-def _trials_120(sk):
+def _trials_120(sk, frames=240):
     from animsynth.synth.mocap import generate_motion as gm
 
-    return {f"t{i}": gm(kind, 240, s, sk, name=f"t{i}")  # 120 fps, 2 s each
+    return {f"t{i}": gm(kind, frames, s, sk, name=f"t{i}")  # 120 fps, 2 s each by default
             for i, (kind, s) in enumerate((("walk_straight", 1), ("walk_turn", 8), ("walk_straight", 5)))}
 
 
@@ -685,7 +701,9 @@ def test_fairmotion_builds_on_the_sources_60_fps_frames_not_the_30_fps_clips_ups
     from animsynth.compare.generators import fairmotion_peer as fp
     from animsynth.compare import protocol, runner
 
-    trials = _trials_120(sk)
+    # 1.5 s trials: a database of two 45-frame clips, five fairmotion nodes each (its three fits, loading and
+    # construction grow with the clips; what the test compares, the loaded frames, does not depend on the length)
+    trials = _trials_120(sk, 180)
     clips = protocol.prepare_clips(trials, {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))
     clip = clips[0]
 
@@ -736,7 +754,8 @@ def test_the_fairmotion_peer_is_a_generator_of_the_interface_on_what_it_is_given
     from animsynth.compare import protocol, runner
     from animsynth.generator import Database, Generator
 
-    clip = protocol.prepare_clips(_trials_120(sk), {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))[0]
+    # the trials of the test above: its fits' loading and construction are built once in this process
+    clip = protocol.prepare_clips(_trials_120(sk, 180), {"w": ["t0", "t1", "t2"]}, {}, dict(_CC, native_fps=[60.0]))[0]
     gen = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0, fixes=FIXES)
     assert isinstance(gen, Generator)
     with pytest.raises(RuntimeError, match=r"call fit\(database\) before generate"):

@@ -205,36 +205,19 @@ def test_genmm_has_its_levels_on_every_clip_of_the_paper_protocol():
     """The paper run's clips (config/cmu.yaml's groups, the trials read from ../shared/data as the workflow reads
     them): GenMM's level count per clip; only the run's temporal split (35_17, 42 frames at 30 fps: databases of
     21 frames) is too short for the floor, and the clips table's note says so."""
-    import copy
-
-    import yaml
-    from snakemake.utils import update_config
-
     from animsynth.capture_check import check_capture
-    from animsynth.config import validate_config
-    from animsynth.data import load_trial
-    from conftest import REPO
+    from cmu_yaml_trials import cmu_yaml_trials, paper_config
 
     need(CMU)
     need(CMU_MANY)
-    config = {}
-    for name in ("config.yaml", "cmu.yaml"):
-        update_config(config, yaml.safe_load((REPO / "config" / name).read_text()))
-    validate_config(config, str(REPO / "config" / "schema.yaml"))
-    records = {t["id"]: t for t in config["trials"]}
+    config = paper_config()
+    parsed = cmu_yaml_trials()  # read as the parse job reads them, parsed once per process (tests/cmu_yaml_trials.py)
     cc = dict(settings.clips_cfg(config), native_fps=[])
     gm = config["compare"]["genmm"]
     rows, short = [], set()
     for subject, (loo, split) in settings.subject_groups(config).items():
         ids = list(dict.fromkeys([t for v in loo.values() for t in v] + list(split.values())))
-        trials = {}
-        for t in ids:
-            r = copy.deepcopy(records[t])
-            root = CMU_MANY if r.get("mirror") == "many" else CMU
-            files = {k: str(root / r[k]) for k in ("amc", "asf", "bvh") if k in r}
-            kw = {k: r[k] for k in ("first_frame", "bvh_length_to_m") if k in r}
-            roles = {**(config.get("joint_roles") or {}), **(r.get("joint_roles") or {})}
-            trials[t] = load_trial(**files, fps=config["fps"], name=t, joint_roles=roles, **kw)
+        trials = {t: parsed[t][1] for t in ids}
         checks = {t: check_capture(m, t, config["capture_check"]).usable for t, m in trials.items()}
         clips = protocol.prepare_clips(trials, loo, split, cc, subjects=settings.trial_subjects(config), usable=checks)
         for c in clips:

@@ -493,6 +493,27 @@ def coerce_booleans(config: dict, schema: dict) -> None:
             coerce_booleans(value, sub)
 
 
+#: :func:`_read_schema`'s parsed schemas: ``{absolute path: (mtime_ns, size, schema)}``.
+_SCHEMAS: dict = {}
+
+
+def _read_schema(schema_path: str) -> dict:
+    """The YAML JSON Schema at ``schema_path``, parsed once per process and version of the file (its modification
+    time and size), handed out as a copy. The schema's pure-Python YAML parse is half of what a validation costs
+    (snakemake's ``validate`` parses it again itself); the test suite validates over a hundred configs."""
+    import copy
+
+    import yaml
+
+    st = os.stat(schema_path)
+    key = os.path.abspath(schema_path)
+    hit = _SCHEMAS.get(key)
+    if hit is None or hit[:2] != (st.st_mtime_ns, st.st_size):
+        with open(schema_path, encoding="utf-8") as fh:
+            hit = _SCHEMAS[key] = (st.st_mtime_ns, st.st_size, yaml.safe_load(fh))
+    return copy.deepcopy(hit[2])
+
+
 def validate_config(config: dict, schema_path: str) -> None:
     """Validate ``config`` against the YAML JSON Schema and fill in defaults.
 
@@ -508,13 +529,11 @@ def validate_config(config: dict, schema_path: str) -> None:
     :func:`explain_schema_error`) instead of the validator's dump. Afterwards
     ``trials`` is a list (:func:`trial_records`: the mapping form becomes one).
     """
-    import yaml
     from snakemake.utils import validate
 
     check_config_size(config)
     check_finite(config)
-    with open(schema_path, encoding="utf-8") as fh:
-        schema = yaml.safe_load(fh)
+    schema = _read_schema(schema_path)
     coerce_booleans(config, schema)
     try:
         validate(config, schema_path)
