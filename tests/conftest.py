@@ -42,15 +42,27 @@ PAPERS = REPO / "tests" / "papers"
 SAFETY_TIMEOUT = 3 * 3600
 
 
+_DEFAULT_CONFIG: dict = {}
+
+
 def default_config() -> dict:
-    """The embedded default config (config/config.yaml), validated against the schema (defaults filled in)."""
+    """The embedded default config (config/config.yaml), validated against the schema (defaults filled in): parsed
+    and validated once per test process (the key: both files' modification times and sizes), a deep copy per call,
+    so a test may change what it gets."""
+    import copy
+
     import yaml
 
     from animsynth.config import validate_config
 
-    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
-    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
-    return cfg
+    files = (REPO / "config" / "config.yaml", REPO / "config" / "schema.yaml")
+    key = tuple((f.stat().st_mtime_ns, f.stat().st_size) for f in files)
+    if key not in _DEFAULT_CONFIG:
+        cfg = yaml.safe_load(files[0].read_text())
+        validate_config(cfg, str(files[1]))
+        _DEFAULT_CONFIG.clear()
+        _DEFAULT_CONFIG[key] = cfg
+    return copy.deepcopy(_DEFAULT_CONFIG[key])
 
 
 def need(path: Path):
