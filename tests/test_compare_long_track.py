@@ -227,3 +227,25 @@ def test_every_long_record_is_a_column_of_the_long_file():
     assert {"repetition_share", "freezing_share", "drift_share", "coverage_after_20s"} <= set(long_track.LONG_NAMES)
     assert "l2p" not in long_track.LONG_NAMES  # the held-out continuation is 2 s: no ground truth for 20 s
 
+
+
+def test_null_long_track_as_a_user_types_it_validates_as_off():
+    # "null (or enabled: false): off" (the schema): the validator fills the block's defaults, so null must not reach
+    # it as null (it failed with "'NoneType' object has no attribute 'setdefault'")
+    import yaml
+
+    from animsynth.config import validate_config
+    from conftest import REPO
+
+    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    cfg["compare"]["long_track"] = None
+    long_ids = [c["id"] for c in cfg["compare"]["claims"] if c.get("track") == "long"]
+    assert long_ids
+    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
+    assert cfg["compare"]["long_track"]["enabled"] is False
+    assert long_track.long_settings(cfg["compare"]["long_track"], "genmm") is None
+    first = next(i for i, c in enumerate(cfg["compare"]["claims"]) if c["id"] == long_ids[0])
+    with pytest.raises(ConfigError, match=rf"compare\.claims\[{first}\]\.track'.*long_track' is off"):
+        settings.check(cfg)  # its long claims name the track that is off
+    cfg["compare"]["claims"] = [c for c in cfg["compare"]["claims"] if c["id"] not in long_ids]
+    settings.check(cfg)

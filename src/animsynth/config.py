@@ -493,6 +493,23 @@ def coerce_booleans(config: dict, schema: dict) -> None:
             coerce_booleans(value, sub)
 
 
+def null_means_off(config: dict, schema: dict) -> None:
+    """A ``null`` given to a schema block that may be null and has an ``enabled`` switch (``compare.long_track``:
+    "null or enabled: false: off") becomes ``{"enabled": false}``, in place, before validation: the validator
+    fills in the block's defaults and cannot fill them into ``null``."""
+    props = schema.get("properties") or {}
+    for key, value in list(config.items()):
+        sub = props.get(key)
+        if not isinstance(sub, dict):
+            continue
+        types = sub.get("type")
+        types = [types] if isinstance(types, str) else (types or [])
+        if value is None and {"object", "null"} <= set(types) and "enabled" in (sub.get("properties") or {}):
+            config[key] = {"enabled": False}
+        elif isinstance(value, dict) and sub.get("properties"):
+            null_means_off(value, sub)
+
+
 #: :func:`_read_schema`'s parsed schemas: ``{absolute path: (mtime_ns, size, schema)}``.
 _SCHEMAS: dict = {}
 
@@ -522,7 +539,8 @@ def validate_config(config: dict, schema_path: str) -> None:
     "billion laughs" file; then any NaN or infinite number
     (:func:`check_finite`: the schema's minimum and maximum let NaN through).
     ``true`` / ``false`` given as text (``--config key=true``) to a boolean
-    key are read as booleans (:func:`coerce_booleans`).
+    key are read as booleans (:func:`coerce_booleans`); ``null`` given to a block with an ``enabled`` switch is
+    ``enabled: false`` (:func:`null_means_off`).
 
     Wraps :func:`snakemake.utils.validate` (which also sets defaults) so that
     a violation raises a :class:`ConfigError` of a few lines (see
@@ -535,6 +553,7 @@ def validate_config(config: dict, schema_path: str) -> None:
     check_finite(config)
     schema = _read_schema(schema_path)
     coerce_booleans(config, schema)
+    null_means_off(config, schema)
     try:
         validate(config, schema_path)
     except Exception as exc:  # snakemake's WorkflowError embeds the whole schema and config
