@@ -473,6 +473,20 @@ def check_finite(config, path=()) -> None:
             check_finite(v, path + (i,))
 
 
+def _schema_keys(config: dict, schema: dict):
+    """Every ``(mapping, key, value, key's schema, its types)`` of ``config`` that the schema's properties describe,
+    depth first (a mapping value whose schema has properties: its keys after it)."""
+    props = schema.get("properties") or {}
+    for key, value in list(config.items()):
+        sub = props.get(key)
+        if not isinstance(sub, dict):
+            continue
+        types = sub.get("type")
+        yield config, key, value, sub, [types] if isinstance(types, str) else (types or [])
+        if isinstance(value, dict) and sub.get("properties"):
+            yield from _schema_keys(value, sub)
+
+
 def coerce_booleans(config: dict, schema: dict) -> None:
     """Read the text ``true`` / ``false`` (any case) of a boolean schema key as a boolean, in place.
 
@@ -480,34 +494,18 @@ def coerce_booleans(config: dict, schema: dict) -> None:
     ``False`` become booleans), so ``--config results_outside_project=true``
     would be refused as a string.
     """
-    props = schema.get("properties") or {}
-    for key, value in list(config.items()):
-        sub = props.get(key)
-        if not isinstance(sub, dict):
-            continue
-        types = sub.get("type")
-        types = [types] if isinstance(types, str) else (types or [])
+    for mapping, key, value, _, types in _schema_keys(config, schema):
         if "boolean" in types and isinstance(value, str) and value.strip().lower() in ("true", "false"):
-            config[key] = value.strip().lower() == "true"
-        elif isinstance(value, dict) and sub.get("properties"):
-            coerce_booleans(value, sub)
+            mapping[key] = value.strip().lower() == "true"
 
 
 def null_means_off(config: dict, schema: dict) -> None:
     """A ``null`` given to a schema block that may be null and has an ``enabled`` switch (``compare.long_track``:
     "null or enabled: false: off") becomes ``{"enabled": false}``, in place, before validation: the validator
     fills in the block's defaults and cannot fill them into ``null``."""
-    props = schema.get("properties") or {}
-    for key, value in list(config.items()):
-        sub = props.get(key)
-        if not isinstance(sub, dict):
-            continue
-        types = sub.get("type")
-        types = [types] if isinstance(types, str) else (types or [])
+    for mapping, key, value, sub, types in _schema_keys(config, schema):
         if value is None and {"object", "null"} <= set(types) and "enabled" in (sub.get("properties") or {}):
-            config[key] = {"enabled": False}
-        elif isinstance(value, dict) and sub.get("properties"):
-            null_means_off(value, sub)
+            mapping[key] = {"enabled": False}
 
 
 #: :func:`_read_schema`'s parsed schemas: ``{absolute path: (mtime_ns, size, schema)}``.
