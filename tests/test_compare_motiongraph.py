@@ -514,7 +514,7 @@ def test_fairmotion_loads_a_shared_trial_once_and_builds_what_a_fresh_load_build
 
     fl.LOADED.clear()
     _, cold_tr, cold_walks = build([c, b])
-    assert len(fl.LOADED) == 2
+    assert len(fl.LOADED) == 2 and len(cold_tr) > 0  # transitions to walk through, at this size too
     fl.LOADED.clear()
     g1, _, _ = build([a, b])  # b loaded here, then its poses walked over
     g1.generate(Motion(a.values[:10], sk, FPS, "s"), 30, seed=7)
@@ -607,7 +607,17 @@ def test_fairmotion_walks_copy_only_the_clips_they_read(sk, monkeypatch):
     g = fp.FairmotionGraph(base=8, blend=4, compare=4, threshold_quantile=1.0, native_fps=60.0,
                            fixes=FIXES).fit(clips)
     before = [np.array([np.asarray(p.data) for p in m.poses]) for m in g._loaded_]
+    views = []
+
+    class Seen(fl.CopyOnRead):  # the lazy copy, each walk's view kept to count the clips it copied
+        def __init__(self, motions):
+            super().__init__(motions)
+            views.append(self)
+
+    monkeypatch.setattr(fp, "CopyOnRead", Seen)
     lazy = [g.generate(start, 40, seed=s).values for s in (1, 2, 3)]
+    monkeypatch.undo()
+    assert len(views) == 3 and min(len(v._copies) for v in views) < len(clips)  # some walk left a clip uncopied
     assert all(np.array_equal(x, np.array([np.asarray(p.data) for p in m.poses]))
                for x, m in zip(before, g._loaded_))
     seen = []

@@ -24,11 +24,10 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pandas as pd
 import pytest
 
 from conftest import REPO, SAFETY_TIMEOUT, SNAKEMAKE, copy_workflow, place_papers, run_snakemake
-from run_outputs import WHOLE_RUN_COMPARED, outputs_that_differ
+from run_outputs import WHOLE_RUN_COMPARED, outputs_that_differ, tables
 
 pytestmark = [pytest.mark.slurm, pytest.mark.workflow]
 
@@ -50,10 +49,6 @@ SLURM_TEST_ARGS = (
 RUN_TIMEOUT = int(os.environ.get("ANIMSYNTH_SLURM_TIMEOUT", str(SAFETY_TIMEOUT)))
 SETUP_TIMEOUT = 3600  # apt-get update + install of slurm-wlm/munge on a fresh machine, daemons started
 CALL_TIMEOUT = 600    # one squeue/scontrol call or the teardown
-# Tables that legitimately differ between runs (machine- and load-dependent).
-VOLATILE = re.compile(r"(timing|^benchmarks\.csv$|^rule_benchmarks)")  # e.g. meshdetail/timing.csv too
-# Columns of otherwise deterministic tables that hold timings (as tests/test_workflow.py).
-TIMING = re.compile(r"(tim(e|ing)|seconds|_ms$|_s$|per_s|fps|memory|peak|duration_wall|speed)", re.I)
 
 
 def _skip_reason() -> str | None:
@@ -150,29 +145,18 @@ def _job_counts(wd: Path) -> dict[str, int]:
     return counts
 
 
-def _tables(root: Path) -> dict[str, pd.DataFrame]:
-    """Every CSV table under results/ except the volatile ones, timing columns dropped."""
-    out = {}
-    for p in sorted((root / "results").rglob("*.csv")):
-        if VOLATILE.search(p.name):
-            continue
-        df = pd.read_csv(p)
-        out[str(p.relative_to(root))] = df[[c for c in df.columns if not TIMING.search(str(c))]]
-    return out
-
-
-def _assert_same_tables(local: Path, remote: Path):
+def _assert_same_outputs(local: Path, remote: Path):
+    """The SLURM run wrote the files the local run wrote under results/, and every one of them but the timing tables
+    holds what the local run's holds (:func:`run_outputs.outputs_that_differ`: tables byte for byte)."""
     assert (local / "results" / "summary.md").is_file(), f"{local} holds no finished local run"
-    a, b = _tables(local), _tables(remote)
-    assert len(a) > 20, sorted(a)  # the whole workflow, not just the data layer
-    assert sorted(a) == sorted(b), (sorted(set(a) ^ set(b)))
-    for rel in a:
-        pd.testing.assert_frame_equal(a[rel], b[rel], check_exact=True, obj=rel)
-    # every results file the local run made exists on the SLURM side too
+    assert len(tables(local)) > 20, sorted(tables(local))  # the whole workflow, not just the data layer
+
     def files(root):
         return {str(p.relative_to(root)) for p in (root / "results").rglob("*") if p.is_file()}
 
     assert files(local) == files(remote), sorted(files(local) ^ files(remote))
+    differ = outputs_that_differ(local, remote)
+    assert not differ, f"{len(differ)} outputs differ between the local and the SLURM run: {differ[:20]}"
 
 
 def _declared_sizes() -> dict[str, tuple[str, int, str]]:
@@ -275,10 +259,8 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
     slurm_logs = sorted((remote / ".snakemake" / "slurm_logs").rglob("*.log"))
     assert len(slurm_logs) == n_jobs, len(slurm_logs)
 
-    _assert_same_tables(local_reference, remote)
-    # every output, not only the tables: the SLURM run is a whole second run of the config, so this is the
-    # determinism check of every job (tests/test_workflow.py then leaves its partial second run out)
-    differ = outputs_that_differ(local_reference, remote)
-    assert not differ, f"{len(differ)} outputs differ between the local and the SLURM run: {differ[:20]}"
+    # every output: the SLURM run is a whole second run of the config, so this is the determinism check of every
+    # job (tests/test_workflow.py then leaves its partial second run out)
+    _assert_same_outputs(local_reference, remote)
     if not os.environ.get("ANIMSYNTH_SLURM_LOCAL_REFERENCE"):  # the session's own tiny run, compared whole
         WHOLE_RUN_COMPARED["tiny"] = True

@@ -112,9 +112,6 @@ def test_every_file_the_tiny_run_wrote_is_a_declared_output(tiny_workflow, tiny_
     assert not untracked, "written but not declared:\n" + "\n".join(untracked[:40])
 
 
-#: Machine- and load-dependent outputs, the only ones allowed to differ between runs.
-# facegraph/table1.md is the rendered view that joins Table 1 with its timing table (as the paper's Table 1 does);
-# table1.csv itself is compared.
 def test_not_compared_is_only_timing_tables():
     names = ["meshdetail/timing.csv", "facegraph/table1_timing.csv", "benchmarks.csv", "rule_benchmarks.csv",
              "rule_benchmarks_per_rule.md", "facegraph/table1.csv", "summary.md", "simplicial/benchmarks_paper.csv"]
