@@ -16,7 +16,7 @@ import logging
 
 import yaml
 
-from animsynth.config import trial_setting, validate_config
+from animsynth.config import TRIAL_READ_KEYS, trial_setting, validate_config
 from animsynth.data import load_trial
 from conftest import CMU, CMU_MANY, REPO
 
@@ -43,7 +43,7 @@ def read_trial(config: dict, rec: dict, first_frame: int | None = None):
     reading settings over the top-level ones); ``first_frame`` overrides the record's."""
     root = CMU_MANY if rec.get("mirror") == "many" else CMU
     files = {k: root / rec[k] for k in ("amc", "asf", "bvh") if k in rec}
-    kw = {k: trial_setting(config, rec, k) for k in ("joint_roles", "bvh_length_to_m", "up_axis", "forward_axis")}
+    kw = {k: trial_setting(config, rec, k) for k in TRIAL_READ_KEYS}
     ff = rec.get("first_frame", 0) if first_frame is None else first_frame
     if rec.get("bvh_root"):
         kw["bvh_root"] = rec["bvh_root"]

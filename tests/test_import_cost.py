@@ -43,3 +43,10 @@ def test_the_record_module_imports_no_measure():
                            "print(' '.join(m for m in sys.modules if m.startswith('animsynth.compare.measures.')))\n"
                            "print('numpy' if 'numpy' in sys.modules else '')")
     assert loaded == {"animsynth.compare.measures.metric_record"}
+
+
+def test_a_download_job_imports_no_numpy():
+    # a download job copies a file and checks its hash: the trial readers (numpy, scipy) load only to parse one
+    loaded = _loaded_after("import animsynth.data, animsynth.workflow_utils, sys\n"
+                           "print(' '.join(m for m in ('numpy', 'scipy') if m in sys.modules))")
+    assert loaded == set()

@@ -1,7 +1,8 @@
 """The own-data route on BVH files of every class found in the wild (tests/bvh_classes.py): one config mixes
 a centimetre Bandai-style skeleton, a CMU-unit (cgspeed) one, a Bip01 skeleton with 6 channels on every joint
 (its roles named on its trials), mixed rotation orders, a rest pose along X and a Z-up file in metres, each
-trial with its own unit; simplicial, re-sequencing (walk and run only: dance is null) and compare run on it.
+trial with its own unit; simplicial, re-sequencing (a walk, a run and a dance, each of another class) and compare
+run on it.
 
 The comparison runs the generators whose code reads the skeleton in its own way (:data:`COMPARE_GENERATORS`): our
 motion graph (feet and floor from the joint roles), fairmotion (the skeleton written to BVH and read by fairmotion's
@@ -9,7 +10,9 @@ loader), motion matching (foot locking on the roles), GenMM, ST-Isomap (the re-s
 quaternions) and the replay bound. The others read the skeleton only through what these already exercise (isomap:
 ST-Isomap's features; Delaunay and k-NN: the DOF values of the simplicial study, which this run fits on every
 class; the motion-matching variants: motion matching's code with other weights; concat: clips cut as replay's), and
-each job costs its start-up, so they run on the tiny run's synthetic skeleton only."""
+each job costs its start-up, so they run on the tiny run's synthetic skeleton only. Subsets left null (the shape of
+config/user_example.yaml) run through the data layer and Table I, and the whole DAG resolves on them, in
+tests/test_user_data.py."""
 
 from __future__ import annotations
 
@@ -33,7 +36,8 @@ TRIALS = [("ban1", "bandai", "walk_straight", 90), ("ban2", "bandai", "walk_stra
           ("cmu3", "cmu_units", "run_straight", 70),
           ("bip1", "every6", "walk_turn", 84), ("bip2", "every6", "walk_turn", 100), ("bip3", "every6", "walk_turn", 70),
           ("mix1", "mixed", "run_turn", 80), ("mix2", "mixed", "run_turn", 60), ("mix3", "mixed", "run_turn", 70),
-          ("lafan", "rest_x", "walk_straight", 120), ("blend", "zup", "run_straight", 100)]
+          ("lafan", "rest_x", "walk_straight", 120), ("blend", "zup", "run_straight", 100),
+          ("dnc", "every6", "dance", 120)]
 
 
 def _config(data):
@@ -51,9 +55,9 @@ def _config(data):
     return {"mocap_source": "user", "data_dir": str(data), "bvh_length_to_m": 0.05644, "trials": trials,
             "subsets": {"w1": ["ban1", "ban2", "ban3"], "r1": ["cmu1", "cmu2", "cmu3"], "w2": ["bip1", "bip2", "bip3"],
                         "r2": ["mix1", "mix2", "mix3"]},
-            "resequencing_trials": {"walk": "lafan", "run": "blend", "dance": None},
+            "resequencing_trials": {"walk": "lafan", "run": "blend", "dance": "dnc"},
             "simplicial": test_cfg["simplicial"], "resequencing": test_cfg["resequencing"],
-            "compare": {**test_cfg["compare"], "subsets": ["w1", "r1"], "resequencing": None,
+            "compare": {**test_cfg["compare"], "subsets": ["w1", "r1"], "resequencing": ["walk", "run"],
                         "generators": COMPARE_GENERATORS}}
 
 
@@ -76,8 +80,8 @@ def test_every_class_through_simplicial_resequencing_and_compare(tmp_path):
     t2 = pd.read_csv(wd / "results/simplicial/table2.csv")
     assert np.isfinite(t2[["w1", "w2", "r1", "r2", "all"]].to_numpy(float)).all()
     sm = pd.read_csv(wd / "results/resequencing/smoothness.csv")
-    assert set(sm["dataset"]) == {"walk", "run"}
-    # the user's own walk and run are not the paper's CMU clips: its min k is not shown beside them
+    assert set(sm["dataset"]) == {"walk", "run", "dance"}
+    # the user's own walk, run and dance are not the paper's CMU clips: its min k is not shown beside them
     k = pd.read_csv(wd / "results/resequencing/table2_min_k.csv")
     assert len(k) and k["min_k_paper"].isna().all() and k["min_k"].notna().all()
     assert "not the paper's CMU trial" in (wd / "results/resequencing/table2_min_k.md").read_text()

@@ -316,6 +316,10 @@ def check_trial_skeleton(trial: dict, where: str, cmu: bool) -> None:
                           f"subject's skeleton: give subjects/{subject}/{subject}.asf")
 
 
+#: the per-trial reading settings (:func:`trial_setting`), in the order the parse job's params list them
+TRIAL_READ_KEYS = ("joint_roles", "bvh_length_to_m", "up_axis", "forward_axis")
+
+
 def trial_setting(config: dict, trial: dict, key: str):
     """A per-trial setting: the trial record's ``key`` if it sets one, else the top-level config value.
 

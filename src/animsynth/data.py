@@ -18,12 +18,15 @@ import os
 import time
 import urllib.error
 import urllib.request
+from typing import TYPE_CHECKING
 
-from .config import ConfigError, resolve_inside
-from .io.amc import read_amc
-from .io.asf import read_asf
 from .atomic import atomic_path
-from .motion import Motion
+from .config import ConfigError, resolve_inside
+
+# The readers and Motion are imported where a trial is parsed: a download job (fetch_file) copies a file and
+# needs none of numpy and scipy.
+if TYPE_CHECKING:
+    from .motion import Motion
 
 log = logging.getLogger("animsynth.data")
 
@@ -178,6 +181,7 @@ def load_trial(amc=None, asf=None, bvh=None, fps: float = 120.0, name: str = "",
     """
     from .axes import to_canonical_frame
     from .kinematics import CANONICAL_FORWARD, CANONICAL_UP
+    from .motion import Motion
     from .retarget import unwrap_angles
 
     shown = dict(source_files or {})
@@ -242,6 +246,9 @@ def _read_trial_files(amc, asf, bvh, fps: float, bvh_length_to_m: float, shown: 
             m = read_bvh(bvh, root=bvh_root)
             m.skeleton.length_to_m = float(bvh_length_to_m)
         else:
+            from .io.amc import read_amc
+            from .io.asf import read_asf
+
             m = read_amc(amc, read_asf(asf), fps=fps)
     except MotionFormatError as exc:
         raise _rename_path(exc, {"amc": amc, "asf": asf, "bvh": bvh}, shown) from None
@@ -250,6 +257,8 @@ def _read_trial_files(amc, asf, bvh, fps: float, bvh_length_to_m: float, shown: 
 
 def _drop_first_frames(m: Motion, first_frame: int, where) -> Motion:
     """``m`` without its frames before ``first_frame`` (config key ``first_frame``; 0 keeps every frame)."""
+    from .motion import Motion
+
     if not first_frame:
         return m
     if not 0 < first_frame < m.n_frames:

@@ -7,8 +7,8 @@ from pathlib import Path
 from snakemake.io import is_flagged, strip_wildcard_constraints
 
 from animsynth.compare.settings import subject_sets
-from animsynth.config import (TRIAL_FILE_KEYS, check_config, derive_seed, normalise_resequencing_trials, trial_mirror,
-                              trial_setting)
+from animsynth.config import (TRIAL_FILE_KEYS, TRIAL_READ_KEYS, check_config, derive_seed, normalise_resequencing_trials,
+                              trial_mirror, trial_setting)
 from animsynth.families import FAMILIES, report_order
 from animsynth.meshdetail.settings import mesh_sequences
 from animsynth.sources import is_archive, is_url, mesh_source_name, missing_below, probe_source
@@ -567,10 +567,7 @@ def trial_settings(wildcards):
     own = {k: rec[k] for k in ("amc", "asf", "bvh") if k in rec}
     root = trial_source(wildcards.trial) if SOURCE != "synthetic" else None
     return {
-        "joint_roles": trial_setting(config, rec, "joint_roles"),
-        "bvh_length_to_m": trial_setting(config, rec, "bvh_length_to_m"),
-        "up_axis": trial_setting(config, rec, "up_axis"),
-        "forward_axis": trial_setting(config, rec, "forward_axis"),
+        **{key: trial_setting(config, rec, key) for key in TRIAL_READ_KEYS},
         "source_files": {k: (f"{root.rstrip('/')}/{v}" if root else v) for k, v in own.items()},
         # only when the record sets it, so the settings (a rerun trigger) of every other trial stay as they were
         **({"first_frame": rec["first_frame"]} if rec.get("first_frame") else {}),
