@@ -13,11 +13,18 @@ from conftest import SAFETY_TIMEOUT
 HEAVY = ("numba", "sklearn", "scipy.stats", "matplotlib")
 
 
-def _loaded_after(code: str) -> set[str]:
-    probe = code + "\nimport sys\nprint(' '.join(m for m in " + repr(HEAVY) + " if m in sys.modules))"
+def _modules_after(code: str, names: tuple) -> set[str]:
+    """Which of ``names`` are in ``sys.modules`` after ``code`` runs in a fresh interpreter (and what ``code``
+    prints)."""
+    probe = code + "\nimport sys\nprint(' '.join(m for m in " + repr(names) + " if m in sys.modules))"
     res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=SAFETY_TIMEOUT)
     assert res.returncode == 0, res.stderr[-2000:]
     return set(res.stdout.split())
+
+
+def _loaded_after(code: str) -> set[str]:
+    """The heavy libraries (:data:`HEAVY`) loaded after ``code`` runs in a fresh interpreter."""
+    return _modules_after(code, HEAVY)
 
 
 def test_family_packages_import_no_heavy_library():
@@ -26,9 +33,18 @@ def test_family_packages_import_no_heavy_library():
 
 
 def test_a_name_loads_its_module_on_first_use():
-    # the lazy export really imports the module behind the name (and with it what that module needs)
-    assert "sklearn" in _loaded_after("from animsynth.simplicial import run_fold")
-    assert "sklearn" in _loaded_after("from animsynth.resequencing import STIsomap")
+    # the lazy export really imports the module behind the name; scikit-learn loads when a fit needs it
+    assert _modules_after("from animsynth.simplicial import run_fold", ("animsynth.simplicial.folds",))
+    assert _modules_after("from animsynth.resequencing import STIsomap", ("animsynth.resequencing.embedding",))
+    assert "sklearn" in _modules_after("from animsynth.simplicial.generator import fit_pca\nimport numpy as np\n"
+                                       "fit_pca([np.random.default_rng(0).normal(size=(20, 6))], 2)", ("sklearn",))
+
+
+def test_the_jobs_that_fit_nothing_import_no_scikit_learn():
+    # the simplicial tables, summary and figures jobs and the re-sequencing path, explain and table jobs read what
+    # the fitting jobs wrote: their modules load scikit-learn only in the functions that fit (PCA, kernel PCA)
+    loaded = _modules_after("import animsynth.simplicial.jobs, animsynth.resequencing.jobs", ("sklearn",))
+    assert loaded == set()
 
 
 def test_the_metric_table_imports_no_heavy_library():

@@ -42,7 +42,6 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, minimum_spanning_tree, shortest_path
 from scipy.spatial.distance import pdist, squareform
-from sklearn.decomposition import KernelPCA
 from threadpoolctl import threadpool_limits
 
 from .distances import check_distance_matrix
@@ -239,6 +238,8 @@ class PrecomputedIsomap:
         self.graph_ = knn_graph(D, k, ranks=R, always=always)
         self.dist_matrix_ = shortest_path(self.graph_, method=self.path_method, directed=False)
         nc = min(int(self.n_components), n - 1)
+        from sklearn.decomposition import KernelPCA  # imported here: jobs that embed nothing skip scikit-learn
+
         kpca = KernelPCA(n_components=nc, kernel="precomputed", eigen_solver="dense")
         with threadpool_limits(limits=self.blas_threads, user_api="blas"):
             self.embedding_ = kpca.fit_transform(-0.5 * self.dist_matrix_ ** 2)

@@ -38,7 +38,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import eigh
 from scipy.sparse.csgraph import connected_components, dijkstra
-from sklearn.decomposition import KernelPCA
 from threadpoolctl import threadpool_limits
 
 from .embedding import DisconnectedGraphError, residual_variance
@@ -207,6 +206,8 @@ def exact_isomap(graph, n_components: int = 2, blas_threads: int | None = 1):
         raise ValueError(f"n_components={d} needs more than {n} frames")
     G = dijkstra(graph, directed=False)
     K = -0.5 * G ** 2
+    from sklearn.decomposition import KernelPCA  # imported here: jobs that embed nothing skip scikit-learn
+
     kpca = KernelPCA(n_components=d, kernel="precomputed", eigen_solver="dense")
     with threadpool_limits(limits=blas_threads, user_api="blas"):
         Y = kpca.fit_transform(K)

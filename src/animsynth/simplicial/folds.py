@@ -48,10 +48,10 @@ The tables built from these rows are in :mod:`~animsynth.simplicial.tables`, the
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
-from sklearn.decomposition import PCA
 
 from .field import DERIVATIVES, VectorField
 from .generator import FieldFollower, fit_pca
@@ -59,6 +59,9 @@ from .geometry import SafeDelaunay
 from .graph import MotionGraph
 from .metrics import error_a, error_f
 from .path import GeneratedPath, TargetPlanner, follow_batch
+
+if TYPE_CHECKING:  # the fitted PCA comes from generator.fit_pca, which imports scikit-learn when it fits
+    from sklearn.decomposition import PCA
 
 GENERATIONS = ("field", "target")
 
