@@ -53,7 +53,6 @@ import logging
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.signal import savgol_filter
 from scipy.sparse.csgraph import dijkstra
 from scipy.special import expit
 
@@ -258,6 +257,8 @@ class FaceSynthesizer:
     def _smooth(self, disp: np.ndarray, segments: list) -> np.ndarray:
         T = disp.shape[0]
         w = min(self.savgol_window, T if T % 2 else T - 1)
+        from scipy.signal import savgol_filter  # imported here: the jobs that synthesise nothing skip scipy.signal
+
         sm = savgol_filter(disp, w, self.savgol_order, axis=0, mode="interp") if w > self.savgol_order + 1 else disp
         if self.sigmoid_weight == 0.0:
             return sm
