@@ -14,22 +14,15 @@ import copy
 import functools
 import logging
 
-import yaml
 
-from animsynth.config import TRIAL_READ_KEYS, trial_setting, validate_config
+from animsynth.config import TRIAL_READ_KEYS, trial_setting
 from animsynth.data import load_trial
-from conftest import CMU, CMU_MANY, REPO
+from conftest import CMU, CMU_MANY, merged_config
 
 
 @functools.cache
 def _config() -> dict:
-    from snakemake.utils import update_config
-
-    config: dict = {}
-    for name in ("config.yaml", "cmu.yaml"):
-        update_config(config, yaml.safe_load((REPO / "config" / name).read_text()))
-    validate_config(config, str(REPO / "config" / "schema.yaml"))
-    return config
+    return merged_config("config.yaml", "cmu.yaml")
 
 
 def paper_config() -> dict:

@@ -42,6 +42,22 @@ PAPERS = REPO / "tests" / "papers"
 SAFETY_TIMEOUT = 3 * 3600
 
 
+def merged_config(*names: str, validate: bool = True) -> dict:
+    """The config files ``names`` of config/ merged as Snakemake merges ``--configfile`` files (each over the ones
+    before), then validated against the schema (defaults filled in) unless ``validate`` is false."""
+    import yaml
+    from snakemake.utils import update_config
+
+    from animsynth.config import validate_config
+
+    cfg: dict = {}
+    for name in names:
+        update_config(cfg, yaml.safe_load((REPO / "config" / name).read_text()))
+    if validate:
+        validate_config(cfg, str(REPO / "config" / "schema.yaml"))
+    return cfg
+
+
 _DEFAULT_CONFIG: dict = {}
 
 

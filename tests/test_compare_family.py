@@ -706,17 +706,9 @@ def test_the_claims_against_the_peer_quote_the_budget_sweep():
 
 def _paper_config() -> dict:
     """config.yaml, cmu.yaml, samba.yaml and paper.yaml merged as the paper run merges them, validated."""
-    import yaml
-    from snakemake.utils import update_config
+    from conftest import merged_config
 
-    from animsynth.config import validate_config
-    from conftest import REPO
-
-    cfg = {}
-    for name in ("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml"):
-        update_config(cfg, yaml.safe_load((REPO / "config" / name).read_text()))
-    validate_config(cfg, str(REPO / "config" / "schema.yaml"))
-    return cfg
+    return merged_config("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml")
 
 
 def _clips_table_of(config: dict, missing=()) -> pd.DataFrame:

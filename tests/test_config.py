@@ -106,13 +106,10 @@ def test_snakemake_stops_on_unknown_key(tmp_path):
 
 def _paper_config(**top) -> dict:
     """config.yaml, cmu.yaml, samba.yaml and paper.yaml merged as the paper run merges them, validated."""
-    from snakemake.utils import update_config
-
     from animsynth.config import validate_config
+    from conftest import merged_config
 
-    cfg = {}
-    for name in ("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml"):
-        update_config(cfg, yaml.safe_load((REPO / "config" / name).read_text()))
+    cfg = merged_config("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml", validate=False)
     cfg.update(top)
     validate_config(cfg, SCHEMA)
     return cfg

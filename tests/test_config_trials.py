@@ -18,7 +18,7 @@ from snakemake.utils import update_config
 from animsynth.compare import settings
 from animsynth.config import ConfigError, check_config, trial_records, validate_config
 
-from conftest import REPO, SAFETY_TIMEOUT, SNAKEMAKE, copy_workflow
+from conftest import REPO, SAFETY_TIMEOUT, SNAKEMAKE, copy_workflow, merged_config
 
 SCHEMA = str(REPO / "config" / "schema.yaml")
 PAPER_FILES = ("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml")
@@ -26,9 +26,7 @@ PAPER_FILES = ("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml")
 
 def _merged(*extra: dict, files=PAPER_FILES) -> dict:
     """The shipped config files merged as Snakemake merges --configfile files, then ``extra`` (a user's configs)."""
-    cfg: dict = {}
-    for name in files:
-        update_config(cfg, yaml.safe_load((REPO / "config" / name).read_text()))
+    cfg = merged_config(*files, validate=False)
     for e in extra:
         update_config(cfg, copy.deepcopy(e))
     return cfg
