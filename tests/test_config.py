@@ -171,3 +171,48 @@ def test_a_trials_mirror_field_picks_cmu_many_mirror_or_cmu_mirror():
     user = dict(cfg, mocap_source="user", data_dir="mine")
     with pytest.raises(ConfigError, match=r"trials\[\d+\]\.mirror.*needs mocap_source 'cmu'"):
         check_config(user)
+
+
+@pytest.mark.parametrize("names", [("config.yaml",), ("config.yaml", "test.yaml"),
+                                   ("config.yaml", "cmu.yaml", "samba.yaml", "paper.yaml"),
+                                   ("config.yaml", "scale.yaml"), ("config.yaml", "user_example.yaml")])
+def test_our_validator_fills_what_snakemakes_validate_fills(names):
+    """validate_config validates with a validator built once per schema (config._default_filling_validator), not
+    through snakemake.utils.validate, which parses the schema again on every call: on each shipped config the
+    two fill in the same defaults, and the same bad value fails both."""
+    from animsynth.config import _schema_entry
+    from conftest import merged_config
+
+    ours = merged_config(*names, validate=False)
+    theirs = copy.deepcopy(ours)
+    _schema_entry(SCHEMA)[3].validate(ours)
+    validate(theirs, SCHEMA)
+    assert ours == theirs
+    assert len(ours) > len(merged_config(*names, validate=False))  # defaults were filled in
+    bad = merged_config(*names, validate=False)
+    bad.setdefault("compare", {})["seeds"] = "three"
+    with pytest.raises(Exception, match="three"):
+        _schema_entry(SCHEMA)[3].validate(copy.deepcopy(bad))
+    with pytest.raises(Exception, match="three"):
+        validate(bad, SCHEMA)
+
+
+def test_filled_defaults_are_not_shared_between_configs():
+    """The validator is cached, so a default list or mapping filled into one config must be a copy: changing it
+    leaves the next config's default (and the cached schema) as declared."""
+    from animsynth.config import _read_schema, validate_config
+
+    def without_simplicial():
+        cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+        del cfg["simplicial"]
+        validate_config(cfg, SCHEMA)
+        return cfg
+
+    first = without_simplicial()
+    assert first["simplicial"]["methods"] == ["delaunay", "knn"]  # filled in from the schema's defaults
+    first["simplicial"]["methods"].append("kdelaunay")
+    first["simplicial"]["latent_dim"] = 7
+    second = without_simplicial()
+    assert second["simplicial"]["methods"] == ["delaunay", "knn"]
+    assert second["simplicial"]["latent_dim"] == 2
+    assert _read_schema(SCHEMA)["properties"]["simplicial"]["properties"]["methods"]["default"] == ["delaunay", "knn"]

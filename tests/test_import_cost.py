@@ -66,3 +66,16 @@ def test_a_download_job_imports_no_numpy():
     loaded = _loaded_after("import animsynth.data, animsynth.workflow_utils, sys\n"
                            "print(' '.join(m for m in ('numpy', 'scipy') if m in sys.modules))")
     assert loaded == set()
+
+
+def test_the_modules_the_snakefile_loads_import_no_heavy_library():
+    # every snakemake call (each SLURM job too) parses the Snakefile, which imports these for its config checks
+    # and job lists: none may load a heavy library, and the data sources and the mesh settings not even scipy
+    # (the mesh settings name the rig's joints from animsynth.rig_layout, not from the skinning module; the io
+    # package loads a format's module on first use of its names)
+    parse_time = ("animsynth.config", "animsynth.workflow_utils", "animsynth.families", "animsynth.sources",
+                  "animsynth.meshdetail.settings", "animsynth.facegraph.settings", "animsynth.simplicial.settings",
+                  "animsynth.resequencing.settings", "animsynth.compare.settings", "animsynth.compare.claims",
+                  "animsynth.compare.long_track", "animsynth.resequencing.tables")
+    assert _loaded_after("import " + ", ".join(parse_time)) == set()
+    assert _modules_after("import animsynth.sources, animsynth.meshdetail.settings", ("scipy",)) == set()

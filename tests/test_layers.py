@@ -31,7 +31,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "animsynth"
 PKG = "animsynth"
 FAMILIES = registry.paper_families()
 LAYERS = {
-    0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "skeleton", "families"],
+    0: ["_lazy", "atomic", "errors", "limits", "verdicts", "published", "joints", "rig_layout", "skeleton", "families"],
     1: ["config", "tables", "benchmark_tables", "motion", "kinematics", "springs", "axes", "retarget", "generator", "pace"],
     2: ["io"],
     3: ["synth", "skinning", "viz", "scoreboard", "sources", "data", "capture_check", "workflow_utils"],

@@ -1,7 +1,15 @@
-"""File formats: ASF/AMC, BVH, OBJ sequences, CK+ landmarks."""
+"""File formats: ASF/AMC, BVH, OBJ sequences, CK+ landmarks.
 
-from .amc import read_amc, write_amc
-from .asf import read_asf, write_asf
-from ..errors import MotionFormatError
+The package's names load their module on first use (:mod:`animsynth._lazy`), so importing one format's module
+(``animsynth.io.obj``, as the data sources do when the Snakefile is parsed) does not load the motion formats and
+scipy behind them."""
 
-__all__ = ["MotionFormatError", "read_amc", "read_asf", "write_amc", "write_asf"]
+from .._lazy import lazy_exports
+
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "MotionFormatError": "..errors",
+    "read_amc": ".amc",
+    "write_amc": ".amc",
+    "read_asf": ".asf",
+    "write_asf": ".asf",
+})

@@ -8,7 +8,7 @@ import re
 import numpy as np
 
 from ..config import ConfigError
-from ..skinning import JOINTS
+from ..rig_layout import JOINTS
 
 __all__ = ["check", "check_character", "check_sequence", "mesh_sequences"]
 
