@@ -185,14 +185,14 @@ def test_our_validator_fills_what_snakemakes_validate_fills(names):
 
     ours = merged_config(*names, validate=False)
     theirs = copy.deepcopy(ours)
-    _schema_entry(SCHEMA)[3].validate(ours)
+    _schema_entry(SCHEMA).validator.validate(ours)
     validate(theirs, SCHEMA)
     assert ours == theirs
     assert len(ours) > len(merged_config(*names, validate=False))  # defaults were filled in
     bad = merged_config(*names, validate=False)
     bad.setdefault("compare", {})["seeds"] = "three"
     with pytest.raises(Exception, match="three"):
-        _schema_entry(SCHEMA)[3].validate(copy.deepcopy(bad))
+        _schema_entry(SCHEMA).validator.validate(copy.deepcopy(bad))
     with pytest.raises(Exception, match="three"):
         validate(bad, SCHEMA)
 
@@ -216,3 +216,19 @@ def test_filled_defaults_are_not_shared_between_configs():
     assert second["simplicial"]["methods"] == ["delaunay", "knn"]
     assert second["simplicial"]["latent_dim"] == 2
     assert _read_schema(SCHEMA)["properties"]["simplicial"]["properties"]["methods"]["default"] == ["delaunay", "knn"]
+
+
+@pytest.mark.parametrize("where,key", [(("joint_roles",), 1), (("compare", "user_generators"), 5),
+                                       (("facegraph",), True)])
+def test_a_key_yaml_read_as_a_number_is_named_not_a_traceback(where, key):
+    # JSON Schema's name patterns cannot match a number: the validator would stop with a TypeError
+    from animsynth.config import validate_config
+
+    cfg = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
+    block = cfg
+    for k in where:
+        block = block.setdefault(k, {})
+    block[key] = "x"
+    with pytest.raises(ConfigError, match=rf"config key '{'.'.join(where)}': the key {key!r} was read as a "
+                                          rf"(number|boolean).*quote it"):
+        validate_config(cfg, SCHEMA)

@@ -7,6 +7,7 @@ import ntpath
 import os
 import posixpath
 import re
+from typing import NamedTuple
 
 
 class ConfigError(ValueError):
@@ -477,6 +478,23 @@ def check_finite(config, path=()) -> None:
             check_finite(v, path + (i,))
 
 
+def check_keys(config, path=()) -> None:
+    """Refuse a mapping key that is not text (YAML reads ``1:`` and ``35_16:`` as numbers, ``yes:`` as a boolean),
+    naming where it is: JSON Schema's name patterns cannot be matched against it, so the validator would stop
+    with a traceback. The ids of a ``trials`` mapping are left to :func:`trial_records`, whose message names the
+    trial."""
+    if isinstance(config, dict):
+        for k, v in config.items():
+            if not isinstance(k, str) and path != ("trials",):
+                kind = "boolean" if isinstance(k, bool) else "number" if isinstance(k, (int, float)) else "value"
+                raise ConfigError(f"config key '{_where(path) or '<top level>'}': the key {k!r} was read as a {kind} "
+                                  f"(YAML reads 35_16 as 3516, yes as true); quote it: \"{k}\":")
+            check_keys(v, path + (k,))
+    elif isinstance(config, (list, tuple)):
+        for i, v in enumerate(config):
+            check_keys(v, path + (i,))
+
+
 def _schema_keys(config: dict, schema: dict):
     """Every ``(mapping, key, value, key's schema, its types)`` of ``config`` that the schema's properties describe,
     depth first (a mapping value whose schema has properties: its keys after it)."""
@@ -512,11 +530,20 @@ def null_means_off(config: dict, schema: dict) -> None:
             mapping[key] = {"enabled": False}
 
 
-#: :func:`_schema_entry`'s parsed schemas: ``{absolute path: (mtime_ns, size, schema, validator)}``.
+class _Schema(NamedTuple):
+    """One version of a schema file: its modification time and size, the parsed schema, its validator."""
+
+    mtime_ns: int
+    size: int
+    schema: dict
+    validator: object
+
+
+#: :func:`_schema_entry`'s parsed schemas: ``{absolute path: _Schema}``.
 _SCHEMAS: dict = {}
 
 
-def _schema_entry(schema_path: str) -> tuple:
+def _schema_entry(schema_path: str) -> _Schema:
     """The YAML JSON Schema at ``schema_path`` and its default-filling validator, built once per process and
     version of the file (its modification time and size). The schema is parsed with libyaml's loader where PyYAML
     has it (the same document as the pure-Python loader's, about nine times faster); the test suite validates
@@ -529,7 +556,7 @@ def _schema_entry(schema_path: str) -> tuple:
     if hit is None or hit[:2] != (st.st_mtime_ns, st.st_size):
         with open(schema_path, encoding="utf-8") as fh:
             schema = yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-        hit = _SCHEMAS[key] = (st.st_mtime_ns, st.st_size, schema, _default_filling_validator(schema))
+        hit = _SCHEMAS[key] = _Schema(st.st_mtime_ns, st.st_size, schema, _default_filling_validator(schema))
     return hit
 
 
@@ -537,28 +564,32 @@ def _read_schema(schema_path: str) -> dict:
     """The YAML JSON Schema at ``schema_path`` (parsed once per process and file version), handed out as a copy."""
     import copy
 
-    return copy.deepcopy(_schema_entry(schema_path)[2])
+    return copy.deepcopy(_schema_entry(schema_path).schema)
 
 
 def _default_filling_validator(schema: dict):
-    """A JSON Schema 2020-12 validator of ``schema`` that fills in each missing property's ``default`` as it
-    validates: the validator that :func:`snakemake.utils.validate` builds (jsonschema's documented
-    ``extend_with_default``), here built once per schema instead of once per call, with each default deep-copied
-    so that no two configs share a default list or mapping with the cached schema. The schema's ``$ref`` are
-    local (``#/$defs/...``), so it needs no registry."""
+    """A validator of ``schema`` (of the dialect its ``$schema`` names, 2020-12 by default, as
+    :func:`explain_schema_error` reads it) that fills in each missing property's ``default`` as it validates: the
+    validator that :func:`snakemake.utils.validate` builds (jsonschema's documented ``extend_with_default``), here
+    built once per schema instead of once per call. Unlike snakemake's, it deep-copies each default, so that no
+    two configs (nor two items of one array) share a default list or mapping with the cached schema, and it fills
+    nothing into a value that is not a mapping (the type check then names it; snakemake's stops on
+    ``setdefault``). The schema's ``$ref`` are local (``#/$defs/...``), so it needs no registry."""
     import copy
 
     from jsonschema import Draft202012Validator, validators
 
-    check_properties = Draft202012Validator.VALIDATORS["properties"]
+    base = validators.validator_for(schema, default=Draft202012Validator)
+    check_properties = base.VALIDATORS["properties"]
 
     def fill_defaults(validator, properties, instance, subschema):
-        for name, sub in properties.items():
-            if "default" in sub and isinstance(instance, dict):
-                instance.setdefault(name, copy.deepcopy(sub["default"]))
+        if isinstance(instance, dict):
+            for name, sub in properties.items():
+                if "default" in sub and name not in instance:
+                    instance[name] = copy.deepcopy(sub["default"])
         yield from check_properties(validator, properties, instance, subschema)
 
-    return validators.extend(Draft202012Validator, {"properties": fill_defaults})(schema)
+    return validators.extend(base, {"properties": fill_defaults})(schema)
 
 
 def validate_config(config: dict, schema_path: str) -> None:
@@ -567,7 +598,8 @@ def validate_config(config: dict, schema_path: str) -> None:
     A config whose YAML aliases expand past :data:`MAX_CONFIG_VALUES` values
     is refused first (:func:`check_config_size`), so validation never walks a
     "billion laughs" file; then any NaN or infinite number
-    (:func:`check_finite`: the schema's minimum and maximum let NaN through).
+    (:func:`check_finite`: the schema's minimum and maximum let NaN through), and any key that is not text
+    (:func:`check_keys`).
     ``true`` / ``false`` given as text (``--config key=true``) to a boolean
     key are read as booleans (:func:`coerce_booleans`); ``null`` given to a block with an ``enabled`` switch is
     ``enabled: false`` (:func:`null_means_off`).
@@ -577,13 +609,17 @@ def validate_config(config: dict, schema_path: str) -> None:
     (see :func:`explain_schema_error`) instead of the validator's dump. Afterwards
     ``trials`` is a list (:func:`trial_records`: the mapping form becomes one).
     """
+    import copy
+
     check_config_size(config)
     check_finite(config)
-    schema = _read_schema(schema_path)
+    check_keys(config)
+    entry = _schema_entry(schema_path)
+    schema = copy.deepcopy(entry.schema)
     coerce_booleans(config, schema)
     null_means_off(config, schema)
     try:
-        _schema_entry(schema_path)[3].validate(config)
+        entry.validator.validate(config)
     except Exception as exc:  # jsonschema's message embeds the failing part of the schema and config
         short = explain_schema_error(config, schema)
         if short is None:

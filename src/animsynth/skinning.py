@@ -30,6 +30,7 @@ from .kinematics import forward_kinematics, matrix_to_xyz_euler, tree_forward, t
 from .rig_layout import CMU_MAP, JOINTS, PARENTS
 from .skeleton import Joint, Skeleton
 
+
 @dataclass
 class Rig:
     """Rest-pose embedding of the 18-joint skeleton.
