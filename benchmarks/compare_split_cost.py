@@ -7,7 +7,7 @@ Usage::
 
 In ``COPY``, ``workflow/rules/compare.smk`` then runs each generator over every subject in one job
 (``compare_all_<generator>``; fairmotion's rows and budget sweep in one job, ``compare_all_fairmotion``), each row
-through the same :func:`animsynth.compare.jobs.run_job` as the committed rules, so that every table but the timing
+through the same :func:`animsynth.compare.jobs.run_rows` as the committed rules, so that every table but the timing
 tables is the same; the benchmark aggregation lists these jobs' files. ``config/before_split.yaml`` switches the long
 track off and keeps the claims of ``config/config.yaml`` that are not on the long track. Then, in ``COPY``::
 
@@ -89,18 +89,13 @@ BENCHMARKS = '''        job_benchmarks("compare_clips", cmpsubj=CMP_SUBJECTS)
 
 SCRIPT = '''"""One generator (or fairmotion's rows and sweep) over every subject in one job: the comparison before its
 per-subject jobs (benchmarks/compare_split_cost.py; measurement only)."""
-from animsynth.compare.jobs import run_job
+from animsynth.compare.jobs import run_rows
 from animsynth.workflow_utils import setup_logging
 
 log = setup_logging(snakemake)
 p, o = snakemake.params, snakemake.output
 for i, subject in enumerate(p.subjects):
-    for name, cfg, roles, prefix, show in p.rows[subject]:
-        keys = ("metrics", "timing", "shown") if show is not None else ("metrics", "timing")
-        if cfg.get("long_track"):
-            keys += ("long_metrics", "long_timing", "long_shown")
-        run_job(snakemake.input[i], name, dict(cfg), int(p.seed), dict(roles), None if show is None else tuple(show),
-                {k: getattr(o, f"s{subject}__{prefix}{k}") for k in keys})
+    run_rows(snakemake.input[i], p.rows[subject], p.seed, lambda name, s=subject: getattr(o, f"s{s}__{name}"))
 '''
 
 

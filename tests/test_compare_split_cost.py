@@ -9,6 +9,7 @@ import sys
 import pytest
 import yaml
 
+from animsynth.compare.generators.names import FAIRMOTION_ROWS
 from conftest import REPO, copy_workflow, run_snakemake
 
 pytestmark = pytest.mark.workflow
@@ -33,8 +34,7 @@ def test_the_copy_runs_one_comparison_job_per_generator_over_every_subject(tmp_p
     test_cfg = yaml.safe_load((REPO / "config" / "test.yaml").read_text())["compare"]
     default = yaml.safe_load((REPO / "config" / "config.yaml").read_text())["compare"]
     gens = test_cfg.get("generators", default["generators"])
-    fairmotion = {"fairmotion", "fairmotion_fixed"}
-    expected = {f"compare_all_{g}" for g in gens if g not in fairmotion} | {"compare_all_fairmotion"}
+    expected = {f"compare_all_{g}" for g in gens if g not in FAIRMOTION_ROWS} | {"compare_all_fairmotion"}
     assert {k for k in counts if k.startswith("compare_all_")} == expected
     assert all(counts[k] == 1 for k in expected)
     assert not any(k.startswith("compare_run") for k in counts)  # the per-subject jobs are gone

@@ -615,13 +615,12 @@ def validate_config(config: dict, schema_path: str) -> None:
     check_finite(config)
     check_keys(config)
     entry = _schema_entry(schema_path)
-    schema = copy.deepcopy(entry.schema)
-    coerce_booleans(config, schema)
-    null_means_off(config, schema)
+    coerce_booleans(config, entry.schema)  # these two and explain_schema_error only read the cached schema
+    null_means_off(config, entry.schema)
     try:
         entry.validator.validate(config)
     except Exception as exc:  # jsonschema's message embeds the failing part of the schema and config
-        short = explain_schema_error(config, schema)
+        short = explain_schema_error(config, copy.deepcopy(entry.schema))
         if short is None:
             short = "\n".join(str(exc).splitlines()[:5])
         raise ConfigError(short) from None

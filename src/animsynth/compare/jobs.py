@@ -5,7 +5,7 @@ reading its inputs and writing its outputs; the work is done by the modules it c
   ``compare/clips/<subject>.npz`` and its table;
 * :func:`run_job`: one generator over one subject's clips and seeds, fitted once per database, scored
   (:mod:`animsynth.compare.runner`, :mod:`animsynth.compare.scoring`) -> ``compare/runs/<subject>/<generator>.csv``,
-  ``<generator>_timing.csv``, the subject's showcase;
+  ``<generator>_timing.csv``, the subject's showcase; :func:`run_rows`: every row of one generator job through it;
 * :func:`tables_job`: the family's tables and summary page, every subject's files gathered
   (:mod:`animsynth.compare.tables`, :mod:`animsynth.compare.verdicts`), the clips table (:func:`gather_clips`);
 * :func:`sweep_job`: the transition budget sweep's table and figure;
@@ -20,7 +20,7 @@ import logging
 
 log = logging.getLogger("animsynth.compare.jobs")
 
-__all__ = ["clips_job", "run_job", "tables_job", "sweep_job", "figures_job", "long_strips_job", "gather_clips"]
+__all__ = ["clips_job", "run_job", "run_rows", "tables_job", "sweep_job", "figures_job", "long_strips_job", "gather_clips"]
 
 
 def clips_job(trials: dict, subsets: dict, resequencing: dict, cfg: dict, out: dict, subjects: dict | None = None,
@@ -72,6 +72,19 @@ def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict
         save_shown(out["shown"], shown)
     if "bvh" in out:
         write_bvh(out["bvh"], shown)
+
+
+def run_rows(clips_path, rows, master_seed: int, output) -> None:
+    """Every row of one generator job (the job's ``rows`` param, rule by rule built by the workflow's
+    ``compare_rows``: ``[name, config, roles, output prefix, showcase]``) through :func:`run_job` on the clips at
+    ``clips_path``; ``output(name)`` is the job's output path named ``name`` (the row's prefix, then ``metrics``,
+    ``timing``, ``shown`` when the row has a showcase, and the long track's three files when its config runs it)."""
+    for name, cfg, roles, prefix, show in rows:
+        keys = ("metrics", "timing", "shown") if show is not None else ("metrics", "timing")
+        if cfg.get("long_track"):  # the long track's files, from the same builds
+            keys += ("long_metrics", "long_timing", "long_shown")
+        run_job(clips_path, name, dict(cfg), int(master_seed), dict(roles), None if show is None else tuple(show),
+                {k: output(f"{prefix}{k}") for k in keys})
 
 
 def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, order) -> None:
