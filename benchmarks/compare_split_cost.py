@@ -54,7 +54,7 @@ def _all_subjects(rows, sweeps):
 
 
 _BEFORE_JOBS = {g: ([(g, "")], [(g, b) for b in CMP_SWEEP] if g in CMP_SWEEP_GRAPH else [])
-                for g in CMP_OWN_JOB + CMP_SWEEP_GRAPH}
+                for g in [g for g in CMP_RUN if g not in CMP_FM]}
 if CMP_FM:
     _BEFORE_JOBS["fairmotion"] = ([(g, f"{g}_") for g in CMP_FM], CMP_FM_SWEEP)
 
@@ -83,7 +83,7 @@ for _job, (_rows, _sweeps) in _BEFORE_JOBS.items():
 '''
 
 BENCHMARKS = '''        job_benchmarks("compare_clips", cmpsubj=CMP_SUBJECTS)
-        + [B(f"compare/run_all/{g}.tsv") for g in CMP_OWN_JOB + CMP_SWEEP_GRAPH]
+        + [B(f"compare/run_all/{g}.tsv") for g in CMP_RUN if g not in CMP_FM]
         + ([B("compare/run_all/fairmotion.tsv")] if CMP_FM and n else [])
 '''
 

@@ -190,11 +190,24 @@ def _planned(res) -> list[tuple[str, dict]]:
     return out
 
 
+def _planned_rows(jobs) -> list[tuple[str, str]]:
+    """(subject, row) of every generator row the planned compare jobs run (``jobs``: :func:`_planned`): a
+    compare_run job's generator, a method job's rows, fairmotion's rows."""
+    from animsynth.compare.generators.names import FAIRMOTION_ROWS, METHOD_ROWS
+
+    rows = {f"compare_run_{m}": list(r) for m, r in METHOD_ROWS.items()}
+    rows["compare_run_fairmotion"] = list(FAIRMOTION_ROWS)
+    return [(w["cmpsubj"], g) for r, w in jobs if r.startswith("compare_run")
+            for g in ([w["cmpgen"]] if "cmpgen" in w else rows[r])]
+
+
 @pytest.mark.workflow
 def test_fairmotion_rows_and_sweep_are_one_job_per_subject_and_our_graph_keeps_its_own(tmp_path):
     """With a budget sweep, fairmotion's two rows and the fixed row's further budgets are planned as one job per
     subject (compare_run_fairmotion, which builds each graph once per database); our motion graph and its budgets are
-    one compare_run_graph job per subject, and every other generator keeps its compare_run job per subject."""
+    one compare_run_graph job per subject; the rows of one method (names.METHOD_ROWS) one compare_run_<method> job
+    per subject, and the other generator (GenMM) its compare_run job per subject: every row once per subject."""
+    from animsynth.compare.generators.names import GENERATORS, METHOD_ROWS
     import re
 
     from conftest import copy_workflow, run_snakemake
@@ -220,9 +233,14 @@ def test_fairmotion_rows_and_sweep_are_one_job_per_subject_and_our_graph_keeps_i
               "sweep/syn\\d+/fairmotion_fixed_8.csv"):
         assert re.search(f"results/compare/{f}", blocks["compare_run_fairmotion"]), f
     assert [w["cmpgen"] for w in by_rule["compare_run_graph"]] == ["motion_graph", "motion_graph"]
-    runs = {w["cmpgen"] for w in by_rule["compare_run"]}
-    assert not runs & {"fairmotion", "fairmotion_fixed", "motion_graph"} and "knn" in runs
-    assert len(by_rule["compare_run"]) == 2 * len(runs)  # every generator once per subject
+    assert sorted(w["cmpgen"] for w in by_rule["compare_run"]) == ["genmm", "genmm"]
+    for method, rows in METHOD_ROWS.items():  # one job per subject, writing each of its rows' files
+        assert sorted(w["cmpsubj"] for w in by_rule[f"compare_run_{method}"]) == ["syn05", "syn35"], method
+        block = "".join(re.findall(rf"^rule compare_run_{method}:\n((?:    .*\n)+)", res.stdout, flags=re.M))
+        for g in rows:
+            assert re.search(f"results/compare/runs/syn05/{g}_long.csv", block), (method, g)
+    planned = _planned_rows(jobs)
+    assert sorted(planned) == sorted((s, g) for s in ("syn05", "syn35") for g in GENERATORS)  # each row once
     assert "compare_sweep_run" not in by_rule
     # without our motion graph the sweep is fairmotion's alone: no compare_run_graph job, and the run still plans
     (wd / "config" / "fm_only.yaml").write_text(
@@ -257,7 +275,10 @@ def test_rerunning_one_subjects_clips_reruns_only_that_subjects_jobs(tiny_workfl
     assert subjects == {"syn05"}, jobs
     rules = [r for r, _w in jobs]
     assert "compare_clips" not in rules and {"compare_tables", "compare_figures"} <= set(rules)
-    assert rules.count("compare_run") == len({w["cmpgen"] for r, w in jobs if r == "compare_run"}) >= 10
+    from animsynth.compare.settings import unavailable
+
+    ran = [g for g in default_config()["compare"]["generators"] if not unavailable(g)]
+    assert sorted(g for _s, g in _planned_rows(jobs)) == sorted(ran)  # every row of syn05 once
     shutil.copy2(kept, clips)  # back as it was
     (wd / "config" / "more.yaml").write_text("compare:\n  subjects: {s35: [syn35_20]}\n")
     res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml", "config/more.yaml")

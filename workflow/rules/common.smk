@@ -501,6 +501,12 @@ def compare_rows(wildcards, rows):
              None if budget else show] for name, budget, prefix in rows]
 
 
+def compare_rows_of(rows):
+    """The ``rows`` param of a job that runs several rows (``[(name, budget or None, prefix)]``, compare_rows) for
+    each subject: a function of the wildcards, bound to these rows (a rule written in a loop)."""
+    return lambda wildcards: compare_rows(wildcards, rows)
+
+
 # Benchmark files of this family's jobs (inputs of rule_benchmarks).
 def compare_benchmarks():
     n = len(CMP_SUBJECTS)
@@ -513,6 +519,7 @@ def compare_benchmarks():
     return (
         job_benchmarks("compare_clips", cmpsubj=CMP_SUBJECTS)
         + per_subject("compare_run", CMP_OWN_JOB)
+        + [f for m in CMP_METHOD_JOBS if n for f in job_benchmarks(f"compare_run_{m}", cmpsubj=CMP_SUBJECTS)]
         + (per_subject("compare_run_graph", CMP_SWEEP_GRAPH) if CMP_SWEEP_GRAPH else [])
         + (job_benchmarks("compare_run_fairmotion", cmpsubj=CMP_SUBJECTS) if CMP_FM and n else [])
         + job_benchmarks("compare_tables")

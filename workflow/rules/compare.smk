@@ -8,7 +8,7 @@
 # generator that cannot run here (fairmotion without its package) is left out at parse time with one line, and the
 # tables and docs say why. Every job gets only the config keys it uses. Resources: measured on CMU (the paper run)
 # with headroom.
-from animsynth.compare.generators.names import FAIRMOTION_ROWS
+from animsynth.compare.generators.names import FAIRMOTION_ROWS, METHOD_ROWS
 from animsynth.compare.long_track import long_settings
 from animsynth.compare.settings import (clips_cfg, first_frames, generator_order, groups, run_generators, showcase,
                                         subject_groups, trial_subjects, user_generators)
@@ -58,7 +58,13 @@ CMP_FM_SWEEP = [(g, b) for b in CMP_SWEEP for g in CMP_GRAPHS if g in CMP_FM]
 # our other graph generator's further budgets run in its own job per subject (compare_run_graph), beside its row
 CMP_OWN_SWEEP = [(g, b) for b in CMP_SWEEP for g in CMP_GRAPHS if g not in CMP_FM]
 CMP_SWEEP_GRAPH = list(dict.fromkeys(g for g, _b in CMP_OWN_SWEEP))
-CMP_OWN_JOB = [g for g in CMP_RUN if g not in CMP_FM and g not in CMP_SWEEP_GRAPH]
+# the rows of one method (names.METHOD_ROWS: Delaunay and k-NN, Isomap and ST-Isomap, motion matching's three feature
+# sets, the two bounds) run in one job per subject (compare_run_<method>): one process start per method, not per
+# row; each row still builds, is timed and scored on its own, and a changed row's config reruns its method's job
+CMP_METHOD_JOBS = {j: [g for g in rows if g in CMP_RUN] for j, rows in METHOD_ROWS.items()}
+CMP_METHOD_JOBS = {j: rows for j, rows in CMP_METHOD_JOBS.items() if rows}
+CMP_OWN_JOB = [g for g in CMP_RUN if g not in CMP_FM and g not in CMP_SWEEP_GRAPH
+               and not any(g in rows for rows in CMP_METHOD_JOBS.values())]
 
 
 wildcard_constraints:
@@ -181,6 +187,33 @@ if CMP_FM:
             L("compare/run/{cmpsubj}/fairmotion_rows_and_sweep.log"),
         benchmark:
             B("compare/run/{cmpsubj}/fairmotion_rows_and_sweep.tsv")
+        conda:
+            "../envs/animsynth.yaml"
+        script:
+            "../scripts/compare_run.py"
+
+
+for _method, _rows in CMP_METHOD_JOBS.items():
+
+    rule:
+        name:
+            f"compare_run_{_method}"
+        input:
+            CMP_CLIPS,
+        output:
+            **{f"{g}_{k}": v.replace("{cmpgen}", g) for g in _rows for k, v in {**CMP_OUT, **CMP_LONG_OUT}.items()},
+        params:
+            # each row's config as compare_run's (job_cfg): a changed block reruns this job only if a row reads it
+            rows=compare_rows_of([(g, None, f"{g}_") for g in _rows]),
+            seed=config["seed"],
+        threads: 1
+        resources:
+            mem_mb=2000,
+            runtime=30,
+        log:
+            L(f"compare/run/{{cmpsubj}}/{_method}-rows.log"),
+        benchmark:
+            B(f"compare/run/{{cmpsubj}}/{_method}-rows.tsv")
         conda:
             "../envs/animsynth.yaml"
         script:

@@ -1,8 +1,9 @@
 """The generators the comparison runs, one module each, and the registry that builds them by row name.
 
 registry        row names -> estimators and their settings (``make_generator``), no method code
-names           the row names (``GENERATORS``, ``FAIRMOTION_ROWS``, ``REFERENCES``, ``DETERMINISTIC``): a
-                leaf module the harness reads without importing a generator
+names           the row names (``GENERATORS``, ``FAIRMOTION_ROWS``, ``REFERENCES``, ``DETERMINISTIC``) and the rows
+                of one method that share a workflow job (``METHOD_ROWS``): a leaf module the harness reads without
+                importing a generator
 motiongraph     the classic motion graph (Kovar, Gleicher & Pighin 2002)
 point_clouds    joint-position point clouds and their closed-form floor alignment (both graphs compare with it)
 fairmotion_peer fairmotion's motion graph on the same clips (the peer row), when it can be imported
