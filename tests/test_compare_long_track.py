@@ -150,6 +150,40 @@ def test_run_job_writes_the_long_files(tmp_path, clips, cfg):
     assert runner.load_shown(out["long_shown"]).name.startswith("concat w1/t0@0 seed 0")
 
 
+def test_the_rows_of_one_job_share_each_clips_reference_and_write_what_their_own_jobs_write(tmp_path, clips, cfg,
+                                                                                              monkeypatch):
+    """A job of two rows (as compare_run_<method> runs them): each clip's reference is made once for both rows and
+    both tracks, and each row's tables and showcases are those the row writes in a job of its own."""
+    from animsynth.compare import scoring
+
+    protocol.save_clips(tmp_path / "clips.npz", clips)
+    c = dict(cfg, long_track=dict(LONG, contexts_per_subject=1))
+    ext = {"metrics": ".csv", "timing": "_timing.csv", "shown": ".npz", "long_metrics": "_long.csv",
+           "long_timing": "_long_timing.csv", "long_shown": "_long.npz"}
+    made, real = [], scoring.reference
+    monkeypatch.setattr(scoring, "reference", lambda clip, *a: made.append(clip.clip) or real(clip, *a))
+    (tmp_path / "together").mkdir()
+    rows = [[g, c, {}, f"{g}_", ["w1/t1", 0]] for g in ("replay", "concat")]
+
+    def together(name):
+        g, k = next((g, name[len(g) + 1:]) for g in ("replay", "concat") if name.startswith(f"{g}_"))
+        return str(tmp_path / "together" / f"{g}{ext[k]}")
+
+    jobs.run_rows(tmp_path / "clips.npz", rows, 7, together)
+    assert sorted(made) == sorted(x.clip for x in clips)  # once per clip, not per row and track
+    for g in ("replay", "concat"):
+        alone = tmp_path / g
+        alone.mkdir()
+        made.clear()
+        jobs.run_job(tmp_path / "clips.npz", g, c, 7, {}, ("w1/t1", 0), {k: str(alone / f"{g}{e}") for k, e in ext.items()})
+        assert sorted(made) == sorted(x.clip for x in clips)  # a job of its own makes them again
+        for k in ("metrics", "long_metrics"):
+            assert (alone / f"{g}{ext[k]}").read_bytes() == (tmp_path / "together" / f"{g}{ext[k]}").read_bytes(), (g, k)
+        for k in ("shown", "long_shown"):
+            a, b = runner.load_shown(alone / f"{g}{ext[k]}"), runner.load_shown(tmp_path / "together" / f"{g}{ext[k]}")
+            assert np.array_equal(a.values, b.values) and a.name == b.name, (g, k)
+
+
 # ----------------------------------------------------------------------------- claims of the long track
 
 

@@ -45,19 +45,23 @@ def clips_job(trials: dict, subsets: dict, resequencing: dict, cfg: dict, out: d
     return clips
 
 
-def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase, out: dict) -> None:
+def run_job(clips_path, generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase, out: dict,
+            clips: list | None = None, refs=None) -> None:
     """One generator over one subject's clips and seeds (one row of a workflow job): ``out`` names ``metrics``,
     ``timing``, and optionally ``shown`` (with ``showcase``: (clip spec, seed[, required]),
     :func:`animsynth.compare.runner.showcase_clip`) and ``bvh`` (the showcase as BVH, start frames included); with
     the long track on (``cfg["long_track"]``), ``long_metrics``, ``long_timing`` and ``long_shown`` (its files,
-    :mod:`animsynth.compare.long_track`, from the same builds)."""
+    :mod:`animsynth.compare.long_track`, from the same builds). ``clips``: the clips already read from
+    ``clips_path``, and ``refs`` their :class:`~animsynth.compare.scoring.References`, when the job's rows share
+    them (:func:`run_rows`)."""
     from ..io.bvh import write_bvh
     from ..tables import write_table
     from .protocol import load_clips
     from .runner import run_isolated, save_shown
 
-    clips = load_clips(clips_path)
-    metrics, timing, shown, long = run_isolated(clips, generator, cfg, master_seed, roles, showcase, out.values())
+    clips = load_clips(clips_path) if clips is None else clips
+    metrics, timing, shown, long = run_isolated(clips, generator, cfg, master_seed, roles, showcase, out.values(),
+                                                refs)
     if "long_metrics" in out:
         if long is None or long["shown"] is None:
             raise ValueError(f"{generator}: the long track ran no context (config key 'compare.long_track')")
@@ -78,13 +82,21 @@ def run_rows(clips_path, rows, master_seed: int, output) -> None:
     """Every row of one generator job (the job's ``rows`` param, rule by rule built by the workflow's
     ``compare_rows``: ``[name, config, roles, output prefix, showcase]``) through :func:`run_job` on the clips at
     ``clips_path``; ``output(name)`` is the job's output path named ``name`` (the row's prefix, then ``metrics``,
-    ``timing``, ``shown`` when the row has a showcase, and the long track's three files when its config runs it)."""
+    ``timing``, ``shown`` when the row has a showcase, and the long track's three files when its config runs it).
+
+    The clips are read once and their references (each database motion's forward kinematics, each clip's
+    :class:`~animsynth.compare.scoring.Reference`) made once for all the rows: no row's value depends on the
+    generator that made them."""
+    from .protocol import load_clips
+    from .scoring import References
+
+    clips, refs = load_clips(clips_path), References()
     for name, cfg, roles, prefix, show in rows:
         keys = ("metrics", "timing", "shown") if show is not None else ("metrics", "timing")
         if cfg.get("long_track"):  # the long track's files, from the same builds
             keys += ("long_metrics", "long_timing", "long_shown")
         run_job(clips_path, name, dict(cfg), int(master_seed), dict(roles), None if show is None else tuple(show),
-                {k: output(f"{prefix}{k}") for k in keys})
+                {k: output(f"{prefix}{k}") for k in keys}, clips, refs)
 
 
 def sweep_job(inp: dict, out: dict, default_budget: float, budgets, generators, order) -> None:

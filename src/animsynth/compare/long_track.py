@@ -41,7 +41,9 @@ log = logging.getLogger("animsynth.compare.long_track")
 LONG_NAMES = track_names("long")
 #: the columns of ``<generator>_long.csv``
 LONG_COLUMNS = KEY_COLUMNS + LONG_NAMES + ["note"]
-#: the columns of ``<generator>_long_timing.csv``: one row per database with a long context
+#: the columns of ``<generator>_long_timing.csv``: one row per database with a long context (``score_cpu_s``: the
+#: scoring, with each context's reference where no earlier row or track of the job made it:
+#: :class:`~animsynth.compare.scoring.References`)
 LONG_TIMING_COLUMNS = ["generator", "database", "contexts", "seeds", "frames_generated", "generate_cpu_s",
                        "generate_wall_s", "score_cpu_s"]
 

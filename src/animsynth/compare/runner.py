@@ -30,7 +30,7 @@ from ..skeleton import Skeleton
 from .generators.registry import make_generator
 from .measures.metric_table import KEY_COLUMNS, METRIC_NAMES
 from .protocol import Clip, clip_seeds
-from .scoring import DatabaseKinematics, reference, run_values, score
+from .scoring import References, run_values, score
 
 __all__ = ["TIMING_COLUMNS", "cpu_seconds", "peak_rss_mb", "run_generator", "run_tracks", "run_isolated", "failed_run",
            "generation_query", "native_inputs", "by_database", "showcase_clip", "save_shown", "load_shown"]
@@ -94,7 +94,7 @@ def run_generator(clips: list[Clip], generator: str, cfg: dict, master_seed: int
 
 
 def run_tracks(clips: list[Clip], generator: str, cfg: dict, master_seed: int, roles: dict | None = None,
-               showcase: tuple[str, int] | None = None):
+               showcase: tuple[str, int] | None = None, refs: References | None = None):
     """:func:`run_generator` and, from the same build of each database, the long track
     (:mod:`animsynth.compare.long_track`, ``cfg["long_track"]``: :func:`~.long_track.long_settings` of the row).
 
@@ -104,11 +104,14 @@ def run_tracks(clips: list[Clip], generator: str, cfg: dict, master_seed: int, r
     long : dict or None (the track off): ``metrics`` (one row per long context x seed,
         :data:`~.long_track.LONG_COLUMNS`), ``timing`` (one row per database with a long context,
         :data:`~.long_track.LONG_TIMING_COLUMNS`), ``shown`` (the first long context's start and seed 0's frames)
+
+    ``refs``: the job's :class:`~animsynth.compare.scoring.References`, shared by the rows it runs on the same
+    clips (made here if not given).
     """
     from .generators.user import UserGeneratorError, close_processes
 
     try:
-        return _run_generator(clips, generator, cfg, master_seed, roles, showcase)
+        return _run_generator(clips, generator, cfg, master_seed, roles, showcase, refs or References())
     except UserGeneratorError as exc:
         return failed_run(clips, generator, cfg, str(exc), showcase)
     finally:
@@ -240,7 +243,7 @@ def _fit(generator, cs, cfg, key, shown, long_frames: int = 0):
     return gen, cost
 
 
-def _run_windows(gen, generator, cs, cfg, master_seed, roles, kin, shown_id):
+def _run_windows(gen, generator, cs, cfg, master_seed, roles, refs, shown_id):
     """Every seed of every window ``cs`` of one database from the fitted ``gen``, scored: (rows, showcase motion or
     None, generation CPU and wall seconds, frames generated, the largest outside memory)."""
     mcfg = cfg["metrics"]
@@ -249,7 +252,7 @@ def _run_windows(gen, generator, cs, cfg, master_seed, roles, kin, shown_id):
         gen.set_label(clip.clip)
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, cfg["seeds"])
         key = {"clip": clip.clip, "group": clip.group, "protocol": clip.protocol, "generator": generator}
-        ref = reference(clip, mcfg, roles, None, kin)  # L2P normalised by this clip's own database
+        ref = refs(clip, mcfg, roles)  # L2P normalised by this clip's own database
         query = {**generation_query(gen, clip), **native_inputs(gen, clip)[1]}
         start, feats = clip.start, []
         for i, s in enumerate(seeds):
@@ -295,13 +298,13 @@ def showcase_clip(clips: list[Clip], spec: str | None) -> str | None:
     return None
 
 
-def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
+def _run_generator(clips, generator, cfg, master_seed, roles, showcase, refs):
     """:func:`run_tracks`: one build per database (:func:`by_database`), every window and seed of it from that
-    build, then the database's long contexts from the same build."""
+    build, then the database's long contexts from the same build (``refs``: the job's references: each database
+    motion's forward kinematics and each clip's reference, once for the whole job)."""
     from .long_track import long_contexts, long_frames, long_settings, not_run_rows
 
     rows, trows, shown = [], [], None
-    kin = DatabaseKinematics(roles)  # each database motion's forward kinematics, once for the whole job
     shown_id = (None, 0) if showcase is None else (showcase_clip(clips, showcase[0]), int(showcase[1]))
     required = showcase is not None and (len(showcase) < 3 or bool(showcase[2]))
     grouped = by_database(clips)
@@ -321,7 +324,7 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
                 long["rows"] += not_run_rows(lcs, generator, ls["seeds"], f"did not run: {cost}")
                 long["shown"] = long["shown"] or _start_only(lcs[0], generator, cost)
             continue
-        r, sh, g_cpu, g_wall, frames, rss = _run_windows(gen, generator, cs, cfg, master_seed, roles, kin, shown_id)
+        r, sh, g_cpu, g_wall, frames, rss = _run_windows(gen, generator, cs, cfg, master_seed, roles, refs, shown_id)
         rows += r
         shown = shown or sh
         trows.append(_timing_row(generator, key, cs, **cost, generate_cpu_s=g_cpu, generate_wall_s=g_wall,
@@ -330,7 +333,7 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
         log.info("%s on %s: build %.3f s CPU, %d windows x %d seeds: %d frames in %.3f s CPU", generator, key,
                  cost["build_cpu_s"], len(cs), int(cfg["seeds"]), frames, g_cpu)
         if lcs:  # the long track from the same build
-            r, sh, lcost = _run_long(gen, generator, lcs, ls, cfg, master_seed, roles, kin, long["said"])
+            r, sh, lcost = _run_long(gen, generator, lcs, ls, cfg, master_seed, roles, refs, long["said"])
             long["rows"] += r
             long["shown"] = long["shown"] or sh or _start_only(lcs[0], generator, r[0]["note"])
             long["timing"].append({**lcost, "database": key})
@@ -341,7 +344,7 @@ def _run_generator(clips, generator, cfg, master_seed, roles, showcase):
     return metrics, pd.DataFrame(trows, columns=TIMING_COLUMNS), shown, _long_frames(long)
 
 
-def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, master_seed: int, roles, kin,
+def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, master_seed: int, roles, refs,
              said: set) -> tuple[list[dict], object, dict]:
     """Every long seed of the windows ``cs`` (one database's chosen long contexts) from the fitted ``gen``
     (:mod:`animsynth.compare.long_track`).
@@ -355,7 +358,7 @@ def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, ma
     cfg : the job's ``compare`` config (``fps``, ``seed``, ``seeds``, ``metrics``)
     master_seed : the config's ``seed``
     roles : joint-role overrides
-    kin : the job's :class:`~animsynth.compare.scoring.DatabaseKinematics`
+    refs : the job's :class:`~animsynth.compare.scoring.References`
     said : the "did not run" reasons already logged by this job (a reason is logged once)
 
     Returns
@@ -387,7 +390,7 @@ def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, ma
                 these[-1]["seed"] = i
                 continue
             c0 = cpu_seconds()
-            ref = reference(clip, mcfg, roles, None, kin) if ref is None else ref
+            ref = refs(clip, mcfg, roles) if ref is None else ref
             row, f = score(clip, ref, m, generator, mcfg, roles, track="long", entry_seam=gen.entry_seam)
             cost["score_cpu_s"] += cpu_seconds() - c0
             cost["frames_generated"] += n
@@ -443,14 +446,15 @@ def load_shown(path) -> Motion:
 
 
 def run_isolated(clips: list[Clip], generator: str, cfg: dict, master_seed: int, roles: dict | None, showcase,
-                 outputs) -> tuple:
+                 outputs, refs: References | None = None) -> tuple:
     """:func:`run_tracks` as one workflow job runs it: with one BLAS thread (the job's threads: 1; the simplex
     searches make many small LAPACK calls) and, for a user generator (``compare.user_generators``), a guard on the
-    project (the working directory) and the folder of the job's ``outputs`` (paths), which it may not change."""
+    project (the working directory) and the folder of the job's ``outputs`` (paths), which it may not change
+    (``refs``: the job's references, :func:`run_tracks`)."""
     from threadpoolctl import threadpool_limits
 
     if generator in (cfg.get("user_generators") or {}):
         outs = [os.path.dirname(os.path.abspath(p)) for p in outputs]
         cfg = dict(cfg, user_guard=list(dict.fromkeys([os.getcwd(), os.path.commonpath(outs)])))
     with threadpool_limits(1, user_api="blas"):
-        return run_tracks(clips, generator, cfg, master_seed, roles, showcase)
+        return run_tracks(clips, generator, cfg, master_seed, roles, showcase, refs)

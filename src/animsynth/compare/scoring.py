@@ -39,7 +39,7 @@ from .protocol import Clip
 
 log = logging.getLogger("animsynth.compare.scoring")
 
-__all__ = ["Reference", "DatabaseKinematics", "run_stats", "reference",
+__all__ = ["Reference", "DatabaseKinematics", "References", "run_stats", "reference",
            "score", "run_values", "SKATING_METRICS", "DATABASE_METRICS", "UNSCORED", "score_motions", "on_skeleton"]
 
 #: foot skating: needs the floor (the database's foot heights, or compare.metrics.floor_m)
@@ -121,6 +121,39 @@ class DatabaseKinematics:
         if hit is None:
             self._memo[motion.name] = (motion.values, pos, fwd, motion.skeleton)
         return pos, fwd
+
+
+class References:
+    """The database side of every clip one job scores, for all its rows: one :class:`DatabaseKinematics` per
+    joint-role mapping, and one :class:`Reference` per clip, ``compare.metrics`` block and joint roles
+    (:func:`reference`, made on the first request).
+
+    A reference depends on its clip, the metrics block and the roles, never on the generator: the rows of one
+    method that run in one workflow job (Delaunay and k-NN, the three motion-matching rows, ...) and a row's two
+    tracks read the first request's. A clip is known by its identity, so the rows must be given the same clip
+    objects (one :func:`animsynth.compare.protocol.load_clips` per job). Calling an instance gives the reference of
+    ``(clip, mcfg, roles)``."""
+
+    def __init__(self):
+        self._kin: dict[str, DatabaseKinematics] = {}
+        self._refs: dict[tuple, tuple] = {}
+
+    @staticmethod
+    def _key(value) -> str:
+        import json
+
+        return json.dumps(value, sort_keys=True, default=repr)
+
+    def kinematics(self, roles: dict | None) -> DatabaseKinematics:
+        """The job's :class:`DatabaseKinematics` for the joint roles ``roles``."""
+        return self._kin.setdefault(self._key(roles), DatabaseKinematics(roles))
+
+    def __call__(self, clip: Clip, mcfg: dict, roles: dict | None = None) -> Reference:
+        key = (id(clip), self._key(mcfg), self._key(roles))
+        hit = self._refs.get(key)
+        if hit is None or hit[0] is not clip:  # the clip object is kept, so its id names it while it is here
+            hit = self._refs[key] = (clip, reference(clip, mcfg, roles, None, self.kinematics(roles)))
+        return hit[1]
 
 
 def _same_skeleton(a, b) -> bool:
