@@ -2,12 +2,12 @@
 # (animsynth.compare, docs/compare.md). The unit of work is the subject: compare_clips builds one subject's held-out
 # windows and their databases (leave one out within each Gauch & Peters subset and each compare.subjects set of 2+
 # trials, a temporal split in blocks of each re-sequencing clip and one-trial subject set) at the working rate; one
-# job per subject and generator fits the generator once per database and runs every seed of every window from its
-# start, scoring each motion (its benchmark file is that job's whole cost); compare_tables, compare_figures and
-# compare_sweep gather them. Rerunning one subject's clips reruns that subject's jobs and the gathering only. A
-# generator that cannot run here (fairmotion without its package) is left out at parse time with one line, and the
-# tables and docs say why. Every job gets only the config keys it uses. Resources: measured on CMU (the paper run)
-# with headroom.
+# job per subject and generator (the variant rows of one method in one job: Delaunay and k-NN, ...) fits each row
+# once per database and runs every seed of every window from its start, scoring each motion (its benchmark file is
+# that job's whole cost); compare_tables, compare_figures and compare_sweep gather them. Rerunning one subject's
+# clips reruns that subject's jobs and the gathering only. A generator that cannot run here (fairmotion without its
+# package) is left out at parse time with one line, and the tables and docs say why. Every job gets only the config
+# keys it uses. Resources: measured on CMU (the paper run) with headroom.
 from animsynth.compare.generators.names import FAIRMOTION_ROWS, METHOD_ROWS
 from animsynth.compare.long_track import long_settings
 from animsynth.compare.settings import (clips_cfg, first_frames, generator_order, groups, run_generators, showcase,
