@@ -157,3 +157,55 @@ def test_every_generator_of_the_family_has_a_cost_model():
     from animsynth.compare.generators.names import GENERATORS
 
     assert set(GENERATORS) <= set(cost.COST_MODELS), sorted(set(GENERATORS) - set(cost.COST_MODELS))
+
+
+_FIRST_USE = r"""
+import json, sys
+
+from animsynth.compare import protocol
+from animsynth.compare.generators.registry import make_generator
+from animsynth.motion import Motion
+from animsynth.synth.mocap import cmu_like_skeleton, generate_motion
+
+cfg, name = json.load(sys.stdin), sys.argv[1]
+sk = cmu_like_skeleton("cmp", 3)
+db = [protocol.resample(generate_motion("walk_straight", 200, s, sk, name=f"t{s}"), 30.0) for s in range(3)]
+gen = make_generator(name, cfg)
+warm = set(sys.modules)
+
+
+def compiled():  # each numba kernel of ours and its compiled signatures
+    return {f"{m}.{a}": len(f.signatures) for m, mod in list(sys.modules.items()) if m.startswith("animsynth")
+            for a, f in vars(mod).items() if hasattr(f, "signatures") and hasattr(f, "py_func")}
+
+
+gen.warm_up()
+before, kernels = set(sys.modules), compiled()
+gen.fit(db[:2])
+gen.generate(Motion(db[2].values[:8], sk, 30.0, "start"), 12, 0)
+heavy = ("animsynth", "sklearn", "scipy", "numba", "networkx", "fairmotion")
+new = lambda mods: sorted(m for m in mods if m.split(".")[0] in heavy)
+print(json.dumps({"warm_up": new(before - warm), "after": new(set(sys.modules) - before),
+                  "kernels": [k for k, n in compiled().items() if n != kernels.get(k, 0)], "loaded": kernels}))
+"""
+
+
+def test_a_build_imports_nothing_after_the_generators_warm_up():
+    """Rows of one method share a job's process, so a build is timed after the generator's warm_up: in a fresh
+    interpreter, fit and generate of a field follower and a re-sequencer import no module warm_up did not, and
+    compile or load no numba kernel it did not (the field follower's warm_up loads its path kernel)."""
+    import json
+    import subprocess
+    import sys
+
+    cfg = json.dumps(settings.job_cfg(default_config()))
+    procs = {g: subprocess.Popen([sys.executable, "-c", _FIRST_USE, g], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, text=True) for g in ("delaunay", "isomap")}
+    for g, p in procs.items():
+        out, err = p.communicate(cfg, timeout=300)
+        assert p.returncode == 0, err[-3000:]
+        seen = json.loads(out.strip().splitlines()[-1])
+        assert seen["after"] == [] and seen["kernels"] == [], (g, seen)
+        assert seen["warm_up"], g
+        if g == "delaunay":
+            assert any(n for k, n in seen["loaded"].items() if k.endswith("advance_serial")), seen["loaded"]

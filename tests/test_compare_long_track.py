@@ -150,10 +150,12 @@ def test_run_job_writes_the_long_files(tmp_path, clips, cfg):
     assert runner.load_shown(out["long_shown"]).name.startswith("concat w1/t0@0 seed 0")
 
 
+@pytest.mark.parametrize("pair", [("replay", "concat"), ("delaunay", "knn")])
 def test_the_rows_of_one_job_share_each_clips_reference_and_write_what_their_own_jobs_write(tmp_path, clips, cfg,
-                                                                                              monkeypatch):
+                                                                                              monkeypatch, pair):
     """A job of two rows (as compare_run_<method> runs them): each clip's reference is made once for both rows and
-    both tracks, and each row's tables and showcases are those the row writes in a job of its own."""
+    both tracks, and each row's tables and showcases are those the row writes in a job of its own (the bounds; the
+    field followers, whose fit keeps state and whose path kernel is compiled)."""
     from animsynth.compare import scoring
 
     protocol.save_clips(tmp_path / "clips.npz", clips)
@@ -163,15 +165,15 @@ def test_the_rows_of_one_job_share_each_clips_reference_and_write_what_their_own
     made, real = [], scoring.reference
     monkeypatch.setattr(scoring, "reference", lambda clip, *a: made.append(clip.clip) or real(clip, *a))
     (tmp_path / "together").mkdir()
-    rows = [[g, c, {}, f"{g}_", ["w1/t1", 0]] for g in ("replay", "concat")]
+    rows = [[g, c, {}, f"{g}_", ["w1/t1", 0]] for g in pair]
 
     def together(name):
-        g, k = next((g, name[len(g) + 1:]) for g in ("replay", "concat") if name.startswith(f"{g}_"))
+        g, k = next((g, name[len(g) + 1:]) for g in pair if name.startswith(f"{g}_"))
         return str(tmp_path / "together" / f"{g}{ext[k]}")
 
     jobs.run_rows(tmp_path / "clips.npz", rows, 7, together)
     assert sorted(made) == sorted(x.clip for x in clips)  # once per clip, not per row and track
-    for g in ("replay", "concat"):
+    for g in pair:
         alone = tmp_path / g
         alone.mkdir()
         made.clear()

@@ -190,6 +190,7 @@ class Second(Wrapped):
 @pytest.mark.parametrize("users, key", [
     ({"concat": "x.py:A"}, "compare.user_generators.concat"),
     ({"mine_timing": "x.py:A"}, "compare.user_generators.mine_timing"),
+    ({"concat_long": "x.py:A"}, "compare.user_generators.concat_long"),  # concat's long-track file
 ])
 def test_settings_check_refuses_names_of_ours_and_of_other_files(users, key):
     cfg = _config()

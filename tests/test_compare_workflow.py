@@ -190,15 +190,17 @@ def _planned(res) -> list[tuple[str, dict]]:
     return out
 
 
-def _planned_rows(jobs) -> list[tuple[str, str]]:
-    """(subject, row) of every generator row the planned compare jobs run (``jobs``: :func:`_planned`): a
-    compare_run job's generator, a method job's rows, fairmotion's rows."""
-    from animsynth.compare.generators.names import FAIRMOTION_ROWS, METHOD_ROWS
+def _planned_rows(res) -> list[tuple[str, str]]:
+    """(subject, row) of every generator row the compare jobs of a dry run write: the metrics files
+    (``compare/runs/<subject>/<row>.csv``) among the outputs of each planned ``compare_run*`` job."""
+    import re
 
-    rows = {f"compare_run_{m}": list(r) for m, r in METHOD_ROWS.items()}
-    rows["compare_run_fairmotion"] = list(FAIRMOTION_ROWS)
-    return [(w["cmpsubj"], g) for r, w in jobs if r.startswith("compare_run")
-            for g in ([w["cmpgen"]] if "cmpgen" in w else rows[r])]
+    out = []
+    for _rule, block in re.findall(r"^rule (compare_run\w*):\n((?:    .*\n)+)", res.stdout, flags=re.M):
+        files = re.search(r"^    output: (.*)$", block, flags=re.M).group(1).split(", ")
+        out += [m.groups() for f in files if (m := re.search(r"compare/runs/(\w+)/(\w+)\.csv$", f))
+                and not m.group(2).endswith(("_timing", "_long"))]
+    return out
 
 
 @pytest.mark.workflow
@@ -239,7 +241,7 @@ def test_fairmotion_rows_and_sweep_are_one_job_per_subject_and_our_graph_keeps_i
         block = "".join(re.findall(rf"^rule compare_run_{method}:\n((?:    .*\n)+)", res.stdout, flags=re.M))
         for g in rows:
             assert re.search(f"results/compare/runs/syn05/{g}_long.csv", block), (method, g)
-    planned = _planned_rows(jobs)
+    planned = _planned_rows(res)
     assert sorted(planned) == sorted((s, g) for s in ("syn05", "syn35") for g in GENERATORS)  # each row once
     assert "compare_sweep_run" not in by_rule
     # without our motion graph the sweep is fairmotion's alone: no compare_run_graph job, and the run still plans
@@ -249,6 +251,10 @@ def test_fairmotion_rows_and_sweep_are_one_job_per_subject_and_our_graph_keeps_i
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-3000:]
     assert "rule compare_run_fairmotion:" in res.stdout and "rule compare_run_graph:" not in res.stdout
+    # a method with some of its rows runs those only (Delaunay without k-NN), and a method with none has no job
+    assert sorted(_planned_rows(res)) == sorted((s, g) for s in ("syn05", "syn35")
+                                                for g in ("delaunay", "fairmotion", "fairmotion_fixed", "replay", "concat"))
+    assert "rule compare_run_isomap:" not in res.stdout and "rule compare_run_simplicial:" in res.stdout
 
 
 @pytest.mark.workflow
@@ -278,7 +284,7 @@ def test_rerunning_one_subjects_clips_reruns_only_that_subjects_jobs(tiny_workfl
     from animsynth.compare.settings import unavailable
 
     ran = [g for g in default_config()["compare"]["generators"] if not unavailable(g)]
-    assert sorted(g for _s, g in _planned_rows(jobs)) == sorted(ran)  # every row of syn05 once
+    assert sorted(g for _s, g in _planned_rows(res)) == sorted(ran)  # every row of syn05 once
     shutil.copy2(kept, clips)  # back as it was
     (wd / "config" / "more.yaml").write_text("compare:\n  subjects: {s35: [syn35_20]}\n")
     res = run_snakemake(wd, "-n", "--configfile", "config/test.yaml", "config/more.yaml")

@@ -248,7 +248,8 @@ def test_whole_tiny_workflow_through_slurm_matches_local_run(slurm_cluster, loca
     # (the rows of one method in one job: compare_run_<method>)
     subjects = {j["comment"].split("_wildcards_", 1)[1] for j in jobs.values()
                 if j["comment"].startswith("rule_compare_clips_wildcards_")}
-    assert len(subjects) >= 2 and rules["compare_run"] % len(subjects) == 0, (subjects, rules)
+    assert len(subjects) >= 2 and rules.get("compare_run", 0) >= len(subjects), (subjects, rules)
+    assert rules["compare_run"] % len(subjects) == 0, (subjects, rules)
     assert all(rules.get(f"compare_run_{m}") == len(subjects) for m in ("simplicial", "motion_matching")), rules
     # Each batch script runs this venv's interpreter (`<venv>/bin/python -m snakemake`
     # ... --executor slurm-jobstep), and each job left its SLURM log.

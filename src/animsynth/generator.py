@@ -194,6 +194,20 @@ class Generator:
                  native_start: Motion | None = None) -> Motion:  # pragma: no cover
         raise NotImplementedError
 
+    #: the modules :meth:`fit` and :meth:`generate` import on first use (:meth:`warm_up` imports them): here the
+    #: joint roles, which playing a path on the skeleton reads
+    lazy_imports: tuple[str, ...] = ("animsynth.joints",)
+
+    def warm_up(self) -> None:
+        """Import :attr:`lazy_imports`, what :meth:`fit` and :meth:`generate` import on first use (a library such
+        as scikit-learn, the method's own modules), so that a timed build or generation is that work, not one
+        process's imports: the comparison calls it before it times a build, and the rows of one method share a
+        process (its first row would otherwise pay the imports for the others)."""
+        import importlib
+
+        for name in self.lazy_imports:
+            importlib.import_module(name)
+
     def run_notes(self) -> dict:
         """Values of the fitted generator that a run records with its metrics, ``{name: number}``; a name a
         generator does not give is recorded as NaN (:meth:`Generator.run_notes` itself gives none).

@@ -131,8 +131,17 @@ class References:
     A reference depends on its clip, the metrics block and the roles, never on the generator: the rows of one
     method that run in one workflow job (Delaunay and k-NN, the three motion-matching rows, ...) and a row's two
     tracks read the first request's. A clip is known by its identity, so the rows must be given the same clip
-    objects (one :func:`animsynth.compare.protocol.load_clips` per job). Calling an instance gives the reference of
-    ``(clip, mcfg, roles)``."""
+    objects (one :func:`animsynth.compare.protocol.load_clips` per job).
+
+    Calling an instance, ``refs(clip, mcfg, roles)``, gives the reference of that clip (:func:`reference` with the
+    job's kinematics, made on the first call).
+
+    Parameters of a call
+    --------------------
+    clip : Clip, one of the job's clips (the same object for every row)
+    mcfg : dict, the ``compare.metrics`` block
+    roles : dict or None, joint-role overrides (config ``joint_roles``)
+    """
 
     def __init__(self):
         self._kin: dict[str, DatabaseKinematics] = {}
@@ -149,6 +158,7 @@ class References:
         return self._kin.setdefault(self._key(roles), DatabaseKinematics(roles))
 
     def __call__(self, clip: Clip, mcfg: dict, roles: dict | None = None) -> Reference:
+        """The reference of ``clip`` under ``mcfg`` and ``roles``, made on the first call."""
         key = (id(clip), self._key(mcfg), self._key(roles))
         hit = self._refs.get(key)
         if hit is None or hit[0] is not clip:  # the clip object is kept, so its id names it while it is here

@@ -288,9 +288,10 @@ def _check_user_generator_names(config: dict) -> None:
         if name in GENERATORS:
             raise ConfigError(f"config key 'compare.user_generators.{name}': {name!r} is the name of one of the "
                               "family's generators; give your generator another name")
-        if name.endswith(("_timing", "_showcase")):
-            raise ConfigError(f"config key 'compare.user_generators.{name}': a name may not end in _timing or "
-                              "_showcase (the names of a generator's other files)")
+        if name.endswith(("_timing", "_showcase", "_long")):
+            raise ConfigError(f"config key 'compare.user_generators.{name}': a name may not end in _timing, "
+                              "_showcase or _long (the names of a generator's other files: concat_long.csv is "
+                              "concat's long track)")
         try:
             parse_spec(spec)
         except ValueError as exc:

@@ -127,6 +127,15 @@ class Resequencer(Generator):
     tree_ : cKDTree of ``features_``
     """
 
+    @property
+    def lazy_imports(self) -> tuple[str, ...]:
+        """The modules :meth:`fit` and :meth:`generate` import on first use (the sparse route's neighbour search
+        too when ``neighbours`` is not dense): :meth:`animsynth.generator.Generator.warm_up`."""
+        mods = Generator.lazy_imports + (
+            "scipy.spatial", "animsynth.resequencing.distances", "animsynth.resequencing.embedding",
+            "animsynth.resequencing.features", "animsynth.resequencing.paths", "animsynth.resequencing.settings")
+        return mods + (() if self.neighbours == "dense" else ("animsynth.resequencing.sparse", "sklearn.neighbors"))
+
     def __init__(self, method: str = "isomap", n_candidates: int = 20, k=None, min_target_gap_s: float = 0.5,
                  stisomap: dict | None = None, neighbours: str = "sparse", metric: str = "l2",
                  global_dof: bool = False, sign_mode: str = "continuous", translation_scale: float = 1.0,

@@ -87,6 +87,10 @@ class FieldFollower(Generator):
     steps_per_frame_ : int (:meth:`fit` only)
     """
 
+    lazy_imports = Generator.lazy_imports + (
+        "scipy.spatial", "sklearn.decomposition", "numba", "animsynth.retarget", "animsynth.simplicial.field",
+        "animsynth.simplicial.geometry", "animsynth.simplicial.path", "animsynth.simplicial.kernels")
+
     def __init__(self, method: str = "delaunay", latent_dim: int = 2, k: int = 16, derivative: str = "half",
                  jitter: float = 0.01, weights: str = "idw", dup_tol: float = 1e-9, rank_tol: float = 1e-9):
         self.method = method
@@ -161,6 +165,18 @@ class FieldFollower(Generator):
         return follow_field(self.field_, x0, steps)
 
     # ------------------------------------------------------------------ the generator interface
+    def warm_up(self) -> None:
+        """Import what fit and generate import on first use (:meth:`animsynth.generator.Generator.warm_up`), then
+        follow a small field of this method for 3 steps: numba loads its compiled kernels (from its cache) at their
+        first call, which would otherwise be the first generation's time."""
+        super().warm_up()
+        from .field import VectorField
+        from .path import follow_field
+
+        pts = np.random.default_rng(0).standard_normal((12, max(int(self.latent_dim), 2)))
+        follow_field(VectorField(self.method, min(int(self.k), 4), self.weights, self.dup_tol, self.rank_tol).fit(
+            pts, -pts), pts[0] * 0.1, 3)
+
     def fit(self, database, native_clips=None) -> "FieldFollower":
         """Fit on a database of motions (list of Motion; ``native_clips``: ignored, it runs at the working rate,
         :class:`animsynth.generator.Generator`): the joint angles of every clip, root removed, each clip

@@ -240,6 +240,11 @@ class FairmotionGraph(Generator):
         self.w_trajectory = w_trajectory
         self.num_comparison = num_comparison
 
+    def warm_up(self) -> None:
+        """Import fairmotion's motion-graph module and what it imports (:func:`_fairmotion`) before a timed build
+        (:meth:`animsynth.generator.Generator.warm_up`): the package's import is not its build."""
+        _fairmotion()
+
     def _seconds(self, frames: int, fps: float) -> float:
         """``frames / fps`` nudged so that fairmotion's ``int(seconds * fps)`` gives ``frames`` back."""
         s = frames / fps

@@ -16,4 +16,4 @@ DETERMINISTIC = ("motion_matching", "motion_matching_pose", "motion_matching_tra
 #: scored on its own; fairmotion's rows have their own job with the budget sweep): {job: rows, in table order}
 METHOD_ROWS = {"simplicial": ("delaunay", "knn"), "isomap": ("isomap", "stisomap"),
                "motion_matching": ("motion_matching", "motion_matching_pose", "motion_matching_traj"),
-               "references": REFERENCES}
+               "bounds": REFERENCES}
