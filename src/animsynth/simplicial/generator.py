@@ -165,23 +165,24 @@ class FieldFollower(Generator):
         return follow_field(self.field_, x0, steps)
 
     # ------------------------------------------------------------------ the generator interface
-    #: the field methods whose path kernel this process has run (:meth:`warm_up` runs it once per method)
+    #: the field methods and weights whose path kernel this process has run (:meth:`warm_up`: once each)
     _warmed: set = set()
 
     def warm_up(self) -> None:
         """Import what fit and generate import on first use (:meth:`animsynth.generator.Generator.warm_up`), then,
-        once per process and field method, follow a small field for 3 steps: numba loads its compiled kernels (from
+        once per process, field method and weights, follow a small field for 3 steps: numba loads its compiled kernels (from
         its cache) at their first call, which would otherwise be the first generation's time."""
         super().warm_up()
-        if self.method in FieldFollower._warmed:
+        if (self.method, self.weights) in FieldFollower._warmed:
             return
         from .field import VectorField
         from .path import follow_field
 
-        pts = np.random.default_rng(0).standard_normal((12, max(int(self.latent_dim), 2)))
+        d = max(int(self.latent_dim), 2)
+        pts = np.random.default_rng(0).standard_normal((max(12, d + 2), d))  # enough points for a d-simplex
         follow_field(VectorField(self.method, min(int(self.k), 4), self.weights, self.dup_tol, self.rank_tol).fit(
             pts, -pts), pts[0] * 0.1, 3)
-        FieldFollower._warmed.add(self.method)
+        FieldFollower._warmed.add((self.method, self.weights))
 
     def fit(self, database, native_clips=None) -> "FieldFollower":
         """Fit on a database of motions (list of Motion; ``native_clips``: ignored, it runs at the working rate,
