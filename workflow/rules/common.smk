@@ -502,8 +502,8 @@ def compare_rows(wildcards, rows):
 
 
 def compare_rows_of(rows):
-    """The ``rows`` param of a job that runs several rows (``[(name, budget or None, prefix)]``, compare_rows) for
-    each subject: a function of the wildcards, bound to these rows (a rule written in a loop)."""
+    """The ``rows`` param of a job whose rows are fixed (``[(name, budget or None, prefix)]``, compare_rows) for
+    each subject: a function of the wildcards bound to these rows (a method's job written in a loop, fairmotion's)."""
     return lambda wildcards: compare_rows(wildcards, rows)
 
 

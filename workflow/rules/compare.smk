@@ -61,8 +61,7 @@ CMP_SWEEP_GRAPH = list(dict.fromkeys(g for g, _b in CMP_OWN_SWEEP))
 # the rows of one method (names.METHOD_ROWS: Delaunay and k-NN, Isomap and ST-Isomap, motion matching's three feature
 # sets, the two bounds) run in one job per subject (compare_run_<method>): one process start per method, not per
 # row; each row still builds, is timed and scored on its own, and a changed row's config reruns its method's job
-CMP_METHOD_JOBS = {j: [g for g in rows if g in CMP_RUN] for j, rows in METHOD_ROWS.items()}
-CMP_METHOD_JOBS = {j: rows for j, rows in CMP_METHOD_JOBS.items() if rows}
+CMP_METHOD_JOBS = {j: [g for g in rows if g in CMP_RUN] for j, rows in METHOD_ROWS.items() if set(rows) & set(CMP_RUN)}
 CMP_OWN_JOB = [g for g in CMP_RUN if g not in CMP_FM and g not in CMP_SWEEP_GRAPH
                and not any(g in rows for rows in CMP_METHOD_JOBS.values())]
 
@@ -174,8 +173,8 @@ if CMP_FM:
         params:
             # each row's and budget's config as compare_run's (job_cfg): a changed block reruns this job only if
             # one of them reads it
-            rows=lambda w: compare_rows(w, [(g, None, f"{g}_") for g in CMP_FM]
-                                        + [(g, b, f"sweep{i}_") for i, (g, b) in enumerate(CMP_FM_SWEEP)]),
+            rows=compare_rows_of([(g, None, f"{g}_") for g in CMP_FM]
+                                 + [(g, b, f"sweep{i}_") for i, (g, b) in enumerate(CMP_FM_SWEEP)]),
             seed=config["seed"],
         # the comparison's longest jobs: started early, so they do not run alone at the end
         priority: 10

@@ -379,7 +379,7 @@ def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, ma
         gen.set_label(f"{clip.clip} long")
         seeds = clip_seeds(master_seed, cfg["seed"], clip.clip, max(n_seeds, int(cfg["seeds"])))[:n_seeds]
         query = {**generation_query(gen, clip), **native_inputs(gen, clip)[1]}
-        ref, feats, these = None, [], []
+        feats, these = [], []
         for i, s in enumerate(seeds):
             c0, w0 = cpu_seconds(), time.perf_counter()
             m, why = generate_long(gen, clip, n, s, query)
@@ -391,8 +391,7 @@ def _run_long(gen, generator: str, cs: list[Clip], settings: dict, cfg: dict, ma
                 these[-1]["seed"] = i
                 continue
             c0 = cpu_seconds()
-            ref = refs(clip, mcfg, roles) if ref is None else ref
-            row, f = score(clip, ref, m, generator, mcfg, roles, track="long", entry_seam=gen.entry_seam)
+            row, f = score(clip, refs(clip, mcfg, roles), m, generator, mcfg, roles, track="long", entry_seam=gen.entry_seam)
             cost["score_cpu_s"] += cpu_seconds() - c0
             cost["frames_generated"] += n
             feats.append(f)

@@ -155,7 +155,10 @@ class References:
 
     def kinematics(self, roles: dict | None) -> DatabaseKinematics:
         """The job's :class:`DatabaseKinematics` for the joint roles ``roles``."""
-        return self._kin.setdefault(self._key(roles), DatabaseKinematics(roles))
+        key = self._key(roles)
+        if key not in self._kin:
+            self._kin[key] = DatabaseKinematics(roles)
+        return self._kin[key]
 
     def __call__(self, clip: Clip, mcfg: dict, roles: dict | None = None) -> Reference:
         """The reference of ``clip`` under ``mcfg`` and ``roles``, made on the first call."""
